@@ -1,0 +1,179 @@
+# RoboELF control software - top-level Makefile (GNU make).
+#
+#   make deps     install the Debian packages the build and tests need
+#   make          build build/bin/{roboelf,galil-load,galil-sim}
+#   make check    build and run every test (the one test command)
+#   make asan     the full check built with -fsanitize=address,undefined
+#   make demo     the whole system on the simulator
+#   make bench    performance figures (printed and written as CSV)
+#   make lint     clang-format dry run and cppcheck
+#   make install / uninstall   (PREFIX, DESTDIR)
+#
+# Source layout conventions (so that adding a file needs no Makefile edit):
+#   pc/gl_*.c            Galil link library          -> $(BUILD)/lib/libgl.a
+#   pc/re_*.c            supervisor modules          -> $(BUILD)/lib/libre.a
+#   pc/roboelf.c         supervisor main             -> $(BUILD)/bin/roboelf
+#   tools/galil-sim/*.c  simulator (main.c = main)   -> libsim.a + galil-sim
+#   tools/galil-load/*.c loader (main.c = main)      -> libload.a + galil-load
+#   tests/harness/*.c    test helpers                -> libharness.a
+#   tests/stub/*.c       the misbehaving socket stub -> $(BUILD)/bin/galil-stub
+#   tests/<dir>/test_*.c one cmocka binary each      -> $(BUILD)/tests/<dir>/test_*
+#     linked with: libload libsim libre libharness libgl (only what is used is
+#     pulled in), plus extra linker flags from an optional tests/<dir>/test_*.ldflags
+#     file (e.g. -Wl,--wrap=sp_open).
+
+CC ?= cc
+CFLAGS ?= -O2 -g
+PREFIX ?= /usr/local
+DESTDIR ?=
+INSTALL ?= install
+BUILD ?= build
+
+WARN = -std=c11 -Wall -Wextra -Wpedantic -Wshadow -Wstrict-prototypes \
+       -Wmissing-prototypes -Wformat=2 -Wvla -Wwrite-strings
+ifeq ($(DEVELOPER),1)
+WARN += -Werror
+endif
+
+PKGS = libserialport yaml-0.1 cmocka
+PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
+PKG_LIBS := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
+
+ifdef SANITIZE
+SAN = -fsanitize=$(SANITIZE) -fno-sanitize-recover=$(SANITIZE) -fno-omit-frame-pointer
+endif
+
+ALL_CFLAGS = $(WARN) $(CFLAGS) $(SAN) -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE \
+             -Ipc -Itools/galil-sim -Itools/galil-load -Itests/harness $(PKG_CFLAGS) -MMD -MP
+ALL_LDFLAGS = $(LDFLAGS) $(SAN)
+LIBS = $(PKG_LIBS) -lpthread -lm
+
+GL_SRC := $(wildcard pc/gl_*.c)
+RE_SRC := $(wildcard pc/re_*.c)
+SIM_SRC := $(filter-out tools/galil-sim/main.c,$(wildcard tools/galil-sim/*.c))
+LOAD_SRC := $(filter-out tools/galil-load/main.c,$(wildcard tools/galil-load/*.c))
+HARN_SRC := $(wildcard tests/harness/*.c)
+STUB_SRC := $(wildcard tests/stub/*.c)
+TEST_SRC := $(wildcard tests/*/test_*.c)
+
+obj = $(patsubst %.c,$(BUILD)/obj/%.o,$(1))
+LIB_GL := $(BUILD)/lib/libgl.a
+LIB_RE := $(BUILD)/lib/libre.a
+LIB_SIM := $(BUILD)/lib/libsim.a
+LIB_LOAD := $(BUILD)/lib/libload.a
+LIB_HARN := $(BUILD)/lib/libharness.a
+LINK_LIBS := $(LIB_LOAD) $(LIB_SIM) $(LIB_RE) $(LIB_HARN) $(LIB_GL)
+
+BINS := $(if $(wildcard pc/roboelf.c),$(BUILD)/bin/roboelf) \
+        $(if $(wildcard tools/galil-load/main.c),$(BUILD)/bin/galil-load) \
+        $(if $(wildcard tools/galil-sim/main.c),$(BUILD)/bin/galil-sim) \
+        $(if $(STUB_SRC),$(BUILD)/bin/galil-stub)
+TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
+
+.PHONY: all check test asan demo bench lint install uninstall clean deps tests
+.SUFFIXES:
+.DELETE_ON_ERROR:
+
+all: $(BINS)
+
+tests: $(BINS) $(TESTS)
+
+$(BUILD)/obj/%.o: %.c
+	@mkdir -p $(@D)
+	$(CC) $(ALL_CFLAGS) -c $< -o $@
+
+define mklib
+$(1): $(call obj,$(2))
+	@mkdir -p $$(@D)
+	@rm -f $$@
+	$$(AR) rcs $$@ $$^
+endef
+$(eval $(call mklib,$(LIB_GL),$(GL_SRC)))
+$(eval $(call mklib,$(LIB_RE),$(RE_SRC)))
+$(eval $(call mklib,$(LIB_SIM),$(SIM_SRC)))
+$(eval $(call mklib,$(LIB_LOAD),$(LOAD_SRC)))
+$(eval $(call mklib,$(LIB_HARN),$(HARN_SRC)))
+
+$(BUILD)/bin/roboelf: $(call obj,pc/roboelf.c) $(LIB_RE) $(LIB_GL)
+	@mkdir -p $(@D)
+	$(CC) $(ALL_LDFLAGS) -o $@ $^ $(LIBS)
+$(BUILD)/bin/galil-load: $(call obj,tools/galil-load/main.c) $(LIB_LOAD) $(LIB_GL)
+	@mkdir -p $(@D)
+	$(CC) $(ALL_LDFLAGS) -o $@ $^ $(LIBS)
+$(BUILD)/bin/galil-sim: $(call obj,tools/galil-sim/main.c) $(LIB_SIM) $(LIB_RE) $(LIB_GL)
+	@mkdir -p $(@D)
+	$(CC) $(ALL_LDFLAGS) -o $@ $^ $(LIBS)
+$(BUILD)/bin/galil-stub: $(call obj,$(STUB_SRC)) $(LIB_GL)
+	@mkdir -p $(@D)
+	$(CC) $(ALL_LDFLAGS) -o $@ $^ $(LIBS)
+
+# Each test: its object, the libraries, and optional extra linker flags.
+.SECONDEXPANSION:
+$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(LINK_LIBS) $$(wildcard tests/$$*.ldflags)
+	@mkdir -p $(@D)
+	$(CC) $(ALL_LDFLAGS) $(shell cat tests/$*.ldflags 2>/dev/null) -o $@ $< \
+		$(LINK_LIBS) $(LIBS)
+
+# ---- test, demo, bench -------------------------------------------------------
+check test: deps
+	@$(MAKE) --no-print-directory tests
+	@BUILD=$(BUILD) tests/run-all.sh
+
+asan: deps
+	@$(MAKE) --no-print-directory BUILD=$(BUILD)/asan SANITIZE=address,undefined \
+		CFLAGS="-O1 -g" check
+
+demo: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) INTERACTIVE=$(INTERACTIVE) tools/demo.sh
+
+bench: deps
+	@$(MAKE) --no-print-directory tests
+	@BUILD=$(BUILD) tests/bench.sh
+
+lint:
+	clang-format --dry-run --Werror $(shell git ls-files '*.c' '*.h' 2>/dev/null)
+	cppcheck --quiet --error-exitcode=1 --std=c11 --enable=warning,portability \
+		--suppress=missingIncludeSystem -Ipc -Itools/galil-sim -Itools/galil-load \
+		pc tools tests
+
+# ---- dependencies ------------------------------------------------------------
+DEB_PKGS = gcc make pkg-config libserialport-dev libyaml-dev libcmocka-dev \
+           clang-format cppcheck
+deps:
+	@missing=""; for p in $(DEB_PKGS); do \
+		dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'ok installed' || missing="$$missing $$p"; \
+	done; \
+	if [ -n "$$missing" ]; then \
+		if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+			echo "deps: installing$$missing"; \
+			apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null || exit 1; \
+		else \
+			echo "deps: missing Debian packages:$$missing"; \
+			echo "deps: run: sudo apt-get install$$missing"; exit 1; \
+		fi; \
+	fi
+
+# ---- install -----------------------------------------------------------------
+MAN1 := $(wildcard docs/*.1)
+MAN5 := $(wildcard docs/*.5)
+install: all
+	$(INSTALL) -d "$(DESTDIR)$(PREFIX)/bin" "$(DESTDIR)$(PREFIX)/share/man/man1" \
+		"$(DESTDIR)$(PREFIX)/share/man/man5" "$(DESTDIR)$(PREFIX)/share/roboelf/dmc" \
+		"$(DESTDIR)$(PREFIX)/share/roboelf/config"
+	$(INSTALL) -m 755 $(BINS:$(BUILD)/bin/galil-stub=) "$(DESTDIR)$(PREFIX)/bin/"
+	$(if $(MAN1),$(INSTALL) -m 644 $(MAN1) "$(DESTDIR)$(PREFIX)/share/man/man1/")
+	$(if $(MAN5),$(INSTALL) -m 644 $(MAN5) "$(DESTDIR)$(PREFIX)/share/man/man5/")
+	$(INSTALL) -m 644 $(wildcard dmc/*.dmc dmc/MANIFEST) "$(DESTDIR)$(PREFIX)/share/roboelf/dmc/"
+	$(INSTALL) -m 644 $(wildcard config/*.yaml) "$(DESTDIR)$(PREFIX)/share/roboelf/config/"
+
+uninstall:
+	rm -f $(addprefix "$(DESTDIR)$(PREFIX)/bin/",roboelf galil-load galil-sim)
+	rm -f $(addprefix "$(DESTDIR)$(PREFIX)/share/man/man1/",$(notdir $(MAN1)))
+	rm -f $(addprefix "$(DESTDIR)$(PREFIX)/share/man/man5/",$(notdir $(MAN5)))
+	rm -rf "$(DESTDIR)$(PREFIX)/share/roboelf"
+
+clean:
+	rm -rf $(BUILD)
+
+-include $(shell find $(BUILD)/obj -name '*.d' 2>/dev/null)

@@ -1,0 +1,132 @@
+/*
+ * ctrl.h - the simulated DMC-4030 controller: DMC interpreter (threads,
+ * variables, arrays, automatic subroutines), motion (profiler, PT, limits,
+ * OE/OA), and the host protocol of each Ethernet handle (framing, TC codes,
+ * DL/UL, QR, CF/CW unsolicited output).
+ *
+ * It knows nothing about sockets or the robot: the plant (sim_plant.h) is
+ * sampled through struct ctrl_sense / struct ctrl_drive once per servo
+ * sample, and host bytes go in and out through ctrl_input()/ctrl_output().
+ * Single-threaded; the caller serialises all calls.
+ */
+#ifndef SIM_CTRL_H
+#define SIM_CTRL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define CTRL_AXES 3		/* DMC-4030: A, B, C */
+#define CTRL_HANDLES 8		/* Ethernet handles A..H */
+#define CTRL_THREADS 8
+#define CTRL_INPUTS 32		/* digital inputs 1..32 (bit n-1) */
+#define CTRL_ANALOG 8		/* analog inputs 1..8 */
+
+struct ctrl;
+
+struct ctrl_cfg {
+	const char *model;	/* ^R^V text, e.g. "DMC4030 Rev 1.2h-sim" */
+	long serial;		/* MG _BN */
+	int sample_us;		/* TM, servo sample period in us (1000) */
+	/* called for each event (motor off and why, limit reached, thread
+	 * stopped, program error ...): one line, no CR LF. May be NULL. */
+	void (*event)(void *ud, const char *line);
+	void *event_ud;
+};
+
+/* What the plant reports to the controller each sample. */
+struct ctrl_sense {
+	double enc[CTRL_AXES];		/* main encoder, counts */
+	int fwd_limit[CTRL_AXES];	/* 1 = forward limit switch active */
+	int rev_limit[CTRL_AXES];	/* 1 = reverse limit switch active */
+	double an_v[CTRL_ANALOG];	/* analog inputs 1..8, volts */
+	uint32_t inputs;		/* digital inputs, bit n-1 = input n, 1 = high */
+	int amp_power;			/* 1 = motor power present (E-stop relay on) */
+};
+
+/* What the controller commands each sample. */
+struct ctrl_drive {
+	double ref[CTRL_AXES];		/* reference position from the profiler, counts */
+	int motor_on[CTRL_AXES];	/* 1 = servo enabled (SH), 0 = MO */
+	double torque_v[CTRL_AXES];	/* servo output, volts (+-TL) */
+	uint32_t outputs;		/* digital outputs, bit n-1 = output n */
+};
+
+/* Snapshot of one axis for tests and the control port. */
+struct ctrl_axis_info {
+	double ref, enc, vel;		/* counts, counts, counts/s (profiler) */
+	int motor_off, moving, stop_code;
+	int fwd_limit, rev_limit;	/* switch active */
+};
+
+/*
+ * ctrl_new() - a controller in its power-up state (no program, motors off).
+ * Return: NULL on allocation failure.
+ */
+struct ctrl *ctrl_new(const struct ctrl_cfg *cfg);
+void ctrl_free(struct ctrl *c);
+
+/* ctrl_handle_open/close() - a host connects to / leaves handle h (0..7). */
+void ctrl_handle_open(struct ctrl *c, int h);
+void ctrl_handle_close(struct ctrl *c, int h);
+
+/*
+ * ctrl_input() - bytes received from the host on handle h. Complete command
+ * lines are executed at once (as the command interpreter does between
+ * samples); replies are queued for ctrl_output().
+ * Return: 0, or GL_ERR_ARG for a bad handle.
+ */
+int ctrl_input(struct ctrl *c, int h, const uint8_t *buf, size_t len);
+
+/*
+ * ctrl_output() - take up to @cap pending bytes for handle h: replies, and
+ * unsolicited output when CF points at h (high bit set under CW1).
+ * Return: the number of bytes copied.
+ */
+size_t ctrl_output(struct ctrl *c, int h, uint8_t *buf, size_t cap);
+
+/*
+ * ctrl_step() - one servo sample: read @in, update profilers, servo and
+ * protection (limits, OE, OA, amplifier), run the program threads for one
+ * sample, and write @out.
+ */
+void ctrl_step(struct ctrl *c, const struct ctrl_sense *in,
+	       struct ctrl_drive *out);
+
+/* ctrl_sample_ms() - the servo sample period in ms (TM / 1000). */
+double ctrl_sample_ms(const struct ctrl *c);
+
+/*
+ * ctrl_command() - run one command line as if sent by a host on a private
+ * handle; @resp gets the reply text without the final ':' (or "?").
+ * Return: 0 on ':', GL_ERR_CTRL on '?' (TC holds the code).
+ */
+int ctrl_command(struct ctrl *c, const char *line, char *resp, size_t cap);
+
+/*
+ * ctrl_download() - DL a program text directly (as a completed download).
+ * @bad_line: [out] optional, 1-based line of the first rejected line.
+ * Return: 0 or GL_ERR_CTRL.
+ */
+int ctrl_download(struct ctrl *c, const char *text, size_t len, int *bad_line);
+
+/*
+ * ctrl_get_var() / ctrl_set_var() - a program variable or array element
+ * ("name" or "name[i]"). Return: 0 or GL_ERR_NOENT.
+ */
+int ctrl_get_var(const struct ctrl *c, const char *name, double *v);
+int ctrl_set_var(struct ctrl *c, const char *name, double v);
+
+/* ctrl_axis_info() - state of axis 0..2. Return 0 or GL_ERR_ARG. */
+int ctrl_axis_info(const struct ctrl *c, int axis, struct ctrl_axis_info *out);
+
+/* ctrl_threads() - bit n = thread n running. */
+unsigned ctrl_threads(const struct ctrl *c);
+
+/*
+ * ctrl_power_cycle() - lose RAM (program, variables, arrays, settings,
+ * positions) but keep what BP/BN/BV burned; run #AUTO if the burned program
+ * has one.
+ */
+void ctrl_power_cycle(struct ctrl *c);
+
+#endif /* SIM_CTRL_H */
