@@ -3,14 +3,17 @@
  * optional second handle for unsolicited messages).
  *
  * The link only moves bytes; framing is done by the pure parser in gl_proto.
- * Every call has a deadline. After a timeout or a malformed reply the link is
- * marked broken (GL_ERR_BROKEN on every later call) unless it could be
+ * Every call has a deadline. After a timeout, a malformed reply, bytes beyond
+ * the awaited reply, or a closed connection the link is marked broken
+ * (GL_ERR_BROKEN on every later call, gl_link_broken() true): it is never
  * resynchronised, so a late reply is never taken as the answer to the next
- * command. Nothing here prints.
+ * command. Close it and open a new link. Nothing here prints; no allocation
+ * after gl_link_open(). Rationale and protocol choices: gl_link.c header.
  */
 #ifndef GL_LINK_H
 #define GL_LINK_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -19,8 +22,8 @@
 typedef struct gl_link gl_link;
 
 #define GL_DEFAULT_PORT 23
-#define GL_ERRTEXT_LEN 128
-#define GL_LINE_MAX 80		/* controller command-line limit, bytes */
+#define GL_ERRTEXT_LEN	128
+#define GL_LINE_MAX	80 /* controller command-line limit, bytes */
 
 /*
  * gl_link_open() - connect to HOST[:PORT] (default port 23).
@@ -52,10 +55,16 @@ int gl_link_set_timeout(gl_link *l, int timeout_ms);
  *        with trailing CR LF and the ':' removed; NUL-terminated.
  * @cap: capacity of @resp.
  * @timeout_ms: deadline for the whole reply; 0 = the link default.
- * On '?' the link asks "TC1" and keeps code and text (gl_link_ctrl_error).
- * Return: the length of @resp (>= 0); GL_ERR_CTRL; GL_ERR_TIMEOUT (the link
- *         is then broken); GL_ERR_PROTO; GL_ERR_CLOSED; GL_ERR_BROKEN;
- *         GL_ERR_OVERFLOW (reply larger than @cap; link stays in step).
+ *       Refused (GL_ERR_ARG, nothing sent): empty, control or non-ASCII
+ *       bytes, an empty command (";;", leading or trailing ';'), an odd
+ *       number of '"'. ';' inside "..." does not separate commands.
+ * @resp: [out] optional (NULL: only the length is returned).
+ * On '?' the link asks "TC1" and keeps code and text (gl_link_ctrl_error);
+ * if TC1 itself fails its error is returned and the link is broken.
+ * Return: the length of the data (>= 0); GL_ERR_ARG; GL_ERR_CTRL;
+ *         GL_ERR_TIMEOUT, GL_ERR_PROTO, GL_ERR_CLOSED, GL_ERR_SYS (the
+ *         link is then broken); GL_ERR_BROKEN; GL_ERR_OVERFLOW (data
+ *         larger than @cap, cut to @cap - 1 bytes; link stays in step).
  */
 int gl_link_command(gl_link *l, const char *cmd, char *resp, size_t cap,
 		    int timeout_ms);
@@ -64,10 +73,11 @@ int gl_link_command(gl_link *l, const char *cmd, char *resp, size_t cap,
  * gl_link_record() - send "[prefix;]QR" and decode the binary record.
  * @prefix: optional commands sent on the same line before QR (e.g. the
  *          heartbeat "hbpc=17"), each answered by ':'; NULL for none.
- * @rec: [out] the decoded record (layout learnt from QZ at open or by
- *       gl_link_query_layout()).
- * One round trip. Return: GL_OK or an error as for gl_link_command(), or
- *         GL_ERR_RECORD for a record that does not decode.
+ * @rec: [out] the decoded record; untouched on error. The layout is learnt
+ *       with QZ on the first call (or by gl_link_query_layout()).
+ * One round trip (plus QZ the first time). The whole line is at most
+ * GL_LINE_MAX bytes. Return: GL_OK or an error as for gl_link_command(), or
+ *         GL_ERR_RECORD for a record that does not decode (link in step).
  */
 int gl_link_record(gl_link *l, const char *prefix, struct gl_record *rec,
 		   int timeout_ms);
@@ -88,14 +98,27 @@ const char *gl_link_ctrl_error(const gl_link *l, int *code);
 
 /*
  * gl_link_download() - DL a program: "DL", the lines, "\", both ':' acks.
- * @prog: the program text, lines separated by CR, LF or CR LF; must not
- *        contain '\'.
- * @bad_line: [out] optional; on GL_ERR_CTRL the 1-based program line that
- *            the controller rejected (0 if unknown).
- * Return: GL_OK, GL_ERR_ARG ('\' in @prog), GL_ERR_CTRL, GL_ERR_TIMEOUT...
+ * @prog: the program text, lines separated by CR, LF or CR LF; every line
+ *        at most GL_LINE_MAX printable characters (TAB allowed), no '\'.
+ * @bad_line: [out] optional; on GL_ERR_ARG the 1-based line refused before
+ *            anything was sent (exact); on GL_ERR_CTRL the last line sent
+ *            when the controller's '?' was seen - the rejected line is that
+ *            one or an earlier one - or 0 when the '?' came after the "\".
+ *            See gl_link_set_dl_pace() for an exact number.
+ * After GL_ERR_CTRL the controller's program must be treated as invalid.
+ * Return: GL_OK, GL_ERR_ARG, GL_ERR_CTRL (TC1 kept), GL_ERR_TIMEOUT,
+ *         GL_ERR_PROTO, GL_ERR_CLOSED, GL_ERR_BROKEN.
  */
 int gl_link_download(gl_link *l, const char *prog, size_t len, int *bad_line,
 		     int timeout_ms);
+
+/*
+ * gl_link_set_dl_pace() - after each DL line wait up to @pace_ms for an
+ * early '?' (0, the default: do not wait). With a pace longer than the
+ * controller's reply time *bad_line is exact, at @pace_ms per line.
+ * Return: GL_OK or GL_ERR_ARG.
+ */
+int gl_link_set_dl_pace(gl_link *l, int pace_ms);
 
 /*
  * gl_link_upload() - UL the program: text up to 0x1A, then ':'.
@@ -114,16 +137,20 @@ int gl_link_identify(gl_link *l, char *model, size_t cap, long *serial);
 /*
  * gl_link_open_messages() - open the second (unsolicited) handle to the same
  * controller, find its handle letter with WH, send "CF <letter>" and "CW1"
- * on the command handle.
- * Return: GL_OK or an error code.
+ * on the command handle. Calling it again reopens the handle.
+ * @timeout_ms: connect and each exchange; 0 = the link default.
+ * Return: GL_OK or an error code (the message handle is then closed).
  */
 int gl_link_open_messages(gl_link *l, int timeout_ms);
 
 /*
  * gl_link_message() - take one complete unsolicited line (high bit cleared,
- * CR LF removed). Never blocks.
+ * CR LF removed). Never blocks. Lines that reached the command handle come
+ * first, then those of the message handle. Lines over GL_PROTO_UNSOL_LINE
+ * (256) bytes are split; when a queue is full, new characters are dropped.
  * Return: its length (>= 0), GL_ERR_AGAIN when no complete line is queued,
- *         GL_ERR_CLOSED, GL_ERR_OVERFLOW (line truncated to @cap - 1).
+ *         GL_ERR_CLOSED (the message handle was closed by the peer),
+ *         GL_ERR_OVERFLOW (line truncated to @cap - 1), GL_ERR_SYS.
  */
 int gl_link_message(gl_link *l, char *line, size_t cap);
 
@@ -132,5 +159,18 @@ int gl_link_message(gl_link *l, char *line, size_t cap);
  */
 void gl_link_stats(const gl_link *l, uint64_t *tx_bytes, uint64_t *rx_bytes,
 		   uint64_t *round_trips);
+
+/*
+ * gl_link_fd() - the command socket, for poll() in an event loop only (never
+ * read or write it). Return: the descriptor, or -1.
+ */
+int gl_link_fd(const gl_link *l);
+
+/*
+ * gl_link_broken() - true once the command handle is out of step (after
+ * GL_ERR_TIMEOUT, GL_ERR_PROTO, GL_ERR_CLOSED or GL_ERR_SYS): close the link
+ * and open a new one.
+ */
+bool gl_link_broken(const gl_link *l);
 
 #endif /* GL_LINK_H */

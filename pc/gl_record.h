@@ -1,5 +1,6 @@
 /*
- * gl_record.h - the Galil QR/DR binary data record, decoded into a typed struct.
+ * gl_record.h - the Galil QR/DR binary data record, decoded into a typed
+ * struct.
  *
  * Layouts (little-endian, galil-notes.md section 2):
  *   DMC-40x0/41x3/500x0: QZ "n,52,26,36"  -> 82 + 36 bytes per axis
@@ -13,41 +14,43 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define GL_REC_MAX_AXES 8
-#define GL_REC_MAX_BYTES 370		/* 40x0 with 8 axes */
+#define GL_REC_MAX_AXES	 8
+#define GL_REC_MAX_BYTES 370 /* 40x0 with 8 axes */
 
 enum gl_rec_layout {
 	GL_LAYOUT_NONE = 0,
-	GL_LAYOUT_4000,			/* DMC-40x0, 41x3, 500x0 */
-	GL_LAYOUT_30000,		/* DMC-30010 */
-	GL_LAYOUT_2103,			/* DMC-21x3 */
+	GL_LAYOUT_4000,	 /* DMC-40x0, 41x3, 500x0 */
+	GL_LAYOUT_30000, /* DMC-30010 */
+	GL_LAYOUT_2103,	 /* DMC-21x3 */
 };
 
 /* Axis status word bits (galil-notes.md 2.3). */
-#define GL_AXST_MOVING		(1u << 15)
-#define GL_AXST_MODE_PAPR	(1u << 14)
-#define GL_AXST_MODE_PA		(1u << 13)
-#define GL_AXST_STOPPING	(1u << 4)
-#define GL_AXST_MOTOR_OFF	(1u << 0)
+#define GL_AXST_MOVING	  (1u << 15)
+#define GL_AXST_MODE_PAPR (1u << 14)
+#define GL_AXST_MODE_PA	  (1u << 13)
+#define GL_AXST_STOPPING  (1u << 4)
+#define GL_AXST_MOTOR_OFF (1u << 0)
 
 /* Axis switch byte bits; limit bits read 0 while the switch is active. */
-#define GL_AXSW_FLS		(1u << 3)	/* forward limit input state */
-#define GL_AXSW_RLS		(1u << 2)	/* reverse limit input state */
-#define GL_AXSW_HOME		(1u << 1)
+#define GL_AXSW_FLS  (1u << 3) /* forward limit input state */
+#define GL_AXSW_RLS  (1u << 2) /* reverse limit input state */
+#define GL_AXSW_HOME (1u << 1)
 
 struct gl_rec_axis {
-	uint16_t status;	/* status word, GL_AXST_* */
-	uint8_t switches;	/* GL_AXSW_* */
-	uint8_t stop_code;	/* _SCx */
-	int32_t ref_pos;	/* _RPx, counts */
-	int32_t motor_pos;	/* _TPx, counts */
-	int32_t pos_err;	/* _TEx, counts */
-	int32_t aux_pos;	/* _TDx, counts */
-	int32_t velocity;	/* 64 x _TVx, counts/s x 64 */
-	int32_t torque;		/* +-32767 = full scale */
-	int32_t analog_in;	/* ADC counts, as sent (UW or SW per AQ) */
-	uint8_t hall;		/* _QHx (40x0 only) */
-	int32_t za;		/* user field ZAx */
+	uint16_t status;   /* status word, GL_AXST_* */
+	uint8_t switches;  /* GL_AXSW_* */
+	uint8_t stop_code; /* _SCx */
+	int32_t ref_pos;   /* _RPx, counts */
+	int32_t motor_pos; /* _TPx, counts */
+	int32_t pos_err;   /* _TEx, counts */
+	int32_t aux_pos;   /* _TDx, counts */
+	int32_t velocity;  /* 64 x _TVx, counts/s x 64 */
+	int32_t torque;	   /* +-32767 = full scale */
+	int32_t analog_in; /* ADC counts, the 16-bit field sign-extended
+			    * (SW: AQ2 default); for UW settings
+			    * (AQ3/AQ4) use (uint16_t)analog_in */
+	uint8_t hall;	   /* _QHx (40x0 only) */
+	int32_t za;	   /* user field ZAx (0 on 21x3) */
 };
 
 struct gl_record {
@@ -60,7 +63,7 @@ struct gl_record {
 	uint8_t handles[8];	/* Ethernet handle A..H status (40x0) */
 	uint8_t error_code;	/* _TC */
 	uint8_t threads;	/* bit n = thread n running (40x0, 30010) */
-	uint8_t general_status;	/* 21x3 only */
+	uint8_t general_status; /* 21x3 only */
 	uint32_t amp_status;	/* amplifier status (firmware dependent) */
 	uint32_t contour_count;
 	uint16_t contour_space;

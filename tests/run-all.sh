@@ -2,6 +2,10 @@
 # run-all.sh - run every test binary under $BUILD/tests, then the script checks
 # in tests/checks/*.sh. Each cmocka binary prints its own summary; this script
 # ends with one line "N passed, N failed" counting test programs.
+#
+# A test program counts as passed only if it exits 0 AND its output has no
+# cmocka "[  FAILED  ]" or "[  ERROR   ]" line (cmocka 1.1.5 returns 0 when a
+# group setup fails) AND, for a cmocka binary, a "[  PASSED  ]" line.
 # Environment given to tests: BUILD, ROBOELF_BIN (the binaries), ROBOELF_TOP.
 set -u
 BUILD=${BUILD:-build}
@@ -9,27 +13,43 @@ ROBOELF_TOP=$(cd "$(dirname "$0")/.." && pwd)
 ROBOELF_BIN=$ROBOELF_TOP/$BUILD/bin
 export BUILD ROBOELF_BIN ROBOELF_TOP
 cd "$ROBOELF_TOP" || exit 1
+LOGDIR=$BUILD/test-logs
+mkdir -p "$LOGDIR"
 passed=0; failed=0; failures=""
-run() {
-	name=$1; shift
+run() { # run NAME KIND CMD... ; KIND = cmocka | script
+	name=$1; kind=$2; shift 2
+	log=$LOGDIR/$(echo "$name" | tr / _).log
 	echo "=== $name"
 	start=$(date +%s)
-	if "$@"; then
-		passed=$((passed + 1)); res=ok
+	"$@" >"$log" 2>&1
+	rc=$?
+	cat "$log"
+	res=ok
+	if [ "$rc" -ne 0 ]; then
+		res="FAILED (exit $rc)"
+	elif grep -qE '^\[  (FAILED|ERROR)   ?\]' "$log"; then
+		res="FAILED (cmocka reported a failure)"
+	elif [ "$kind" = cmocka ] && ! grep -q '^\[  PASSED  \]' "$log"; then
+		res="FAILED (no cmocka summary)"
+	elif grep -q '^\[  PASSED  \] 0 test' "$log"; then
+		res="FAILED (no test ran)"
+	fi
+	if [ "$res" = ok ]; then
+		passed=$((passed + 1))
 	else
-		failed=$((failed + 1)); failures="$failures $name"; res=FAILED
+		failed=$((failed + 1)); failures="$failures $name"
 	fi
 	echo "=== $name: $res ($(( $(date +%s) - start )) s)"
 }
 for dir in unit load sim dmc system; do
 	for t in "$BUILD/tests/$dir"/test_*; do
 		[ -x "$t" ] || continue
-		run "$dir/$(basename "$t")" "$t"
+		run "$dir/$(basename "$t")" cmocka "$t"
 	done
 done
 for s in tests/checks/*.sh; do
 	[ -f "$s" ] || continue
-	run "checks/$(basename "$s")" sh "$s"
+	run "checks/$(basename "$s")" script sh "$s"
 done
 [ -n "$failures" ] && echo "failed:$failures"
 echo "$passed passed, $failed failed"

@@ -129,4 +129,35 @@ unsigned ctrl_threads(const struct ctrl *c);
  */
 void ctrl_power_cycle(struct ctrl *c);
 
+/*
+ * ctrl_handle_close_wanted() - 1 when the controller wants the connection
+ * on handle @h closed (IHS=>-3, IHT=>-3, IHB=>-2 ..., or a power cycle):
+ * the network layer closes the socket and calls ctrl_handle_close().
+ */
+int ctrl_handle_close_wanted(const struct ctrl *c, int h);
+
+/*
+ * ctrl_handle_lost() - the TCP connection of handle @h failed (peer gone
+ * while output was pending, ...): the handle is closed, TC 123, _IA4 = h,
+ * and #TCPERR runs if the program has it.
+ */
+void ctrl_handle_lost(struct ctrl *c, int h);
+
+/* ctrl_handle_peer() - optional: ports and peer address, for TH and _IH. */
+void ctrl_handle_peer(struct ctrl *c, int h, int local_port, uint32_t peer_ip,
+		      int peer_port);
+
+/*
+ * ctrl_serial_output() - take up to @cap bytes of the unsolicited output
+ * routed to the serial port (CF S, the power-up default), which the
+ * simulator does not have. Return: bytes copied.
+ */
+size_t ctrl_serial_output(struct ctrl *c, uint8_t *buf, size_t cap);
+
+/*
+ * ctrl_set_line_budget() - program lines all threads together may run per
+ * servo sample (default 16; see docs/galil-sim-controller.md).
+ */
+void ctrl_set_line_budget(struct ctrl *c, int lines_per_sample);
+
 #endif /* SIM_CTRL_H */

@@ -4,15 +4,39 @@
  * wall clock for the TCP servers (sim_net.h).
  *
  * The DMC tests (tests/dmc) and galil-sim's main use only this API.
+ * Single-threaded: the caller serialises every call on one struct sim.
+ *
+ * Motor power: the virtual E-stop relay starts OFF (power cut), as the real
+ * one does at start-up. An in-process test that wants the motors to move
+ * switches it on with sim_control(s, "relay on", ...) (or through the relay
+ * pty after sim_attach_relay()).
  */
 #ifndef SIM_H
 #define SIM_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "ctrl.h"
 
 struct sim;
+struct sim_plant;
+struct sim_relay;
+
+#define SIM_EVENT_LEN	160  /* bytes per event text, NUL included */
+#define SIM_EVENTS_MAX	2048 /* events kept until read; older are dropped */
+#define SIM_REQUEST_MAX 256  /* bytes per control request */
+#define SIM_WATCH_MAX	16   /* variables in the state line */
+/* a response buffer this large holds any control answer */
+#define SIM_RESPONSE_MAX (SIM_EVENTS_MAX * (SIM_EVENT_LEN + 24) + 64)
+
+/* Link faults injected on the command port (sim_net.h applies them). */
+enum sim_link {
+	SIM_LINK_OK,
+	SIM_LINK_DROP,	/* close every command connection, refuse new */
+	SIM_LINK_STALL, /* sockets stay open, nothing flows */
+	SIM_LINK_DELAY, /* replies held back by delay_ms */
+};
 
 /*
  * sim_new() - a simulator with the plant from @plant_file (YAML), or the
@@ -26,9 +50,33 @@ void sim_free(struct sim *s);
 /* sim_ctrl() - the controller inside, for ctrl_* calls. */
 struct ctrl *sim_ctrl(struct sim *s);
 
+/* sim_get_plant() / sim_get_relay() - the robot and the relay inside. */
+struct sim_plant *sim_get_plant(struct sim *s);
+struct sim_relay *sim_get_relay(struct sim *s);
+
+/* sim_seed() - restart the potentiometer noise from @seed. */
+void sim_seed(struct sim *s, unsigned long seed);
+
+/*
+ * sim_attach_relay() - give the virtual relay a pseudo-terminal speaking
+ * @protocol ("devantech", "icstation", "lcus", "kmtronic") and optionally a
+ * symbolic link @link_path to it (NULL or "" for none). The relay is off.
+ * @err: [out] the reason on failure.
+ * Return: 0, GL_ERR_ARG (unknown protocol, link refused), GL_ERR_SYS.
+ */
+int sim_attach_relay(struct sim *s, const char *protocol, const char *link_path,
+		     char *err, size_t errlen);
+
+/*
+ * sim_step() - one servo sample: plant sensors -> ctrl_step -> plant
+ * motion; simulated time advances by ctrl_sample_ms().
+ */
+void sim_step(struct sim *s);
+
 /*
  * sim_advance_ms() - run the controller and the plant for @ms milliseconds
- * of simulated time, one servo sample at a time.
+ * of simulated time, one servo sample at a time. The relay pty is not
+ * serviced here (sim_net does it in real time).
  */
 void sim_advance_ms(struct sim *s, double ms);
 
@@ -36,9 +84,22 @@ void sim_advance_ms(struct sim *s, double ms);
 double sim_time_ms(const struct sim *s);
 
 /*
+ * sim_power_cycle() - switch the controller off and on: every command
+ * connection is closed, the encoder counters restart at 0 where the motors
+ * are, the controller loses RAM and runs a burned #AUTO (ctrl_power_cycle).
+ * The robot and the relay are not affected.
+ */
+void sim_power_cycle(struct sim *s);
+
+/* sim_power() - 1 when motor power is on (relay energised and healthy). */
+int sim_power(const struct sim *s);
+
+/*
  * sim_control() - one request of the control-port text protocol
  * ("joy A fwd", "pot B offset 0.3", "state", "events", ...), without the
- * newline. @resp gets "ok", a value, or "error: <reason>".
+ * newline. @resp gets "ok", a value, or "error: <reason>"; the answer to
+ * "events" is several lines separated by '\n', the last one "end" (no
+ * final newline). docs/galil-sim.md lists the requests.
  * Return: 0, or GL_ERR_ARG when @resp starts with "error:".
  */
 int sim_control(struct sim *s, const char *req, char *resp, size_t cap);
@@ -48,6 +109,26 @@ int sim_control(struct sim *s, const char *req, char *resp, size_t cap);
  * the controller's event callback and the fault injections).
  */
 void sim_event(struct sim *s, const char *fmt, ...)
-	__attribute__((format(printf, 2, 3)));
+    __attribute__((format(printf, 2, 3)));
+
+/*
+ * sim_set_event_hook() - also pass every event to @fn (e.g. galil-sim
+ * --verbose prints them). @fn gets the simulated time and the text.
+ */
+void sim_set_event_hook(struct sim *s,
+			void (*fn)(void *ud, double t_ms, const char *text),
+			void *ud);
+
+/* sim_link() - the injected link fault and its delay (ms). */
+enum sim_link sim_link(const struct sim *s, double *delay_ms);
+
+/*
+ * sim_set_disconnect() - @fn is called to close every command connection
+ * (link drop, power cycle) before the controller state changes.
+ */
+void sim_set_disconnect(struct sim *s, void (*fn)(void *ud), void *ud);
+
+/* sim_quit_requested() - 1 after the "quit" request. */
+int sim_quit_requested(const struct sim *s);
 
 #endif /* SIM_H */

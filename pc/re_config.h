@@ -1,0 +1,218 @@
+/*
+ * re_config.h - the supervisor's configuration (YAML, read with libyaml).
+ *
+ * Every field is typed and range-checked; unknown keys, duplicate keys, an
+ * empty file and a root that is not a mapping are rejected. Errors read
+ * "FILE:LINE:COLUMN: message" (1-based), e.g.
+ *   roboelf.yaml:12:3: unknown key 'relay_prot'
+ * and nothing is applied on error. docs/config.md documents every field,
+ * its unit, range and default; config/roboelf.yaml is the commented default.
+ *
+ * Units: positions and steps in encoder counts, velocities in counts/s,
+ * times in ms, analog values in volts, tolerances as fractions (0.1 = 10 %).
+ */
+#ifndef RE_CONFIG_H
+#define RE_CONFIG_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "re_relay.h"
+
+#define RE_AXES		  3   /* A, B (rotary), C (linear) */
+#define RE_JOY_INPUTS	  12  /* 6 commands x 2 redundant switches */
+#define RE_NAME_MAX	  16  /* axis name, bytes including the NUL */
+#define RE_ADDR_MAX	  128 /* controller address, bytes incl. NUL */
+#define RE_MODEL_MAX	  32  /* controller model, bytes incl. NUL */
+#define RE_PATH_MAX	  256 /* file paths, bytes incl. NUL */
+#define RE_CONFIG_ERR_MAX 512 /* a good size for the @err buffers */
+/* most table points per axis: travel_counts / step_counts at most this */
+#define RE_CONFIG_POINTS_MAX 10000
+
+enum re_mode {
+	RE_MODE_CLINICAL = 0, /* default: real relay through libserialport,
+			       * real (non-loopback) controller */
+	RE_MODE_DEVELOPMENT,  /* simulator allowed: pty relay, loopback */
+};
+
+struct re_config_controller {
+	char address[RE_ADDR_MAX]; /* "host", "host:port", "[v6]:port" */
+	char model[RE_MODEL_MAX];  /* expected model, e.g. "DMC4030" */
+	int timeout_ms;		   /* deadline of one command reply */
+	int connect_timeout_ms;	   /* deadline of the TCP connect */
+};
+
+struct re_config_relay {
+	char port_clinical[RE_PATH_MAX];    /* used in clinical mode */
+	char port_development[RE_PATH_MAX]; /* used in development mode */
+	enum re_relay_proto protocol;
+	int channel; /* 1..8 */
+	enum re_relay_backend backend;
+	int baud; /* bits/s */
+	int write_timeout_ms;
+	bool readback; /* Devantech state query */
+	int readback_timeout_ms;
+	uint8_t on[RE_RELAY_CODE_MAX]; /* protocol {on:, off:} only */
+	size_t on_len;
+	uint8_t off[RE_RELAY_CODE_MAX];
+	size_t off_len;
+	char icstation_state[RE_PATH_MAX]; /* handshake record file */
+};
+
+struct re_config_watchdog {
+	double noncritical_factor; /* x period_ms: logged, no stop */
+	double critical_factor;	   /* x period_ms: WATCHDOG fault */
+	int controller_timeout_ms; /* DMC-side watchdog (wdto), ms */
+};
+
+struct re_config_joystick {
+	/* Digital input number (1..32) of each switch, in the order
+	 * A fwd a, A fwd b, A rev a, A rev b, B fwd a, B fwd b, B rev a,
+	 * B rev b, C fwd a, C fwd b, C rev a, C rev b (= DMC jin[0..11]). */
+	int inputs[RE_JOY_INPUTS];
+	bool active_low;	/* closed switch reads 0 (DMC jpol) */
+	int invalid_timeout_ms; /* DMC jto */
+};
+
+struct re_config_encoder_failure {
+	bool enabled;	  /* OA */
+	int time_samples; /* OT, servo samples, 2..32000 */
+	double torque_v;  /* OV, volts */
+};
+
+struct re_config_analog {
+	int input;		 /* analog input 1..8 (AN[n]) */
+	double expected_range_v; /* pot span over the full travel, V */
+	double range_tolerance;	 /* fraction of expected_range_v */
+};
+
+struct re_config_axis {
+	char name[RE_NAME_MAX];	 /* "A", "B", "C" by default */
+	int vmax_cps;		 /* maximum velocity, counts/s */
+	int vmin_cps;		 /* minimum (starting) velocity, counts/s;
+				  * default vmax_cps / 4 */
+	int accel_start_ms;	 /* acceleration window start */
+	int accel_end_ms;	 /* acceleration window end */
+	int step_counts;	 /* table step and tracking step */
+	int travel_counts;	 /* expected hard-limit to hard-limit
+				  * travel, counts */
+	double travel_tolerance; /* fraction of travel_counts */
+	double kp, ki, kd;	 /* PID gains (KP, KI, KD) */
+	double torque_limit_v;	 /* TL, volts */
+	int position_error_limit_counts; /* ER */
+	bool off_on_error;		 /* OE */
+	struct re_config_encoder_failure encoder_failure;
+	struct re_config_analog analog;
+	double allowed_error;	   /* fraction of the local pot step */
+	int persistence_cycles;	   /* cycles an ENCODER mismatch must
+				    * last before it is a fault, >= 1 */
+	double monotonic_margin_v; /* calibration noise margin, V */
+};
+
+struct re_config_calibration {
+	char file[RE_PATH_MAX]; /* calibration table file */
+	bool backup;		/* keep the previous file as FILE.bak */
+	int backoff_counts;	/* distance backed off a hard limit */
+	int move_timeout_ms;	/* deadline of one calibration move */
+};
+
+struct re_config_log {
+	char path[RE_PATH_MAX];
+	long max_bytes; /* rotate when the file reaches this */
+	int keep;	/* rotated files kept: PATH.1 .. PATH.n */
+};
+
+struct re_config {
+	enum re_mode mode;
+	int period_ms; /* supervisor cycle, 2..100 */
+	struct re_config_controller controller;
+	struct re_config_relay relay;
+	struct re_config_watchdog watchdog;
+	struct re_config_joystick joystick;
+	struct re_config_axis axes[RE_AXES];
+	struct re_config_calibration calibration;
+	struct re_config_log log;
+};
+
+/*
+ * re_config_defaults() - fill @out with the documented defaults.
+ * The defaults are safe, not convenient: mode is clinical, and the clinical
+ * relay port is empty, so a clinical start without a configured relay fails
+ * validation. config/roboelf.yaml is the development default.
+ * @out: [out] must not be NULL.
+ */
+void re_config_defaults(struct re_config *out);
+
+/*
+ * re_config_parse() - parse a YAML configuration held in memory.
+ * @buf: [in] the file content (need not be NUL-terminated).
+ * @len: length of @buf, bytes.
+ * @filename: [in] name used in messages (e.g. "roboelf.yaml"); NULL gives
+ *            "<config>".
+ * @out: [out] the configuration: defaults overridden by the file. Written
+ *       only on success; untouched on error (nothing half-applied).
+ * @err: [out] optional; on error "FILE:LINE:COLUMN: message".
+ * @errlen: size of @err (RE_CONFIG_ERR_MAX is enough).
+ * Fields absent from the file keep their defaults; the result is validated
+ * as re_config_validate() does, each cross-field error reported at the
+ * position of the later of the fields involved.
+ * Return: GL_OK; GL_ERR_CONFIG (syntax, unknown or duplicate key, wrong
+ *         type, out of range, inconsistent); GL_ERR_NOMEM.
+ */
+int re_config_parse(const char *buf, size_t len, const char *filename,
+		    struct re_config *out, char *err, size_t errlen);
+
+/*
+ * re_config_load_file() - read @path and re_config_parse() it.
+ * Messages use @path as FILE. A file that cannot be read gives
+ * "cannot read 'PATH': <strerror>" (no position).
+ * Return: as re_config_parse(), plus GL_ERR_SYS (errno kept) when the file
+ *         cannot be read.
+ */
+int re_config_load_file(const char *path, struct re_config *out, char *err,
+			size_t errlen);
+
+/*
+ * re_config_validate() - check the ranges and cross-field rules of @cfg,
+ * e.g. after command-line overrides (--period, --relay, --galil).
+ * @err: [out] optional; on error a message without position, e.g.
+ *       "'period_ms' must be between 2 and 100, got 500".
+ * Return: GL_OK or GL_ERR_CONFIG.
+ */
+int re_config_validate(const struct re_config *cfg, char *err, size_t errlen);
+
+/*
+ * re_config_relay_port() - the relay port for @cfg's operating mode.
+ * Return: relay.port_clinical or relay.port_development; never NULL.
+ */
+const char *re_config_relay_port(const struct re_config *cfg);
+
+/*
+ * re_config_relay_cfg() - the settings for re_relay_open(): the port of the
+ * current mode, protocol, channel, back-end, and clinical = (mode is
+ * clinical).
+ * @out: [out] must not be NULL.
+ */
+void re_config_relay_cfg(const struct re_config *cfg, struct re_relay_cfg *out);
+
+/*
+ * re_config_hash() - FNV-1a 64 (pc/gl_hash.h) over the fields a calibration
+ * table depends on: per axis its name, step_counts, travel_counts,
+ * travel_tolerance, analog input, expected_range_v, range_tolerance,
+ * allowed_error and monotonic_margin_v. A calibration file whose hash
+ * differs was made for another configuration.
+ */
+uint64_t re_config_hash(const struct re_config *cfg);
+
+/*
+ * re_config_dump() - a one-paragraph summary for the log (no newline).
+ * @buf: [out] NUL-terminated, truncated to @cap.
+ * Return: the length the full summary needs (as snprintf).
+ */
+int re_config_dump(const struct re_config *cfg, char *buf, size_t cap);
+
+/* re_mode_name() - "clinical" or "development". */
+const char *re_mode_name(enum re_mode mode);
+
+#endif /* RE_CONFIG_H */

@@ -1,0 +1,343 @@
+/*
+ * re_console.c - status board, messages, FAULT line and keyboard.
+ * See re_console.h.
+ */
+#include "re_console.h"
+
+#include <ctype.h>
+#include <poll.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define BAR_WIDTH 20
+#define ANSI_RED "\033[1;31m"
+#define ANSI_GREEN "\033[32m"
+#define ANSI_YELLOW "\033[33m"
+#define ANSI_OFF "\033[0m"
+
+static const char *const cmd_names[7] = {
+	"none", "A fwd", "A rev", "B fwd", "B rev", "C fwd", "C rev",
+};
+
+int re_console_open(struct re_console *c, FILE *out, int in_fd)
+{
+	const char *term = getenv("TERM");
+	const char *nc = getenv("NO_COLOR");
+
+	memset(c, 0, sizeof(*c));
+	c->out = out;
+	c->out_fd = fileno(out);
+	c->in_fd = in_fd;
+	c->tty_out = isatty(c->out_fd);
+	c->tty_in = in_fd >= 0 && isatty(in_fd);
+	c->color = c->tty_out && !(nc && nc[0]) &&
+		   !(term && !strcmp(term, "dumb"));
+	return 0;
+}
+
+void re_console_raw(struct re_console *c)
+{
+	struct termios t;
+
+	if (!c->tty_in || c->raw || tcgetattr(c->in_fd, &c->saved) < 0)
+		return;
+	t = c->saved;
+	t.c_lflag &= ~(tcflag_t)(ICANON | ECHO);
+	t.c_cc[VMIN] = 0;
+	t.c_cc[VTIME] = 0;
+	if (tcsetattr(c->in_fd, TCSANOW, &t) == 0)
+		c->raw = 1;
+}
+
+void re_console_restore(struct re_console *c)
+{
+	if (c->raw) {
+		tcsetattr(c->in_fd, TCSANOW, &c->saved);
+		c->raw = 0;
+	}
+}
+
+void re_console_close(struct re_console *c)
+{
+	re_console_restore(c);
+	fflush(c->out);
+}
+
+/* Take the board off the screen so that a message can scroll above it. */
+static void board_erase(struct re_console *c)
+{
+	if (c->tty_out && c->board_lines > 0)
+		fprintf(c->out, "\033[%dA\r\033[J", c->board_lines);
+	c->board_lines = 0;
+	c->drawn = 0;
+}
+
+void re_console_msg(struct re_console *c, const char *fmt, ...)
+{
+	va_list ap;
+
+	board_erase(c);
+	va_start(ap, fmt);
+	vfprintf(c->out, fmt, ap);
+	va_end(ap);
+	fputc('\n', c->out);
+	fflush(c->out);
+}
+
+void re_console_fault(struct re_console *c, const char *line)
+{
+	board_erase(c);
+	if (c->color)
+		fprintf(c->out, ANSI_RED "%s" ANSI_OFF "\n", line);
+	else
+		fprintf(c->out, "%s\n", line);
+	fflush(c->out);
+}
+
+int re_console_key(struct re_console *c)
+{
+	struct pollfd p = {.fd = c->in_fd, .events = POLLIN};
+	unsigned char ch;
+	ssize_t n;
+
+	if (c->in_fd < 0 || !c->tty_in)
+		return 0;
+	if (poll(&p, 1, 0) <= 0)
+		return 0;
+	n = read(c->in_fd, &ch, 1);
+	if (n == 0)
+		return -1;
+	return n == 1 ? ch : 0;
+}
+
+/* ---- texts ------------------------------------------------------------- */
+
+static const char *relay_text(enum re_relay_state r)
+{
+	switch (r) {
+	case RE_RELAY_ON: return "ON";
+	case RE_RELAY_OFF: return "OFF (motor power cut)";
+	default: return "UNKNOWN";
+	}
+}
+
+static const char *cmd_text(int k)
+{
+	if (k < 0)
+		return "invalid";
+	return k <= 6 ? cmd_names[k] : "?";
+}
+
+static void ctrl_text(const struct re_status *st, char *buf, size_t cap)
+{
+	if (!st->have_za)
+		snprintf(buf, cap, "no data");
+	else if (st->za.state == RE_DMC_FAULT || st->za.fcode)
+		snprintf(buf, cap, "FAULT code %d axis %d", st->za.fcode,
+			 st->za.faxis);
+	else
+		snprintf(buf, cap, "%s",
+			 st->za.state == RE_DMC_ARMED ? "armed" : "unarmed");
+}
+
+static const char *motion_text(const struct re_axis_status *a)
+{
+	if (a->motor_off)
+		return "off";
+	return a->moving ? "moving" : "stopped";
+}
+
+static const char *limit_text(const struct re_axis_status *a)
+{
+	if (a->fwd_limit && a->rev_limit)
+		return "F+R";
+	if (a->fwd_limit)
+		return "FWD";
+	return a->rev_limit ? "REV" : "-";
+}
+
+int re_console_format_line(const struct re_status *st, char *buf, size_t cap)
+{
+	char ctl[48];
+	size_t n;
+
+	ctrl_text(st, ctl, sizeof(ctl));
+	n = (size_t)snprintf(buf, cap, "status %.1fs mode=%s relay=%s link=%s"
+			     " ctrl=\"%s\"", st->uptime_s, st->mode_name,
+			     st->relay == RE_RELAY_ON ? "on" :
+			     st->relay == RE_RELAY_OFF ? "off" : "unknown",
+			     st->link_ok ? "ok" : "down", ctl);
+	for (int i = 0; i < st->n_axes && n < cap; i++) {
+		const struct re_axis_status *a = &st->axis[i];
+
+		n += (size_t)snprintf(buf + n, cap - n, " %s enc=%d pot=%.3fV",
+				      st->axis_names[i], (int)a->enc_counts,
+				      a->pot_v);
+		if (n < cap && a->have_expect)
+			n += (size_t)snprintf(buf + n, cap - n,
+					      " exp=%.3fV margin=%.3fV",
+					      a->pot_expected_v, a->margin_v);
+		if (n < cap)
+			n += (size_t)snprintf(buf + n, cap - n,
+					      " vel=%.0f %s lim=%s",
+					      a->vel_cps, motion_text(a),
+					      limit_text(a));
+	}
+	if (n < cap)
+		n += (size_t)snprintf(buf + n, cap - n, " wd=%.1f/%.1fms "
+				      "overruns=%llu%s", st->wd_last_ms,
+				      st->wd_worst_ms,
+				      (unsigned long long)st->overruns,
+				      st->latched ? " LATCHED" : "");
+	return (int)n;
+}
+
+/* ---- the board --------------------------------------------------------- */
+
+static void bar(char out[BAR_WIDTH + 3], double pct)
+{
+	int pos = pct < 0 ? -1 : (int)(pct / 100.0 * (BAR_WIDTH - 1) + 0.5);
+
+	out[0] = '[';
+	for (int i = 0; i < BAR_WIDTH; i++)
+		out[1 + i] = i == pos ? '#' : (pct >= 0 ? '-' : '?');
+	out[BAR_WIDTH + 1] = ']';
+	out[BAR_WIDTH + 2] = '\0';
+}
+
+static const char *col(const struct re_console *c, const char *code)
+{
+	return c->color ? code : "";
+}
+
+static void board_axis(struct re_console *c, const struct re_status *st,
+		       int i)
+{
+	const struct re_axis_status *a = &st->axis[i];
+	char b[BAR_WIDTH + 3], exp[48] = "      -        -";
+
+	bar(b, a->pos_pct);
+	if (a->have_expect)
+		snprintf(exp, sizeof(exp), "%6.3f %s%+8.3f%s",
+			 a->pot_expected_v,
+			 col(c, a->margin_v < 0 ? ANSI_RED : ""), a->margin_v,
+			 col(c, a->margin_v < 0 ? ANSI_OFF : ""));
+	fprintf(c->out, "%-3s %8d %s %5.1f%% %6.3f %s %7.0f %-7s %-3s %s\n",
+		st->axis_names[i], (int)a->enc_counts, b,
+		a->pos_pct < 0 ? 0.0 : a->pos_pct, a->pot_v, exp, a->vel_cps,
+		motion_text(a), limit_text(a), a->motor_off ? "off" : "on");
+}
+
+static void board_draw(struct re_console *c, const struct re_status *st)
+{
+	char ctl[48];
+	int n = 0;
+
+	board_erase(c);
+	ctrl_text(st, ctl, sizeof(ctl));
+	fprintf(c->out, "RoboELF  mode %s  up %.1f s  relay %s%s%s  link %s\n",
+		st->mode_name, st->uptime_s,
+		col(c, st->relay == RE_RELAY_ON ? ANSI_GREEN : ANSI_YELLOW),
+		relay_text(st->relay), col(c, ANSI_OFF),
+		st->link_ok ? "ok" : "DOWN");
+	fprintf(c->out, "ax   encoder position               %%      pot V "
+			"expect   margin   vel/s state   lim motor\n");
+	n += 2;
+	for (int i = 0; i < st->n_axes; i++, n++)
+		board_axis(c, st, i);
+	fprintf(c->out, "watchdog %.1f ms (worst %.1f, warnings %llu)  period "
+			"%.0f ms  late %.1f/%.1f ms  overruns %llu\n",
+		st->wd_last_ms, st->wd_worst_ms,
+		(unsigned long long)st->wd_warnings, st->period_ms,
+		st->late_last_ms, st->late_worst_ms,
+		(unsigned long long)st->overruns);
+	fprintf(c->out, "controller %s  joystick %s  moving %s  %s\n", ctl,
+		st->have_za ? cmd_text(st->za.jcmd) : "-",
+		st->have_za ? cmd_text(st->za.mcmd) : "-",
+		st->latched ? "LATCHED: quit with q" : "q: quit");
+	n += 2;
+	c->board_lines = n;
+	c->drawn = 1;
+	fflush(c->out);
+}
+
+void re_console_status(struct re_console *c, const struct re_status *st,
+		       int64_t now_ns, int force)
+{
+	char line[1024];
+	int64_t gap = c->tty_out ? RE_CONSOLE_BOARD_NS : RE_CONSOLE_LINE_NS;
+
+	if (!force && c->last_draw_ns && now_ns - c->last_draw_ns < gap)
+		return;
+	c->last_draw_ns = now_ns;
+	if (c->tty_out) {
+		board_draw(c, st);
+		return;
+	}
+	re_console_format_line(st, line, sizeof(line));
+	fprintf(c->out, "%s\n", line);
+	fflush(c->out);
+}
+
+/* ---- questions ------------------------------------------------------------ */
+
+/* Read one answer line from the keyboard (cooked mode). */
+static int read_answer(struct re_console *c, char *buf, size_t cap)
+{
+	size_t n = 0;
+	char ch;
+
+	while (n + 1 < cap) {
+		ssize_t r = read(c->in_fd, &ch, 1);
+
+		if (r <= 0)
+			return n ? (int)n : -1;
+		if (ch == '\n')
+			break;
+		buf[n++] = (char)tolower((unsigned char)ch);
+	}
+	buf[n] = '\0';
+	while (n > 0 && isspace((unsigned char)buf[n - 1]))
+		buf[--n] = '\0';
+	return (int)n;
+}
+
+enum re_calib_choice re_console_ask_calibration(struct re_console *c)
+{
+	char a[32];
+
+	if (!c->tty_in)
+		return RE_CALIB_ASK;
+	for (;;) {
+		re_console_msg(c, "Calibration: [f]ull (move every axis "
+				  "end to end) or [l]oad from file?");
+		if (read_answer(c, a, sizeof(a)) < 0)
+			return RE_CALIB_ASK;
+		if (!strcmp(a, "f") || !strcmp(a, "full"))
+			return RE_CALIB_FULL;
+		if (!strcmp(a, "l") || !strcmp(a, "load") ||
+		    !strcmp(a, "file"))
+			return RE_CALIB_FILE;
+		re_console_msg(c, "invalid answer '%s': type f or l", a);
+	}
+}
+
+int re_console_ask_yes(struct re_console *c, const char *question)
+{
+	char a[32];
+
+	if (!c->tty_in)
+		return 0;
+	for (;;) {
+		re_console_msg(c, "%s [y/n]", question);
+		if (read_answer(c, a, sizeof(a)) < 0)
+			return 0;
+		if (!strcmp(a, "y") || !strcmp(a, "yes"))
+			return 1;
+		if (!strcmp(a, "n") || !strcmp(a, "no"))
+			return 0;
+		re_console_msg(c, "invalid answer '%s': type y or n", a);
+	}
+}

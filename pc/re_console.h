@@ -1,0 +1,123 @@
+/*
+ * re_console.h - the operator's console: start-up progress lines, the
+ * status board, the FAULT line, the keyboard (q to quit) and the
+ * calibration question.
+ *
+ * On a terminal: a status board redrawn in place at most 10 times a second
+ * (per axis encoder counts, position as a 0-100 % bar, potentiometer volts
+ * against the expected value and the margin left, velocity, motion state,
+ * limit switches, motor on/off; relay state, watchdog latency last/worst,
+ * loop period, lateness and overruns, controller fault, operating mode).
+ * Messages (progress, warnings, the FAULT line) scroll above the board.
+ * Colour only on a terminal and only when NO_COLOR is unset (no-color.org)
+ * and TERM is not "dumb". The keyboard is in raw mode (no echo, no line
+ * buffering) between re_console_open() and re_console_close().
+ *
+ * Not on a terminal: one "status ..." line per second, no escape codes.
+ *
+ * This is the only supervisor module that prints.
+ */
+#ifndef RE_CONSOLE_H
+#define RE_CONSOLE_H
+
+#include <stdint.h>
+#include <stdio.h>
+#include <termios.h>
+
+#include "re_super.h"
+
+#define RE_CONSOLE_BOARD_NS 100000000LL	/* >= 100 ms between redraws */
+#define RE_CONSOLE_LINE_NS 1000000000LL	/* 1 s between status lines */
+
+struct re_console {
+	FILE *out;		/* stdout */
+	int out_fd;
+	int in_fd;		/* keyboard, -1 when none */
+	int tty_out;		/* @out is a terminal: status board */
+	int tty_in;		/* @in_fd is a terminal: raw keys, questions */
+	int color;
+	int raw;		/* termios changed; restore on close */
+	int board_lines;	/* lines of the board now on screen */
+	int64_t last_draw_ns;
+	int drawn;
+	struct termios saved;	/* the terminal before raw mode */
+};
+
+enum re_calib_choice {
+	RE_CALIB_ASK = 0,
+	RE_CALIB_FULL,
+	RE_CALIB_FILE,
+};
+
+/*
+ * re_console_open() - set up the console on @out (and keyboard @in_fd,
+ * -1 for none). Reads NO_COLOR and TERM.
+ * Return: 0 (never fails; without a terminal it degrades to plain lines).
+ */
+int re_console_open(struct re_console *c, FILE *out, int in_fd);
+
+/*
+ * re_console_raw() - put the keyboard in raw mode (no echo, one key at a
+ * time) for the run loop. Restored by re_console_close() and
+ * re_console_restore(). No-op without a terminal.
+ */
+void re_console_raw(struct re_console *c);
+
+/* re_console_restore() - give the terminal back its settings (idempotent;
+ * async-signal-safe enough to call on the way out). */
+void re_console_restore(struct re_console *c);
+
+/* re_console_close() - erase nothing, restore the terminal, flush. */
+void re_console_close(struct re_console *c);
+
+/*
+ * re_console_msg() - one message line above the board (start-up progress,
+ * warnings, "RoboELF Ready for Use"). A trailing newline is added.
+ */
+void re_console_msg(struct re_console *c, const char *fmt, ...)
+	__attribute__((format(printf, 2, 3)));
+
+/*
+ * re_console_fault() - the FAULT line, exactly as given, on one line (in
+ * red on a colour terminal), above the board; flushed at once.
+ */
+void re_console_fault(struct re_console *c, const char *line);
+
+/*
+ * re_console_status() - show @st: redraw the board when at least
+ * RE_CONSOLE_BOARD_NS passed since the last redraw (@force: now), or print
+ * one status line per RE_CONSOLE_LINE_NS without a terminal.
+ * @now_ns: monotonic time.
+ */
+void re_console_status(struct re_console *c, const struct re_status *st,
+		       int64_t now_ns, int force);
+
+/*
+ * re_console_key() - one key from the keyboard if one is waiting (never
+ * blocks). Return: the character, 0 when none, -1 at end of input.
+ */
+int re_console_key(struct re_console *c);
+
+/*
+ * re_console_ask_calibration() - ask "full or file" on the terminal until a
+ * valid answer (f/full, l/file/load), or end of input.
+ * Return: RE_CALIB_FULL, RE_CALIB_FILE, or RE_CALIB_ASK when no terminal or
+ *         end of input (the caller then exits 2).
+ */
+enum re_calib_choice re_console_ask_calibration(struct re_console *c);
+
+/*
+ * re_console_ask_yes() - ask a yes/no question on the terminal.
+ * Return: 1 yes, 0 no or no terminal / end of input.
+ */
+int re_console_ask_yes(struct re_console *c, const char *question);
+
+/*
+ * re_console_format_line() - the one-line status (also used without a
+ * terminal), e.g. "status 12.3s relay=on link=ok A enc=120 pct=50.1
+ * pot=2.512V exp=2.510V margin=0.058V vel=0 ..." (pure, for tests).
+ * Return: the length (as snprintf).
+ */
+int re_console_format_line(const struct re_status *st, char *buf, size_t cap);
+
+#endif /* RE_CONSOLE_H */

@@ -1,0 +1,148 @@
+/*
+ * re_io.c - the real binding of struct re_io: gl_link, re_relay, re_log and
+ * CLOCK_MONOTONIC. See re_io.h.
+ */
+#include "re_io.h"
+
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <time.h>
+
+#include "gl_err.h"
+
+int64_t re_io_now_ns(void)
+{
+	struct timespec ts;
+
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+static int real_record(void *ud, const char *prefix, struct gl_record *rec,
+		       int timeout_ms)
+{
+	struct re_io_real *r = ud;
+
+	if (!r->link)
+		return GL_ERR_CLOSED;
+	return gl_link_record(r->link, prefix, rec, timeout_ms);
+}
+
+static int real_command(void *ud, const char *cmd, char *resp, size_t cap,
+			int timeout_ms)
+{
+	struct re_io_real *r = ud;
+
+	if (!r->link)
+		return GL_ERR_CLOSED;
+	return gl_link_command(r->link, cmd, resp, cap, timeout_ms);
+}
+
+static const char *real_ctrl_error(void *ud, int *code)
+{
+	struct re_io_real *r = ud;
+
+	if (code)
+		*code = 0;
+	return r->link ? gl_link_ctrl_error(r->link, code) : "";
+}
+
+static int real_message(void *ud, char *line, size_t cap)
+{
+	struct re_io_real *r = ud;
+
+	if (!r->link)
+		return GL_ERR_AGAIN;
+	return gl_link_message(r->link, line, cap);
+}
+
+static int real_relay_check(void *ud, char *why, size_t cap)
+{
+	struct re_io_real *r = ud;
+	int rc;
+
+	if (!r->relay) {
+		snprintf(why, cap, "relay not open");
+		return GL_ERR_RELAY;
+	}
+	rc = re_relay_check(r->relay);
+	if (rc != GL_OK)
+		snprintf(why, cap, "%s", re_relay_errmsg(r->relay));
+	return rc;
+}
+
+static int real_relay_off(void *ud)
+{
+	struct re_io_real *r = ud;
+
+	return r->relay ? re_relay_off(r->relay) : GL_ERR_RELAY;
+}
+
+static enum re_relay_state real_relay_state(void *ud)
+{
+	struct re_io_real *r = ud;
+
+	return r->relay ? re_relay_state(r->relay) : RE_RELAY_UNKNOWN;
+}
+
+static int real_log(void *ud, enum re_log_level lvl, const char *text)
+{
+	struct re_io_real *r = ud;
+
+	if (!r->log || !r->log->is_open)
+		return GL_OK;
+	if (lvl == RE_LOG_FAULT)
+		return re_log_fault(r->log, "%s", text);
+	return re_log_msg(r->log, lvl, "%s", text);
+}
+
+static int64_t real_now_ns(void *ud)
+{
+	(void)ud;
+	return re_io_now_ns();
+}
+
+static void real_sleep_until(void *ud, int64_t t_ns)
+{
+	struct timespec ts = {
+		.tv_sec = (time_t)(t_ns / 1000000000),
+		.tv_nsec = (long)(t_ns % 1000000000),
+	};
+
+	(void)ud;
+	while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) ==
+	       EINTR)
+		;
+}
+
+static const struct re_io_ops real_ops = {
+	.record = real_record,
+	.command = real_command,
+	.ctrl_error = real_ctrl_error,
+	.message = real_message,
+	.relay_check = real_relay_check,
+	.relay_off = real_relay_off,
+	.relay_state = real_relay_state,
+	.log = real_log,
+	.now_ns = real_now_ns,
+	.sleep_until = real_sleep_until,
+};
+
+void re_io_bind(struct re_io *io, struct re_io_real *real)
+{
+	io->ops = &real_ops;
+	io->ud = real;
+}
+
+int re_io_logf(const struct re_io *io, enum re_log_level lvl,
+	       const char *fmt, ...)
+{
+	char text[RE_LOG_LINE_MAX];
+	va_list ap;
+
+	va_start(ap, fmt);
+	vsnprintf(text, sizeof(text), fmt, ap);
+	va_end(ap);
+	return io->ops->log(io->ud, lvl, text);
+}

@@ -1,0 +1,77 @@
+/*
+ * re_io.h - the supervisor's outside world behind one table of functions:
+ * the controller link, the E-stop relay, the failure log and the clock.
+ *
+ * The cycle (re_super) and the calibration procedure (re_calib) talk to the
+ * world only through struct re_io, so that unit tests can run them against a
+ * fake controller and a fake clock (tests/unit/test_re_super.c) while
+ * roboelf binds the real gl_link, re_relay and re_log (re_io_bind()).
+ * Nothing here prints. The real binding allocates nothing per call.
+ */
+#ifndef RE_IO_H
+#define RE_IO_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "gl_link.h"
+#include "gl_record.h"
+#include "re_log.h"
+#include "re_relay.h"
+
+struct re_io_ops {
+	/* gl_link_record(): one "[prefix;]QR" round trip. */
+	int (*record)(void *ud, const char *prefix, struct gl_record *rec,
+		      int timeout_ms);
+	/* gl_link_command(): one command line and its reply. */
+	int (*command)(void *ud, const char *cmd, char *resp, size_t cap,
+		       int timeout_ms);
+	/* gl_link_ctrl_error(): the TC1 text (and code, @code may be NULL)
+	 * after GL_ERR_CTRL; never NULL. */
+	const char *(*ctrl_error)(void *ud, int *code);
+	/* gl_link_message(): one unsolicited line; GL_ERR_AGAIN if none. */
+	int (*message)(void *ud, char *line, size_t cap);
+	/* re_relay_check(): GL_OK or GL_ERR_RELAY with @why filled. */
+	int (*relay_check)(void *ud, char *why, size_t cap);
+	/* re_relay_off(): GL_OK or GL_ERR_RELAY. */
+	int (*relay_off)(void *ud);
+	/* re_relay_state(): what was last confirmed written. */
+	enum re_relay_state (*relay_state)(void *ud);
+	/* re_log: one event; RE_LOG_FAULT is on disk (fsync) on return. */
+	int (*log)(void *ud, enum re_log_level lvl, const char *text);
+	/* CLOCK_MONOTONIC, ns. */
+	int64_t (*now_ns)(void *ud);
+	/* Sleep until the absolute monotonic time @t_ns. */
+	void (*sleep_until)(void *ud, int64_t t_ns);
+};
+
+struct re_io {
+	const struct re_io_ops *ops;
+	void *ud;
+};
+
+/* The real world: any member may be NULL (then its calls fail safely). */
+struct re_io_real {
+	gl_link *link;
+	re_relay *relay;
+	struct re_log *log;
+};
+
+/*
+ * re_io_bind() - point @io at the real link, relay, log and clock in @real.
+ * @real must outlive @io. Calls on a NULL link return GL_ERR_CLOSED, on a
+ * NULL relay GL_ERR_RELAY; log calls on a NULL or closed log do nothing.
+ */
+void re_io_bind(struct re_io *io, struct re_io_real *real);
+
+/* re_io_now_ns() - CLOCK_MONOTONIC in ns (for callers without an io). */
+int64_t re_io_now_ns(void);
+
+/*
+ * re_io_logf() - printf-style log event through @io (INFO, WARN or FAULT).
+ * Formats into a stack buffer; no allocation. Return: as ops->log.
+ */
+int re_io_logf(const struct re_io *io, enum re_log_level lvl,
+	       const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+
+#endif /* RE_IO_H */

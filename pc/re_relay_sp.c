@@ -1,0 +1,160 @@
+/*
+ * re_relay_sp.c - relay back-end over libserialport, for real USB relays.
+ *
+ * libserialport returns SP_ERR_FAIL with the OS error in errno
+ * (sp_last_error_code() is errno on Unix); we format strerror(errno)
+ * ourselves rather than call sp_last_error_message(), which allocates and
+ * shows a stale errno after SP_ERR_ARG (relays-and-serial.md).
+ */
+#include <errno.h>
+#include <libserialport.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "gl_err.h"
+#include "re_relay_be.h"
+
+static const char *sp_reason(enum sp_return rc)
+{
+	switch (rc) {
+	case SP_ERR_ARG: return "not a serial port known to libserialport";
+	case SP_ERR_MEM: return "out of memory";
+	case SP_ERR_SUPP: return "operation not supported";
+	case SP_ERR_FAIL: return strerror(errno);
+	default: return "unknown libserialport error";
+	}
+}
+
+static int sp_fail(const struct re_relay_io *io, const char *what,
+		   enum sp_return rc, char *err, size_t errlen)
+{
+	int saved = errno;
+
+	if (err && errlen)
+		snprintf(err, errlen, "relay '%s': %s: %s", io->path, what,
+			 sp_reason(rc));
+	errno = saved;
+	return rc == SP_ERR_MEM ? GL_ERR_NOMEM : GL_ERR_SYS;
+}
+
+static enum sp_return sp_configure(struct sp_port *port, int baud)
+{
+	enum sp_return rc;
+
+	rc = sp_set_baudrate(port, baud);
+	if (rc == SP_OK)
+		rc = sp_set_bits(port, 8);
+	if (rc == SP_OK)
+		rc = sp_set_parity(port, SP_PARITY_NONE);
+	if (rc == SP_OK)
+		rc = sp_set_stopbits(port, 1);
+	if (rc == SP_OK)
+		rc = sp_set_flowcontrol(port, SP_FLOWCONTROL_NONE);
+	return rc;
+}
+
+static int spb_open(struct re_relay_io *io, int baud, char *err, size_t errlen)
+{
+	struct sp_port *port = NULL;
+	enum sp_return rc;
+	int ret;
+
+	rc = sp_get_port_by_name(io->path, &port);
+	if (rc != SP_OK)
+		return sp_fail(io, "cannot open", rc, err, errlen);
+	rc = sp_open(port, SP_MODE_READ_WRITE);
+	if (rc != SP_OK) {
+		ret = sp_fail(io, "cannot open", rc, err, errlen);
+		goto out_free;
+	}
+	rc = sp_configure(port, baud);
+	if (rc != SP_OK) {
+		ret = sp_fail(io, "cannot configure", rc, err, errlen);
+		goto out_close;
+	}
+	io->port = port;
+	return GL_OK;
+out_close:
+	sp_close(port);
+out_free:
+	sp_free_port(port);
+	return ret;
+}
+
+static int spb_send(struct re_relay_io *io, const uint8_t *buf, size_t len,
+		    int timeout_ms, char *err, size_t errlen)
+{
+	enum sp_return rc;
+
+	if (!io->port) {
+		errno = EBADF;
+		return sp_fail(io, "write failed", SP_ERR_FAIL, err, errlen);
+	}
+	if (timeout_ms > 0)
+		rc = sp_blocking_write(io->port, buf, len,
+				       (unsigned int)timeout_ms);
+	else
+		rc = sp_nonblocking_write(io->port, buf, len);
+	if (rc < 0)
+		return sp_fail(io, "write failed", rc, err, errlen);
+	if ((size_t)rc < len) {
+		if (err && errlen)
+			snprintf(err, errlen,
+				 "relay '%s': write failed: only "
+				 "%d of %zu bytes written within %d ms",
+				 io->path, (int)rc, len, timeout_ms);
+		return GL_ERR_TIMEOUT;
+	}
+	if (timeout_ms > 0) {
+		rc = sp_drain(io->port);
+		if (rc != SP_OK)
+			return sp_fail(io, "drain failed", rc, err, errlen);
+	}
+	return GL_OK;
+}
+
+static int spb_recv(struct re_relay_io *io, uint8_t *buf, size_t len,
+		    int timeout_ms, char *err, size_t errlen)
+{
+	enum sp_return rc;
+
+	if (!io->port) {
+		errno = EBADF;
+		return sp_fail(io, "read failed", SP_ERR_FAIL, err, errlen);
+	}
+	if (timeout_ms > 0)
+		rc = sp_blocking_read(io->port, buf, len,
+				      (unsigned int)timeout_ms);
+	else
+		rc = sp_nonblocking_read(io->port, buf, len);
+	if (rc < 0)
+		return sp_fail(io, "read failed", rc, err, errlen);
+	return (int)rc;
+}
+
+static int spb_fd(const struct re_relay_io *io)
+{
+	int fd = -1;
+
+	if (!io->port || sp_get_port_handle(io->port, &fd) != SP_OK)
+		return -1;
+	return fd;
+}
+
+static void spb_close(struct re_relay_io *io)
+{
+	if (!io->port)
+		return;
+	sp_close(io->port);
+	sp_free_port(io->port);
+	io->port = NULL;
+}
+
+const struct re_relay_be_ops re_relay_be_serialport = {
+    .name = "serialport",
+    .open = spb_open,
+    .send = spb_send,
+    .recv = spb_recv,
+    .fd = spb_fd,
+    .close = spb_close,
+};

@@ -1,0 +1,696 @@
+/*
+ * roboelf.c - the RoboELF operator's console supervisor (robotTask and its
+ * GUI, rebuilt): options, the life cycle Configure -> Startup -> Run every
+ * period -> Cleanup, signals and exit codes.
+ *
+ *   roboelf [-c FILE] [--galil HOST[:PORT]] [--relay PORT]
+ *           [--calibration full|file] [--period MS] [--log FILE]
+ *   roboelf --show-calibration FILE
+ *
+ * Exit codes: 0 normal quit; 2 configuration or usage error (also: a
+ * calibration file that cannot be used, without a terminal to offer a full
+ * calibration); 3 no relay, no controller, or the controller refused the
+ * start-up (wrong program, read-back differs); 4 a fault was latched.
+ *
+ * Start-up order (issue 6): relay open and on (no relay, no start); connect,
+ * identify, program identity, close foreign handles; configure and read
+ * back; calibration (full or from file); soft limits; arm; "RoboELF Ready
+ * for Use". Any fault on the way, or in the cycle, goes through
+ * re_super_fault(): relay off, motors off, latch, log fsync'ed, FAULT line.
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "gl_err.h"
+#include "gl_link.h"
+#include "re_calfile.h"
+#include "re_calib.h"
+#include "re_calshow.h"
+#include "re_check.h"
+#include "re_config.h"
+#include "re_console.h"
+#include "re_ctl.h"
+#include "re_io.h"
+#include "re_log.h"
+#include "re_relay.h"
+#include "re_super.h"
+
+#define EXIT_USAGE 2
+#define EXIT_CONNECT 3
+#define EXIT_FAULT 4
+#define DEFAULT_CONFIG "config/roboelf.yaml"
+
+struct opts {
+	const char *config;
+	const char *galil;
+	const char *relay;
+	const char *log;
+	const char *show_cal;
+	int period_ms;		/* 0: from the configuration */
+	enum re_calib_choice calib;
+};
+
+struct app {
+	struct opts o;
+	struct re_config cfg;
+	struct re_log log;
+	struct re_console con;
+	re_relay *relay;
+	gl_link *link;
+	struct re_io_real real;
+	struct re_io io;
+	struct re_ctl_info info;
+	struct re_calset *cal;
+	struct re_super *sup;
+	const char *names[RE_AXES];
+	long hbpc;
+	char err[RE_CONFIG_ERR_MAX];
+};
+
+static volatile sig_atomic_t quit_signal;
+
+static void on_signal(int sig)
+{
+	quit_signal = sig;
+}
+
+static void install_signals(void)
+{
+	struct sigaction sa;
+
+	memset(&sa, 0, sizeof(sa));
+	sa.sa_handler = on_signal;
+	sigemptyset(&sa.sa_mask);
+	sigaction(SIGINT, &sa, NULL);
+	sigaction(SIGTERM, &sa, NULL);
+	sigaction(SIGHUP, &sa, NULL);
+	sa.sa_handler = SIG_IGN;
+	sigaction(SIGPIPE, &sa, NULL);
+}
+
+/* ---- options ----------------------------------------------------------- */
+
+static void usage(FILE *f)
+{
+	fprintf(f,
+		"usage: roboelf [-c FILE] [--galil HOST[:PORT]] [--relay PORT]\n"
+		"               [--calibration full|file] [--period MS] "
+		"[--log FILE]\n"
+		"       roboelf --show-calibration FILE\n"
+		"\n"
+		"  -c, --config FILE        configuration (default %s)\n"
+		"      --galil HOST[:PORT]  controller address (overrides the "
+		"file)\n"
+		"      --relay PORT         E-stop relay port for this mode\n"
+		"      --calibration MODE   full: calibrate now; file: load "
+		"the tables\n"
+		"      --period MS          supervisor period, 2..100 ms\n"
+		"      --log FILE           failure log\n"
+		"      --show-calibration FILE  print a calibration file (and "
+		"plot it)\n"
+		"  -h, --help               this text\n"
+		"\n"
+		"exit: 0 quit, 2 usage/config, 3 no relay/controller, "
+		"4 fault latched\n", DEFAULT_CONFIG);
+}
+
+static int parse_period(const char *s, int *out)
+{
+	char *end;
+	long v;
+
+	errno = 0;
+	v = strtol(s, &end, 10);
+	if (errno || end == s || *end || v < 2 || v > 100)
+		return -1;
+	*out = (int)v;
+	return 0;
+}
+
+static int parse_calib(const char *s, enum re_calib_choice *out)
+{
+	if (!strcmp(s, "full"))
+		*out = RE_CALIB_FULL;
+	else if (!strcmp(s, "file"))
+		*out = RE_CALIB_FILE;
+	else
+		return -1;
+	return 0;
+}
+
+static int opt_value(struct opts *o, int c, const char *arg)
+{
+	switch (c) {
+	case 'c': o->config = arg; return 0;
+	case 'g': o->galil = arg; return 0;
+	case 'r': o->relay = arg; return 0;
+	case 'l': o->log = arg; return 0;
+	case 's': o->show_cal = arg; return 0;
+	case 'p':
+		if (parse_period(arg, &o->period_ms) == 0)
+			return 0;
+		fprintf(stderr, "roboelf: error: invalid period '%s': must be "
+			"2..100 ms\n", arg);
+		return -1;
+	case 'k':
+		if (parse_calib(arg, &o->calib) == 0)
+			return 0;
+		fprintf(stderr, "roboelf: error: invalid calibration '%s': "
+			"use full or file\n", arg);
+		return -1;
+	default:
+		usage(stderr);
+		return -1;
+	}
+}
+
+/* Return: 0 to run, 1 after --help, -1 on a usage error. */
+static int parse_opts(int argc, char **argv, struct opts *o)
+{
+	static const struct option lo[] = {
+		{"config", required_argument, NULL, 'c'},
+		{"galil", required_argument, NULL, 'g'},
+		{"relay", required_argument, NULL, 'r'},
+		{"calibration", required_argument, NULL, 'k'},
+		{"period", required_argument, NULL, 'p'},
+		{"log", required_argument, NULL, 'l'},
+		{"show-calibration", required_argument, NULL, 's'},
+		{"help", no_argument, NULL, 'h'},
+		{NULL, 0, NULL, 0},
+	};
+	int c;
+
+	memset(o, 0, sizeof(*o));
+	o->config = DEFAULT_CONFIG;
+	while ((c = getopt_long(argc, argv, "c:h", lo, NULL)) != -1) {
+		if (c == 'h') {
+			usage(stdout);
+			return 1;
+		}
+		if (opt_value(o, c, optarg) < 0)
+			return -1;
+	}
+	if (optind < argc) {
+		fprintf(stderr, "roboelf: error: unexpected argument '%s'\n",
+			argv[optind]);
+		return -1;
+	}
+	return 0;
+}
+
+/* ---- configuration and log ---------------------------------------------- */
+
+static void apply_overrides(struct app *a)
+{
+	struct re_config *c = &a->cfg;
+	char *port = c->mode == RE_MODE_CLINICAL ? c->relay.port_clinical :
+						   c->relay.port_development;
+
+	if (a->o.galil)
+		snprintf(c->controller.address, sizeof(c->controller.address),
+			 "%s", a->o.galil);
+	if (a->o.relay)
+		snprintf(port, RE_PATH_MAX, "%s", a->o.relay);
+	if (a->o.period_ms)
+		c->period_ms = a->o.period_ms;
+	if (a->o.log)
+		snprintf(c->log.path, sizeof(c->log.path), "%s", a->o.log);
+}
+
+static int check_analog(const struct re_config *c, char *err, size_t len)
+{
+	for (int i = 0; i < RE_AXES; i++) {
+		if (c->axes[i].analog.input > RE_AXES) {
+			snprintf(err, len, "axis '%s': analog input %d is not "
+				 "in the DMC-4030 data record (use 1..%d)",
+				 c->axes[i].name, c->axes[i].analog.input,
+				 RE_AXES);
+			return GL_ERR_CONFIG;
+		}
+	}
+	return GL_OK;
+}
+
+static int load_config(struct app *a)
+{
+	if (re_config_load_file(a->o.config, &a->cfg, a->err,
+				sizeof(a->err)) != GL_OK) {
+		fprintf(stderr, "%s\n", a->err);
+		return -1;
+	}
+	apply_overrides(a);
+	if (re_config_validate(&a->cfg, a->err, sizeof(a->err)) != GL_OK ||
+	    check_analog(&a->cfg, a->err, sizeof(a->err)) != GL_OK) {
+		fprintf(stderr, "roboelf: error: %s\n", a->err);
+		return -1;
+	}
+	for (int i = 0; i < RE_AXES; i++)
+		a->names[i] = a->cfg.axes[i].name;
+	return 0;
+}
+
+static int open_log(struct app *a)
+{
+	struct re_log_cfg lc = re_log_cfg_default();
+	char dump[1536];
+	int rc;
+
+	lc.max_bytes = (size_t)a->cfg.log.max_bytes;
+	if (a->cfg.log.keep >= 1 && a->cfg.log.keep <= 9)
+		lc.keep = a->cfg.log.keep;
+	rc = re_log_open(&a->log, a->cfg.log.path, &lc);
+	if (rc != GL_OK) {
+		fprintf(stderr, "roboelf: error: cannot open log '%s': %s\n",
+			a->cfg.log.path, rc == GL_ERR_SYS ? strerror(errno) :
+			gl_strerror(rc));
+		return -1;
+	}
+	re_log_msg(&a->log, RE_LOG_INFO, "start: roboelf, config '%s'",
+		   a->o.config);
+	re_config_dump(&a->cfg, dump, sizeof(dump));
+	re_log_msg(&a->log, RE_LOG_INFO, "config: %s", dump);
+	return 0;
+}
+
+/* ---- start-up ------------------------------------------------------------ */
+
+static void progress(struct app *a, const char *fmt, ...)
+	__attribute__((format(printf, 2, 3)));
+
+static void progress(struct app *a, const char *fmt, ...)
+{
+	char text[512];
+	va_list ap;
+
+	va_start(ap, fmt);
+	vsnprintf(text, sizeof(text), fmt, ap);
+	va_end(ap);
+	re_console_msg(&a->con, "roboelf: %s", text);
+	re_log_msg(&a->log, RE_LOG_INFO, "%s", text);
+}
+
+static int fail(struct app *a, const char *what)
+{
+	re_console_msg(&a->con, "roboelf: error: %s", what);
+	re_log_msg(&a->log, RE_LOG_WARN, "start-up refused: %s", what);
+	return EXIT_CONNECT;
+}
+
+static int start_relay(struct app *a)
+{
+	struct re_relay_cfg rc;
+
+	re_config_relay_cfg(&a->cfg, &rc);
+	progress(a, "opening the E-stop relay '%s'", rc.port);
+	if (re_relay_open(&a->relay, &rc, a->err, sizeof(a->err)) != GL_OK)
+		return fail(a, a->err);
+	a->real.relay = a->relay;
+	if (re_relay_on(a->relay) != GL_OK) {
+		snprintf(a->err, sizeof(a->err), "cannot switch motor power "
+			 "on: %s", re_relay_errmsg(a->relay));
+		return fail(a, a->err);
+	}
+	progress(a, "motor power on (relay closed)");
+	return 0;
+}
+
+static int start_link(struct app *a)
+{
+	char e[GL_ERRTEXT_LEN];
+	char id[256];
+
+	progress(a, "connecting to the controller at %s",
+		 a->cfg.controller.address);
+	if (gl_link_open(&a->link, a->cfg.controller.address,
+			 a->cfg.controller.connect_timeout_ms, e) != GL_OK)
+		return fail(a, e);
+	gl_link_set_timeout(a->link, a->cfg.controller.timeout_ms);
+	a->real.link = a->link;
+	if (re_ctl_identify(a->link, &a->cfg, &a->info, a->err,
+			    sizeof(a->err)) != GL_OK)
+		return fail(a, a->err);
+	snprintf(id, sizeof(id), "%s, serial %ld, program id %016llX",
+		 a->info.model, a->info.serial,
+		 (unsigned long long)a->info.program_id);
+	progress(a, "controller %s", id);
+	progress(a, "configuring the controller");
+	if (re_ctl_configure(&a->io, &a->cfg, a->err, sizeof(a->err)) != GL_OK)
+		return fail(a, a->err);
+	progress(a, "controller configured and read back");
+	return 0;
+}
+
+static int init_super(struct app *a)
+{
+	struct re_super_cfg sc;
+
+	memset(&sc, 0, sizeof(sc));
+	sc.n_axes = RE_AXES;
+	sc.period_ns = (int64_t)a->cfg.period_ms * 1000000;
+	sc.wdog.period_ns = sc.period_ns;
+	sc.wdog.noncrit_factor = a->cfg.watchdog.noncritical_factor;
+	sc.wdog.crit_factor = a->cfg.watchdog.critical_factor;
+	sc.alive.sample_limit_ns = (int64_t)(sc.wdog.crit_factor *
+					     (double)sc.period_ns);
+	sc.alive.hb_limit_ns = sc.alive.sample_limit_ns;
+	for (int i = 0; i < RE_AXES; i++) {
+		sc.encpot[i].allowed_error = a->cfg.axes[i].allowed_error;
+		sc.encpot[i].persistence_cycles =
+			a->cfg.axes[i].persistence_cycles;
+		sc.axis_names[i] = a->names[i];
+		sc.pot_input[i] = a->cfg.axes[i].analog.input;
+	}
+	sc.fault_cmd_timeout_ms = a->cfg.controller.timeout_ms;
+	sc.mode_name = re_mode_name(a->cfg.mode);
+	a->sup = calloc(1, sizeof(*a->sup));
+	if (!a->sup || re_super_init(a->sup, &a->io, &sc, NULL, 0) != GL_OK)
+		return fail(a, "cannot set up the supervisor");
+	return 0;
+}
+
+/* The supervisor's heartbeat limit needs the program's own period. */
+static void set_hb_limit(struct app *a)
+{
+	int64_t mainms_ns = (int64_t)a->info.mainms * 1000000;
+	int64_t p = a->sup->cfg.period_ns;
+
+	a->sup->cfg.alive.hb_limit_ns = (int64_t)(
+		a->cfg.watchdog.critical_factor *
+		(double)(mainms_ns > p ? mainms_ns : p));
+}
+
+static int latch(struct app *a, const struct re_fault *f)
+{
+	if (re_super_fault(a->sup, f) == RE_FAULT)
+		re_console_fault(&a->con, re_super_fault_line(a->sup));
+	return EXIT_FAULT;
+}
+
+/* ---- calibration --------------------------------------------------------- */
+
+static void log_calibration(struct app *a, const char *how, double secs)
+{
+	for (int i = 0; i < a->cal->n_axes; i++) {
+		const struct re_caltable *t = &a->cal->axis[i];
+
+		re_log_msg(&a->log, RE_LOG_INFO, "calibration (%s) axis %s: "
+			   "%d points, start %.0f, step %.0f counts, soft "
+			   "limits %.0f..%.0f, pot %.3f..%.3f V", how,
+			   a->names[i], t->n, t->start_counts, t->step_counts,
+			   t->soft_rev, t->soft_fwd, t->pot_v[0],
+			   t->pot_v[t->n - 1]);
+	}
+	re_log_msg(&a->log, RE_LOG_INFO, "calibration (%s) done in %.1f s",
+		   how, secs);
+	re_console_msg(&a->con, "roboelf: calibration (%s) done in %.1f s",
+		       how, secs);
+}
+
+static void stamp_calset(struct app *a)
+{
+	snprintf(a->cal->serial, sizeof(a->cal->serial), "%ld",
+		 a->info.serial);
+	a->cal->config_hash = re_config_hash(&a->cfg);
+	re_calfile_date(time(NULL), a->cal->date, sizeof(a->cal->date));
+}
+
+static int calib_full(struct app *a, struct re_calib *c,
+		      const struct re_calib_cfg *cc)
+{
+	struct re_fault f;
+	double secs = 0;
+	int rc;
+
+	progress(a, "full calibration: every axis end to end");
+	rc = re_calib_full(c, &a->io, cc, a->cal, &f, &secs);
+	if (rc == RE_FAULT)
+		return latch(a, &f);
+	if (rc != GL_OK)
+		return rc == GL_ERR_AGAIN ? 0 : fail(a, "calibration failed");
+	stamp_calset(a);
+	log_calibration(a, "full", secs);
+	if (re_calfile_save(a->cfg.calibration.file, a->cal, a->err,
+			    sizeof(a->err)) != GL_OK) {
+		re_console_msg(&a->con, "roboelf: warning: %s", a->err);
+		re_log_msg(&a->log, RE_LOG_WARN, "calibration not saved: %s",
+			   a->err);
+	} else {
+		progress(a, "calibration saved to '%s'",
+			 a->cfg.calibration.file);
+	}
+	return 0;
+}
+
+static void fill_expect(struct app *a, const struct re_calib_cfg *cc,
+			struct re_calfile_expect *e, char *serial)
+{
+	memset(e, 0, sizeof(*e));
+	snprintf(serial, 32, "%ld", a->info.serial);
+	e->serial = serial;
+	e->n_axes = RE_AXES;
+	e->config_hash = re_config_hash(&a->cfg);
+	for (int i = 0; i < RE_AXES; i++) {
+		snprintf(e->name[i], sizeof(e->name[i]), "%s", a->names[i]);
+		e->step_counts[i] = a->cfg.axes[i].step_counts;
+		e->check[i] = cc->axis[i].check;
+	}
+}
+
+/* Load the tables; on failure offer a full calibration (terminal only).
+ * Return: 0 loaded, 1 run a full calibration instead, EXIT_USAGE. */
+static int calib_load(struct app *a, const struct re_calib_cfg *cc)
+{
+	struct re_calfile_expect e;
+	char serial[32];
+
+	progress(a, "loading calibration '%s'", a->cfg.calibration.file);
+	fill_expect(a, cc, &e, serial);
+	if (re_calfile_load(a->cfg.calibration.file, &e, a->cal, a->err,
+			    sizeof(a->err)) == GL_OK)
+		return 0;
+	re_console_msg(&a->con, "roboelf: error: %s", a->err);
+	re_log_msg(&a->log, RE_LOG_WARN, "calibration file refused: %s",
+		   a->err);
+	if (re_console_ask_yes(&a->con, "Run a full calibration instead?"))
+		return 1;
+	re_console_msg(&a->con, "roboelf: run again with --calibration full");
+	return EXIT_USAGE;
+}
+
+static int calib_file(struct app *a, struct re_calib *c,
+		      const struct re_calib_cfg *cc)
+{
+	struct re_fault f;
+	int rc = calib_load(a, cc);
+
+	if (rc == 1)
+		return calib_full(a, c, cc);
+	if (rc)
+		return rc;
+	progress(a, "checking the robot against the file, moving to the "
+		 "centre");
+	rc = re_calib_check_robot(c, &a->io, cc, a->cal, &f);
+	if (rc == RE_FAULT)
+		return latch(a, &f);
+	if (rc != GL_OK)
+		return rc == GL_ERR_AGAIN ? 0 : fail(a, "calibration failed");
+	log_calibration(a, "file", 0);
+	return 0;
+}
+
+static int choose_calibration(struct app *a)
+{
+	if (a->o.calib != RE_CALIB_ASK)
+		return a->o.calib;
+	return re_console_ask_calibration(&a->con);
+}
+
+static int calibrate(struct app *a)
+{
+	struct re_calib_cfg cc;
+	struct re_calib *c;
+	int how = choose_calibration(a), rc;
+
+	if (how != RE_CALIB_FULL && how != RE_CALIB_FILE)
+		return EXIT_USAGE;
+	a->cal = calloc(1, sizeof(*a->cal));
+	if (!a->cal || re_calib_new(&c) != GL_OK)
+		return fail(a, "out of memory");
+	re_calib_cfg_from(&a->cfg, a->names, &cc);
+	cc.stop = &quit_signal;
+	rc = how == RE_CALIB_FULL ? calib_full(a, c, &cc) :
+				    calib_file(a, c, &cc);
+	re_calib_free(c);
+	return rc;
+}
+
+static int arm(struct app *a)
+{
+	const struct re_caltable *t[RE_AXES];
+	struct re_fault f;
+	int rc;
+
+	if (re_ctl_set_limits(&a->io, a->cal, a->err, sizeof(a->err)) !=
+	    GL_OK)
+		goto out_config;
+	progress(a, "soft limits set and read back; arming");
+	rc = re_ctl_arm(&a->io, &a->cfg, a->cal, &a->info, &a->hbpc, &f,
+			a->err, sizeof(a->err));
+	if (rc == RE_FAULT)
+		return latch(a, &f);
+	if (rc != GL_OK)
+		goto out_config;
+	set_hb_limit(a);
+	for (int i = 0; i < RE_AXES; i++)
+		t[i] = &a->cal->axis[i];
+	re_super_start(a->sup, t, a->hbpc);
+	return 0;
+
+out_config:
+	re_fault_set(&f, RE_F_CONFIG, -1);
+	snprintf(f.s, sizeof(f.s), "%.*s", (int)sizeof(f.s) - 1, a->err);
+	return latch(a, &f);
+}
+
+static int startup(struct app *a)
+{
+	int rc = start_relay(a);
+
+	if (!rc)
+		rc = start_link(a);
+	if (!rc)
+		rc = init_super(a);
+	if (!rc && !quit_signal)
+		rc = calibrate(a);
+	if (!rc && !quit_signal)
+		rc = arm(a);
+	if (!rc && !quit_signal) {
+		re_console_msg(&a->con, "RoboELF Ready for Use");
+		re_log_msg(&a->log, RE_LOG_INFO, "RoboELF Ready for Use");
+	}
+	return rc;
+}
+
+/* ---- run and cleanup ------------------------------------------------------ */
+
+static const char *quit_reason(int key)
+{
+	if (key)
+		return "operator pressed q";
+	switch (quit_signal) {
+	case SIGINT: return "Ctrl-C (SIGINT)";
+	case SIGTERM: return "SIGTERM";
+	case SIGHUP: return "SIGHUP";
+	default: return "signal";
+	}
+}
+
+/* Every period until the operator quits; a latched fault keeps the status
+ * board running. */
+static void run(struct app *a)
+{
+	struct re_status st;
+	int key = 0;
+
+	re_console_raw(&a->con);
+	while (!quit_signal) {
+		re_super_wait(a->sup);
+		if (re_super_cycle(a->sup) == RE_FAULT)
+			re_console_fault(&a->con, re_super_fault_line(a->sup));
+		re_super_status(a->sup, &st);
+		re_console_status(&a->con, &st, re_io_now_ns(), 0);
+		key = re_console_key(&a->con);
+		if (key == 'q' || key == 'Q')
+			break;
+		key = 0;
+	}
+	re_log_msg(&a->log, RE_LOG_INFO, "stop: %s", quit_reason(key));
+}
+
+static void cleanup(struct app *a)
+{
+	int rc = GL_OK;
+
+	if (a->sup)
+		rc = re_super_shutdown(a->sup);
+	else if (a->link)
+		rc = re_ctl_stop(&a->io, a->cfg.controller.timeout_ms);
+	if (rc != GL_OK)
+		re_log_msg(&a->log, RE_LOG_WARN, "shutdown: %s",
+			   gl_strerror(rc));
+	if (a->relay && re_relay_close(a->relay) != GL_OK)
+		re_log_msg(&a->log, RE_LOG_WARN, "relay off not confirmed at "
+			   "close");
+	a->relay = a->real.relay = NULL;
+	gl_link_close(a->link);
+	a->link = a->real.link = NULL;
+	re_console_msg(&a->con, "roboelf: motors off, motor power off; %s",
+		       a->sup && a->sup->latched ? "a fault was latched" :
+						  "bye");
+	re_log_msg(&a->log, RE_LOG_INFO, "stop: motors off, relay off%s",
+		   a->sup && a->sup->latched ? " (fault latched)" : "");
+	re_console_close(&a->con);
+	re_log_close(&a->log);
+	free(a->sup);
+	free(a->cal);
+}
+
+static int supervise(struct app *a)
+{
+	int rc;
+
+	re_console_open(&a->con, stdout, STDIN_FILENO);
+	if (a->o.calib == RE_CALIB_ASK && !a->con.tty_in) {
+		fprintf(stderr, "roboelf: error: no terminal to ask full or "
+			"file calibration: use --calibration full or "
+			"--calibration file\n");
+		re_log_close(&a->log);
+		return EXIT_USAGE;
+	}
+	a->real.log = &a->log;
+	re_io_bind(&a->io, &a->real);
+	install_signals();
+	rc = startup(a);
+	if ((rc == 0 || rc == EXIT_FAULT) && a->sup)
+		run(a);
+	cleanup(a);
+	if (a->sup && a->sup->latched)
+		return EXIT_FAULT;
+	return rc == EXIT_FAULT ? EXIT_FAULT : rc;
+}
+
+/* --show-calibration: the tables, and a plot per axis where gnuplot is
+ * installed; the tolerance band from the configuration when it loads. */
+static int show_calibration(struct app *a)
+{
+	double allowed[RE_AXES];
+
+	if (re_config_load_file(a->o.config, &a->cfg, a->err,
+				sizeof(a->err)) != GL_OK)
+		re_config_defaults(&a->cfg);
+	for (int i = 0; i < RE_AXES; i++)
+		allowed[i] = a->cfg.axes[i].allowed_error;
+	return re_calshow_print(a->o.show_cal, allowed, RE_AXES, stdout,
+				stderr) == GL_OK ? 0 : EXIT_USAGE;
+}
+
+int main(int argc, char **argv)
+{
+	static struct app a;
+	int rc = parse_opts(argc, argv, &a.o);
+
+	if (rc)
+		return rc > 0 ? 0 : EXIT_USAGE;
+	if (a.o.show_cal)
+		return show_calibration(&a);
+	if (load_config(&a) < 0 || open_log(&a) < 0)
+		return EXIT_USAGE;
+	return supervise(&a);
+}

@@ -1,0 +1,132 @@
+/*
+ * test_dmc_watchdog.c - the controller side of the PC watchdog and the
+ * program heartbeat (issue 4, point 5): if hbpc does not change within
+ * wdto while armed, every axis is stopped and switched off and fault 2
+ * WATCHDOG is latched; thread 1 backs thread 0 up; pcflt latches 12.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "dmc_h.h"
+
+/* Heartbeat stopped during motion: nothing happens before wdto - mainms;
+ * every axis is stopped and off within wdto + one main loop (+1 sample) of
+ * the last change; fault 2 with fdet = ms since that change was seen. */
+static void test_heartbeat_stopped(void **state)
+{
+	struct dmc_h *h = *state;
+	double wdto = dmc_h_var(h, "wdto"), mainms = dmc_h_var(h, "mainms");
+	double t_last, t_off, det = 0;
+	int code = 0, axis = -1;
+
+	DMC_H_CHECK(h, dmc_h_control(h, "joy A fwd"));
+	dmc_h_advance(h, 1000);
+	assert_true(dmc_h_axis(h, 0).moving);
+	/* the next advance writes hbpc at its start: the last change */
+	while (dmc_h_now(h) < h->hb_next_ms - 1e-9)
+		dmc_h_advance(h, 1);
+	t_last = dmc_h_now(h);
+	dmc_h_advance(h, 1);
+	h->hb_on = 0;
+	dmc_h_advance(h, wdto - mainms - 1);
+	assert_int_equal(dmc_h_axis(h, 0).motor_off, 0);
+	assert_true(dmc_h_var(h, "state") == 1);
+	t_off = dmc_h_wait_motor_off(h, 7, 3 * mainms);
+	assert_true(t_off >= 0);
+	t_off = dmc_h_now(h) - t_last;
+	assert_true(t_off > wdto - mainms);
+	assert_true(t_off <= wdto + mainms + 1);
+	assert_true(dmc_h_var(h, "state") == 2);
+	assert_true(dmc_h_var(h, "fcode") == 2);
+	/* fdet: ms since thread 0 saw the last change (up to mainms late) */
+	assert_true(dmc_h_var(h, "fdet") > wdto - mainms);
+	assert_true(dmc_h_var(h, "fdet") <= wdto + mainms + 1);
+	dmc_h_advance(h, 200);
+	for (int i = 0; i < DMC_H_AXES; i++) {
+		assert_int_equal(dmc_h_axis(h, i).moving, 0);
+		assert_int_equal(dmc_h_axis(h, i).motor_off, 1);
+	}
+	assert_int_equal(dmc_h_fault_lines(h, &code, &axis, &det), 1);
+	assert_int_equal(code, 2);
+	assert_int_equal(axis, 0);
+	/* the program itself keeps running: heartbeat and record */
+	det = dmc_h_var(h, "hbdmc");
+	dmc_h_advance(h, 100);
+	assert_true(dmc_h_var(h, "hbdmc") > det);
+}
+
+/* A heartbeat slower than the supervisor's but inside wdto - mainms never
+ * trips (3 s). */
+static void test_heartbeat_slow_ok(void **state)
+{
+	struct dmc_h *h = *state;
+
+	h->hb_period_ms = dmc_h_var(h, "wdto") - dmc_h_var(h, "mainms") - 5;
+	DMC_H_CHECK(h, dmc_h_control(h, "joy C fwd"));
+	dmc_h_advance(h, 3000);
+	assert_true(dmc_h_var(h, "state") == 1);
+	assert_int_equal(dmc_h_axis(h, 2).motor_off, 0);
+	assert_int_equal(dmc_h_fault_lines(h, NULL, NULL, NULL), 0);
+}
+
+/* Thread 0 halted (HX0) while the PC keeps its heartbeat: thread 1 stops
+ * and switches off every axis within wdto + 2 main loops + one motion loop
+ * of the last change thread 0 saw. */
+static void test_thread0_halted(void **state)
+{
+	struct dmc_h *h = *state;
+	double wdto = dmc_h_var(h, "wdto"), mainms = dmc_h_var(h, "mainms");
+	double loopms = dmc_h_var(h, "loopms"), t_hx, t;
+
+	DMC_H_CHECK(h, dmc_h_control(h, "joy B rev"));
+	dmc_h_advance(h, 1000);
+	t_hx = dmc_h_now(h);
+	DMC_H_CHECK(h, dmc_h_cmd(h, "HX0", NULL, 0));
+	t = dmc_h_wait_motor_off(h, 7, wdto + 2 * mainms + loopms + 20);
+	assert_true(t >= 0);
+	assert_true(t <= wdto + 2 * mainms + loopms + 1);
+	assert_true(dmc_h_var(h, "mflt") == 2);
+	dmc_h_advance(h, 200);
+	for (int i = 0; i < DMC_H_AXES; i++)
+		assert_int_equal(dmc_h_axis(h, i).moving, 0);
+	assert_int_equal(ctrl_threads(h->ctrl), 0u);
+	(void)t_hx;
+}
+
+/* pcflt=1 from the supervisor: fault 12 within one main loop. */
+static void test_pcflt(void **state)
+{
+	struct dmc_h *h = *state;
+	double t;
+
+	DMC_H_CHECK(h, dmc_h_control(h, "joy A rev"));
+	dmc_h_advance(h, 500);
+	DMC_H_CHECK(h, dmc_h_set(h, "pcflt", 1));
+	t = dmc_h_wait_motor_off(h, 7, 100);
+	assert_true(t >= 0 && t <= dmc_h_var(h, "mainms") + 1);
+	assert_true(dmc_h_var(h, "fcode") == 12);
+	assert_true(dmc_h_var(h, "state") == 2);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	    cmocka_unit_test_setup_teardown(test_heartbeat_stopped,
+					    dmc_h_fx_armed, dmc_h_fx_free),
+	    cmocka_unit_test_setup_teardown(test_heartbeat_slow_ok,
+					    dmc_h_fx_armed, dmc_h_fx_free),
+	    cmocka_unit_test_setup_teardown(test_thread0_halted, dmc_h_fx_armed,
+					    dmc_h_fx_free),
+	    cmocka_unit_test_setup_teardown(test_pcflt, dmc_h_fx_armed,
+					    dmc_h_fx_free),
+	};
+
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}

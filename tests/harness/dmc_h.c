@@ -1,0 +1,605 @@
+/*
+ * dmc_h.c - test harness for the DMC programs on galil-sim (see dmc_h.h).
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dmc_h.h"
+#include "gl_err.h"
+
+#define UNSOL_HANDLE 0	/* handle A: CF A, the program's MG lines */
+#define QR_HANDLE    1	/* handle B: QR for the ZA fields */
+#define REC_AXIS0    82 /* DMC-40x0 record: first axis block */
+#define REC_AXIS_LEN 36
+#define REC_ZA	     32 /* ZA inside an axis block (SL) */
+
+/* ---- preprocessing ------------------------------------------------------ */
+
+static int is_comment(const char *s, size_t n)
+{
+	return (n >= 1 && s[0] == '\'') ||
+	       (n >= 3 && !strncmp(s, "REM", 3) &&
+		(n == 3 || s[3] == ' ' || s[3] == '\t'));
+}
+
+int dmc_h_preprocess(const char *src, size_t len, char *out, size_t cap)
+{
+	size_t o = 0, i = 0;
+
+	while (i < len) {
+		size_t b = i, e;
+
+		while (i < len && src[i] != '\n')
+			i++;
+		e = i++;
+		while (b < e && (src[b] == ' ' || src[b] == '\t'))
+			b++;
+		while (e > b && (src[e - 1] == ' ' || src[e - 1] == '\t' ||
+				 src[e - 1] == '\r'))
+			e--;
+		if (e == b || is_comment(src + b, e - b))
+			continue;
+		if (o + (e - b) + 2 > cap)
+			return GL_ERR_OVERFLOW;
+		memcpy(out + o, src + b, e - b);
+		o += e - b;
+		out[o++] = '\n';
+	}
+	if (o < cap)
+		out[o] = '\0';
+	return (int)o;
+}
+
+static int read_file(const char *path, char **buf, size_t *len)
+{
+	FILE *f = fopen(path, "rb");
+	long n;
+
+	if (!f)
+		return GL_ERR_NOENT;
+	if (fseek(f, 0, SEEK_END) < 0 || (n = ftell(f)) < 0 ||
+	    fseek(f, 0, SEEK_SET) < 0) {
+		fclose(f);
+		return GL_ERR_SYS;
+	}
+	*buf = malloc((size_t)n + 1);
+	if (!*buf) {
+		fclose(f);
+		return GL_ERR_NOMEM;
+	}
+	*len = fread(*buf, 1, (size_t)n, f);
+	(*buf)[*len] = '\0';
+	fclose(f);
+	return 0;
+}
+
+static const char *top_dir(const char *top)
+{
+	const char *env = getenv("ROBOELF_TOP");
+
+	if (top)
+		return top;
+	return env && *env ? env : ".";
+}
+
+static int load_one(const char *top, const char *name, char *out, size_t cap,
+		    char *err, size_t errlen)
+{
+	char path[512];
+	char *src;
+	size_t len;
+	int n;
+
+	snprintf(path, sizeof(path), "%s/dmc/%s", top, name);
+	if (read_file(path, &src, &len) < 0) {
+		snprintf(err, errlen, "%s: %s", path, strerror(errno));
+		return GL_ERR_NOENT;
+	}
+	n = dmc_h_preprocess(src, len, out, cap);
+	free(src);
+	if (n < 0)
+		snprintf(err, errlen, "%s: program too large", path);
+	return n;
+}
+
+int dmc_h_load_program(const char *top, char *out, size_t cap, char *err,
+		       size_t errlen)
+{
+	char path[512], *man, *line, *save = NULL;
+	size_t len, o = 0;
+	int n, files = 0;
+
+	top = top_dir(top);
+	snprintf(path, sizeof(path), "%s/dmc/MANIFEST", top);
+	if (read_file(path, &man, &len) < 0) {
+		snprintf(err, errlen, "%s: cannot read", path);
+		return GL_ERR_NOENT;
+	}
+	for (line = strtok_r(man, "\r\n", &save); line;
+	     line = strtok_r(NULL, "\r\n", &save)) {
+		while (*line == ' ' || *line == '\t')
+			line++;
+		if (!*line || *line == '#')
+			continue;
+		n = load_one(top, line, out + o, cap - o, err, errlen);
+		if (n < 0) {
+			free(man);
+			return n;
+		}
+		o += (size_t)n;
+		files++;
+	}
+	free(man);
+	if (!files) {
+		snprintf(err, errlen, "%s: no files listed", path);
+		return GL_ERR_FORMAT;
+	}
+	return (int)o;
+}
+
+/* ---- simulator set-up -----------------------------------------------------
+ */
+
+static void drain(struct dmc_h *h)
+{
+	uint8_t buf[512];
+	size_t n;
+
+	while ((n = ctrl_output(h->ctrl, UNSOL_HANDLE, buf, sizeof(buf))) > 0) {
+		for (size_t i = 0; i < n; i++) {
+			char c = (char)(buf[i] & 0x7f);
+
+			if (c == '\r' || c == '\0')
+				continue;
+			if (h->unsol_len + 1 < sizeof(h->unsol))
+				h->unsol[h->unsol_len++] = c;
+		}
+		h->unsol[h->unsol_len] = '\0';
+	}
+}
+
+int dmc_h_cmd(struct dmc_h *h, const char *line, char *resp, size_t cap)
+{
+	char r[256], tc[128] = "";
+
+	if (ctrl_command(h->ctrl, line, r, sizeof(r)) == 0) {
+		if (resp)
+			snprintf(resp, cap, "%s", r);
+		return 0;
+	}
+	ctrl_command(h->ctrl, "TC1", tc, sizeof(tc));
+	snprintf(h->err, sizeof(h->err), "'%s' rejected: %s", line, tc);
+	if (resp)
+		snprintf(resp, cap, "%s", r);
+	return GL_ERR_CTRL;
+}
+
+int dmc_h_control(struct dmc_h *h, const char *req)
+{
+	char resp[200];
+
+	if (sim_control(h->sim, req, resp, sizeof(resp)) < 0) {
+		snprintf(h->err, sizeof(h->err), "control '%s': %s", req, resp);
+		return GL_ERR_ARG;
+	}
+	return 0;
+}
+
+int dmc_h_open(struct dmc_h *h)
+{
+	static char prog[DMC_H_PROG_MAX];
+	int n, bad = 0, rc;
+
+	memset(h, 0, sizeof(*h));
+	h->hb_period_ms = 50;
+	rc = sim_new(&h->sim, NULL, h->err, sizeof(h->err));
+	if (rc < 0)
+		return rc;
+	h->ctrl = sim_ctrl(h->sim);
+	ctrl_handle_open(h->ctrl, UNSOL_HANDLE);
+	ctrl_handle_open(h->ctrl, QR_HANDLE);
+	if ((rc = dmc_h_control(h, "relay on")) < 0 ||
+	    (rc = dmc_h_cmd(h, "CF A", NULL, 0)) < 0)
+		return rc;
+	n = dmc_h_load_program(NULL, prog, sizeof(prog), h->err,
+			       sizeof(h->err));
+	if (n < 0)
+		return n;
+	/* the controller has been on for a while before the download: its
+	 * power-up (#AUTO of an empty memory) is over */
+	sim_advance_ms(h->sim, 10);
+	if (ctrl_download(h->ctrl, prog, (size_t)n, &bad) < 0) {
+		snprintf(h->err, sizeof(h->err),
+			 "download rejected at program line %d", bad);
+		return GL_ERR_CTRL;
+	}
+	sim_advance_ms(h->sim, 1);
+	return 0;
+}
+
+void dmc_h_close(struct dmc_h *h)
+{
+	if (h->sim)
+		sim_free(h->sim);
+	h->sim = NULL;
+	h->ctrl = NULL;
+}
+
+/* ---- time -----------------------------------------------------------------
+ */
+
+double dmc_h_now(const struct dmc_h *h)
+{
+	return sim_time_ms(h->sim);
+}
+
+void dmc_h_advance(struct dmc_h *h, double ms)
+{
+	double end = dmc_h_now(h) + ms;
+
+	while (dmc_h_now(h) < end - 1e-9) {
+		double now = dmc_h_now(h), step = end - now;
+
+		if (h->hb_on) {
+			if (now >= h->hb_next_ms - 1e-9) {
+				ctrl_set_var(h->ctrl, "hbpc", (double)++h->hb);
+				h->hb_next_ms = now + h->hb_period_ms;
+			}
+			if (h->hb_next_ms - now < step)
+				step = h->hb_next_ms - now;
+		}
+		sim_advance_ms(h->sim, step);
+		drain(h);
+	}
+}
+
+double dmc_h_var(struct dmc_h *h, const char *name)
+{
+	double v;
+
+	return ctrl_get_var(h->ctrl, name, &v) == 0 ? v : NAN;
+}
+
+int dmc_h_set(struct dmc_h *h, const char *name, double v)
+{
+	if (ctrl_set_var(h->ctrl, name, v) < 0) {
+		snprintf(h->err, sizeof(h->err), "cannot set '%s'", name);
+		return GL_ERR_NOENT;
+	}
+	return 0;
+}
+
+struct ctrl_axis_info dmc_h_axis(struct dmc_h *h, int axis)
+{
+	struct ctrl_axis_info ai;
+
+	if (ctrl_axis_info(h->ctrl, axis, &ai) < 0)
+		memset(&ai, 0, sizeof(ai));
+	return ai;
+}
+
+double dmc_h_wait_var(struct dmc_h *h, const char *name, double value,
+		      double timeout_ms)
+{
+	double t0 = dmc_h_now(h);
+
+	for (;;) {
+		double v = dmc_h_var(h, name);
+
+		if (!isnan(v) && fabs(v - value) < 1e-6)
+			return dmc_h_now(h) - t0;
+		if (dmc_h_now(h) - t0 >= timeout_ms)
+			return -1;
+		dmc_h_advance(h, 1);
+	}
+}
+
+double dmc_h_wait_motor_off(struct dmc_h *h, unsigned mask, double timeout_ms)
+{
+	double t0 = dmc_h_now(h);
+
+	for (;;) {
+		int all = 1;
+
+		for (int i = 0; i < DMC_H_AXES; i++)
+			if ((mask & (1u << i)) && !dmc_h_axis(h, i).motor_off)
+				all = 0;
+		if (all)
+			return dmc_h_now(h) - t0;
+		if (dmc_h_now(h) - t0 >= timeout_ms)
+			return -1;
+		dmc_h_advance(h, 1);
+	}
+}
+
+/* ---- program start, parameters, arming ---------------------------------- */
+
+int dmc_h_start(struct dmc_h *h)
+{
+	int rc = dmc_h_cmd(h, "XQ #AUTO,0", NULL, 0);
+	double hb0;
+
+	if (rc < 0)
+		return rc;
+	/* #INIT done when the heartbeat exists */
+	for (double t0 = dmc_h_now(h);
+	     isnan(dmc_h_var(h, "hbdmc")) || dmc_h_var(h, "state") != 0;) {
+		if (dmc_h_now(h) - t0 > 200) {
+			snprintf(h->err, sizeof(h->err),
+				 "program did not start");
+			return GL_ERR_TIMEOUT;
+		}
+		dmc_h_advance(h, 1);
+	}
+	dmc_h_advance(h, 20); /* past #INIT after a restart too */
+	hb0 = dmc_h_var(h, "hbdmc");
+	dmc_h_advance(h, 50);
+	if (!(dmc_h_var(h, "hbdmc") > hb0)) {
+		snprintf(h->err, sizeof(h->err), "hbdmc does not advance");
+		return GL_ERR_TIMEOUT;
+	}
+	return 0;
+}
+
+void dmc_h_params_default(struct dmc_h_params *p)
+{
+	static const double jin[DMC_H_SWITCHES] = {1, 2, 3,  4,	 5,  6,
+						   7, 8, 17, 18, 19, 20};
+	static const double vmax[DMC_H_AXES] = {10000, 10000, 8000};
+	static const double lim[DMC_H_AXES] = {50000, 50000, 40000};
+
+	memset(p, 0, sizeof(*p));
+	for (int i = 0; i < DMC_H_AXES; i++) {
+		p->vmax[i] = vmax[i];
+		p->vmin[i] = vmax[i] / 4;
+		p->wst[i] = 500;
+		p->wen[i] = 2000;
+		p->stp[i] = 1000;
+		p->srev[i] = -(lim[i] - 5000);
+		p->sfwd[i] = lim[i] - 5000;
+		p->er[i] = 500;
+	}
+	memcpy(p->jin, jin, sizeof(jin));
+	for (int k = 0, v = 3; k < 6; k++, v *= 4)
+		p->jval[k] = v;
+	p->jpol = 0;
+	p->jto = 500;
+	p->wdto = 125;
+	p->oe = 1;
+}
+
+static int set_checked(struct dmc_h *h, const char *name, double v)
+{
+	double back;
+
+	if (ctrl_set_var(h->ctrl, name, v) < 0 ||
+	    ctrl_get_var(h->ctrl, name, &back) < 0 || fabs(back - v) > 1e-4) {
+		snprintf(h->err, sizeof(h->err), "cannot set '%s' to %g", name,
+			 v);
+		return GL_ERR_MISMATCH;
+	}
+	return 0;
+}
+
+static int set_array(struct dmc_h *h, const char *name, const double *v, int n)
+{
+	char el[32];
+	int rc;
+
+	for (int i = 0; i < n; i++) {
+		snprintf(el, sizeof(el), "%s[%d]", name, i);
+		if ((rc = set_checked(h, el, v[i])) < 0)
+			return rc;
+	}
+	return 0;
+}
+
+int dmc_h_configure(struct dmc_h *h, const struct dmc_h_params *p)
+{
+	char line[80];
+	int rc;
+
+	snprintf(line, sizeof(line), "ER %g,%g,%g", p->er[0], p->er[1],
+		 p->er[2]);
+	if ((rc = dmc_h_cmd(h, line, NULL, 0)) < 0)
+		return rc;
+	snprintf(line, sizeof(line), "OE %d,%d,%d", p->oe, p->oe, p->oe);
+	if ((rc = dmc_h_cmd(h, line, NULL, 0)) < 0)
+		return rc;
+	if ((rc = set_array(h, "vmin", p->vmin, DMC_H_AXES)) < 0 ||
+	    (rc = set_array(h, "vmax", p->vmax, DMC_H_AXES)) < 0 ||
+	    (rc = set_array(h, "wst", p->wst, DMC_H_AXES)) < 0 ||
+	    (rc = set_array(h, "wen", p->wen, DMC_H_AXES)) < 0 ||
+	    (rc = set_array(h, "stp", p->stp, DMC_H_AXES)) < 0 ||
+	    (rc = set_array(h, "srev", p->srev, DMC_H_AXES)) < 0 ||
+	    (rc = set_array(h, "sfwd", p->sfwd, DMC_H_AXES)) < 0 ||
+	    (rc = set_array(h, "jin", p->jin, DMC_H_SWITCHES)) < 0 ||
+	    (rc = set_array(h, "jval", p->jval, 6)) < 0)
+		return rc;
+	if ((rc = set_checked(h, "jpol", p->jpol)) < 0 ||
+	    (rc = set_checked(h, "jto", p->jto)) < 0 ||
+	    (rc = set_checked(h, "wdto", p->wdto)) < 0)
+		return rc;
+	return 0;
+}
+
+int dmc_h_arm(struct dmc_h *h)
+{
+	double t0 = dmc_h_now(h);
+	int rc;
+
+	h->hb_on = 1;
+	h->hb_next_ms = t0;
+	dmc_h_advance(h, 1);
+	if ((rc = dmc_h_set(h, "armreq", 1)) < 0)
+		return rc;
+	while (dmc_h_now(h) - t0 < 1000) {
+		double st = dmc_h_var(h, "state");
+
+		if (st == 1) {
+			/* let thread 1 run a few loops (and see neutral) */
+			dmc_h_advance(h, 30);
+			return 0;
+		}
+		if (st == 2) {
+			dmc_h_advance(h, 10); /* the FAULT line */
+			snprintf(h->err, sizeof(h->err),
+				 "arm refused: fault %g axis %g detail %g",
+				 dmc_h_var(h, "fcode"), dmc_h_var(h, "faxis"),
+				 dmc_h_var(h, "fdet"));
+			return GL_ERR_CTRL;
+		}
+		dmc_h_advance(h, 1);
+	}
+	snprintf(h->err, sizeof(h->err), "not armed after 1000 ms");
+	return GL_ERR_TIMEOUT;
+}
+
+int dmc_h_setup(struct dmc_h *h)
+{
+	struct dmc_h_params p;
+	int rc;
+
+	dmc_h_params_default(&p);
+	if ((rc = dmc_h_open(h)) < 0 || (rc = dmc_h_start(h)) < 0 ||
+	    (rc = dmc_h_configure(h, &p)) < 0 || (rc = dmc_h_arm(h)) < 0)
+		return rc;
+	return 0;
+}
+
+/* ---- what the program reported --------------------------------------------
+ */
+
+int dmc_h_fault_lines(const struct dmc_h *h, int *code, int *axis,
+		      double *detail)
+{
+	const char *p = h->unsol;
+	int n = 0;
+
+	while (*p) {
+		const char *eol = strchr(p, '\n');
+
+		if (!eol)
+			break; /* a partial line is not a line yet */
+		if (!strncmp(p, "FAULT", 5)) {
+			if (n++ == 0) {
+				char *e;
+				double c = strtod(p + 5, &e);
+				double a = strtod(e, &e);
+				double d = strtod(e, &e);
+
+				if (code)
+					*code = (int)c;
+				if (axis)
+					*axis = (int)a;
+				if (detail)
+					*detail = d;
+			}
+		}
+		p = eol + 1;
+	}
+	return n;
+}
+
+int dmc_h_unsol_has(const struct dmc_h *h, const char *prefix)
+{
+	size_t n = strlen(prefix);
+
+	for (const char *p = h->unsol; *p;) {
+		const char *eol = strchr(p, '\n');
+
+		while (*p == ' ')
+			p++;
+		if (!strncmp(p, prefix, n))
+			return 1;
+		if (!eol)
+			break;
+		p = eol + 1;
+	}
+	return 0;
+}
+
+static long rd_sl(const uint8_t *b)
+{
+	uint32_t u = (uint32_t)b[0] | ((uint32_t)b[1] << 8) |
+		     ((uint32_t)b[2] << 16) | ((uint32_t)b[3] << 24);
+
+	return (long)(int32_t)u;
+}
+
+int dmc_h_za(struct dmc_h *h, struct dmc_h_za *za)
+{
+	static const uint8_t qr[] = "QR\r";
+	uint8_t rec[512];
+	size_t n = 0, got;
+	long zb, zc;
+
+	/* the reply comes at once: the interpreter answers between samples */
+	ctrl_input(h->ctrl, QR_HANDLE, qr, sizeof(qr) - 1);
+	while ((got = ctrl_output(h->ctrl, QR_HANDLE, rec + n,
+				  sizeof(rec) - n)) > 0)
+		n += got;
+	if (n < REC_AXIS0 + 3 * REC_AXIS_LEN + 1 || rec[n - 1] != ':' ||
+	    (size_t)(rec[2] | (rec[3] << 8)) != n - 1) {
+		snprintf(h->err, sizeof(h->err), "QR: %zu bytes", n);
+		return GL_ERR_NOENT;
+	}
+	za->hbdmc = rd_sl(rec + REC_AXIS0 + REC_ZA);
+	zb = rd_sl(rec + REC_AXIS0 + REC_AXIS_LEN + REC_ZA);
+	zc = rd_sl(rec + REC_AXIS0 + 2 * REC_AXIS_LEN + REC_ZA);
+	za->state = (int)(zb % 10);
+	za->fcode = (int)(zb / 10 % 100);
+	za->faxis = (int)(zb / 1000);
+	za->jraw = (int)(zc % 4096);
+	za->jcmd = (int)(zc / 4096 % 8) - 1;
+	za->mcmd = (int)(zc / 32768);
+	return 0;
+}
+
+double dmc_h_ramp_vel(const struct dmc_h_params *p, int ax, double t_ms)
+{
+	if (t_ms < p->wst[ax])
+		return p->vmin[ax];
+	if (t_ms >= p->wen[ax])
+		return p->vmax[ax];
+	return p->vmin[ax] + (p->vmax[ax] - p->vmin[ax]) * (t_ms - p->wst[ax]) /
+				 (p->wen[ax] - p->wst[ax]);
+}
+
+/* ---- cmocka fixtures --------------------------------------------------------
+ */
+
+int dmc_h_fx_new(void **state)
+{
+	*state = calloc(1, sizeof(struct dmc_h));
+	return *state ? 0 : -1;
+}
+
+int dmc_h_fx_armed(void **state)
+{
+	struct dmc_h *h;
+
+	if (dmc_h_fx_new(state) < 0)
+		return -1;
+	h = *state;
+	if (dmc_h_setup(h) < 0) {
+		fprintf(stderr, "set-up: %s\n", h->err);
+		return -1;
+	}
+	return 0;
+}
+
+int dmc_h_fx_free(void **state)
+{
+	struct dmc_h *h = *state;
+
+	if (h)
+		dmc_h_close(h);
+	free(h);
+	*state = NULL;
+	return 0;
+}

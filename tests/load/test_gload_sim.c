@@ -1,0 +1,324 @@
+/*
+ * test_gload_sim.c - galil-load (child process) against galil-sim, which
+ * really runs the DMC: a clean program loaded, verified, started and
+ * running (the variable its #AUTO sets); the identity stamp read back and
+ * verified as roboelf does at start-up; a second load found unchanged; a
+ * running program halted before a forced reload; --burn then a power cycle
+ * runs #AUTO (and without --burn the power cycle leaves nothing); -c round
+ * trips and a rejected command.
+ *
+ * Needs $ROBOELF_BIN/galil-sim and galil-load. One simulator per test,
+ * started with --port 0 --control-port 0, killed by pid.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "gl_err.h"
+#include "gl_ident.h"
+#include "gl_link.h"
+#include "proc.h"
+
+#define GOOD		"tests/data/dmc_good/"
+#define RUN_DEADLINE_MS 30000
+#define READY_MS	10000
+#define CLEAN_ID	0x32DC74A870EEBF04ULL
+
+static char load_bin[512];
+static const char *bin_dir;
+
+static int setup_group(void **state)
+{
+	char sim[512];
+
+	(void)state;
+	bin_dir = getenv("ROBOELF_BIN");
+	if (!bin_dir || !*bin_dir) {
+		fprintf(stderr, "test_gload_sim: ROBOELF_BIN is not set (run "
+				"through tests/run-all.sh or make check)\n");
+		return -1;
+	}
+	snprintf(load_bin, sizeof(load_bin), "%s/galil-load", bin_dir);
+	snprintf(sim, sizeof(sim), "%s/galil-sim", bin_dir);
+	if (access(load_bin, X_OK) != 0 || access(sim, X_OK) != 0) {
+		fprintf(stderr, "test_gload_sim: '%s' or '%s' is missing\n",
+			load_bin, sim);
+		return -1;
+	}
+	return 0;
+}
+
+struct simctx {
+	struct proc_sim s;
+	char addr[32];
+	int ctl; /* control-port socket */
+};
+
+static void sim_start(struct simctx *c)
+{
+	memset(c, 0, sizeof(*c));
+	if (proc_sim_start(&c->s, bin_dir, NULL, NULL, READY_MS) != 0)
+		fail_msg("galil-sim did not print its ready line within %d ms",
+			 READY_MS);
+	snprintf(c->addr, sizeof(c->addr), "127.0.0.1:%d", c->s.port);
+	c->ctl = proc_ctl_connect(c->s.ctl_port, 2000);
+	if (c->ctl < 0) {
+		proc_kill(&c->s.p);
+		fail_msg("cannot connect to galil-sim's control port %d",
+			 c->s.ctl_port);
+	}
+}
+
+static void sim_stop(struct simctx *c)
+{
+	if (c->ctl >= 0)
+		close(c->ctl);
+	proc_kill(&c->s.p);
+}
+
+static int run(struct proc *p, const struct simctx *c, const char *const *args)
+{
+	char *argv[32];
+	int i, status;
+
+	argv[0] = load_bin;
+	argv[1] = (char *)"-a";
+	argv[2] = (char *)c->addr;
+	for (i = 0; i < 28 && args[i]; i++)
+		argv[i + 3] = (char *)args[i];
+	argv[i + 3] = NULL;
+	assert_int_equal(proc_spawn(p, argv, NULL), 0);
+	if (proc_wait_exit(p, RUN_DEADLINE_MS, &status) != 0) {
+		proc_kill(p);
+		fail_msg("galil-load did not exit within %d ms",
+			 RUN_DEADLINE_MS);
+	}
+	return proc_exit_code(p);
+}
+
+static gl_link *sim_link(const struct simctx *c)
+{
+	char err[GL_ERRTEXT_LEN];
+	gl_link *l = NULL;
+
+	if (gl_link_open(&l, c->addr, 2000, err) != GL_OK)
+		fail_msg("%s", err);
+	return l;
+}
+
+/* "MG @name" on a new connection: GL_OK and the value, or the error. */
+static int sim_query(const struct simctx *c, const char *cmd, double *v)
+{
+	gl_link *l = sim_link(c);
+	char resp[128];
+	int rc = gl_link_command(l, cmd, resp, sizeof(resp), 2000);
+
+	gl_link_close(l);
+	if (rc >= 0)
+		*v = strtod(resp, NULL);
+	return rc < 0 ? rc : GL_OK;
+}
+
+/* Wait (deadline @ms) until "MG @var" answers @want. */
+static int wait_value(const struct simctx *c, const char *cmd, double want,
+		      int ms)
+{
+	long long end = proc_now_ms() + ms;
+	double v;
+
+	do {
+		if (sim_query(c, cmd, &v) == GL_OK && v == want)
+			return 0;
+		usleep(20 * 1000); /* poll interval */
+	} while (proc_now_ms() < end);
+	return -1;
+}
+
+static int has(const struct proc *p, enum proc_stream s, const char *text)
+{
+	return strstr(proc_output(p, s), text) != NULL;
+}
+
+/* Load, verify and start; #AUTO runs; the stamp verifies as in roboelf. */
+static void test_clean_start(void **state)
+{
+	static const char *const args[] = {"--start", GOOD "clean.dmc", NULL};
+	char prog[8192];
+	struct simctx c;
+	struct proc p;
+	uint64_t id = 0;
+	gl_link *l;
+	double v;
+	int n;
+
+	(void)state;
+	sim_start(&c);
+	assert_int_equal(run(&p, &c, args), 0);
+	assert_true(has(&p, PROC_STDOUT,
+			"verified: the read-back matches, "
+			"identity 32DC74A870EEBF04\n"));
+	assert_true(has(&p, PROC_STDOUT, "started: #AUTO in thread 0"));
+	assert_string_equal(proc_output(&p, PROC_STDERR), "");
+	proc_kill(&p);
+	assert_int_equal(wait_value(&c, "MG booted", 1, 2000), 0);
+	assert_int_equal(sim_query(&c, "MG sum", &v), GL_OK);
+	assert_true(v == 5); /* JS #add(2,3) */
+	assert_int_equal(sim_query(&c, "MG _XQ0", &v), GL_OK);
+	assert_true(v >= 0);
+	l = sim_link(&c);
+	n = gl_link_upload(l, prog, sizeof(prog), 5000);
+	gl_link_close(l);
+	assert_true(n > 0);
+	assert_int_equal(gl_ident_verify(prog, (size_t)n, &id), GL_OK);
+	assert_true(id == CLEAN_ID);
+	sim_stop(&c);
+}
+
+/* A second load of the same program downloads nothing; a forced load
+ * halts the running program first (DL is refused while it runs). */
+static void test_unchanged_and_forced(void **state)
+{
+	static const char *const start[] = {"--start", GOOD "clean.dmc", NULL};
+	static const char *const again[] = {GOOD "clean.dmc", NULL};
+	static const char *const force[] = {"-f", GOOD "clean.dmc", NULL};
+	struct simctx c;
+	struct proc p;
+	double v;
+
+	(void)state;
+	sim_start(&c);
+	assert_int_equal(run(&p, &c, start), 0);
+	proc_kill(&p);
+	assert_int_equal(wait_value(&c, "MG booted", 1, 2000), 0);
+	assert_int_equal(run(&p, &c, again), 0);
+	assert_true(has(&p, PROC_STDOUT,
+			"unchanged: the controller already "
+			"holds this program"));
+	proc_kill(&p);
+	assert_int_equal(sim_query(&c, "MG _XQ0", &v), GL_OK);
+	assert_true(v == -1); /* halted, not restarted */
+	assert_int_equal(run(&p, &c, start), 0);
+	proc_kill(&p);
+	assert_int_equal(run(&p, &c, force), 0);
+	assert_true(has(&p, PROC_STDOUT, "halted: threads stopped"));
+	assert_true(has(&p, PROC_STDOUT, "verified: the read-back matches"));
+	proc_kill(&p);
+	assert_int_equal(sim_query(&c, "MG _XQ0", &v), GL_OK);
+	assert_true(v == -1);
+	sim_stop(&c);
+}
+
+static void power_cycle(struct simctx *c)
+{
+	char resp[128];
+
+	assert_true(proc_ctl_request(c->ctl, "power-cycle", resp, sizeof(resp),
+				     5000) >= 0);
+	assert_string_equal(resp, "ok");
+}
+
+/* Without --burn a power cycle loses the program; with it #AUTO runs. */
+static void test_burn_power_cycle(void **state)
+{
+	static const char *const plain[] = {GOOD "clean.dmc", NULL};
+	static const char *const burn[] = {"-f", "--burn", GOOD "clean.dmc",
+					   NULL};
+	char prog[8192];
+	struct simctx c;
+	struct proc p;
+	gl_link *l;
+	double v;
+
+	(void)state;
+	sim_start(&c);
+	assert_int_equal(run(&p, &c, plain), 0);
+	proc_kill(&p);
+	power_cycle(&c);
+	l = sim_link(&c);
+	assert_int_equal(gl_link_upload(l, prog, sizeof(prog), 5000), 0);
+	gl_link_close(l);
+	assert_int_equal(sim_query(&c, "MG _XQ0", &v), GL_OK);
+	assert_true(v == -1);
+	assert_int_equal(run(&p, &c, burn), 0);
+	assert_true(has(&p, PROC_STDOUT, "burned: #AUTO runs at power-up\n"));
+	proc_kill(&p);
+	assert_int_equal(sim_query(&c, "MG _XQ0", &v), GL_OK);
+	assert_true(v == -1); /* loaded, not started */
+	power_cycle(&c);
+	assert_int_equal(wait_value(&c, "MG booted", 1, 3000), 0);
+	assert_int_equal(sim_query(&c, "MG _XQ0", &v), GL_OK);
+	assert_true(v >= 0);
+	sim_stop(&c);
+}
+
+/* -c: left-to-right arithmetic and a variable; a rejected command. */
+static void test_commands(void **state)
+{
+	static const char *const ok[] = {"-c", "abc=6",	 "-c", "MG 1+2*3",
+					 "-c", "MG abc", NULL};
+	static const char *const bad[] = {"-c", "bg A", NULL};
+	struct simctx c;
+	struct proc p;
+	double a, b;
+
+	(void)state;
+	sim_start(&c);
+	assert_int_equal(run(&p, &c, ok), 0);
+	assert_int_equal(
+	    sscanf(proc_output(&p, PROC_STDOUT), "%lf\n%lf", &a, &b), 2);
+	assert_true(a == 9);
+	assert_true(b == 6);
+	proc_kill(&p);
+	assert_int_equal(run(&p, &c, bad), 4);
+	assert_string_equal(proc_output(&p, PROC_STDERR),
+			    "galil-load: controller rejected 'bg A': 1 "
+			    "Unrecognized command\n");
+	proc_kill(&p);
+	sim_stop(&c);
+}
+
+/* A controller that stops answering (control port "link stall"): exit 3
+ * after the command timeout; answering again ("link ok"): exit 0. */
+static void test_stalled(void **state)
+{
+	static const char *const args[] = {"-t", "300", "-c", "MG 2", NULL};
+	char resp[128];
+	struct simctx c;
+	struct proc p;
+
+	(void)state;
+	sim_start(&c);
+	assert_true(proc_ctl_request(c.ctl, "link stall", resp, sizeof(resp),
+				     2000) >= 0);
+	assert_string_equal(resp, "ok");
+	assert_int_equal(run(&p, &c, args), 3);
+	assert_string_equal(proc_output(&p, PROC_STDERR),
+			    "galil-load: no reply to 'MG 2' within 300 ms\n");
+	proc_kill(&p);
+	assert_true(
+	    proc_ctl_request(c.ctl, "link ok", resp, sizeof(resp), 2000) >= 0);
+	assert_string_equal(resp, "ok");
+	assert_int_equal(run(&p, &c, args), 0);
+	proc_kill(&p);
+	sim_stop(&c);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	    cmocka_unit_test(test_clean_start),
+	    cmocka_unit_test(test_unchanged_and_forced),
+	    cmocka_unit_test(test_burn_power_cycle),
+	    cmocka_unit_test(test_commands),
+	    cmocka_unit_test(test_stalled),
+	};
+
+	return cmocka_run_group_tests(tests, setup_group, NULL);
+}

@@ -1,0 +1,509 @@
+/*
+ * test_sim_net.c - the galil-sim program ($ROBOELF_BIN/galil-sim) over its
+ * real ports: the ready line, the control port, the command port and its
+ * link faults (drop, stall, delay), the relay pty behind its link, quit and
+ * SIGTERM (clean exit, link removed), and start-up errors.
+ *
+ * Every wait polls with a deadline; processes are signalled by pid only.
+ */
+#include <errno.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <setjmp.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <termios.h>
+#include <unistd.h>
+#include <arpa/inet.h>
+
+#include <cmocka.h>
+
+#include "proc.h"
+
+#define START_MS 5000 /* ready line deadline */
+#define REPLY_MS 2000 /* generous reply deadline */
+#define QUIET_MS 300  /* "no reply" is judged over this */
+
+struct fx {
+	struct proc_sim sim;
+	char dir[64];
+	char link[128];
+	int ctl; /* control connection */
+	char resp[65536];
+};
+
+static const char *bin_dir(void)
+{
+	const char *b = getenv("ROBOELF_BIN");
+
+	if (!b)
+		fail_msg(
+		    "ROBOELF_BIN is not set (run through tests/run-all.sh)");
+	return b;
+}
+
+static int setup(void **state)
+{
+	struct fx *f = calloc(1, sizeof(*f));
+
+	assert_non_null(f);
+	snprintf(f->dir, sizeof(f->dir), "/tmp/test_sim_net.XXXXXX");
+	assert_non_null(mkdtemp(f->dir));
+	snprintf(f->link, sizeof(f->link), "%s/relay", f->dir);
+	f->ctl = -1;
+	*state = f;
+	if (proc_sim_start(&f->sim, bin_dir(), f->link, NULL, START_MS) < 0)
+		fail_msg("galil-sim did not start");
+	f->ctl = proc_ctl_connect(f->sim.ctl_port, REPLY_MS);
+	assert_true(f->ctl >= 0);
+	return 0;
+}
+
+static int teardown(void **state)
+{
+	struct fx *f = *state;
+
+	if (f->ctl >= 0)
+		close(f->ctl);
+	proc_kill(&f->sim.p);
+	unlink(f->link);
+	rmdir(f->dir);
+	free(f);
+	return 0;
+}
+
+static const char *ctl(struct fx *f, const char *req)
+{
+	if (proc_ctl_request(f->ctl, req, f->resp, sizeof(f->resp), REPLY_MS) <
+	    0)
+		fail_msg("no answer to '%s'", req);
+	return f->resp;
+}
+
+static long state_long(struct fx *f, const char *key)
+{
+	char val[64];
+
+	if (proc_ctl_state_get(ctl(f, "state"), key, val, sizeof(val)) < 0)
+		fail_msg("no '%s' in the state line", key);
+	return strtol(val, NULL, 10);
+}
+
+static int cmd_connect(struct fx *f)
+{
+	int fd = proc_ctl_connect(f->sim.port, REPLY_MS);
+
+	assert_true(fd >= 0);
+	return fd;
+}
+
+/* Read until ':' or '?' ends a reply; return bytes, -1 on timeout, 0 on
+ * close. */
+static int read_reply(int fd, char *buf, size_t cap, int timeout_ms)
+{
+	long long end = proc_now_ms() + timeout_ms;
+	size_t n = 0;
+
+	while (n + 1 < cap) {
+		struct pollfd p = {fd, POLLIN, 0};
+		long long left = end - proc_now_ms();
+		ssize_t r;
+
+		if (left <= 0 || poll(&p, 1, (int)left) <= 0)
+			return -1;
+		r = recv(fd, buf + n, cap - n - 1, 0);
+		if (r <= 0)
+			return 0;
+		n += (size_t)r;
+		buf[n] = '\0';
+		if (buf[n - 1] == ':' || buf[n - 1] == '?')
+			return (int)n;
+	}
+	return (int)n;
+}
+
+static void send_cmd(int fd, const char *cmd)
+{
+	assert_int_equal(send(fd, cmd, strlen(cmd), MSG_NOSIGNAL),
+			 (ssize_t)strlen(cmd));
+}
+
+/* "MG 1" answered: the value then ':'. */
+static void expect_mg1(int fd)
+{
+	char buf[128];
+
+	send_cmd(fd, "MG 1\r");
+	assert_true(read_reply(fd, buf, sizeof(buf), REPLY_MS) > 0);
+	assert_non_null(strstr(buf, "1.0000"));
+	assert_int_equal(buf[strlen(buf) - 1], ':');
+}
+
+/* The peer closes @fd within the deadline. */
+static void expect_closed(int fd)
+{
+	char buf[64];
+	struct pollfd p = {fd, POLLIN, 0};
+
+	assert_int_equal(poll(&p, 1, REPLY_MS), 1);
+	assert_int_equal(recv(fd, buf, sizeof(buf), 0), 0);
+}
+
+/* Poll the control port until @req answers @want (deadline). */
+static void wait_answer(struct fx *f, const char *req, const char *want)
+{
+	long long end = proc_now_ms() + REPLY_MS;
+
+	while (strcmp(ctl(f, req), want)) {
+		if (proc_now_ms() > end)
+			fail_msg("'%s' still '%s', want '%s'", req, f->resp,
+				 want);
+		poll(NULL, 0, 5);
+	}
+}
+
+/* ---- start-up ----------------------------------------------------------- */
+
+/* The ready line names the ports and the pty; the link points at it. */
+static void test_ready_line_and_link(void **state)
+{
+	struct fx *f = *state;
+	char line[512], want[512], target[256];
+	ssize_t n;
+
+	assert_int_equal(proc_find_line(&f->sim.p, PROC_STDOUT,
+					"galil-sim:", line, sizeof(line)),
+			 0);
+	snprintf(want, sizeof(want),
+		 "galil-sim: listening on 127.0.0.1:%d "
+		 "control %d relay %s",
+		 f->sim.port, f->sim.ctl_port, f->sim.relay);
+	assert_string_equal(line, want);
+	assert_memory_equal(f->sim.relay, "/dev/pts/", 9);
+	n = readlink(f->link, target, sizeof(target) - 1);
+	assert_true(n > 0);
+	target[n] = '\0';
+	assert_string_equal(target, f->sim.relay);
+	/* exactly one line on stdout */
+	assert_int_equal(strchr(proc_output(&f->sim.p, PROC_STDOUT), '\n') -
+			     proc_output(&f->sim.p, PROC_STDOUT),
+			 (long)strlen(line));
+	assert_string_equal(ctl(f, "relay"), "off");
+}
+
+/* Simulated time follows the wall clock. */
+static void test_real_time(void **state)
+{
+	struct fx *f = *state;
+	long long w0 = proc_now_ms(), w1;
+	long t0 = strtol(ctl(f, "time"), NULL, 10), t1;
+
+	do {
+		poll(NULL, 0, 20);
+		w1 = proc_now_ms();
+	} while (w1 - w0 < 500);
+	t1 = strtol(ctl(f, "time"), NULL, 10);
+	w1 = proc_now_ms() - w0;
+	/* the loop catches up when late: simulated time never runs ahead
+	 * and lags by well under the wall-clock span */
+	assert_true(t1 - t0 <= w1 + 20);
+	assert_true(t1 - t0 >= w1 / 2);
+}
+
+/* ---- command port and link faults -------------------------------------- */
+
+static void test_command_port_and_delay(void **state)
+{
+	struct fx *f = *state;
+	int fd = cmd_connect(f);
+	long long t;
+	char buf[128];
+
+	expect_mg1(fd);
+	assert_string_equal(ctl(f, "link delay 300"), "ok");
+	t = proc_now_ms();
+	expect_mg1(fd);
+	assert_true(proc_now_ms() - t >= 290);
+	ctl(f, "link ok");
+	send_cmd(fd, "bogus\r");
+	assert_true(read_reply(fd, buf, sizeof(buf), REPLY_MS) > 0);
+	assert_string_equal(buf, "?");
+	close(fd);
+}
+
+/* Stall: the socket stays open and nothing comes back; what is sent
+ * meanwhile is lost. After "link ok" the link works again. */
+static void test_link_stall(void **state)
+{
+	struct fx *f = *state;
+	int fd = cmd_connect(f);
+	char buf[128];
+
+	expect_mg1(fd);
+	ctl(f, "link stall");
+	send_cmd(fd, "MG 1\r");
+	assert_int_equal(read_reply(fd, buf, sizeof(buf), QUIET_MS), -1);
+	ctl(f, "link ok");
+	expect_mg1(fd);
+	assert_int_equal(read_reply(fd, buf, sizeof(buf), QUIET_MS), -1);
+	close(fd);
+}
+
+/* Drop: every command connection is closed and new ones are refused until
+ * "link ok". */
+static void test_link_drop(void **state)
+{
+	struct fx *f = *state;
+	int a = cmd_connect(f), b = cmd_connect(f), c;
+
+	expect_mg1(a);
+	expect_mg1(b);
+	ctl(f, "link drop");
+	expect_closed(a);
+	expect_closed(b);
+	c = cmd_connect(f);
+	expect_closed(c);
+	close(c);
+	ctl(f, "link ok");
+	c = cmd_connect(f);
+	expect_mg1(c);
+	close(a);
+	close(b);
+	close(c);
+}
+
+/* Eight handles: a ninth connection is closed at once. */
+static void test_eight_handles(void **state)
+{
+	struct fx *f = *state;
+	int fd[9];
+
+	for (int i = 0; i < 8; i++) {
+		fd[i] = cmd_connect(f);
+		expect_mg1(fd[i]);
+	}
+	fd[8] = cmd_connect(f);
+	expect_closed(fd[8]);
+	close(fd[0]);
+	fd[0] = cmd_connect(f);
+	expect_mg1(fd[0]);
+	for (int i = 0; i < 9; i++)
+		close(fd[i]);
+}
+
+/* A power cycle closes the command connections. */
+static void test_power_cycle_closes(void **state)
+{
+	struct fx *f = *state;
+	int fd = cmd_connect(f);
+
+	expect_mg1(fd);
+	ctl(f, "power-cycle");
+	expect_closed(fd);
+	close(fd);
+	fd = cmd_connect(f);
+	expect_mg1(fd);
+	close(fd);
+}
+
+/* ---- the relay behind its link ----------------------------------------- */
+
+static int open_relay(const char *path)
+{
+	struct termios tio;
+	int fd = open(path, O_RDWR | O_NOCTTY | O_CLOEXEC);
+
+	if (fd < 0)
+		return -1;
+	tcgetattr(fd, &tio);
+	cfmakeraw(&tio);
+	tcsetattr(fd, TCSANOW, &tio);
+	return fd;
+}
+
+static void test_relay_over_pty(void **state)
+{
+	struct fx *f = *state;
+	int fd = open_relay(f->link);
+	struct pollfd p;
+	uint8_t b = 0xAA;
+	struct stat st;
+
+	assert_true(fd >= 0);
+	assert_int_equal(write(fd, "\x65", 1), 1);
+	wait_answer(f, "relay", "on");
+	assert_int_equal(state_long(f, "power"), 1);
+	assert_int_equal(write(fd, "\x5b", 1), 1);
+	p = (struct pollfd){fd, POLLIN, 0};
+	assert_int_equal(poll(&p, 1, REPLY_MS), 1);
+	assert_int_equal(read(fd, &b, 1), 1);
+	assert_int_equal(b, 0x01);
+	assert_int_equal(write(fd, "\x6f", 1), 1);
+	wait_answer(f, "relay", "off");
+
+	ctl(f, "relayfault unplug");
+	errno = 0;
+	assert_int_equal(write(fd, "\x65", 1), -1);
+	assert_int_equal(errno, EIO);
+	assert_int_equal(lstat(f->link, &st), -1);
+	assert_int_equal(stat(f->sim.relay, &st), -1);
+	close(fd);
+	ctl(f, "relayfault ok");
+	fd = open_relay(f->link);
+	assert_true(fd >= 0);
+	assert_int_equal(write(fd, "\x65", 1), 1);
+	wait_answer(f, "relay", "on");
+	close(fd);
+	proc_ctl_request_multi(f->ctl, "events", f->resp, sizeof(f->resp),
+			       REPLY_MS);
+	assert_non_null(strstr(f->resp, " relay on (byte 0x65)\n"));
+	assert_non_null(strstr(f->resp, " inject: relayfault unplug\n"));
+	assert_non_null(strstr(f->resp, " relay plugged in at /dev/pts/"));
+}
+
+/* ---- ending ------------------------------------------------------------- */
+
+static void test_quit(void **state)
+{
+	struct fx *f = *state;
+	int st;
+	struct stat sb;
+
+	assert_string_equal(ctl(f, "quit"), "ok");
+	assert_int_equal(proc_wait_exit(&f->sim.p, REPLY_MS, &st), 0);
+	assert_int_equal(proc_exit_code(&f->sim.p), 0);
+	assert_int_equal(lstat(f->link, &sb), -1);
+}
+
+static void test_sigterm(void **state)
+{
+	struct fx *f = *state;
+	int st;
+	struct stat sb;
+
+	assert_int_equal(lstat(f->link, &sb), 0);
+	assert_int_equal(proc_signal(&f->sim.p, SIGTERM), 0);
+	assert_int_equal(proc_wait_exit(&f->sim.p, REPLY_MS, &st), 0);
+	assert_int_equal(proc_exit_code(&f->sim.p), 0);
+	assert_int_equal(lstat(f->link, &sb), -1);
+	assert_string_equal(proc_output(&f->sim.p, PROC_STDERR), "");
+}
+
+/* ---- start-up errors (no fixture) -------------------------------------- */
+
+/* Run galil-sim with @args; expect exit @code and @err on stderr. */
+static void run_expect(char *const *args, int code, const char *err)
+{
+	char bin[512], *argv[16];
+	struct proc p;
+	int n = 0, st;
+
+	snprintf(bin, sizeof(bin), "%s/galil-sim", bin_dir());
+	argv[n++] = bin;
+	for (int i = 0; args[i]; i++)
+		argv[n++] = args[i];
+	argv[n] = NULL;
+	assert_int_equal(proc_spawn(&p, argv, NULL), 0);
+	if (proc_wait_exit(&p, START_MS, &st) < 0) {
+		proc_kill(&p);
+		fail_msg("galil-sim did not exit");
+	}
+	assert_int_equal(proc_exit_code(&p), code);
+	if (strcmp(proc_output(&p, PROC_STDERR), err))
+		fail_msg("stderr '%s', want '%s'", proc_output(&p, PROC_STDERR),
+			 err);
+	assert_string_equal(proc_output(&p, PROC_STDOUT), "");
+	proc_kill(&p);
+}
+
+static void test_bad_plant_file(void **state)
+{
+	char dir[] = "/tmp/test_sim_net.XXXXXX", path[96], want[256];
+	FILE *fp;
+
+	(void)state;
+	assert_non_null(mkdtemp(dir));
+	snprintf(path, sizeof(path), "%s/plant.yaml", dir);
+	fp = fopen(path, "w");
+	assert_non_null(fp);
+	fputs("axes:\n  A:\n    fwd_limit: 1\n    lag: 2\n", fp);
+	fclose(fp);
+	snprintf(want, sizeof(want), "%s:4:5: unknown key 'lag' in axes.A\n",
+		 path);
+	run_expect((char *const[]){(char *)"--plant", path,
+				   (char *)"--no-relay-link", NULL},
+		   2, want);
+	unlink(path);
+	rmdir(dir);
+}
+
+static void test_usage_errors(void **state)
+{
+	(void)state;
+	run_expect(
+	    (char *const[]){(char *)"--relay-protocol", (char *)"numato", NULL},
+	    2,
+	    "galil-sim: unknown relay protocol 'numato' (devantech, "
+	    "icstation, lcus, kmtronic)\n");
+	run_expect((char *const[]){(char *)"--port", (char *)"70000", NULL}, 2,
+		   "galil-sim: bad port '70000'\ntry 'galil-sim --help'\n");
+	run_expect((char *const[]){(char *)"extra", NULL}, 2,
+		   "galil-sim: unexpected argument 'extra'\n");
+}
+
+/* A port in use: exit 1 with the reason. */
+static void test_port_in_use(void **state)
+{
+	struct sockaddr_in sa = {.sin_family = AF_INET};
+	socklen_t len = sizeof(sa);
+	int fd = socket(AF_INET, SOCK_STREAM, 0);
+	char port[16], want[128];
+
+	(void)state;
+	sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+	assert_int_equal(bind(fd, (struct sockaddr *)&sa, sizeof(sa)), 0);
+	assert_int_equal(listen(fd, 1), 0);
+	getsockname(fd, (struct sockaddr *)&sa, &len);
+	snprintf(port, sizeof(port), "%d", ntohs(sa.sin_port));
+	snprintf(want, sizeof(want),
+		 "galil-sim: cannot listen on "
+		 "127.0.0.1:%s: Address already in use\n",
+		 port);
+	run_expect((char *const[]){(char *)"--port", port,
+				   (char *)"--control-port", (char *)"0",
+				   (char *)"--no-relay-link", NULL},
+		   1, want);
+	close(fd);
+}
+
+#define T(name) cmocka_unit_test_setup_teardown(name, setup, teardown)
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	    T(test_ready_line_and_link),
+	    T(test_real_time),
+	    T(test_command_port_and_delay),
+	    T(test_link_stall),
+	    T(test_link_drop),
+	    T(test_eight_handles),
+	    T(test_power_cycle_closes),
+	    T(test_relay_over_pty),
+	    T(test_quit),
+	    T(test_sigterm),
+	    cmocka_unit_test(test_bad_plant_file),
+	    cmocka_unit_test(test_usage_errors),
+	    cmocka_unit_test(test_port_in_use),
+	};
+
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}

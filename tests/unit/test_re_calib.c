@@ -1,0 +1,473 @@
+/*
+ * test_re_calib.c - the calibration procedure (re_calib) against a small
+ * fake controller and robot behind struct re_io, in fake time: three axes
+ * between limit switches at +-50000 counts, potentiometers 0.5..4.5 V with
+ * a sine bow, PR/PA/SP/BG/ST/SH/MO. Covers a clean calibration (table
+ * values, soft limits, centre, time), a limit switch that never comes, a
+ * non-monotonic potentiometer, a wrong range, a motor switched off
+ * mid-calibration, a lost relay, the stop flag, and the check of loaded
+ * tables against the robot. The same procedure runs on galil-sim in the
+ * system tests.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "gl_err.h"
+#include "re_calib.h"
+#include "re_super.h"
+
+#define MS 1000000LL
+#define LIMIT 50000.0
+
+struct fax {
+	double pos, target, v, sp;
+	int moving, stop_code, motor_on;
+	int no_fwd_switch;	/* the switch never closes */
+	double enc_offset;	/* encoder origin shift */
+};
+
+static struct {
+	int64_t now, last_step;
+	struct fax ax[3];
+	double gain[3];		/* pot volts per full travel */
+	double dip_at, dip_v;	/* non-monotonic stretch on axis C */
+	int trip_axis;		/* motor off (stop code 8) at trip_pos */
+	double trip_pos;
+	int relay_bad;
+	int n_records;
+	char last_cmd[96];
+} fk;
+
+static double pot_volts(int i, double pos)
+{
+	double u = (pos + LIMIT) / (2 * LIMIT);
+	double v = 0.5 + fk.gain[i] * u + 0.05 * sin(M_PI * u);
+
+	if (i == 2 && fk.dip_v != 0 && fabs(pos - fk.dip_at) < 1500)
+		v -= fk.dip_v;
+	return v;
+}
+
+static int fwd_active(const struct fax *a)
+{
+	return !a->no_fwd_switch && a->pos >= LIMIT;
+}
+
+static void stop(struct fax *a, int code)
+{
+	a->moving = 0;
+	a->stop_code = code;
+}
+
+/* Move axis i for dt seconds at its speed toward its target. */
+static void move_axis(int i, double dt)
+{
+	struct fax *a = &fk.ax[i];
+	double d = a->target - a->pos, s = a->v * dt;
+
+	if (!a->moving)
+		return;
+	if (!a->motor_on) {
+		stop(a, a->stop_code);
+		return;
+	}
+	a->pos += fabs(d) <= s ? d : (d > 0 ? s : -s);
+	if (a->pos <= -LIMIT && d < 0) {
+		a->pos = -LIMIT;
+		stop(a, 3);
+	} else if (fwd_active(a) && d > 0) {
+		a->pos = LIMIT;
+		stop(a, 2);
+	} else if (a->pos == a->target) {
+		stop(a, 1);
+	}
+	if (fk.trip_axis == i + 1 && a->pos >= fk.trip_pos) {
+		a->motor_on = 0;
+		stop(a, 8);
+	}
+}
+
+static void plant_run(void)
+{
+	while (fk.last_step + MS <= fk.now) {
+		for (int i = 0; i < 3; i++)
+			move_axis(i, 0.001);
+		fk.last_step += MS;
+	}
+}
+
+static int axis_of(char c)
+{
+	return c >= 'A' && c <= 'C' ? c - 'A' : -1;
+}
+
+static void begin(int i)
+{
+	if (fk.ax[i].motor_on && fk.ax[i].target != fk.ax[i].pos) {
+		fk.ax[i].moving = 1;
+		fk.ax[i].v = fk.ax[i].sp;
+		fk.ax[i].stop_code = 0;
+	}
+}
+
+static void three(const char *args, double v[3])
+{
+	sscanf(args, "%lf,%lf,%lf", &v[0], &v[1], &v[2]);
+}
+
+static int one_cmd(const char *c)
+{
+	double v[3];
+	int i = axis_of(c[2]);
+
+	if (!strcmp(c, "SH ABC")) {
+		for (i = 0; i < 3; i++)
+			fk.ax[i].motor_on = 1;
+	} else if (!strncmp(c, "SP", 2) && c[3] == '=' && i >= 0) {
+		fk.ax[i].sp = atof(c + 4);
+	} else if (!strncmp(c, "PR", 2) && c[3] == '=' && i >= 0) {
+		fk.ax[i].target = fk.ax[i].pos + atof(c + 4);
+	} else if (!strncmp(c, "BG", 2) && i >= 0 && c[3] == '\0') {
+		begin(i);
+	} else if (!strncmp(c, "SP ", 3)) {
+		three(c + 3, v);
+		for (i = 0; i < 3; i++)
+			fk.ax[i].sp = v[i];
+	} else if (!strncmp(c, "PA ", 3)) {
+		three(c + 3, v);
+		for (i = 0; i < 3; i++)
+			fk.ax[i].target = v[i] - fk.ax[i].enc_offset;
+	} else if (!strcmp(c, "BG ABC")) {
+		for (i = 0; i < 3; i++)
+			begin(i);
+	} else {
+		return GL_ERR_CTRL;
+	}
+	return GL_OK;
+}
+
+static int f_command(void *ud, const char *cmd, char *resp, size_t cap,
+		     int timeout_ms)
+{
+	char buf[128], *save = NULL;
+
+	(void)ud;
+	(void)timeout_ms;
+	plant_run();
+	snprintf(fk.last_cmd, sizeof(fk.last_cmd), "%s", cmd);
+	snprintf(buf, sizeof(buf), "%s", cmd);
+	for (char *c = strtok_r(buf, ";", &save); c;
+	     c = strtok_r(NULL, ";", &save))
+		if (one_cmd(c) != GL_OK)
+			return GL_ERR_CTRL;
+	if (cap)
+		resp[0] = '\0';
+	return 0;
+}
+
+static int f_record(void *ud, const char *prefix, struct gl_record *rec,
+		    int timeout_ms)
+{
+	(void)ud;
+	(void)prefix;
+	(void)timeout_ms;
+	plant_run();
+	fk.n_records++;
+	memset(rec, 0, sizeof(*rec));
+	rec->layout = GL_LAYOUT_4000;
+	rec->n_axes = 3;
+	for (int i = 0; i < 3; i++) {
+		const struct fax *a = &fk.ax[i];
+		struct gl_rec_axis *r = &rec->axis[i];
+
+		r->motor_pos = (int32_t)lround(a->pos + a->enc_offset);
+		r->status = (uint16_t)((a->moving ? GL_AXST_MOVING : 0) |
+				       (a->motor_on ? 0 : GL_AXST_MOTOR_OFF));
+		r->stop_code = (uint8_t)a->stop_code;
+		r->switches = (uint8_t)((fwd_active(a) ? 0 : GL_AXSW_FLS) |
+					(a->pos <= -LIMIT ? 0 : GL_AXSW_RLS));
+		r->analog_in = (int32_t)lround(pot_volts(i, a->pos) *
+					       RE_AN_COUNTS_PER_V);
+	}
+	return GL_OK;
+}
+
+static const char *f_ctrl_error(void *ud, int *code)
+{
+	(void)ud;
+	if (code)
+		*code = 1;
+	return "Unrecognized command";
+}
+
+static int f_message(void *ud, char *line, size_t cap)
+{
+	(void)ud;
+	(void)line;
+	(void)cap;
+	return GL_ERR_AGAIN;
+}
+
+static int f_relay_check(void *ud, char *why, size_t cap)
+{
+	(void)ud;
+	if (!fk.relay_bad)
+		return GL_OK;
+	snprintf(why, cap, "relay gone");
+	return GL_ERR_RELAY;
+}
+
+static int f_relay_off(void *ud)
+{
+	(void)ud;
+	return GL_OK;
+}
+
+static enum re_relay_state f_relay_state(void *ud)
+{
+	(void)ud;
+	return RE_RELAY_ON;
+}
+
+static int f_log(void *ud, enum re_log_level lvl, const char *text)
+{
+	(void)ud;
+	(void)lvl;
+	(void)text;
+	return GL_OK;
+}
+
+static int64_t f_now(void *ud)
+{
+	(void)ud;
+	return fk.now;
+}
+
+static void f_sleep_until(void *ud, int64_t t)
+{
+	(void)ud;
+	if (t > fk.now)
+		fk.now = t;
+}
+
+static const struct re_io_ops ops = {
+	f_record, f_command, f_ctrl_error, f_message, f_relay_check,
+	f_relay_off, f_relay_state, f_log, f_now, f_sleep_until,
+};
+
+static const struct re_io io = {&ops, NULL};
+static const char *const names[3] = {"A", "B", "C"};
+static struct re_calib_cfg cfg;
+static struct re_calib *cal;
+static struct re_calset set;
+static volatile sig_atomic_t stop_flag;
+
+static int setup(void **state)
+{
+	(void)state;
+	memset(&fk, 0, sizeof(fk));
+	fk.now = fk.last_step = 1000 * MS;
+	for (int i = 0; i < 3; i++) {
+		fk.gain[i] = 4.0;
+		fk.ax[i].pos = i * 10000.0 - 10000;	/* anywhere */
+	}
+	memset(&cfg, 0, sizeof(cfg));
+	cfg.n_axes = 3;
+	cfg.names = names;
+	cfg.move_timeout_ms = 30000;
+	cfg.cmd_timeout_ms = 100;
+	for (int i = 0; i < 3; i++) {
+		struct re_calib_axis_cfg *a = &cfg.axis[i];
+
+		a->vmax_cps = 8000;
+		a->step_counts = 1000;
+		a->travel_counts = 100000;
+		a->travel_tol = 0.1;
+		a->backoff_counts = 500;
+		a->pot_input = i + 1;
+		a->check.noise_margin_v = 0.005;
+		a->check.expected_range_v = 4.0;
+		a->check.range_tol = 0.1;
+		a->check.min_points = 89;
+		a->check.max_points = 111;
+		a->check.step_tol_counts = 500;
+		a->encpot.allowed_error = 0.5;
+		a->encpot.persistence_cycles = 1;
+	}
+	stop_flag = 0;
+	cfg.stop = &stop_flag;
+	return re_calib_new(&cal);
+}
+
+static int teardown(void **state)
+{
+	(void)state;
+	re_calib_free(cal);
+	return 0;
+}
+
+/* All three axes in one run: 100 points each from -49500 to +49500, the
+ * values on the potentiometer curve, every axis at the centre, < 30 s. */
+static void test_calib_clean(void **state)
+{
+	struct re_fault f;
+	double secs = 0;
+
+	(void)state;
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, &secs),
+			 GL_OK);
+	assert_int_equal(set.n_axes, 3);
+	for (int i = 0; i < 3; i++) {
+		const struct re_caltable *t = &set.axis[i];
+
+		assert_int_equal(t->n, 100);
+		assert_true(fabs(t->start_counts + 49500) <= 1);
+		assert_true(fabs(t->soft_fwd - 49500) <= 1);
+		assert_true(fabs(t->soft_rev - t->start_counts) < 0.5);
+		for (int j = 0; j < t->n; j++)
+			assert_true(fabs(t->pot_v[j] - pot_volts(i,
+				t->start_counts + j * 1000.0)) < 0.0005);
+		assert_true(fabs(fk.ax[i].pos) <= 1);
+		assert_string_equal(set.name[i], names[i]);
+	}
+	print_message("calibration took %.2f s (fake time)\n", secs);
+	assert_true(secs > 20 && secs < 30);
+}
+
+/* The forward switch of B never closes: the bounded sweep ends without it. */
+static void test_calib_switch_never_comes(void **state)
+{
+	struct re_fault f;
+
+	(void)state;
+	fk.ax[1].no_fwd_switch = 1;
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL),
+			 RE_FAULT);
+	assert_int_equal(f.id, RE_F_CAL_ABORT);
+	assert_int_equal(f.axis, 1);
+	assert_non_null(strstr(f.s, "forward limit switch never came"));
+	assert_int_equal(set.n_axes, 0);
+}
+
+/* A dip in C's potentiometer: not rising at a point. */
+static void test_calib_nonmonotonic(void **state)
+{
+	struct re_fault f;
+
+	(void)state;
+	fk.dip_at = 10000;
+	fk.dip_v = 0.1;
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL),
+			 RE_FAULT);
+	assert_int_equal(f.id, RE_F_CAL_NONMONO);
+	assert_int_equal(f.axis, 2);
+	assert_int_equal(f.i[0], 58);	/* point at +8500 counts */
+}
+
+/* A's potentiometer spans 3 V instead of 4 V +- 10 %. */
+static void test_calib_wrong_range(void **state)
+{
+	struct re_fault f;
+
+	(void)state;
+	fk.gain[0] = 3.0;
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL),
+			 RE_FAULT);
+	assert_int_equal(f.id, RE_F_CAL_RANGE);
+	assert_int_equal(f.axis, 0);
+}
+
+/* Position error mid-sweep: the controller switched B off; abort. */
+static void test_calib_motor_off(void **state)
+{
+	struct re_fault f;
+
+	(void)state;
+	fk.trip_axis = 2;
+	fk.trip_pos = 0;
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL),
+			 RE_FAULT);
+	assert_int_equal(f.id, RE_F_CAL_ABORT);
+	assert_int_equal(f.axis, 1);
+	assert_non_null(strstr(f.s, "switched the motor off"));
+	assert_non_null(strstr(f.s, "stop code 8"));
+}
+
+/* The relay goes during calibration: ESTOP. */
+static void test_calib_relay_lost(void **state)
+{
+	struct re_fault f;
+
+	(void)state;
+	fk.relay_bad = 1;
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL),
+			 RE_FAULT);
+	assert_int_equal(f.id, RE_F_ESTOP_LOST);
+}
+
+/* SIGTERM during calibration: stop at the next sample. */
+static void test_calib_stop_flag(void **state)
+{
+	struct re_fault f;
+
+	(void)state;
+	stop_flag = 1;
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL),
+			 GL_ERR_AGAIN);
+	assert_int_equal(set.n_axes, 0);
+}
+
+/* Loaded tables: accepted where the robot agrees, then to the centre;
+ * refused when the encoder origin moved (controller restarted). */
+static void test_calib_check_robot(void **state)
+{
+	static struct re_calset saved;
+	struct re_fault f;
+
+	(void)state;
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &saved, &f, NULL),
+			 GL_OK);
+	fk.ax[0].pos = 20000;
+	fk.ax[0].motor_on = 0;
+	assert_int_equal(re_calib_check_robot(cal, &io, &cfg, &saved, &f),
+			 GL_OK);
+	assert_true(fabs(fk.ax[0].pos) <= 1);
+	fk.ax[1].enc_offset = 20000;	/* encoders restarted elsewhere */
+	assert_int_equal(re_calib_check_robot(cal, &io, &cfg, &saved, &f),
+			 RE_FAULT);
+	assert_int_equal(f.id, RE_F_CAL_ABORT);
+	assert_int_equal(f.axis, 1);
+	assert_non_null(strstr(f.s, "does not match the robot"));
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test_setup_teardown(test_calib_clean, setup,
+						teardown),
+		cmocka_unit_test_setup_teardown(test_calib_switch_never_comes,
+						setup, teardown),
+		cmocka_unit_test_setup_teardown(test_calib_nonmonotonic, setup,
+						teardown),
+		cmocka_unit_test_setup_teardown(test_calib_wrong_range, setup,
+						teardown),
+		cmocka_unit_test_setup_teardown(test_calib_motor_off, setup,
+						teardown),
+		cmocka_unit_test_setup_teardown(test_calib_relay_lost, setup,
+						teardown),
+		cmocka_unit_test_setup_teardown(test_calib_stop_flag, setup,
+						teardown),
+		cmocka_unit_test_setup_teardown(test_calib_check_robot, setup,
+						teardown),
+	};
+
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}

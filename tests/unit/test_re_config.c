@@ -1,0 +1,801 @@
+/*
+ * test_re_config.c - the configuration loader (pc/re_config.c).
+ *
+ * Every malformed file in tests/data/config/bad_*.yaml is listed below with
+ * the exact message and position it must produce; the default file must load
+ * and equal the documented defaults; every field must survive a round trip
+ * through YAML text; nothing is applied on error.
+ */
+#include <errno.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "gl_err.h"
+#include "re_config.h"
+
+#define DATA_DIR "tests/data/config/"
+
+struct bad_case {
+	const char *file;    /* under DATA_DIR */
+	int line, column;    /* 1-based */
+	const char *message; /* after "FILE:LINE:COLUMN: " */
+};
+
+static const struct bad_case bad_cases[] = {
+    {"bad_analog_shared.yaml", 6, 14,
+     "analog input 1 is used by axes 'A' and 'B'"},
+    {"bad_axes_count.yaml", 3, 3,
+     "'axes' must list exactly 3 axes (A, B, C), got 2"},
+    {"bad_axes_not_list.yaml", 3, 3,
+     "expected a list for 'axes', got a mapping"},
+    {"bad_axis_name_long.yaml", 3, 11, "'name' is too long (at most 15 bytes)"},
+    {"bad_axis_name_twice.yaml", 4, 11, "axis name 'A' is used twice"},
+    {"bad_backend.yaml", 3, 12,
+     "'backend' must be auto, serialport or tty, got 'usb'"},
+    {"bad_baud.yaml", 3, 9,
+     "'baud' must be 1200, 2400, 4800, 9600, 19200, 38400, 57600 or 115200, "
+     "got 9601"},
+    {"bad_bool.yaml", 3, 15,
+     "expected true or false for 'active_low', got 'yes'"},
+    {"bad_channel.yaml", 3, 12, "'channel' must be between 1 and 8, got 9"},
+    {"bad_clinical_loopback.yaml", 5, 12,
+     "'address' 127.0.0.1:23023 is a loopback address; clinical mode needs the "
+     "real controller"},
+    {"bad_clinical_noport.yaml", 1, 7,
+     "'port_clinical' must be set in clinical mode"},
+    {"bad_clinical_pty.yaml", 5, 18,
+     "'port_clinical' must be a serial device under /dev, got '/dev/pts/3'"},
+    {"bad_clinical_tty.yaml", 6, 7,
+     "'backend' tty is not allowed in clinical mode (a pseudo-terminal is "
+     "never a real relay)"},
+    {"bad_comments_only.yaml", 1, 1, "empty configuration file"},
+    {"bad_controller_timeout.yaml", 4, 26,
+     "'controller_timeout_ms' (200) must be at least 'critical_factor' x "
+     "'period_ms' (250)"},
+    {"bad_critical_factor.yaml", 4, 20,
+     "'critical_factor' (1.4) must be greater than 'noncritical_factor' (1.5)"},
+    {"bad_dev_noport.yaml", 3, 21,
+     "'port_development' must be set in development mode"},
+    {"bad_duplicate_key.yaml", 5, 1, "duplicate key 'period_ms'"},
+    {"bad_duplicate_nested.yaml", 5, 3, "duplicate key 'critical_factor'"},
+    {"bad_empty.yaml", 1, 1, "empty configuration file"},
+    {"bad_er_huge.yaml", 4, 34,
+     "'position_error_limit_counts' must be between 1 and 2147483647, got "
+     "99999999999"},
+    {"bad_inputs_count.yaml", 3, 11,
+     "'inputs' must list exactly 12 inputs, got 11"},
+    {"bad_inputs_duplicate.yaml", 3, 48,
+     "'inputs' lists input 3 twice (entries 3 and 12)"},
+    {"bad_inputs_range.yaml", 3, 48,
+     "'inputs' must be between 1 and 32, got 33"},
+    {"bad_invalid_timeout.yaml", 3, 23,
+     "'invalid_timeout_ms' must be between 50 and 5000, got 20"},
+    {"bad_key_not_scalar.yaml", 2, 3, "expected a key name, got a list"},
+    {"bad_log_keep.yaml", 3, 9, "'keep' must be between 0 and 99, got 100"},
+    {"bad_log_path_empty.yaml", 3, 9, "'path' must not be empty"},
+    {"bad_map_for_number.yaml", 2, 12,
+     "expected an integer for 'period_ms', got a mapping"},
+    {"bad_missing_value.yaml", 2, 11, "missing value for 'period_ms'"},
+    {"bad_mode.yaml", 1, 7,
+     "'mode' must be clinical or development, got 'clinic'"},
+    {"bad_name_control.yaml", 3, 11, "'name' contains a control character"},
+    {"bad_nan.yaml", 4, 9, "expected a number for 'kp', got '.nan'"},
+    {"bad_noncritical_after.yaml", 4, 23,
+     "'critical_factor' (2) must be greater than 'noncritical_factor' (2)"},
+    {"bad_ot_range.yaml", 5, 21,
+     "'time_samples' must be between 2 and 32000, got 1"},
+    {"bad_period_high.yaml", 2, 12,
+     "'period_ms' must be between 2 and 100, got 500"},
+    {"bad_period_huge.yaml", 2, 12,
+     "'period_ms' must be between 2 and 100, got 99999999999999999999"},
+    {"bad_period_low.yaml", 2, 12,
+     "'period_ms' must be between 2 and 100, got 1"},
+    {"bad_protocol_byte.yaml", 4, 22,
+     "'on' bytes must be between 0 and 255, got 0x101"},
+    {"bad_protocol_name.yaml", 3, 13,
+     "'protocol' must be devantech, icstation, lcus or kmtronic, got 'numato'"},
+    {"bad_protocol_no_off.yaml", 3, 13,
+     "'protocol' needs both 'on' and 'off' bytes"},
+    {"bad_protocol_same.yaml", 5, 10, "'on' and 'off' bytes must differ"},
+    {"bad_protocol_too_long.yaml", 4, 9,
+     "'on' must list 1 to 16 bytes, got 17"},
+    {"bad_quoted_number.yaml", 2, 12,
+     "expected an integer for 'period_ms', got a quoted string"},
+    {"bad_readback_protocol.yaml", 4, 13,
+     "'readback' needs the devantech protocol"},
+    {"bad_root_list.yaml", 1, 1,
+     "expected a mapping of settings at the top level, got a list"},
+    {"bad_root_scalar.yaml", 1, 1,
+     "expected a mapping of settings at the top level, got a value"},
+    {"bad_scalar_for_map.yaml", 2, 13,
+     "expected a mapping for 'controller', got '127.0.0.1'"},
+    {"bad_syntax_indent.yaml", 4, 2,
+     "did not find expected key (while parsing a block mapping at line 1 "
+     "column 1)"},
+    {"bad_syntax_tab.yaml", 3, 1,
+     "found character that cannot start any token (while scanning for the next "
+     "token at line 3 column 1)"},
+    {"bad_syntax_unclosed.yaml", 3, 1,
+     "did not find expected ',' or ']' (while parsing a flow sequence at line "
+     "2 column 12)"},
+    {"bad_tl_range.yaml", 3, 31,
+     "'torque_limit_v' must be between 0 and 9.9982, got 10"},
+    {"bad_tolerance_negative.yaml", 5, 41,
+     "'range_tolerance' must be between 0 and 1, got -0.1"},
+    {"bad_travel_step.yaml", 4, 18,
+     "'travel_counts' (100000) must be 4 to 10000 times 'step_counts' (50000)"},
+    {"bad_two_documents.yaml", 2, 1, "only one document is allowed"},
+    {"bad_undefined_alias.yaml", 2, 12, "found undefined alias"},
+    {"bad_unknown_key.yaml", 12, 3, "unknown key 'relay_prot'"},
+    {"bad_unknown_nested.yaml", 4, 14, "unknown key 'inptu'"},
+    {"bad_utf8.yaml", 3, 11, "invalid leading UTF-8 octet"},
+    {"bad_vmax_below_vmin.yaml", 6, 11,
+     "'vmin' (3000) must not exceed 'vmax' (2000)"},
+    {"bad_vmax_fraction.yaml", 3, 21,
+     "expected an integer for 'vmax', got '8000.5'"},
+    {"bad_vmax_text.yaml", 4, 11, "expected a number for 'vmax', got 'fast'"},
+    {"bad_vmin_above_vmax.yaml", 5, 11,
+     "'vmin' (9000) must not exceed 'vmax' (8000)"},
+    {"bad_window_length.yaml", 4, 22,
+     "'accel_window_ms' must list exactly 2 times (start and end), got 1"},
+    {"bad_window_order.yaml", 6, 29,
+     "'accel_window_ms' end (500) must be after its start (2000) and at most "
+     "60000"},
+};
+
+#define N_BAD (sizeof(bad_cases) / sizeof(bad_cases[0]))
+
+/* One malformed file: exact message, nothing written to @out. */
+static void test_bad_file(void **state)
+{
+	const struct bad_case *bc = *state;
+	struct re_config cfg, pattern;
+	char path[256], want[768], err[RE_CONFIG_ERR_MAX];
+	int rc;
+
+	snprintf(path, sizeof(path), DATA_DIR "%s", bc->file);
+	snprintf(want, sizeof(want), "%s:%d:%d: %s", path, bc->line, bc->column,
+		 bc->message);
+	memset(&cfg, 0xA5, sizeof(cfg));
+	memset(&pattern, 0xA5, sizeof(pattern));
+	rc = re_config_load_file(path, &cfg, err, sizeof(err));
+	assert_int_equal(rc, GL_ERR_CONFIG);
+	assert_string_equal(err, want);
+	assert_memory_equal(&cfg, &pattern, sizeof(cfg));
+}
+
+/* Parse @text (NUL-terminated) as "t.yaml"; returns the code. */
+static int parse_text(const char *text, struct re_config *cfg, char *err,
+		      size_t errlen)
+{
+	return re_config_parse(text, strlen(text), "t.yaml", cfg, err, errlen);
+}
+
+/* The documented defaults (docs/config.md), field by field. */
+static void test_defaults_documented(void **state)
+{
+	static const int joy[RE_JOY_INPUTS] = {1, 2, 3,	 4,  5,	 6,
+					       7, 8, 17, 18, 19, 20};
+	struct re_config c;
+	int i;
+
+	(void)state;
+	re_config_defaults(&c);
+	assert_int_equal(c.mode, RE_MODE_CLINICAL);
+	assert_int_equal(c.period_ms, 50);
+	assert_string_equal(c.controller.address, "127.0.0.1:23023");
+	assert_string_equal(c.controller.model, "DMC4030");
+	assert_int_equal(c.controller.timeout_ms, 100);
+	assert_int_equal(c.controller.connect_timeout_ms, 2000);
+	assert_string_equal(c.relay.port_clinical, "");
+	assert_string_equal(c.relay.port_development, "/tmp/roboelf-relay");
+	assert_int_equal(c.relay.protocol, RE_RELAY_DEVANTECH);
+	assert_int_equal(c.relay.channel, 1);
+	assert_int_equal(c.relay.backend, RE_RELAY_BACKEND_AUTO);
+	assert_int_equal(c.relay.baud, 9600);
+	assert_int_equal(c.relay.write_timeout_ms, 100);
+	assert_true(c.relay.readback);
+	assert_int_equal(c.relay.readback_timeout_ms, 500);
+	assert_string_equal(c.relay.icstation_state,
+			    "/tmp/roboelf-icstation.state");
+	assert_true(c.watchdog.noncritical_factor == 1.5);
+	assert_true(c.watchdog.critical_factor == 2.5);
+	assert_int_equal(c.watchdog.controller_timeout_ms, 200);
+	assert_memory_equal(c.joystick.inputs, joy, sizeof(joy));
+	assert_false(c.joystick.active_low);
+	assert_int_equal(c.joystick.invalid_timeout_ms, 500);
+	for (i = 0; i < RE_AXES; i++) {
+		const struct re_config_axis *a = &c.axes[i];
+
+		assert_string_equal(a->name, i == 0 ? "A" : i == 1 ? "B" : "C");
+		assert_int_equal(a->vmax_cps, 8000);
+		assert_int_equal(a->vmin_cps, 2000); /* vmax / 4 */
+		assert_int_equal(a->accel_start_ms, 500);
+		assert_int_equal(a->accel_end_ms, 2000);
+		assert_int_equal(a->step_counts, 1000);
+		assert_int_equal(a->travel_counts, i == 2 ? 80000 : 100000);
+		assert_true(a->travel_tolerance == 0.1);
+		assert_true(a->kp == 6.0 && a->ki == 0.0 && a->kd == 64.0);
+		assert_true(a->torque_limit_v == 5.0);
+		assert_int_equal(a->position_error_limit_counts, 2000);
+		assert_true(a->off_on_error);
+		assert_true(a->encoder_failure.enabled);
+		assert_int_equal(a->encoder_failure.time_samples, 100);
+		assert_true(a->encoder_failure.torque_v == 2.0);
+		assert_int_equal(a->analog.input, i + 1);
+		assert_true(a->analog.expected_range_v == 4.0);
+		assert_true(a->analog.range_tolerance == 0.1);
+		assert_true(a->allowed_error == 0.5);
+		assert_int_equal(a->persistence_cycles, 1);
+		assert_true(a->monotonic_margin_v == 0.005);
+	}
+	assert_string_equal(c.calibration.file, "roboelf-calibration.txt");
+	assert_true(c.calibration.backup);
+	assert_int_equal(c.calibration.backoff_counts, 500);
+	assert_int_equal(c.calibration.move_timeout_ms, 30000);
+	assert_string_equal(c.log.path, "roboelf.log");
+	assert_int_equal(c.log.max_bytes, 10485760);
+	assert_int_equal(c.log.keep, 5);
+}
+
+/* The built-in defaults are clinical without a relay port: refused. */
+static void test_defaults_refused_clinical(void **state)
+{
+	struct re_config c;
+	char err[RE_CONFIG_ERR_MAX];
+
+	(void)state;
+	re_config_defaults(&c);
+	assert_int_equal(re_config_validate(&c, err, sizeof(err)),
+			 GL_ERR_CONFIG);
+	assert_string_equal(err,
+			    "'port_clinical' must be set in clinical mode");
+	c.mode = RE_MODE_DEVELOPMENT;
+	assert_int_equal(re_config_validate(&c, err, sizeof(err)), GL_OK);
+}
+
+/* config/roboelf.yaml loads and is exactly the defaults in development. */
+static void test_default_file_loads(void **state)
+{
+	struct re_config c, d;
+	char err[RE_CONFIG_ERR_MAX];
+
+	(void)state;
+	assert_int_equal(
+	    re_config_load_file("config/roboelf.yaml", &c, err, sizeof(err)),
+	    GL_OK);
+	assert_string_equal(err, "");
+	re_config_defaults(&d);
+	d.mode = RE_MODE_DEVELOPMENT;
+	assert_memory_equal(&c, &d, sizeof(c));
+}
+
+/* An empty mapping gives the defaults (here in development mode). */
+static void test_minimal_file(void **state)
+{
+	struct re_config c, d;
+	char err[RE_CONFIG_ERR_MAX];
+
+	(void)state;
+	assert_int_equal(
+	    parse_text("mode: development\n", &c, err, sizeof(err)), GL_OK);
+	re_config_defaults(&d);
+	d.mode = RE_MODE_DEVELOPMENT;
+	assert_memory_equal(&c, &d, sizeof(c));
+}
+
+/* ---- round trip: struct -> YAML text -> struct ---- */
+
+struct sbuf {
+	char *p;
+	size_t n, cap;
+};
+
+static void put(struct sbuf *b, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+static void put(struct sbuf *b, const char *fmt, ...)
+{
+	va_list ap;
+	int n;
+
+	va_start(ap, fmt);
+	n = vsnprintf(b->p + b->n, b->cap - b->n, fmt, ap);
+	va_end(ap);
+	assert_true(n >= 0 && (size_t)n < b->cap - b->n);
+	b->n += (size_t)n;
+}
+
+static void put_bytes(struct sbuf *b, const char *key, const uint8_t *v,
+		      size_t n)
+{
+	size_t i;
+
+	put(b, "    %s: [", key);
+	for (i = 0; i < n; i++)
+		put(b, "%s0x%02X", i ? ", " : "", v[i]);
+	put(b, "]\n");
+}
+
+static const char *tf(bool v)
+{
+	return v ? "true" : "false";
+}
+
+static void emit_axis(struct sbuf *b, const struct re_config_axis *a)
+{
+	put(b, "  - name: \"%s\"\n    vmax: %d\n    vmin: %d\n", a->name,
+	    a->vmax_cps, a->vmin_cps);
+	put(b, "    accel_window_ms: [%d, %d]\n", a->accel_start_ms,
+	    a->accel_end_ms);
+	put(b, "    step_counts: %d\n    travel_counts: %d\n", a->step_counts,
+	    a->travel_counts);
+	put(b, "    travel_tolerance: %.17g\n", a->travel_tolerance);
+	put(b, "    kp: %.17g\n    ki: %.17g\n    kd: %.17g\n", a->kp, a->ki,
+	    a->kd);
+	put(b, "    torque_limit_v: %.17g\n", a->torque_limit_v);
+	put(b, "    position_error_limit_counts: %d\n",
+	    a->position_error_limit_counts);
+	put(b, "    off_on_error: %s\n", tf(a->off_on_error));
+	put(b,
+	    "    encoder_failure: {enabled: %s, time_samples: %d, "
+	    "torque_v: %.17g}\n",
+	    tf(a->encoder_failure.enabled), a->encoder_failure.time_samples,
+	    a->encoder_failure.torque_v);
+	put(b,
+	    "    analog: {input: %d, expected_range_v: %.17g, "
+	    "range_tolerance: %.17g}\n",
+	    a->analog.input, a->analog.expected_range_v,
+	    a->analog.range_tolerance);
+	put(b, "    allowed_error: %.17g\n    persistence_cycles: %d\n",
+	    a->allowed_error, a->persistence_cycles);
+	put(b, "    monotonic_margin_v: %.17g\n", a->monotonic_margin_v);
+}
+
+/* emit() - every field of @c as YAML. */
+static void emit(struct sbuf *b, const struct re_config *c)
+{
+	static const char *const be[] = {"auto", "serialport", "tty"};
+	int i;
+
+	put(b, "mode: %s\nperiod_ms: %d\n", re_mode_name(c->mode),
+	    c->period_ms);
+	put(b, "controller:\n  address: \"%s\"\n  model: %s\n",
+	    c->controller.address, c->controller.model);
+	put(b, "  timeout_ms: %d\n  connect_timeout_ms: %d\n",
+	    c->controller.timeout_ms, c->controller.connect_timeout_ms);
+	put(b, "relay:\n  port_clinical: \"%s\"\n  port_development: \"%s\"\n",
+	    c->relay.port_clinical, c->relay.port_development);
+	if (c->relay.protocol == RE_RELAY_EXPLICIT) {
+		put(b, "  protocol:\n");
+		put_bytes(b, "on", c->relay.on, c->relay.on_len);
+		put_bytes(b, "off", c->relay.off, c->relay.off_len);
+	} else {
+		put(b, "  protocol: %s\n",
+		    re_relay_proto_name(c->relay.protocol));
+	}
+	put(b, "  channel: %d\n  backend: %s\n  baud: %d\n", c->relay.channel,
+	    be[c->relay.backend], c->relay.baud);
+	put(b, "  write_timeout_ms: %d\n  readback: %s\n",
+	    c->relay.write_timeout_ms, tf(c->relay.readback));
+	put(b, "  readback_timeout_ms: %d\n  icstation_state: \"%s\"\n",
+	    c->relay.readback_timeout_ms, c->relay.icstation_state);
+	put(b,
+	    "watchdog:\n  noncritical_factor: %.17g\n"
+	    "  critical_factor: %.17g\n  controller_timeout_ms: %d\n",
+	    c->watchdog.noncritical_factor, c->watchdog.critical_factor,
+	    c->watchdog.controller_timeout_ms);
+	put(b, "joystick:\n  inputs: [");
+	for (i = 0; i < RE_JOY_INPUTS; i++)
+		put(b, "%s%d", i ? ", " : "", c->joystick.inputs[i]);
+	put(b, "]\n  active_low: %s\n  invalid_timeout_ms: %d\naxes:\n",
+	    tf(c->joystick.active_low), c->joystick.invalid_timeout_ms);
+	for (i = 0; i < RE_AXES; i++)
+		emit_axis(b, &c->axes[i]);
+	put(b, "calibration:\n  file: \"%s\"\n  backup: %s\n",
+	    c->calibration.file, tf(c->calibration.backup));
+	put(b, "  backoff_counts: %d\n  move_timeout_ms: %d\n",
+	    c->calibration.backoff_counts, c->calibration.move_timeout_ms);
+	put(b, "log:\n  path: \"%s\"\n  max_bytes: %ld\n  keep: %d\n",
+	    c->log.path, c->log.max_bytes, c->log.keep);
+}
+
+/* A configuration with every field away from its default. */
+static void changed(struct re_config *c)
+{
+	static const uint8_t on[] = {0xA0, 0x02, 0x01, 0xA3};
+	static const uint8_t off[] = {0xA0, 0x02, 0x00, 0xA2};
+	int i;
+
+	re_config_defaults(c);
+	c->mode = RE_MODE_CLINICAL;
+	c->period_ms = 20;
+	strcpy(c->controller.address, "192.168.42.7:23");
+	strcpy(c->controller.model, "DMC4040");
+	c->controller.timeout_ms = 75;
+	c->controller.connect_timeout_ms = 1500;
+	strcpy(c->relay.port_clinical, "/dev/serial/by-id/usb-relay");
+	strcpy(c->relay.port_development, "/tmp/other-relay");
+	c->relay.protocol = RE_RELAY_EXPLICIT;
+	memcpy(c->relay.on, on, sizeof(on));
+	c->relay.on_len = sizeof(on);
+	memcpy(c->relay.off, off, sizeof(off));
+	c->relay.off_len = sizeof(off);
+	c->relay.channel = 2;
+	c->relay.backend = RE_RELAY_BACKEND_SERIALPORT;
+	c->relay.baud = 19200;
+	c->relay.write_timeout_ms = 40;
+	c->relay.readback = false;
+	c->relay.readback_timeout_ms = 300;
+	strcpy(c->relay.icstation_state, "/run/roboelf/ics.state");
+	c->watchdog.noncritical_factor = 1.25;
+	c->watchdog.critical_factor = 3.75;
+	c->watchdog.controller_timeout_ms = 150;
+	for (i = 0; i < RE_JOY_INPUTS; i++)
+		c->joystick.inputs[i] = 21 + i;
+	c->joystick.active_low = true;
+	c->joystick.invalid_timeout_ms = 400;
+	for (i = 0; i < RE_AXES; i++) {
+		struct re_config_axis *a = &c->axes[i];
+
+		snprintf(a->name, sizeof(a->name), "axis-%c", 'a' + i);
+		a->vmax_cps = 9000 + i;
+		a->vmin_cps = 1000 + i;
+		a->accel_start_ms = 300 + i;
+		a->accel_end_ms = 1700 + i;
+		a->step_counts = 800 + i;
+		a->travel_counts = 90000 + i;
+		a->travel_tolerance = 0.07;
+		a->kp = 12.5;
+		a->ki = 0.25;
+		a->kd = 100.125;
+		a->torque_limit_v = 3.3;
+		a->position_error_limit_counts = 1500 + i;
+		a->off_on_error = false;
+		a->encoder_failure.enabled = false;
+		a->encoder_failure.time_samples = 250;
+		a->encoder_failure.torque_v = 1.1;
+		a->analog.input = 6 + i;
+		a->analog.expected_range_v = 3.6;
+		a->analog.range_tolerance = 0.15;
+		a->allowed_error = 0.3;
+		a->persistence_cycles = 2 + i;
+		a->monotonic_margin_v = 0.01;
+	}
+	strcpy(c->calibration.file, "/var/lib/roboelf/cal.txt");
+	c->calibration.backup = false;
+	c->calibration.backoff_counts = 750;
+	c->calibration.move_timeout_ms = 20000;
+	strcpy(c->log.path, "/var/log/roboelf/roboelf.log");
+	c->log.max_bytes = 65536;
+	c->log.keep = 3;
+}
+
+/* Every field written as YAML reads back to the same struct. */
+static void test_round_trip_every_field(void **state)
+{
+	struct re_config want, got, def;
+	char text[8192], err[RE_CONFIG_ERR_MAX];
+	struct sbuf b = {text, 0, sizeof(text)};
+
+	(void)state;
+	changed(&want);
+	assert_int_equal(re_config_validate(&want, err, sizeof(err)), GL_OK);
+	emit(&b, &want);
+	assert_int_equal(
+	    re_config_parse(text, b.n, "rt.yaml", &got, err, sizeof(err)),
+	    GL_OK);
+	assert_string_equal(err, "");
+	assert_memory_equal(&got, &want, sizeof(got));
+	/* ... and the change really touched every field the file can set. */
+	re_config_defaults(&def);
+	assert_int_not_equal(got.relay.readback_timeout_ms,
+			     def.relay.readback_timeout_ms);
+	assert_true(re_config_hash(&got) != re_config_hash(&def));
+	/* The defaults round-trip too. */
+	def.mode = RE_MODE_DEVELOPMENT;
+	b.n = 0;
+	emit(&b, &def);
+	assert_int_equal(
+	    re_config_parse(text, b.n, "rt.yaml", &got, err, sizeof(err)),
+	    GL_OK);
+	assert_memory_equal(&got, &def, sizeof(got));
+}
+
+/* ---- derived defaults and individual rules ---- */
+
+/* vmin defaults to vmax / 4 when only vmax is given. */
+static void test_vmin_follows_vmax(void **state)
+{
+	struct re_config c;
+	char err[RE_CONFIG_ERR_MAX];
+
+	(void)state;
+	assert_int_equal(parse_text("mode: development\naxes:\n"
+				    "  - {vmax: 10000}\n  - {vmax: 7}\n"
+				    "  - {vmax: 8000, vmin: 8000}\n",
+				    &c, err, sizeof(err)),
+			 GL_OK);
+	assert_int_equal(c.axes[0].vmin_cps, 2500);
+	assert_int_equal(c.axes[1].vmin_cps, 1); /* 7 / 4 */
+	assert_int_equal(c.axes[2].vmin_cps, 8000);
+	assert_string_equal(c.axes[1].name, "B"); /* untouched */
+}
+
+/* controller_timeout_ms defaults to 4 x period, at least 100 ms. */
+static void test_controller_timeout_auto(void **state)
+{
+	struct re_config c;
+	char err[RE_CONFIG_ERR_MAX];
+
+	(void)state;
+	assert_int_equal(parse_text("mode: development\nperiod_ms: 100\n", &c,
+				    err, sizeof(err)),
+			 GL_OK);
+	assert_int_equal(c.watchdog.controller_timeout_ms, 400);
+	assert_int_equal(parse_text("mode: development\nperiod_ms: 2\n", &c,
+				    err, sizeof(err)),
+			 GL_OK);
+	assert_int_equal(c.watchdog.controller_timeout_ms, 100);
+	assert_int_equal(parse_text("mode: development\nperiod_ms: 2\n"
+				    "watchdog: {controller_timeout_ms: 20}\n",
+				    &c, err, sizeof(err)),
+			 GL_OK);
+	assert_int_equal(c.watchdog.controller_timeout_ms, 20);
+}
+
+/* Read-back is on by default for Devantech only. */
+static void test_readback_default(void **state)
+{
+	struct re_config c;
+	char err[RE_CONFIG_ERR_MAX];
+
+	(void)state;
+	assert_int_equal(parse_text("mode: development\n"
+				    "relay: {protocol: icstation}\n",
+				    &c, err, sizeof(err)),
+			 GL_OK);
+	assert_int_equal(c.relay.protocol, RE_RELAY_ICSTATION);
+	assert_false(c.relay.readback);
+	assert_int_equal(parse_text("mode: development\n"
+				    "relay: {protocol: devantech}\n",
+				    &c, err, sizeof(err)),
+			 GL_OK);
+	assert_true(c.relay.readback);
+	assert_int_equal(parse_text("mode: development\n"
+				    "relay: {readback: false}\n",
+				    &c, err, sizeof(err)),
+			 GL_OK);
+	assert_false(c.relay.readback);
+}
+
+/* A clinical configuration that passes every clinical rule. */
+static void test_clinical_accepted(void **state)
+{
+	struct re_config c;
+	struct re_relay_cfg r;
+	char err[RE_CONFIG_ERR_MAX];
+
+	(void)state;
+	assert_int_equal(parse_text("mode: clinical\ncontroller:\n"
+				    "  address: 10.0.0.2\nrelay:\n"
+				    "  port_clinical: /dev/ttyUSB0\n"
+				    "  channel: 2\n",
+				    &c, err, sizeof(err)),
+			 GL_OK);
+	assert_string_equal(re_config_relay_port(&c), "/dev/ttyUSB0");
+	re_config_relay_cfg(&c, &r);
+	assert_string_equal(r.port, "/dev/ttyUSB0");
+	assert_true(r.clinical);
+	assert_int_equal(r.channel, 2);
+	assert_int_equal(r.proto, RE_RELAY_DEVANTECH);
+	assert_int_equal(r.baud, 9600);
+	assert_true(r.readback);
+	c.mode = RE_MODE_DEVELOPMENT;
+	re_config_relay_cfg(&c, &r);
+	assert_string_equal(r.port, "/tmp/roboelf-relay");
+	assert_false(r.clinical);
+}
+
+/* Command-line overrides are validated without a position. */
+static void test_validate_overrides(void **state)
+{
+	struct re_config c;
+	char err[RE_CONFIG_ERR_MAX];
+
+	(void)state;
+	re_config_defaults(&c);
+	c.mode = RE_MODE_DEVELOPMENT;
+	c.period_ms = 500;
+	assert_int_equal(re_config_validate(&c, err, sizeof(err)),
+			 GL_ERR_CONFIG);
+	assert_string_equal(err, "'period_ms' must be between 2 and 100, "
+				 "got 500");
+	c.period_ms = 100; /* 2.5 x 100 > 200 */
+	assert_int_equal(re_config_validate(&c, err, sizeof(err)),
+			 GL_ERR_CONFIG);
+	assert_string_equal(err, "'controller_timeout_ms' (200) must be at "
+				 "least 'critical_factor' x 'period_ms' (250)");
+	c.period_ms = 50;
+	c.relay.protocol = RE_RELAY_EXPLICIT; /* with no bytes */
+	assert_int_equal(re_config_validate(&c, err, sizeof(err)),
+			 GL_ERR_CONFIG);
+	assert_string_equal(err, "'on' and 'off' must list 1 to 16 bytes "
+				 "each");
+	c.relay.protocol = RE_RELAY_KMTRONIC;
+	c.relay.readback = false;
+	assert_int_equal(re_config_validate(&c, err, sizeof(err)), GL_OK);
+	c.mode = RE_MODE_CLINICAL;
+	strcpy(c.relay.port_clinical, "/dev/ttyACM0");
+	assert_int_equal(re_config_validate(&c, err, sizeof(err)),
+			 GL_ERR_CONFIG);
+	assert_string_equal(err,
+			    "'address' 127.0.0.1:23023 is a loopback "
+			    "address; clinical mode needs the real controller");
+}
+
+/* Strings and names may be quoted; numbers may not (see bad_quoted_*). */
+static void test_quoted_strings(void **state)
+{
+	struct re_config c;
+	char err[RE_CONFIG_ERR_MAX];
+
+	(void)state;
+	assert_int_equal(parse_text("mode: \"development\"\n"
+				    "relay: {protocol: 'lcus', backend: tty}\n"
+				    "log: {path: 'my log.txt'}\n",
+				    &c, err, sizeof(err)),
+			 GL_OK);
+	assert_int_equal(c.mode, RE_MODE_DEVELOPMENT);
+	assert_int_equal(c.relay.protocol, RE_RELAY_LCUS);
+	assert_int_equal(c.relay.backend, RE_RELAY_BACKEND_TTY);
+	assert_string_equal(c.log.path, "my log.txt");
+	assert_int_equal(parse_text("mode: \"\"\n", &c, err, sizeof(err)),
+			 GL_ERR_CONFIG);
+	assert_string_equal(err, "t.yaml:1:7: 'mode' must be clinical or "
+				 "development, got ''");
+}
+
+/* The buffer need not be NUL-terminated; the name defaults. */
+static void test_buffer_not_terminated(void **state)
+{
+	static const char text[] = "mode: development\nperiod_ms: 20XXX";
+	struct re_config c;
+	char err[RE_CONFIG_ERR_MAX];
+
+	(void)state;
+	assert_int_equal(re_config_parse(text, sizeof(text) - 4, "b.yaml", &c,
+					 err, sizeof(err)),
+			 GL_OK);
+	assert_int_equal(c.period_ms, 20);
+	assert_int_equal(
+	    re_config_parse(text, sizeof(text) - 1, NULL, &c, err, sizeof(err)),
+	    GL_ERR_CONFIG);
+	assert_string_equal(err, "<config>:2:12: expected a number for "
+				 "'period_ms', got '20XXX'");
+}
+
+/* A missing file: "cannot read", GL_ERR_SYS, errno kept. */
+static void test_missing_file(void **state)
+{
+	struct re_config c;
+	char err[RE_CONFIG_ERR_MAX];
+
+	(void)state;
+	assert_int_equal(re_config_load_file(DATA_DIR "no-such-file.yaml", &c,
+					     err, sizeof(err)),
+			 GL_ERR_SYS);
+	assert_int_equal(errno, ENOENT);
+	assert_string_equal(err, "cannot read '" DATA_DIR "no-such-file.yaml"
+				 "': No such file or directory");
+	assert_int_equal(re_config_load_file(DATA_DIR, &c, err, sizeof(err)),
+			 GL_ERR_SYS);
+	assert_string_equal(err, "cannot read '" DATA_DIR "': Invalid "
+				 "argument");
+}
+
+/* A short error buffer is truncated, never overrun. */
+static void test_short_error_buffer(void **state)
+{
+	struct re_config c;
+	char err[16];
+
+	(void)state;
+	memset(err, 'x', sizeof(err));
+	assert_int_equal(parse_text("period_ms: 500\n", &c, err, 12),
+			 GL_ERR_CONFIG);
+	assert_string_equal(err, "t.yaml:1:12");
+	assert_int_equal(err[12], 'x');
+}
+
+/* The hash covers calibration fields only. */
+static void test_hash(void **state)
+{
+	struct re_config a, b;
+	uint64_t h;
+
+	(void)state;
+	re_config_defaults(&a);
+	b = a;
+	h = re_config_hash(&a);
+	assert_true(h == re_config_hash(&b));
+	b.period_ms = 20;
+	b.axes[1].vmax_cps = 100;
+	b.relay.channel = 3;
+	assert_true(h == re_config_hash(&b));
+	b.axes[2].step_counts = 999;
+	assert_true(h != re_config_hash(&b));
+	b = a;
+	strcpy(b.axes[0].name, "X");
+	assert_true(h != re_config_hash(&b));
+	b = a;
+	b.axes[1].analog.expected_range_v = 4.1;
+	assert_true(h != re_config_hash(&b));
+	b = a;
+	b.axes[2].allowed_error = 0.6;
+	assert_true(h != re_config_hash(&b));
+}
+
+/* The summary names the essentials and is safely truncated. */
+static void test_dump(void **state)
+{
+	struct re_config c;
+	char buf[4096], small[32];
+	int n;
+
+	(void)state;
+	re_config_defaults(&c);
+	c.mode = RE_MODE_DEVELOPMENT;
+	n = re_config_dump(&c, buf, sizeof(buf));
+	assert_int_equal(n, (int)strlen(buf));
+	assert_non_null(strstr(buf, "mode development, period 50 ms, "
+				    "controller 127.0.0.1:23023 (DMC4030"));
+	assert_non_null(strstr(buf, "relay /tmp/roboelf-relay (devantech, "
+				    "channel 1"));
+	assert_non_null(strstr(buf, "; axis C: v 2000..8000 counts/s"));
+	assert_null(strchr(buf, '\n'));
+	assert_int_equal(re_config_dump(&c, small, sizeof(small)), n);
+	assert_int_equal(strlen(small), sizeof(small) - 1);
+	assert_memory_equal(small, buf, sizeof(small) - 1);
+	assert_int_equal(re_config_dump(&c, NULL, 0), n);
+}
+
+int main(void)
+{
+	static const struct CMUnitTest fixed[] = {
+	    cmocka_unit_test(test_defaults_documented),
+	    cmocka_unit_test(test_defaults_refused_clinical),
+	    cmocka_unit_test(test_default_file_loads),
+	    cmocka_unit_test(test_minimal_file),
+	    cmocka_unit_test(test_round_trip_every_field),
+	    cmocka_unit_test(test_vmin_follows_vmax),
+	    cmocka_unit_test(test_controller_timeout_auto),
+	    cmocka_unit_test(test_readback_default),
+	    cmocka_unit_test(test_clinical_accepted),
+	    cmocka_unit_test(test_validate_overrides),
+	    cmocka_unit_test(test_quoted_strings),
+	    cmocka_unit_test(test_buffer_not_terminated),
+	    cmocka_unit_test(test_missing_file),
+	    cmocka_unit_test(test_short_error_buffer),
+	    cmocka_unit_test(test_hash),
+	    cmocka_unit_test(test_dump),
+	};
+	enum { N_FIXED = sizeof(fixed) / sizeof(fixed[0]) };
+	static struct CMUnitTest tests[N_FIXED + N_BAD];
+	size_t i;
+
+	memcpy(tests, fixed, sizeof(fixed));
+	for (i = 0; i < N_BAD; i++) {
+		tests[N_FIXED + i].name = bad_cases[i].file;
+		tests[N_FIXED + i].test_func = test_bad_file;
+		tests[N_FIXED + i].initial_state = (void *)&bad_cases[i];
+	}
+	return _cmocka_run_group_tests("re_config", tests, N_FIXED + N_BAD,
+				       NULL, NULL);
+}

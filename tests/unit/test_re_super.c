@@ -1,0 +1,595 @@
+/*
+ * test_re_super.c - the supervisor cycle (re_super) against a fake
+ * controller, relay, log and clock behind struct re_io: no sockets, no
+ * sleeping. Covers one round trip per cycle, every fault path and its
+ * reaction order (relay off, then "ST ABC;MO ABC;pcflt=1", then the fsync'ed
+ * log entry), the latch, the watchdog levels, the schedule (overruns) and
+ * that the cycle allocates nothing.
+ */
+#include <malloc.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "gl_err.h"
+#include "re_super.h"
+
+#define MS 1000000LL
+#define PERIOD_MS 50
+
+/* ---- allocation counter (linked with --wrap, see .ldflags) --------------- */
+
+static long n_allocs;
+void *__real_malloc(size_t n);
+void *__real_calloc(size_t n, size_t m);
+void *__real_realloc(void *p, size_t n);
+void *__wrap_malloc(size_t n);
+void *__wrap_calloc(size_t n, size_t m);
+void *__wrap_realloc(void *p, size_t n);
+
+void *__wrap_malloc(size_t n)
+{
+	n_allocs++;
+	return __real_malloc(n);
+}
+
+void *__wrap_calloc(size_t n, size_t m)
+{
+	n_allocs++;
+	return __real_calloc(n, m);
+}
+
+void *__wrap_realloc(void *p, size_t n)
+{
+	n_allocs++;
+	return __real_realloc(p, n);
+}
+
+/* ---- the fake world ------------------------------------------------------ */
+
+struct fake {
+	int64_t now;			/* fake CLOCK_MONOTONIC */
+	struct gl_record rec;		/* what the next QR returns */
+	int record_rc;			/* GL_OK or an error to return */
+	int64_t delay_ns;		/* round-trip time */
+	int freeze_hb, freeze_sample;
+	int n_records;
+	char last_prefix[64];
+	int last_timeout_ms;
+	int relay_check_rc;
+	int relay_off_rc;
+	int n_relay_off;
+	char commands[8][96];
+	int n_commands;
+	char mg_fdet[32];		/* answer to "MG fdet" */
+	char logs[16][1024];
+	int log_level[16];
+	int n_logs;
+	char seq[512];			/* order of reactions */
+	const char *msgs[4];
+	int n_msgs;
+};
+
+static struct fake fk;
+
+static void seq_add(const char *what)
+{
+	size_t n = strlen(fk.seq);
+
+	snprintf(fk.seq + n, sizeof(fk.seq) - n, "%s%s", n ? "," : "", what);
+}
+
+static int f_record(void *ud, const char *prefix, struct gl_record *rec,
+		    int timeout_ms)
+{
+	(void)ud;
+	fk.n_records++;
+	snprintf(fk.last_prefix, sizeof(fk.last_prefix), "%s",
+		 prefix ? prefix : "(none)");
+	fk.last_timeout_ms = timeout_ms;
+	if (fk.record_rc == GL_ERR_TIMEOUT ||
+	    fk.delay_ns > (int64_t)timeout_ms * MS) {
+		fk.now += (int64_t)timeout_ms * MS;
+		return GL_ERR_TIMEOUT;
+	}
+	fk.now += fk.delay_ns;
+	if (fk.record_rc != GL_OK)
+		return fk.record_rc;
+	if (!fk.freeze_sample)
+		fk.rec.sample += 50;
+	if (!fk.freeze_hb)
+		fk.rec.axis[0].za = (fk.rec.axis[0].za + 5) % 1000000;
+	*rec = fk.rec;
+	return GL_OK;
+}
+
+static int f_command(void *ud, const char *cmd, char *resp, size_t cap,
+		     int timeout_ms)
+{
+	char s[128];
+
+	(void)ud;
+	(void)timeout_ms;
+	if (fk.n_commands < 8)
+		snprintf(fk.commands[fk.n_commands++], 96, "%s", cmd);
+	snprintf(s, sizeof(s), "cmd:%s", cmd);
+	seq_add(s);
+	snprintf(resp, cap, "%s", strcmp(cmd, "MG fdet") ? "" : fk.mg_fdet);
+	return (int)strlen(resp);
+}
+
+static const char *f_ctrl_error(void *ud, int *code)
+{
+	(void)ud;
+	if (code)
+		*code = 1;
+	return "";
+}
+
+static int f_message(void *ud, char *line, size_t cap)
+{
+	(void)ud;
+	if (fk.n_msgs == 0)
+		return GL_ERR_AGAIN;
+	snprintf(line, cap, "%s", fk.msgs[--fk.n_msgs]);
+	return (int)strlen(line);
+}
+
+static int f_relay_check(void *ud, char *why, size_t cap)
+{
+	(void)ud;
+	if (fk.relay_check_rc != GL_OK)
+		snprintf(why, cap, "relay '/tmp/r': device vanished");
+	return fk.relay_check_rc;
+}
+
+static int f_relay_off(void *ud)
+{
+	(void)ud;
+	fk.n_relay_off++;
+	seq_add("relay_off");
+	return fk.relay_off_rc;
+}
+
+static enum re_relay_state f_relay_state(void *ud)
+{
+	(void)ud;
+	return fk.n_relay_off ? RE_RELAY_OFF : RE_RELAY_ON;
+}
+
+static int f_log(void *ud, enum re_log_level lvl, const char *text)
+{
+	(void)ud;
+	if (fk.n_logs < 16) {
+		snprintf(fk.logs[fk.n_logs], sizeof(fk.logs[0]), "%s", text);
+		fk.log_level[fk.n_logs++] = lvl;
+	}
+	seq_add(lvl == RE_LOG_FAULT ? "log:FAULT" : "log");
+	return GL_OK;
+}
+
+static int64_t f_now(void *ud)
+{
+	(void)ud;
+	return fk.now;
+}
+
+static void f_sleep_until(void *ud, int64_t t)
+{
+	(void)ud;
+	if (t > fk.now)
+		fk.now = t;
+}
+
+static const struct re_io_ops fake_ops = {
+	f_record, f_command, f_ctrl_error, f_message, f_relay_check, f_relay_off,
+	f_relay_state, f_log, f_now, f_sleep_until,
+};
+
+/* ---- fixtures ------------------------------------------------------------ */
+
+static struct re_caltable table;
+static const struct re_caltable *tables[3] = {&table, &table, &table};
+static const char *const names[3] = {"A", "B", "C"};
+static struct re_super sup;
+
+static void make_table(void)
+{
+	memset(&table, 0, sizeof(table));
+	table.n = 101;
+	table.start_counts = -50000;
+	table.step_counts = 1000;
+	for (int i = 0; i < table.n; i++)
+		table.pot_v[i] = 0.5 + 0.04 * i;	/* 2.5 V at 0 */
+	table.soft_rev = -50000;
+	table.soft_fwd = 50000;
+}
+
+static void set_pot(int axis, double volts)
+{
+	fk.rec.axis[axis].analog_in = (int32_t)(volts * RE_AN_COUNTS_PER_V +
+						(volts < 0 ? -0.5 : 0.5));
+}
+
+static void make_record(void)
+{
+	struct gl_record *r = &fk.rec;
+
+	memset(r, 0, sizeof(*r));
+	r->layout = GL_LAYOUT_4000;
+	r->n_axes = 3;
+	r->threads = 0x03;
+	for (int i = 0; i < 3; i++) {
+		r->axis[i].switches = GL_AXSW_FLS | GL_AXSW_RLS;
+		set_pot(i, 2.5);
+	}
+	r->axis[1].za = 1;		/* ZAB: armed, no fault */
+	r->axis[2].za = 4096;		/* ZAC: jcmd 0 */
+}
+
+static struct re_super_cfg make_cfg(void)
+{
+	struct re_super_cfg c;
+
+	memset(&c, 0, sizeof(c));
+	c.n_axes = 3;
+	c.period_ns = PERIOD_MS * MS;
+	c.wdog.period_ns = c.period_ns;
+	c.wdog.noncrit_factor = 1.5;
+	c.wdog.crit_factor = 2.5;
+	c.alive.hb_limit_ns = 125 * MS;
+	c.alive.sample_limit_ns = 125 * MS;
+	for (int i = 0; i < 3; i++) {
+		c.encpot[i].allowed_error = 0.5;
+		c.encpot[i].persistence_cycles = 1;
+		c.axis_names[i] = names[i];
+	}
+	c.fault_cmd_timeout_ms = 100;
+	c.mode_name = "development";
+	return c;
+}
+
+static int setup(void **state)
+{
+	struct re_io io = {&fake_ops, NULL};
+	struct re_super_cfg c = make_cfg();
+
+	(void)state;
+	memset(&fk, 0, sizeof(fk));
+	fk.now = 1000 * MS;
+	fk.delay_ns = MS / 10;
+	make_table();
+	make_record();
+	return re_super_init(&sup, &io, &c, tables, 1) == GL_OK ? 0 : -1;
+}
+
+/* One cycle: wait for the deadline, then run it. */
+static int step(void)
+{
+	re_super_wait(&sup);
+	return re_super_cycle(&sup);
+}
+
+static int run(int n)
+{
+	int v = RE_OK;
+
+	for (int i = 0; i < n && v != RE_FAULT; i++)
+		v = step();
+	return v;
+}
+
+static const char *fault_log(void)
+{
+	for (int i = 0; i < fk.n_logs; i++)
+		if (fk.log_level[i] == RE_LOG_FAULT)
+			return fk.logs[i];
+	return NULL;
+}
+
+/* ---- tests --------------------------------------------------------------- */
+
+/* A healthy controller: one QR round trip per cycle, heartbeat counting. */
+static void test_super_healthy_one_round_trip(void **state)
+{
+	(void)state;
+	assert_int_equal(run(100), RE_OK);
+	assert_int_equal(fk.n_records, 100);
+	assert_int_equal(fk.n_commands, 0);
+	assert_string_equal(fk.last_prefix, "hbpc=100");
+	assert_int_equal(fk.n_relay_off, 0);
+	assert_int_equal(fk.n_logs, 0);
+	assert_string_equal(re_super_fault_line(&sup), "");
+	/* the record deadline is what is left until the critical limit:
+	 * 125 ms after the last reply, which came 0.1 ms into the last cycle */
+	assert_int_equal(fk.last_timeout_ms, 76);
+}
+
+/* The reaction order: relay off, controller stop, log fsync'ed - in the
+ * cycle that sees the fault; ENCODER after persistence + 1 cycles. */
+static void test_super_encpot_fault_order(void **state)
+{
+	(void)state;
+	assert_int_equal(run(3), RE_OK);
+	set_pot(1, 2.5 + 0.1);	/* tolerance is 1.5 x 0.04 V = 0.06 V */
+	assert_int_equal(step(), RE_OK);	/* persistence 1: tolerated */
+	assert_int_equal(fk.n_relay_off, 0);
+	assert_int_equal(step(), RE_FAULT);
+	assert_string_equal(fk.seq, "relay_off,cmd:ST ABC;MO ABC;pcflt=1,"
+				    "log:FAULT");
+	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT ENCODER: ",
+			     15));
+	assert_non_null(strstr(re_super_fault_line(&sup), "Recovery: "));
+	assert_non_null(strstr(fault_log(), re_super_fault_line(&sup)));
+	assert_non_null(strstr(fault_log(), "relay off: confirmed"));
+	assert_non_null(strstr(fault_log(), "B enc=0"));
+}
+
+/* A single violating cycle between good ones never trips. */
+static void test_super_encpot_transient(void **state)
+{
+	(void)state;
+	for (int i = 0; i < 10; i++) {
+		set_pot(0, i % 2 ? 2.6 : 2.5);
+		assert_int_equal(step(), RE_OK);
+	}
+	assert_int_equal(fk.n_relay_off, 0);
+}
+
+/* Late reply between the limits: logged, not a fault. */
+static void test_super_watchdog_noncritical(void **state)
+{
+	(void)state;
+	assert_int_equal(run(2), RE_OK);
+	/* the reply comes 40 ms into the cycle: 89.9 ms after the last */
+	fk.delay_ns = 40 * MS;
+	assert_int_equal(step(), RE_WARN);
+	assert_int_equal(fk.n_logs, 1);
+	assert_int_equal(fk.log_level[0], RE_LOG_WARN);
+	assert_non_null(strstr(fk.logs[0], "watchdog: reply after 89.9 ms"));
+	fk.delay_ns = MS / 10;
+	assert_int_equal(step(), RE_OK);
+	assert_int_equal(fk.n_relay_off, 0);
+}
+
+/* No reply before the critical limit: WATCHDOG fault in that cycle. */
+static void test_super_watchdog_critical(void **state)
+{
+	(void)state;
+	assert_int_equal(run(2), RE_OK);
+	fk.record_rc = GL_ERR_TIMEOUT;
+	assert_int_equal(step(), RE_FAULT);
+	assert_int_equal(fk.last_timeout_ms, 76);	/* 125 - 49.9 */
+	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT WATCHDOG: ",
+			     16));
+	assert_int_equal(fk.n_relay_off, 1);
+}
+
+/* A closed connection: COMM fault. */
+static void test_super_comm_fault(void **state)
+{
+	(void)state;
+	fk.record_rc = GL_ERR_CLOSED;
+	assert_int_equal(step(), RE_FAULT);
+	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT COMM: ", 12));
+	assert_non_null(strstr(re_super_fault_line(&sup),
+			       gl_strerror(GL_ERR_CLOSED)));
+}
+
+/* Relay lost: ESTOP; the motors are switched off through the controller
+ * even though the relay cannot confirm "off". */
+static void test_super_relay_lost(void **state)
+{
+	(void)state;
+	assert_int_equal(run(2), RE_OK);
+	fk.relay_check_rc = GL_ERR_RELAY;
+	fk.relay_off_rc = GL_ERR_RELAY;
+	assert_int_equal(step(), RE_FAULT);
+	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT ESTOP: ", 13));
+	assert_string_equal(fk.commands[0], "ST ABC;MO ABC;pcflt=1");
+	assert_non_null(strstr(fault_log(), "relay off: NOT confirmed"));
+}
+
+/* A fault latched by the program (position error on B) is read from ZAB,
+ * its detail asked with MG fdet after the stop. */
+static void test_super_controller_fault(void **state)
+{
+	(void)state;
+	assert_int_equal(run(2), RE_OK);
+	fk.rec.axis[1].za = 2 + 10 * 4 + 1000 * 2;
+	fk.rec.axis[1].status |= GL_AXST_MOTOR_OFF;
+	snprintf(fk.mg_fdet, sizeof(fk.mg_fdet), " 5012.0000");
+	assert_int_equal(step(), RE_FAULT);
+	assert_string_equal(fk.commands[0], "ST ABC;MO ABC;pcflt=1");
+	assert_string_equal(fk.commands[1], "MG fdet");
+	assert_int_equal(sup.fault.id, RE_F_CTRL_POSERR);
+	assert_int_equal(sup.fault.axis, 1);
+	assert_int_equal(sup.fault.i[0], 5012);
+	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT MOTION: ",
+			     14));
+}
+
+/* A motor the controller switched off, seen before the program latched. */
+static void test_super_motor_off(void **state)
+{
+	(void)state;
+	assert_int_equal(run(2), RE_OK);
+	fk.rec.axis[2].status |= GL_AXST_MOTOR_OFF;
+	fk.rec.axis[2].stop_code = 12;
+	assert_int_equal(step(), RE_FAULT);
+	assert_int_equal(sup.fault.id, RE_F_MOTOR_OFF);
+	assert_int_equal(sup.fault.axis, 2);
+	assert_non_null(strstr(re_super_fault_line(&sup), "encoder failure"));
+}
+
+/* The motion thread stopped while armed. */
+static void test_super_thread_missing(void **state)
+{
+	(void)state;
+	assert_int_equal(run(2), RE_OK);
+	fk.rec.threads = 0x01;
+	assert_int_equal(step(), RE_FAULT);
+	assert_int_equal(sup.fault.id, RE_F_THREAD);
+	assert_int_equal(sup.fault.i[0], 1);
+}
+
+/* The program heartbeat stops: WATCHDOG after its limit, not before. */
+static void test_super_heartbeat_frozen(void **state)
+{
+	(void)state;
+	assert_int_equal(run(2), RE_OK);
+	fk.freeze_hb = 1;
+	assert_int_equal(run(2), RE_OK);	/* 100 ms frozen < 125 ms */
+	assert_int_equal(step(), RE_FAULT);	/* 150 ms */
+	assert_int_equal(sup.fault.id, RE_F_WDOG_HEARTBEAT);
+	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT WATCHDOG: ",
+			     16));
+}
+
+/* The record's sample number frozen (stale data from a live TCP stack). */
+static void test_super_sample_frozen(void **state)
+{
+	(void)state;
+	assert_int_equal(run(2), RE_OK);
+	fk.freeze_sample = 1;
+	assert_int_equal(run(10), RE_FAULT);
+	assert_int_equal(sup.fault.id, RE_F_WDOG_SAMPLE);
+}
+
+/* Once latched: no more reactions, no heartbeat, status polling only; a
+ * second fault is only logged. */
+static void test_super_latch(void **state)
+{
+	struct re_fault f;
+	struct re_status st;
+
+	(void)state;
+	fk.record_rc = GL_ERR_CLOSED;
+	assert_int_equal(step(), RE_FAULT);
+	fk.record_rc = GL_OK;
+	fk.relay_check_rc = GL_ERR_RELAY;
+	assert_int_equal(run(20), RE_OK);
+	assert_int_equal(fk.n_relay_off, 1);
+	assert_int_equal(fk.n_commands, 1);
+	assert_string_equal(fk.last_prefix, "(none)");
+	re_fault_set(&f, RE_F_ESTOP_LOST, -1);
+	assert_int_equal(re_super_fault(&sup, &f), RE_OK);
+	assert_int_equal(fk.n_relay_off, 1);
+	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT COMM: ", 12));
+	re_super_status(&sup, &st);
+	assert_int_equal(st.latched, 1);
+	assert_int_equal(st.armed, 0);
+	assert_int_equal(st.relay, RE_RELAY_OFF);
+}
+
+/* Absolute deadlines: a long cycle is one overrun and no burst after. */
+static void test_super_schedule_overrun(void **state)
+{
+	int64_t t;
+
+	(void)state;
+	assert_int_equal(run(4), RE_OK);
+	t = fk.now;
+	assert_int_equal(sup.overruns, 0);
+	fk.now += 120 * MS;		/* the process was held up */
+	re_super_wait(&sup);
+	assert_int_equal(sup.overruns, 1);
+	t = fk.now;
+	re_super_wait(&sup);		/* the next one is a full period on */
+	assert_int_equal(fk.now - t, PERIOD_MS * MS);
+	assert_int_equal(sup.overruns, 1);
+}
+
+/* The quit path: stop and motors off first, then the relay. */
+static void test_super_shutdown(void **state)
+{
+	(void)state;
+	assert_int_equal(run(2), RE_OK);
+	assert_int_equal(re_super_shutdown(&sup), GL_OK);
+	assert_string_equal(fk.seq, "cmd:ST ABC;MO ABC,relay_off");
+}
+
+/* Status snapshot: position %, pot against expected, limits, margin. */
+static void test_super_status(void **state)
+{
+	struct re_status st;
+
+	(void)state;
+	fk.rec.axis[0].motor_pos = 25000;
+	set_pot(0, 3.5);
+	fk.rec.axis[0].switches = GL_AXSW_RLS;	/* forward limit active */
+	assert_int_equal(step(), RE_OK);
+	re_super_status(&sup, &st);
+	assert_int_equal(st.axis[0].enc_counts, 25000);
+	assert_true(st.axis[0].pos_pct > 74.99 && st.axis[0].pos_pct < 75.01);
+	assert_true(st.axis[0].have_expect);
+	assert_true(st.axis[0].pot_expected_v > 3.499 &&
+		    st.axis[0].pot_expected_v < 3.501);
+	assert_true(st.axis[0].margin_v > 0.059 && st.axis[0].margin_v < 0.061);
+	assert_int_equal(st.axis[0].fwd_limit, 1);
+	assert_int_equal(st.axis[0].rev_limit, 0);
+	assert_int_equal(st.cycles, 1);
+}
+
+/* Unsolicited lines from the program go to the log. */
+static void test_super_messages_logged(void **state)
+{
+	(void)state;
+	fk.msgs[0] = "FAULT 4 2 5012";
+	fk.n_msgs = 1;
+	assert_int_equal(step(), RE_OK);
+	assert_int_equal(fk.n_logs, 1);
+	assert_string_equal(fk.logs[0], "controller: FAULT 4 2 5012");
+}
+
+/* No heap allocation in the cycle (wrapped malloc count and the arena). */
+static void test_super_no_alloc(void **state)
+{
+	struct mallinfo2 before, after;
+	long n0;
+
+	(void)state;
+	assert_int_equal(run(2), RE_OK);
+	before = mallinfo2();
+	n0 = n_allocs;
+	assert_int_equal(run(1000), RE_OK);
+	set_pot(0, 3.0);
+	assert_int_equal(run(5), RE_FAULT);
+	assert_int_equal(run(50), RE_OK);
+	after = mallinfo2();
+	assert_int_equal(n_allocs, n0);
+	assert_int_equal(after.uordblks, before.uordblks);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test_setup(test_super_healthy_one_round_trip,
+				       setup),
+		cmocka_unit_test_setup(test_super_encpot_fault_order, setup),
+		cmocka_unit_test_setup(test_super_encpot_transient, setup),
+		cmocka_unit_test_setup(test_super_watchdog_noncritical, setup),
+		cmocka_unit_test_setup(test_super_watchdog_critical, setup),
+		cmocka_unit_test_setup(test_super_comm_fault, setup),
+		cmocka_unit_test_setup(test_super_relay_lost, setup),
+		cmocka_unit_test_setup(test_super_controller_fault, setup),
+		cmocka_unit_test_setup(test_super_motor_off, setup),
+		cmocka_unit_test_setup(test_super_thread_missing, setup),
+		cmocka_unit_test_setup(test_super_heartbeat_frozen, setup),
+		cmocka_unit_test_setup(test_super_sample_frozen, setup),
+		cmocka_unit_test_setup(test_super_latch, setup),
+		cmocka_unit_test_setup(test_super_schedule_overrun, setup),
+		cmocka_unit_test_setup(test_super_shutdown, setup),
+		cmocka_unit_test_setup(test_super_status, setup),
+		cmocka_unit_test_setup(test_super_messages_logged, setup),
+		cmocka_unit_test_setup(test_super_no_alloc, setup),
+	};
+
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}

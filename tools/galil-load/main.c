@@ -1,0 +1,622 @@
+/*
+ * galil-load - check, preprocess, download, verify, burn and start DMC
+ * programs on a Galil controller; send diagnostic commands.
+ *
+ *   galil-load [-a HOST[:PORT]] [options] FILE.dmc...|DIR
+ *
+ * See docs/galil-load.1 and docs/galil-load.md. Every step that touches the
+ * controller comes after the offline check has passed; a failed download or
+ * read-back leaves the controller halted and empty.
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <limits.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "gl_err.h"
+#include "gl_link.h"
+#include "gload_check.h"
+#include "gload_dl.h"
+#include "gload_prep.h"
+
+#define DEFAULT_TIMEOUT_MS 5000 /* gclib's default [galil-notes 1.6] */
+#define MAX_COMMANDS	   64
+
+struct opts {
+	const char *addr;
+	const struct gload_model *model;
+	int check_only;
+	int burn;
+	int start;
+	int force;
+	int timeout_ms;
+	char start_label[GLOAD_LABEL_MAX + 1];
+	const char *output;
+	const char *cmds[MAX_COMMANDS];
+	int ncmds;
+	char **paths;
+	int npaths;
+};
+
+static const char usage_text[] =
+    "usage: galil-load [-a HOST[:PORT]] [options] FILE.dmc...|DIR\n"
+    "\n"
+    "  -a, --address HOST[:PORT]  controller (default port 23)\n"
+    "      --check                check and preprocess only; no controller\n"
+    "  -m, --model MODEL          limits of 40x0 (default), 41x3, 21x3, 30010\n"
+    "  -o, --output FILE          also write the stamped program to FILE\n"
+    "  -f, --force                download even if the controller already\n"
+    "                             holds the same program\n"
+    "      --burn                 burn the program to flash (BP) after the\n"
+    "                             read-back; #AUTO then runs at power-up\n"
+    "      --start[=LABEL]        start LABEL (default AUTO) in thread 0 and\n"
+    "                             confirm it runs\n"
+    "      --no-start             do not start the program (the default)\n"
+    "  -c, --command CMD          send CMD and print the reply (repeatable;\n"
+    "                             after any download)\n"
+    "  -t, --timeout MS           reply timeout (default 5000; DL, UL and BP\n"
+    "                             take at least 10000)\n"
+    "  -h, --help                 this text\n"
+    "\n"
+    "A DIR is loaded through DIR/MANIFEST (one file name per line, '#'\n"
+    "comments). Exit: 0 ok, 1 check failed, 2 usage, 3 connection,\n"
+    "4 controller rejected or verify failed.\n";
+
+static int usage_error(const char *fmt, ...)
+    __attribute__((format(printf, 1, 2)));
+
+static int usage_error(const char *fmt, ...)
+{
+	va_list ap;
+
+	fprintf(stderr, "galil-load: ");
+	va_start(ap, fmt);
+	vfprintf(stderr, fmt, ap);
+	va_end(ap);
+	fprintf(stderr, "\n%s", usage_text);
+	return GLOAD_EXIT_USAGE;
+}
+
+static int parse_int(const char *s, int lo, int hi, int *out)
+{
+	char *end;
+	long v;
+
+	errno = 0;
+	v = strtol(s, &end, 10);
+	if (errno || end == s || *end || v < lo || v > hi)
+		return -1;
+	*out = (int)v;
+	return 0;
+}
+
+static int set_start_label(struct opts *o, const char *arg)
+{
+	size_t i, n;
+
+	o->start = 1;
+	if (!arg)
+		arg = "AUTO";
+	if (arg[0] == '#')
+		arg++;
+	n = strlen(arg);
+	if (n == 0 || n > GLOAD_LABEL_MAX ||
+	    !((arg[0] >= 'A' && arg[0] <= 'Z') ||
+	      (arg[0] >= 'a' && arg[0] <= 'z')))
+		return -1;
+	for (i = 0; i < n; i++)
+		if (!(arg[i] == '_' || (arg[i] >= '0' && arg[i] <= '9') ||
+		      (arg[i] >= 'A' && arg[i] <= 'Z') ||
+		      (arg[i] >= 'a' && arg[i] <= 'z')))
+			return -1;
+	memcpy(o->start_label, arg, n + 1);
+	return 0;
+}
+
+static int add_command(struct opts *o, const char *cmd)
+{
+	static const char *const refused[] = {"DL", "UL", "ED",
+					      "QD", "QU", "QR"};
+	size_t i;
+
+	if (o->ncmds == MAX_COMMANDS)
+		return usage_error("too many -c commands (at most %d)",
+				   MAX_COMMANDS);
+	if (strlen(cmd) == 0 || strlen(cmd) > GL_LINE_MAX)
+		return usage_error("command '%s' is empty or longer than 80 "
+				   "characters",
+				   cmd);
+	if (strchr(cmd, '\r') || strchr(cmd, '\n'))
+		return usage_error("command '%s' holds a line end", cmd);
+	for (i = 0; i < sizeof(refused) / sizeof(refused[0]); i++)
+		if (!strncmp(cmd, refused[i], 2))
+			return usage_error("'%s' cannot be sent with -c "
+					   "(give program files to download)",
+					   cmd);
+	o->cmds[o->ncmds++] = cmd;
+	return 0;
+}
+
+enum { OPT_CHECK = 256, OPT_BURN, OPT_START, OPT_NO_START };
+
+static const struct option long_opts[] = {
+    {"address", required_argument, NULL, 'a'},
+    {"check", no_argument, NULL, OPT_CHECK},
+    {"model", required_argument, NULL, 'm'},
+    {"output", required_argument, NULL, 'o'},
+    {"force", no_argument, NULL, 'f'},
+    {"burn", no_argument, NULL, OPT_BURN},
+    {"start", optional_argument, NULL, OPT_START},
+    {"no-start", no_argument, NULL, OPT_NO_START},
+    {"command", required_argument, NULL, 'c'},
+    {"timeout", required_argument, NULL, 't'},
+    {"help", no_argument, NULL, 'h'},
+    {NULL, 0, NULL, 0},
+};
+
+/* One option; return 0, -1 for --help, or an exit code. */
+static int parse_opt(struct opts *o, int ch, const char *arg)
+{
+	switch (ch) {
+	case 'a': o->addr = arg; return 0;
+	case OPT_CHECK: o->check_only = 1; return 0;
+	case 'o': o->output = arg; return 0;
+	case 'f': o->force = 1; return 0;
+	case OPT_BURN: o->burn = 1; return 0;
+	case OPT_NO_START: o->start = 0; return 0;
+	case 'c': return add_command(o, arg);
+	case 'h': return -1;
+	case 'm':
+		o->model = gload_model_find(arg);
+		return o->model ? 0
+				: usage_error("unknown model '%s' (40x0, "
+					      "41x3, 21x3, 30010)",
+					      arg);
+	case 't':
+		return parse_int(arg, 1, 600000, &o->timeout_ms)
+			   ? usage_error("invalid timeout '%s' (1..600000 "
+					 "ms)",
+					 arg)
+			   : 0;
+	case OPT_START:
+		return set_start_label(o, arg)
+			   ? usage_error("invalid label '%s' for --start", arg)
+			   : 0;
+	}
+	return usage_error("%s", "unknown option");
+}
+
+/* Combinations that make no sense or would be unsafe. */
+static int check_combination(const struct opts *o)
+{
+	if (o->check_only && (o->ncmds || o->burn || o->start))
+		return usage_error("%s",
+				   "--check does not talk to a "
+				   "controller; drop -c, --burn and --start");
+	if (o->check_only && o->npaths == 0)
+		return usage_error("%s", "--check needs program files");
+	if (o->npaths == 0 && (o->burn || o->start || o->output))
+		return usage_error("%s",
+				   "--burn, --start and -o need program "
+				   "files (only a checked program is burned or "
+				   "started)");
+	if (o->npaths == 0 && o->ncmds == 0)
+		return usage_error("%s", "no program files and no commands");
+	if (!o->check_only && !o->addr)
+		return usage_error("%s", "no controller address (-a HOST); use "
+					 "--check to check offline");
+	return 0;
+}
+
+/* Return 0 to go on, -1 for --help, or an exit code. */
+static int parse_args(int argc, char **argv, struct opts *o)
+{
+	int ch, rc;
+
+	memset(o, 0, sizeof(*o));
+	o->model = gload_model_default();
+	o->timeout_ms = DEFAULT_TIMEOUT_MS;
+	opterr = 0;
+	while ((ch = getopt_long(argc, argv, ":a:m:o:fc:t:h", long_opts,
+				 NULL)) != -1) {
+		if (ch == '?' || ch == ':')
+			return usage_error("invalid or incomplete option '%s'",
+					   argv[optind - 1]);
+		rc = parse_opt(o, ch, optarg);
+		if (rc)
+			return rc;
+	}
+	o->paths = argv + optind;
+	o->npaths = argc - optind;
+	return check_combination(o);
+}
+
+static void print_diags(struct gload_diags *d)
+{
+	int i;
+
+	gload_diags_sort(d);
+	for (i = 0; i < d->n; i++)
+		fprintf(stderr, "%s\n", d->v[i].text);
+	if (d->dropped)
+		fprintf(stderr,
+			"galil-load: %d more problems (out of memory)\n",
+			d->dropped);
+}
+
+/* Write the stamped program to @path through a temporary file. */
+static int write_output(const char *path, const struct gload_prog *p)
+{
+	char tmp[PATH_MAX];
+	FILE *f;
+	int ok;
+
+	if (snprintf(tmp, sizeof(tmp), "%s.tmp%ld", path, (long)getpid()) >=
+	    (int)sizeof(tmp))
+		return -1;
+	f = fopen(tmp, "wb");
+	if (!f)
+		goto out_err;
+	ok = fwrite(p->text, 1, p->text_len, f) == p->text_len;
+	ok = (fclose(f) == 0) && ok;
+	if (ok && rename(tmp, path) == 0)
+		return 0;
+	unlink(tmp);
+out_err:
+	fprintf(stderr, "galil-load: cannot write '%s': %s\n", path,
+		strerror(errno));
+	return -1;
+}
+
+static void print_sizes(const struct gload_prog *p,
+			const struct gload_stats *st, const struct opts *o)
+{
+	printf("source: %d file%s, %ld lines, %zu bytes\n", p->nfiles,
+	       p->nfiles == 1 ? "" : "s", p->src_lines, p->src_bytes);
+	printf("program: %d lines, %zu bytes with the identity line '%s'\n",
+	       st->lines, p->text_len, p->stamp);
+	printf("check: ok (%s%s: %d/%d lines, %d/%d labels, %d/%d "
+	       "variables)\n",
+	       o->model->title,
+	       o->model->confirmed ? "" : ", unconfirmed limits", st->lines,
+	       o->model->max_lines, st->labels, o->model->max_labels, st->vars,
+	       o->model->max_vars);
+}
+
+/* Read, preprocess, check and stamp. Return 0 or an exit code. */
+static int prepare(const struct opts *o, struct gload_prog *p)
+{
+	struct gload_diags d = {0};
+	struct gload_stats st;
+	int i, rc = 0, n;
+
+	for (i = 0; i < o->npaths; i++)
+		if (gload_prep_path(p, o->paths[i], &d) != GL_OK)
+			rc = GLOAD_EXIT_CHECK;
+	if (rc == 0) {
+		n = gload_check(p, o->model, &d, &st);
+		if (n != 0 || d.n > 0)
+			rc = GLOAD_EXIT_CHECK;
+	}
+	if (rc == 0 && gload_prog_finish(p) != GL_OK)
+		rc = GLOAD_EXIT_CHECK;
+	print_diags(&d);
+	if (rc)
+		fprintf(stderr,
+			"galil-load: check failed (%d problem%s); "
+			"nothing was sent to the controller\n",
+			d.n, d.n == 1 ? "" : "s");
+	gload_diags_free(&d);
+	if (rc == 0 && o->start && !gload_prog_has_label(p, o->start_label)) {
+		fprintf(stderr,
+			"galil-load: --start: the program has no "
+			"label '#%s'\n",
+			o->start_label);
+		rc = GLOAD_EXIT_USAGE;
+	}
+	if (rc == 0)
+		print_sizes(p, &st, o);
+	if (rc == 0 && o->output && write_output(o->output, p))
+		rc = GLOAD_EXIT_CHECK;
+	return rc;
+}
+
+/* The timeout of DL, UL and BP: at least GLOAD_SLOW_TIMEOUT_MS. */
+static int slow_ms(const struct opts *o)
+{
+	return o->timeout_ms > GLOAD_SLOW_TIMEOUT_MS ? o->timeout_ms
+						     : GLOAD_SLOW_TIMEOUT_MS;
+}
+
+/* Say why a link call failed; return the exit code. */
+static int link_failed(gl_link *l, const char *what, int rc, int timeout_ms)
+{
+	int code = 0;
+
+	if (rc == GL_ERR_CTRL) {
+		const char *text = gl_link_ctrl_error(l, &code);
+
+		fprintf(stderr, "galil-load: controller rejected %s: %d %s\n",
+			what, code, text);
+	} else if (rc == GL_ERR_TIMEOUT) {
+		fprintf(stderr, "galil-load: no reply to %s within %d ms\n",
+			what, timeout_ms);
+	} else {
+		fprintf(stderr, "galil-load: %s failed: %s\n", what,
+			gl_strerror(rc));
+	}
+	return gload_exit_for(rc);
+}
+
+static int open_link(const struct opts *o, gl_link **l)
+{
+	char err[GL_ERRTEXT_LEN] = "";
+	int rc = gl_link_open(l, o->addr, o->timeout_ms, err);
+
+	if (rc != GL_OK) {
+		fprintf(stderr, "galil-load: %s\n",
+			err[0] ? err : gl_strerror(rc));
+		*l = NULL;
+		return GLOAD_EXIT_CONN;
+	}
+	return 0;
+}
+
+/* Leave the controller halted and empty after a failed download. */
+static void erase_after_failure(gl_link **l, const struct opts *o)
+{
+	int rc = *l ? gload_dl_erase(*l, o->timeout_ms) : GL_ERR_CLOSED;
+	char failed[GLOAD_CMD_LEN];
+	int running;
+
+	if (rc != GL_OK && rc != GL_ERR_MISMATCH) {
+		gl_link_close(*l);
+		*l = NULL;
+		if (open_link(o, l) == 0) {
+			rc = gload_dl_halt(*l, o->model->threads, &running,
+					   failed, o->timeout_ms);
+			if (rc == GL_OK)
+				rc = gload_dl_erase(*l, o->timeout_ms);
+		}
+	}
+	if (rc == GL_OK)
+		fprintf(stderr, "galil-load: the controller is halted and its "
+				"program erased\n");
+	else
+		fprintf(stderr,
+			"galil-load: could not erase the controller "
+			"(%s): it may hold a partial program; do not start "
+			"it; run galil-load again\n",
+			gl_strerror(rc));
+}
+
+static void print_bad_line(const struct gload_prog *p, int bad)
+{
+	if (bad >= 1 && bad <= p->nlines) {
+		const struct gload_line *ln = &p->lines[bad - 1];
+
+		fprintf(stderr,
+			"%s:%d: the controller rejected program line "
+			"%d '%s' or a line before it\n",
+			p->files[ln->file], ln->src_line, bad, ln->text);
+	} else if (bad == p->nlines + 1) {
+		fprintf(stderr,
+			"galil-load: the controller rejected the "
+			"identity line %d '%s' or a line before it\n",
+			bad, p->stamp);
+	} else {
+		fprintf(stderr, "galil-load: the controller did not say which "
+				"line it rejected\n");
+	}
+}
+
+/* Download and read back. Return 0 or an exit code (controller erased). */
+static int download(gl_link **l, const struct opts *o,
+		    const struct gload_prog *p, char *ul)
+{
+	int rc, bad = 0, line = 0;
+
+	printf("downloading %d lines to %s\n", p->nlines + 1, o->addr);
+	rc = gload_dl_download(*l, p->text, p->text_len, &bad, o->timeout_ms);
+	if (rc != GL_OK) {
+		int ex = link_failed(*l, "the download (DL)", rc, slow_ms(o));
+
+		if (rc == GL_ERR_CTRL)
+			print_bad_line(p, bad);
+		erase_after_failure(l, o);
+		return ex;
+	}
+	rc = gload_dl_upload(*l, ul, GLOAD_UPLOAD_CAP, o->timeout_ms);
+	if (rc >= 0)
+		rc = gload_dl_compare(p->text, p->text_len, ul, (size_t)rc,
+				      &line);
+	if (rc == GL_ERR_MISMATCH)
+		fprintf(stderr,
+			"galil-load: verify failed: the program read "
+			"back (UL) differs at line %d\n",
+			line);
+	else if (rc != GL_OK)
+		link_failed(*l, "the read-back (UL)", rc, slow_ms(o));
+	if (rc != GL_OK) {
+		erase_after_failure(l, o);
+		return rc == GL_ERR_MISMATCH ? GLOAD_EXIT_CTRL
+					     : gload_exit_for(rc);
+	}
+	printf("verified: the read-back matches, identity %016llX\n",
+	       (unsigned long long)p->id);
+	return 0;
+}
+
+/* 1 when the controller already holds exactly this program. */
+static int same_program(gl_link *l, const struct opts *o,
+			const struct gload_prog *p, char *ul, int *ex)
+{
+	int rc, line;
+
+	*ex = 0;
+	rc = gload_dl_upload(l, ul, GLOAD_UPLOAD_CAP, o->timeout_ms);
+	if (rc == GL_ERR_CTRL || rc == GL_ERR_OVERFLOW)
+		return 0;
+	if (rc < 0) {
+		*ex = link_failed(l, "the upload (UL)", rc, slow_ms(o));
+		return 0;
+	}
+	return gload_dl_compare(p->text, p->text_len, ul, (size_t)rc, &line) ==
+	       GL_OK;
+}
+
+static int identify_and_halt(gl_link *l, const struct opts *o)
+{
+	char model[128] = "", failed[GLOAD_CMD_LEN], what[GLOAD_CMD_LEN + 16];
+	long serial = 0;
+	int rc, running = -1;
+
+	rc = gl_link_identify(l, model, sizeof(model), &serial);
+	if (rc == GL_OK)
+		printf("controller: %s, serial %ld\n", model, serial);
+	else if (rc != GL_ERR_CTRL)
+		return link_failed(l, "identification (^R^V, MG _BN)", rc,
+				   o->timeout_ms);
+	rc = gload_dl_halt(l, o->model->threads, &running, failed,
+			   o->timeout_ms);
+	if (rc == GL_ERR_MISMATCH) {
+		fprintf(stderr,
+			"galil-load: thread %d still runs after "
+			"HX%d\n",
+			running, running);
+		return GLOAD_EXIT_CTRL;
+	}
+	snprintf(what, sizeof(what), "'%s'", failed);
+	if (rc != GL_OK)
+		return link_failed(l, what, rc, o->timeout_ms);
+	printf("halted: threads stopped, axes stopped, motors off\n");
+	return 0;
+}
+
+static int burn_and_start(gl_link *l, const struct opts *o)
+{
+	double xq0 = -1;
+	char what[64];
+	int rc;
+
+	if (o->burn) {
+		rc = gload_dl_burn(l, o->timeout_ms);
+		if (rc != GL_OK)
+			return link_failed(l, "the burn (BP)", rc, slow_ms(o));
+		printf("burned: #AUTO runs at power-up\n");
+	}
+	if (!o->start)
+		return 0;
+	snprintf(what, sizeof(what), "'XQ #%s,0'", o->start_label);
+	rc = gload_dl_start(l, o->start_label, &xq0, o->timeout_ms);
+	if (rc == GL_ERR_MISMATCH) {
+		fprintf(stderr,
+			"galil-load: thread 0 is not running after "
+			"%s (_XQ0 = -1)\n",
+			what);
+		return GLOAD_EXIT_CTRL;
+	}
+	if (rc != GL_OK)
+		return link_failed(l, what, rc, o->timeout_ms);
+	printf("started: #%s in thread 0 (at line %.0f)\n", o->start_label,
+	       xq0);
+	return 0;
+}
+
+static int load(gl_link **l, const struct opts *o, const struct gload_prog *p)
+{
+	char *ul = malloc(GLOAD_UPLOAD_CAP);
+	int ex, same;
+
+	if (!ul) {
+		fprintf(stderr, "galil-load: out of memory\n");
+		return GLOAD_EXIT_CONN;
+	}
+	ex = identify_and_halt(*l, o);
+	if (ex)
+		goto out_free;
+	same = !o->force && same_program(*l, o, p, ul, &ex);
+	if (ex)
+		goto out_free;
+	if (same)
+		printf("unchanged: the controller already holds this program "
+		       "(identity %016llX); not downloaded\n",
+		       (unsigned long long)p->id);
+	else
+		ex = download(l, o, p, ul);
+	if (!ex)
+		ex = burn_and_start(*l, o);
+out_free:
+	free(ul);
+	return ex;
+}
+
+/* The reply as text lines; nothing for a command that returns no data. */
+static void print_reply(const char *s)
+{
+	if (!*s)
+		return;
+	for (; *s; s++)
+		if (*s != '\r')
+			putchar(*s);
+	putchar('\n');
+}
+
+static int run_commands(gl_link *l, const struct opts *o)
+{
+	static char resp[64 * 1024];
+	char what[GL_LINE_MAX + 8];
+	int i, rc, tmo;
+
+	for (i = 0; i < o->ncmds; i++) {
+		const char *c = o->cmds[i];
+
+		/* burns and BZ pause the controller [galil-notes 1.6] */
+		tmo = (c[0] == 'B' && c[1] && strchr("PNVZ", c[1]))
+			  ? GLOAD_SLOW_TIMEOUT_MS
+			  : o->timeout_ms;
+		if (tmo < o->timeout_ms)
+			tmo = o->timeout_ms;
+		rc = gl_link_command(l, c, resp, sizeof(resp), tmo);
+		snprintf(what, sizeof(what), "'%s'", c);
+		if (rc < 0)
+			return link_failed(l, what, rc, tmo);
+		print_reply(resp);
+	}
+	return 0;
+}
+
+int main(int argc, char **argv)
+{
+	struct gload_prog p = {0};
+	struct opts o;
+	gl_link *l = NULL;
+	int ex;
+
+	setvbuf(stdout, NULL, _IOLBF, 0);
+	ex = parse_args(argc, argv, &o);
+	if (ex == -1) {
+		fputs(usage_text, stdout);
+		return 0;
+	}
+	if (ex)
+		return ex;
+	if (o.npaths > 0)
+		ex = prepare(&o, &p);
+	if (ex || o.check_only)
+		goto out_free;
+	fflush(stdout);
+	ex = open_link(&o, &l);
+	if (!ex && o.npaths > 0)
+		ex = load(&l, &o, &p);
+	if (!ex && l)
+		ex = run_commands(l, &o);
+	gl_link_close(l);
+out_free:
+	gload_prog_free(&p);
+	return ex;
+}

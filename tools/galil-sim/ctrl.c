@@ -1,0 +1,400 @@
+/*
+ * ctrl.c - the simulated DMC-4030: life cycle, one servo sample, burning
+ * (BP/BN/BV) and the simulated power cycle, and the small public getters.
+ */
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ctrl_int.h"
+#include "gl_err.h"
+
+#define DEFAULT_MODEL "DMC4030 Rev 1.2h-sim"
+
+void ctrl_event(struct ctrl *c, const char *fmt, ...)
+{
+	char line[200];
+	va_list ap;
+
+	if (!c->cfg.event)
+		return;
+	va_start(ap, fmt);
+	vsnprintf(line, sizeof(line), fmt, ap);
+	va_end(ap);
+	c->cfg.event(c->cfg.event_ud, line);
+}
+
+/* ctrl_axis_defaults() - factory settings (DMC-40x0 command reference). */
+void ctrl_axis_defaults(struct ctrl_axis_par *p)
+{
+	memset(p, 0, sizeof(*p));
+	p->sp = 25000;
+	p->ac = 256000;
+	p->dc = 256000;
+	p->sd = 256000;
+	p->kp = 6;
+	p->kd = 64;
+	p->tl = 9.9982;
+	p->il = 9.9982;
+	p->ov = 0.9438;
+	p->er = 16384;
+	p->fl = 2147483647.0;
+	p->bl = -2147483648.0;
+	p->ot = 30;
+	p->tw = 32766;
+	p->motor_off = 1;	/* simulator choice: see the docs */
+}
+
+static void settings_defaults(struct ctrl *c)
+{
+	const struct ctrl_flash *f = &c->flash;
+	int i;
+
+	c->cf = CTRL_SERIAL;
+	c->cw_hibit = f->have_par ? f->cw_hibit : 0;
+	c->cw_drop = f->have_par ? f->cw_drop : 0;
+	c->cn0 = f->have_par ? f->cn0 : -1;
+	c->sample_us = f->have_par ? f->sample_us :
+		       c->cfg.sample_us > 0 ? c->cfg.sample_us : 1000;
+	c->vf_m = f->have_par ? f->vf_m : 10;
+	c->vf_n = f->have_par ? f->vf_n : 4;
+	c->pf_m = f->have_par ? f->pf_m : 10;
+	c->pf_n = f->have_par ? f->pf_n : 0;
+	c->lz = f->have_par ? f->lz : 1;
+	c->outputs = f->have_par ? f->outputs : 0;
+	for (i = 0; i < 8; i++)
+		c->axdes[i] = i;
+}
+
+static void axes_power_up(struct ctrl *c)
+{
+	int i;
+
+	for (i = 0; i < CTRL_AXES; i++) {
+		struct ctrl_axis *a = &c->ax[i];
+
+		memset(a, 0, sizeof(*a));
+		if (c->flash.have_par)
+			a->p = c->flash.ax[i];
+		else
+			ctrl_axis_defaults(&a->p);
+		a->jg = 25000;
+		a->next_mode = CTRL_MODE_PR;
+	}
+}
+
+/* RAM as after power-up: burned program, parameters and variables. */
+static void power_up(struct ctrl *c)
+{
+	c->time = 0;
+	memset(c->th, 0, sizeof(c->th));
+	memset(c->autosub_pend, 0, sizeof(c->autosub_pend));
+	c->tc = 0;
+	c->ed_line = 0;
+	c->ed_thread = -1;
+	c->ia4 = -1;
+	c->ta0 = 0;
+	settings_defaults(c);
+	axes_power_up(c);
+	ctrl_prog_free(&c->prog);
+	if (c->flash.have_prog && ctrl_prog_copy(&c->prog, &c->flash.prog))
+		ctrl_event(c, "power-up: cannot restore the burned program");
+	ctrl_vars_clear(&c->vars);
+	if (c->flash.have_vars && ctrl_vars_copy(&c->vars, &c->flash.vars))
+		ctrl_event(c, "power-up: cannot restore the burned variables");
+	c->zero_pending = 1;
+	c->auto_pending = 1;
+	ctrl_proto_reset(c);
+}
+
+struct ctrl *ctrl_new(const struct ctrl_cfg *cfg)
+{
+	struct ctrl *c = calloc(1, sizeof(*c));
+
+	if (!c)
+		return NULL;
+	if (cfg)
+		c->cfg = *cfg;
+	snprintf(c->model, sizeof(c->model), "%s",
+		 c->cfg.model ? c->cfg.model : DEFAULT_MODEL);
+	c->cfg.model = c->model;
+	c->lines_per_sample = CTRL_LINES_PER_SAMPLE;
+	power_up(c);
+	return c;
+}
+
+void ctrl_free(struct ctrl *c)
+{
+	int h;
+
+	if (!c)
+		return;
+	ctrl_prog_free(&c->prog);
+	ctrl_prog_free(&c->flash.prog);
+	ctrl_vars_clear(&c->vars);
+	ctrl_vars_clear(&c->flash.vars);
+	for (h = 0; h < CTRL_NHANDLES; h++) {
+		ctrl_buf_free(&c->h[h].out);
+		ctrl_buf_free(&c->h[h].dl);
+	}
+	ctrl_buf_free(&c->serial);
+	ctrl_buf_free(&c->tmp);
+	free(c);
+}
+
+/* #AUTO of the program in memory starts in thread 0 at power-up. */
+static void start_auto(struct ctrl *c)
+{
+	uint64_t key;
+	int line;
+
+	c->auto_pending = 0;
+	if (ctrl_name_key("AUTO", 4, &key))
+		return;
+	line = ctrl_prog_label(&c->prog, key);
+	if (line < 0)
+		return;
+	ctrl_thread_start(c, 0, c->prog.first[line]);
+	ctrl_event(c, "#AUTO started in thread 0 at line %d", line);
+}
+
+void ctrl_step(struct ctrl *c, const struct ctrl_sense *in,
+	       struct ctrl_drive *out)
+{
+	if (!c || !in || !out)
+		return;
+	ctrl_motion_sense(c, in);
+	ctrl_motion_sample(c);
+	if (c->auto_pending)
+		start_auto(c);
+	ctrl_threads_run(c);
+	ctrl_motion_drive(c, out);
+	c->time++;
+}
+
+double ctrl_sample_ms(const struct ctrl *c)
+{
+	return c ? c->sample_us / 1000.0 : 1.0;
+}
+
+void ctrl_set_line_budget(struct ctrl *c, int lines_per_sample)
+{
+	if (!c)
+		return;
+	if (lines_per_sample < 1)
+		lines_per_sample = 1;
+	if (lines_per_sample > 1000)
+		lines_per_sample = 1000;
+	c->lines_per_sample = lines_per_sample;
+}
+
+/* ---- burning and power ---------------------------------------------- */
+
+int ctrl_burn_program(struct ctrl *c)
+{
+	if (ctrl_prog_copy(&c->flash.prog, &c->prog))
+		return -1;
+	c->flash.have_prog = 1;
+	ctrl_event(c, "program burned (BP): %d lines", c->prog.nlines);
+	return 0;
+}
+
+void ctrl_burn_params(struct ctrl *c)
+{
+	struct ctrl_flash *f = &c->flash;
+	int i;
+
+	for (i = 0; i < CTRL_AXES; i++)
+		f->ax[i] = c->ax[i].p;
+	f->cw_hibit = c->cw_hibit;
+	f->cw_drop = c->cw_drop;
+	f->cn0 = c->cn0;
+	f->sample_us = c->sample_us;
+	f->vf_m = c->vf_m;
+	f->vf_n = c->vf_n;
+	f->pf_m = c->pf_m;
+	f->pf_n = c->pf_n;
+	f->lz = c->lz;
+	f->outputs = c->outputs;
+	f->have_par = 1;
+	ctrl_event(c, "parameters burned (BN)");
+}
+
+int ctrl_burn_vars(struct ctrl *c)
+{
+	if (ctrl_vars_copy(&c->flash.vars, &c->vars))
+		return -1;
+	c->flash.have_vars = 1;
+	ctrl_event(c, "variables burned (BV)");
+	return 0;
+}
+
+void ctrl_power_cycle(struct ctrl *c)
+{
+	if (!c)
+		return;
+	ctrl_event(c, "power cycle");
+	power_up(c);
+}
+
+/* ---- programs -------------------------------------------------------- */
+
+/*
+ * ctrl_load_program() - replace program memory; on a refused text the
+ * memory is left empty. Return 0 or the TC code (TC is set too).
+ */
+int ctrl_load_program(struct ctrl *c, const char *text, size_t len,
+		      int *bad_line)
+{
+	struct ctrl_prog np;
+	int rc, tc;
+
+	memset(&np, 0, sizeof(np));
+	rc = ctrl_prog_load(&np, text, len, bad_line, &tc);
+	ctrl_prog_free(&c->prog);
+	if (rc) {
+		tc = rc < 0 ? 60 : tc;
+		c->tc = tc;
+		ctrl_event(c, "download refused: line %d TC %d %s (program "
+			      "memory erased)", *bad_line, tc,
+			   ctrl_tc_text(tc));
+		return tc;
+	}
+	c->prog = np;
+	ctrl_event(c, "program loaded: %d lines, %d labels", np.nlines,
+		   np.nlabels);
+	return 0;
+}
+
+int ctrl_download(struct ctrl *c, const char *text, size_t len, int *bad_line)
+{
+	int bad = 0;
+
+	if (!c || (!text && len))
+		return GL_ERR_ARG;
+	if (ctrl_any_running(c)) {
+		c->tc = 17;
+		return GL_ERR_CTRL;
+	}
+	if (ctrl_load_program(c, text ? text : "", len, &bad)) {
+		if (bad_line)
+			*bad_line = bad;
+		return GL_ERR_CTRL;
+	}
+	return GL_OK;
+}
+
+int ctrl_command(struct ctrl *c, const char *line, char *resp, size_t cap)
+{
+	struct ctrl_handle *hd;
+	size_t n = 0;
+	int errors;
+
+	if (!c || !line)
+		return GL_ERR_ARG;
+	hd = &c->h[CTRL_PRIV_HANDLE];
+	if (!hd->open)
+		ctrl_handle_open(c, CTRL_PRIV_HANDLE);
+	ctrl_buf_clear(&hd->out);
+	if (strlen(line) > CTRL_LINE_MAX) {
+		hd->overflow = 1;
+		hd->semis = 0;
+	}
+	errors = ctrl_proto_host(c, CTRL_PRIV_HANDLE, line);
+	if (resp && cap) {
+		n = ctrl_buf_take(&hd->out, (uint8_t *)resp, cap - 1);
+		if (n && resp[n - 1] == ':')
+			n--;
+		resp[n] = '\0';
+	}
+	ctrl_buf_clear(&hd->out);
+	return errors ? GL_ERR_CTRL : GL_OK;
+}
+
+/* ---- variables and state ----------------------------------------------- */
+
+/* "name" or "name[i]": the storage, or NULL. */
+static double *var_ref(struct ctrl *c, const char *name, int create)
+{
+	size_t n = ctrl_ident_len(name);
+	struct ctrl_array *arr;
+	uint64_t key;
+	char *end;
+	long i;
+	int slot;
+
+	if (ctrl_name_key(name, n, &key))
+		return NULL;
+	if (name[n] == '[') {
+		arr = ctrl_array_find(&c->vars, key);
+		i = strtol(name + n + 1, &end, 10);
+		if (!arr || end == name + n + 1 || strcmp(end, "]") ||
+		    i < 0 || i >= arr->n)
+			return NULL;
+		return &arr->v[i];
+	}
+	if (name[n] != '\0')
+		return NULL;
+	slot = ctrl_var_find(&c->vars, key);
+	if (slot < 0 && create && !ctrl_var_set(&c->vars, key, 0, &slot))
+		return &c->vars.slot[slot].v;
+	return slot < 0 ? NULL : &c->vars.slot[slot].v;
+}
+
+int ctrl_get_var(const struct ctrl *c, const char *name, double *v)
+{
+	double *p;
+
+	if (!c || !name || !v)
+		return GL_ERR_ARG;
+	p = var_ref((struct ctrl *)c, name, 0);
+	if (!p)
+		return GL_ERR_NOENT;
+	*v = *p;
+	return GL_OK;
+}
+
+int ctrl_set_var(struct ctrl *c, const char *name, double v)
+{
+	double *p;
+
+	if (!c || !name)
+		return GL_ERR_ARG;
+	p = var_ref(c, name, 1);
+	if (!p)
+		return GL_ERR_NOENT;
+	*p = ctrl_fx(v);
+	return GL_OK;
+}
+
+int ctrl_axis_info(const struct ctrl *c, int axis, struct ctrl_axis_info *out)
+{
+	const struct ctrl_axis *a;
+
+	if (!c || !out || axis < 0 || axis >= CTRL_AXES)
+		return GL_ERR_ARG;
+	a = &c->ax[axis];
+	out->ref = a->ref;
+	out->enc = a->enc;
+	out->vel = a->vel;
+	out->motor_off = a->p.motor_off;
+	out->moving = a->profiling;
+	out->stop_code = a->stop_code;
+	out->fwd_limit = a->lim_f;
+	out->rev_limit = a->lim_r;
+	return GL_OK;
+}
+
+unsigned ctrl_threads(const struct ctrl *c)
+{
+	unsigned m = 0;
+	int t;
+
+	if (!c)
+		return 0;
+	for (t = 0; t < CTRL_THREADS; t++)
+		if (c->th[t].running)
+			m |= 1u << t;
+	return m;
+}

@@ -1,0 +1,577 @@
+/*
+ * ctrl_axcmd.c - axis commands: the parameters (SP AC DC SD KP KI KD TL IL
+ * OF OV ER OE OA OT LD FL BL TW), motion (PA PR JG PT DP ZA BG ST AB SH MO)
+ * and the reports (TP TE TD RP TV TT TS SC), with their _operands.
+ *
+ * Ranges and resolutions are those of the DMC-40x0 command reference; a
+ * value out of range is TC 6 and nothing is changed.
+ */
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#include "ctrl_int.h"
+
+struct par_desc {
+	char name[3];
+	size_t off;		/* in struct ctrl_axis_par */
+	double lo, hi;
+	double step;		/* resolution: values are rounded down to it */
+	int fmt;		/* CTRL_NUM_* for queries */
+	int in_motion;		/* may change while the axis profiles */
+};
+
+#define P(f) offsetof(struct ctrl_axis_par, f)
+static const struct par_desc par_table[] = {
+	{ "AC", P(ac), 1024, 1073740800, 1024, CTRL_NUM_INT, 1 },
+	{ "BL", P(bl), -2147483648.0, 2147483647, 1, CTRL_NUM_PF, 1 },
+	{ "DC", P(dc), 1024, 1073740800, 1024, CTRL_NUM_INT, 0 },
+	{ "ER", P(er), -1, 2147483647, 1, CTRL_NUM_INT, 1 },
+	{ "FL", P(fl), -2147483648.0, 2147483647, 1, CTRL_NUM_PF, 1 },
+	{ "IL", P(il), -9.9982, 9.9982, 0, CTRL_NUM_GAIN, 1 },
+	{ "KD", P(kd), 0, 4095.875, 0.125, CTRL_NUM_GAIN, 1 },
+	{ "KI", P(ki), 0, 255.999, 0, CTRL_NUM_GAIN, 1 },
+	{ "KP", P(kp), 0, 1023.875, 0.125, CTRL_NUM_GAIN, 1 },
+	{ "OF", P(of), -9.9982, 9.9982, 0, CTRL_NUM_GAIN, 1 },
+	{ "OV", P(ov), 0, 9.9982, 0, CTRL_NUM_GAIN, 1 },
+	{ "SD", P(sd), 1024, 1073740800, 1024, CTRL_NUM_INT, 1 },
+	{ "SP", P(sp), 0, 15000000, 2, CTRL_NUM_INT, 1 },
+	{ "TL", P(tl), 0, 9.9982, 0, CTRL_NUM_GAIN, 1 },
+	{ "TW", P(tw), -1, 32767, 1, CTRL_NUM_INT, 1 },
+};
+#undef P
+
+/* Integer parameters kept as int in struct ctrl_axis_par. */
+struct ipar_desc {
+	char name[3];
+	size_t off;
+	int lo, hi;
+};
+
+static const struct ipar_desc ipar_table[] = {
+	{ "LD", offsetof(struct ctrl_axis_par, ld), 0, 3 },
+	{ "OA", offsetof(struct ctrl_axis_par, oa), 0, 1 },
+	{ "OE", offsetof(struct ctrl_axis_par, oe), 0, 3 },
+	{ "OT", offsetof(struct ctrl_axis_par, ot), 1, 32000 },
+};
+
+static const struct par_desc *par_find(const char *name)
+{
+	size_t i;
+
+	for (i = 0; i < sizeof(par_table) / sizeof(par_table[0]); i++)
+		if (!strcmp(par_table[i].name, name))
+			return &par_table[i];
+	return NULL;
+}
+
+static const struct ipar_desc *ipar_find(const char *name)
+{
+	size_t i;
+
+	for (i = 0; i < sizeof(ipar_table) / sizeof(ipar_table[0]); i++)
+		if (!strcmp(ipar_table[i].name, name))
+			return &ipar_table[i];
+	return NULL;
+}
+
+static double *par_ptr(struct ctrl_axis_par *p, const struct par_desc *d)
+{
+	return (double *)((char *)p + d->off);
+}
+
+static int *ipar_ptr(struct ctrl_axis_par *p, const struct ipar_desc *d)
+{
+	return (int *)((char *)p + d->off);
+}
+
+/* Print the queried fields: " 1, 2\r\n". */
+static void put_queries(struct ctrl_xc *x, const struct ctrl_args *a,
+			const double *v, int fmt)
+{
+	int i, first = 1;
+
+	for (i = 0; i < CTRL_AXES; i++) {
+		if (a->set[i] != 2)
+			continue;
+		if (!first)
+			ctrl_buf_puts(&x->c->tmp, ",");
+		ctrl_put_num(x, v[i], fmt);
+		first = 0;
+	}
+	if (!first)
+		ctrl_buf_puts(&x->c->tmp, "\r\n");
+}
+
+/*
+ * Generic "XX n,n,n" for a value per axis: range check all, then store.
+ * @get/@set read and write one axis; @fmt for queries.
+ */
+static int axis_values(struct ctrl_xc *x, const char *a, double lo,
+		       double hi, double step, int fmt,
+		       double *(*slot)(struct ctrl *c, int axis,
+				       const void *ud),
+		       const void *ud)
+{
+	struct ctrl_args args;
+	double cur[CTRL_AXES];
+	int i, rc = ctrl_parse_axis_args(x, a, &args);
+
+	if (rc)
+		return rc;
+	for (i = 0; i < CTRL_AXES; i++) {
+		cur[i] = *slot(x->c, i, ud);
+		if (args.set[i] == 1 && (args.v[i] < lo || args.v[i] > hi))
+			return 6;
+	}
+	for (i = 0; i < CTRL_AXES; i++) {
+		if (args.set[i] != 1)
+			continue;
+		*slot(x->c, i, ud) = step > 0 ?
+			trunc(args.v[i] / step) * step : args.v[i];
+	}
+	put_queries(x, &args, cur, fmt);
+	return 0;
+}
+
+static double *par_slot(struct ctrl *c, int axis, const void *ud)
+{
+	return par_ptr(&c->ax[axis].p, ud);
+}
+
+static int cmd_par(struct ctrl_xc *x, const struct par_desc *d, const char *a)
+{
+	struct ctrl_args args;
+	int i, rc;
+
+	if (!d->in_motion) {
+		rc = ctrl_parse_axis_args(x, a, &args);
+		if (rc)
+			return rc;
+		for (i = 0; i < CTRL_AXES; i++)
+			if (args.set[i] == 1 && x->c->ax[i].profiling &&
+			    !x->c->ax[i].stopping &&
+			    x->c->ax[i].mode != CTRL_MODE_JG)
+				return 7;
+	}
+	if (!strcmp(d->name, "OV")) {
+		rc = ctrl_parse_axis_args(x, a, &args);
+		if (rc)
+			return rc;
+		for (i = 0; i < CTRL_AXES; i++)
+			if (args.set[i] == 1 && args.v[i] > x->c->ax[i].p.tl)
+				return 6;
+	}
+	return axis_values(x, a, d->lo, d->hi, d->step, d->fmt, par_slot, d);
+}
+
+static int cmd_ipar(struct ctrl_xc *x, const struct ipar_desc *d,
+		    const char *a)
+{
+	struct ctrl_args args;
+	double cur[CTRL_AXES];
+	int i, rc = ctrl_parse_axis_args(x, a, &args);
+
+	if (rc)
+		return rc;
+	for (i = 0; i < CTRL_AXES; i++) {
+		cur[i] = *ipar_ptr(&x->c->ax[i].p, d);
+		if (args.set[i] == 1 && (args.v[i] != (int)args.v[i] ||
+					 args.v[i] < d->lo || args.v[i] > d->hi))
+			return 6;
+	}
+	for (i = 0; i < CTRL_AXES; i++)
+		if (args.set[i] == 1)
+			*ipar_ptr(&x->c->ax[i].p, d) = (int)args.v[i];
+	put_queries(x, &args, cur, CTRL_NUM_INT);
+	return 0;
+}
+
+/* ---- PA PR JG PT DP ZA --------------------------------------------------- */
+
+static int cmd_pa(struct ctrl_xc *x, const char *a)
+{
+	struct ctrl *c = x->c;
+	struct ctrl_args args;
+	double cur[CTRL_AXES];
+	int i, rc = ctrl_parse_axis_args(x, a, &args);
+
+	if (rc)
+		return rc;
+	for (i = 0; i < CTRL_AXES; i++) {
+		cur[i] = c->ax[i].pa_last;
+		if (args.set[i] != 1)
+			continue;
+		if (args.v[i] < -2147483648.0 || args.v[i] > 2147483647)
+			return 6;
+		if (!c->ax[i].pt && c->ax[i].profiling)
+			return 7;
+		if (c->ax[i].pt && c->ax[i].p.motor_off)
+			return 20;
+	}
+	for (i = 0; i < CTRL_AXES; i++) {
+		if (args.set[i] != 1)
+			continue;
+		if (c->ax[i].pt) {
+			ctrl_motion_pt_target(c, i, floor(args.v[i]));
+		} else {
+			c->ax[i].pa = floor(args.v[i]);
+			c->ax[i].next_mode = CTRL_MODE_PA;
+		}
+	}
+	put_queries(x, &args, cur, CTRL_NUM_PF);
+	return 0;
+}
+
+static int cmd_pr(struct ctrl_xc *x, const char *a)
+{
+	struct ctrl *c = x->c;
+	struct ctrl_args args;
+	double cur[CTRL_AXES];
+	int i, rc = ctrl_parse_axis_args(x, a, &args);
+
+	if (rc)
+		return rc;
+	for (i = 0; i < CTRL_AXES; i++) {
+		struct ctrl_axis *ax = &c->ax[i];
+
+		cur[i] = ax->next_mode == CTRL_MODE_PA ? ax->pa - ax->ref :
+							 ax->pr;
+		if (args.set[i] != 1)
+			continue;
+		if (fabs(args.v[i]) > 2147483647)
+			return 6;
+		if (ax->profiling)
+			return 7;
+	}
+	for (i = 0; i < CTRL_AXES; i++) {
+		if (args.set[i] != 1)
+			continue;
+		c->ax[i].pr = floor(args.v[i]);
+		c->ax[i].next_mode = CTRL_MODE_PR;
+	}
+	put_queries(x, &args, cur, CTRL_NUM_PF);
+	return 0;
+}
+
+static int cmd_jg(struct ctrl_xc *x, const char *a)
+{
+	struct ctrl *c = x->c;
+	struct ctrl_args args;
+	double cur[CTRL_AXES];
+	int i, rc = ctrl_parse_axis_args(x, a, &args);
+
+	if (rc)
+		return rc;
+	for (i = 0; i < CTRL_AXES; i++) {
+		struct ctrl_axis *ax = &c->ax[i];
+
+		cur[i] = ax->jg;
+		if (args.set[i] != 1)
+			continue;
+		if (fabs(args.v[i]) > 15000000)
+			return 6;
+		if (ax->profiling && ax->mode != CTRL_MODE_JG)
+			return 13;
+	}
+	for (i = 0; i < CTRL_AXES; i++) {
+		if (args.set[i] != 1)
+			continue;
+		c->ax[i].jg = trunc(args.v[i] / 2) * 2;
+		c->ax[i].p.sp = fabs(c->ax[i].jg);
+		if (!c->ax[i].profiling)
+			c->ax[i].next_mode = CTRL_MODE_JG;
+	}
+	put_queries(x, &args, cur, CTRL_NUM_INT);
+	return 0;
+}
+
+static int cmd_pt(struct ctrl_xc *x, const char *a)
+{
+	struct ctrl *c = x->c;
+	struct ctrl_args args;
+	double cur[CTRL_AXES];
+	int i, rc = ctrl_parse_axis_args(x, a, &args);
+
+	if (rc)
+		return rc;
+	for (i = 0; i < CTRL_AXES; i++) {
+		cur[i] = c->ax[i].pt;
+		if (args.set[i] == 1 && args.v[i] != 0 && args.v[i] != 1)
+			return 6;
+		if (args.set[i] == 1 && args.v[i] == 1 && !c->ax[i].pt &&
+		    c->ax[i].profiling)
+			return 7;
+	}
+	for (i = 0; i < CTRL_AXES; i++) {
+		if (args.set[i] != 1)
+			continue;
+		if (args.v[i] == 1 && !c->ax[i].pt)
+			c->ax[i].target = c->ax[i].ref;
+		c->ax[i].pt = args.v[i] == 1;
+	}
+	put_queries(x, &args, cur, CTRL_NUM_INT);
+	return 0;
+}
+
+static int cmd_dp(struct ctrl_xc *x, const char *a)
+{
+	struct ctrl *c = x->c;
+	struct ctrl_args args;
+	double cur[CTRL_AXES];
+	int i, rc = ctrl_parse_axis_args(x, a, &args);
+
+	if (rc)
+		return rc;
+	for (i = 0; i < CTRL_AXES; i++) {
+		cur[i] = round(c->ax[i].enc);
+		if (args.set[i] == 1 && c->ax[i].profiling)
+			return 7;
+		if (args.set[i] == 1 && fabs(args.v[i]) > 2147483647)
+			return 6;
+	}
+	for (i = 0; i < CTRL_AXES; i++) {
+		struct ctrl_axis *ax = &c->ax[i];
+		double v = floor(args.v[i]);
+
+		if (args.set[i] != 1)
+			continue;
+		ax->offset += v - ax->enc;
+		ax->enc = v;
+		ax->ref = v;
+		ax->target = v;
+		ax->pa_last = v;
+		ax->err_prev = 0;
+		ax->integ = 0;
+	}
+	put_queries(x, &args, cur, CTRL_NUM_PF);
+	return 0;
+}
+
+static double *za_slot(struct ctrl *c, int axis, const void *ud)
+{
+	(void)ud;
+	return &c->ax[axis].za;
+}
+
+/* ---- BG ST AB SH MO ------------------------------------------------------ */
+
+static int cmd_bg(struct ctrl_xc *x, const char *a)
+{
+	unsigned mask;
+	int i, rc = ctrl_parse_mask(x, a, &mask);
+
+	if (rc)
+		return rc;
+	for (i = 0; i < CTRL_AXES; i++)
+		if ((mask & (1u << i)) &&
+		    (rc = ctrl_motion_begin(x->c, i, 1)) != 0)
+			return rc;
+	for (i = 0; i < CTRL_AXES; i++)
+		if (mask & (1u << i))
+			ctrl_motion_begin(x->c, i, 0);
+	return 0;
+}
+
+static int cmd_st(struct ctrl_xc *x, const char *a)
+{
+	unsigned mask;
+	int i, rc = ctrl_parse_mask(x, a, &mask);
+
+	if (rc)
+		return rc;
+	for (i = 0; i < CTRL_AXES; i++)
+		if (mask & (1u << i))
+			ctrl_motion_stop(x->c, i, 4, x->c->ax[i].p.dc);
+	/* a bare ST from a host also stops the program */
+	if (x->thread < 0 && *ctrl_skip(a) == '\0')
+		ctrl_threads_halt_all(x->c, "halted by ST from a host");
+	return 0;
+}
+
+static int cmd_ab(struct ctrl_xc *x, const char *a)
+{
+	double v = 0;
+	int i, rc = ctrl_num_list(x, a, &v, 1, NULL);
+
+	if (rc)
+		return rc;
+	if (v != 0 && v != 1)
+		return 6;
+	for (i = 0; i < CTRL_AXES; i++)
+		ctrl_motion_abort(x->c, i);
+	if (v == 0) {
+		ctrl_threads_halt_all(x->c, "aborted by AB");
+		return x->thread >= 0 ? CTRL_STOP : 0;
+	}
+	return 0;
+}
+
+static int cmd_shmo(struct ctrl_xc *x, const char *a, int on)
+{
+	struct ctrl *c = x->c;
+	unsigned mask;
+	int i, rc = ctrl_parse_mask(x, a, &mask);
+
+	if (rc)
+		return rc;
+	for (i = 0; i < CTRL_AXES; i++)
+		if ((mask & (1u << i)) && c->ax[i].profiling)
+			return 7;
+	for (i = 0; i < CTRL_AXES; i++) {
+		struct ctrl_axis *ax = &c->ax[i];
+
+		if (!(mask & (1u << i)))
+			continue;
+		if (!on) {
+			if (!ax->p.motor_off)
+				ctrl_motion_off(c, i, -1, "MO");
+			continue;
+		}
+		ax->p.motor_off = 0;
+		ax->ref = ax->enc;
+		ax->target = ax->enc;
+		ax->vel = 0;
+		ax->err_prev = 0;
+		ax->integ = 0;
+		ax->poserr = 0;
+		ax->oa_cnt = 0;
+	}
+	return 0;
+}
+
+/* ---- reports and operands ------------------------------------------------ */
+
+static int switches(const struct ctrl *c, int i, int ts)
+{
+	const struct ctrl_axis *ax = &c->ax[i];
+	double te = round(ax->ref) - round(ax->enc);
+	int v = 0x02;		/* home input: not wired, reads 1 */
+
+	if (!ax->lim_f)
+		v |= 0x08;
+	if (!ax->lim_r)
+		v |= 0x04;
+	if (ts) {
+		if (ax->profiling)
+			v |= 0x80;
+		if (ax->p.er >= 0 && fabs(te) > ax->p.er)
+			v |= 0x40;
+		if (ax->p.motor_off)
+			v |= 0x20;
+	}
+	return v;
+}
+
+/*
+ * ctrl_axis_operand() - _XXa: state (TP RP TE TD TV TT TS SC MO BG LF LR
+ * HM PA PR JG PT DP ZA) or a parameter. Return 0 or TC 1.
+ */
+int ctrl_axis_operand(struct ctrl *c, const char *n, int i, double *v)
+{
+	const struct ctrl_axis *ax = &c->ax[i];
+	const struct par_desc *d = par_find(n);
+	const struct ipar_desc *id = ipar_find(n);
+
+	if (d)
+		*v = *par_ptr((struct ctrl_axis_par *)&ax->p, d);
+	else if (id)
+		*v = *ipar_ptr((struct ctrl_axis_par *)&ax->p, id);
+	else if (!strcmp(n, "TP") || !strcmp(n, "DP"))
+		*v = round(ax->enc);
+	else if (!strcmp(n, "RP"))
+		*v = round(ax->ref);
+	else if (!strcmp(n, "TE"))
+		*v = round(ax->ref) - round(ax->enc);
+	else if (!strcmp(n, "TD"))
+		*v = 0;
+	else if (!strcmp(n, "TV"))
+		*v = round(ctrl_axis_tv(ax, ctrl_dt(c)));
+	else if (!strcmp(n, "TT"))
+		*v = ax->torque;
+	else if (!strcmp(n, "TS"))
+		*v = switches(c, i, 1);
+	else if (!strcmp(n, "SC"))
+		*v = ax->stop_code;
+	else if (!strcmp(n, "MO"))
+		*v = ax->p.motor_off;
+	else if (!strcmp(n, "BG"))
+		*v = ax->profiling;
+	else if (!strcmp(n, "LF"))
+		*v = !ax->lim_f;
+	else if (!strcmp(n, "LR"))
+		*v = !ax->lim_r;
+	else if (!strcmp(n, "HM"))
+		*v = 1;
+	else if (!strcmp(n, "PA"))
+		*v = ax->pa_last;
+	else if (!strcmp(n, "PR"))
+		*v = ax->pr;
+	else if (!strcmp(n, "JG"))
+		*v = fabs(ax->jg);
+	else if (!strcmp(n, "PT"))
+		*v = ax->pt;
+	else if (!strcmp(n, "ZA"))
+		*v = ax->za;
+	else
+		return 1;
+	return 0;
+}
+
+/* TP TE TD RP TV TT TS SC [mask] */
+static int cmd_report(struct ctrl_xc *x, const char *name, const char *a)
+{
+	unsigned mask;
+	int i, first = 1, fmt, rc = ctrl_parse_mask(x, a, &mask);
+	double v;
+
+	if (rc)
+		return rc;
+	fmt = strchr("PEDR", name[1]) && name[0] != 'S' ? CTRL_NUM_PF :
+	      !strcmp(name, "TT") ? CTRL_NUM_GAIN : CTRL_NUM_INT;
+	for (i = 0; i < CTRL_AXES; i++) {
+		if (!(mask & (1u << i)))
+			continue;
+		ctrl_axis_operand(x->c, name, i, &v);
+		if (!first)
+			ctrl_buf_puts(&x->c->tmp, ",");
+		ctrl_put_num(x, v, fmt);
+		first = 0;
+	}
+	ctrl_buf_puts(&x->c->tmp, "\r\n");
+	return 0;
+}
+
+int ctrl_axis_param_get(const struct ctrl *c, const char *name, int axis,
+			double *v)
+{
+	return ctrl_axis_operand((struct ctrl *)c, name, axis, v);
+}
+
+/* ctrl_axis_cmd() - the axis commands of the command table. */
+int ctrl_axis_cmd(struct ctrl_xc *x, const char *name, const char *a)
+{
+	const struct par_desc *d = par_find(name);
+	const struct ipar_desc *id = ipar_find(name);
+
+	if (d)
+		return cmd_par(x, d, a);
+	if (id)
+		return cmd_ipar(x, id, a);
+	switch (name[0] << 8 | name[1]) {
+	case 'P' << 8 | 'A': return cmd_pa(x, a);
+	case 'P' << 8 | 'R': return cmd_pr(x, a);
+	case 'J' << 8 | 'G': return cmd_jg(x, a);
+	case 'P' << 8 | 'T': return cmd_pt(x, a);
+	case 'D' << 8 | 'P': return cmd_dp(x, a);
+	case 'Z' << 8 | 'A':
+		return axis_values(x, a, -2147483648.0, 2147483647, 1,
+				   CTRL_NUM_INT, za_slot, NULL);
+	case 'B' << 8 | 'G': return cmd_bg(x, a);
+	case 'S' << 8 | 'T': return cmd_st(x, a);
+	case 'A' << 8 | 'B': return cmd_ab(x, a);
+	case 'S' << 8 | 'H': return cmd_shmo(x, a, 1);
+	case 'M' << 8 | 'O': return cmd_shmo(x, a, 0);
+	}
+	return cmd_report(x, name, a);
+}

@@ -1,0 +1,453 @@
+/*
+ * ctrl_int.h - internals of the simulated DMC-4030 (ctrl.h), shared by the
+ * ctrl_*.c files only. Nothing here is part of the public API.
+ *
+ * Layout of the controller:
+ *   ctrl_num.c    32.16 fixed-point numbers, Galil number formats
+ *   ctrl_buf.c    growable byte buffers (replies, unsolicited output)
+ *   ctrl_var.c    variables and arrays
+ *   ctrl_expr.c   expression evaluator (strictly left to right) and operands
+ *   ctrl_prog.c   program memory: download checks, statements, labels
+ *   ctrl_exec.c   statement dispatch, threads, errors, automatic subroutines
+ *   ctrl_flow.c   IF/ELSE/ENDIF JP JS EN RE ZS XQ HX and the trippoints
+ *   ctrl_cmd.c    command table and the general commands
+ *   ctrl_axcmd.c  axis commands (SP AC ... PA PR BG ST SH MO TP ...)
+ *   ctrl_motion.c profiler, servo and protection, once per sample
+ *   ctrl_mg.c     MG and its formatters
+ *   ctrl_proto.c  host handles: framing, DL/UL, unsolicited routing
+ *   ctrl_rec.c    the QR data record
+ *   ctrl.c        life cycle, ctrl_step(), burn and power cycle
+ */
+#ifndef SIM_CTRL_INT_H
+#define SIM_CTRL_INT_H
+
+#include <stdint.h>
+#include <stddef.h>
+
+#include "ctrl.h"
+
+/* Limits of a DMC-40x0 (galil-notes.md 3.4; DMC command reference). */
+#define CTRL_LINE_MAX 80	/* characters per line (host and program) */
+#define CTRL_PROG_LINES 4000	/* program lines */
+#define CTRL_LABELS 510		/* labels */
+#define CTRL_VARS 510		/* variables */
+#define CTRL_VAR_SLOTS 1024	/* hash slots, power of two > 2 * CTRL_VARS */
+#define CTRL_ARRAYS 30		/* arrays */
+#define CTRL_ARRAY_SPACE 24000	/* array elements in total */
+#define CTRL_STACK_DEPTH 16	/* JS nesting (TC 12) */
+#define CTRL_NAME_MAX 8		/* variable / array name characters */
+#define CTRL_LABEL_MAX 7	/* label characters after '#' */
+#define CTRL_NPARAM 8		/* ^a .. ^h */
+
+/* Model choices (documented in docs/galil-sim-controller.md). */
+#define CTRL_LINES_PER_SAMPLE 16	/* program lines per servo sample */
+#define CTRL_UNSOL_FIFO 1024	/* bytes pending on a handle = "FIFO full" */
+#define CTRL_OUT_MAX (4u << 20)	/* bytes pending on a handle before dropping */
+#define CTRL_SERIAL_MAX 65536	/* bytes kept for the (absent) serial port */
+#define CTRL_TV_SAMPLES 256	/* TV averaging window, samples (~0.25 s) */
+
+#define CTRL_NHANDLES (CTRL_HANDLES + 1)
+#define CTRL_PRIV_HANDLE CTRL_HANDLES	/* ctrl_command()'s private port */
+#define CTRL_SERIAL (-1)		/* CF S */
+
+/* Special statement results besides 0 (ok) and TC codes (> 0). */
+#define CTRL_RETRY (-1)		/* run the same statement again next sample */
+#define CTRL_STOP (-2)		/* the running thread was halted (HX, AB) */
+
+/* ---- growable buffer (ctrl_buf.c) ------------------------------------- */
+
+struct ctrl_buf {
+	uint8_t *p;
+	size_t start;		/* first unread byte */
+	size_t len;		/* end of data */
+	size_t cap;
+};
+
+int ctrl_buf_put(struct ctrl_buf *b, const void *data, size_t n);
+int ctrl_buf_puts(struct ctrl_buf *b, const char *s);
+int ctrl_buf_printf(struct ctrl_buf *b, const char *fmt, ...)
+	__attribute__((format(printf, 2, 3)));
+size_t ctrl_buf_pending(const struct ctrl_buf *b);
+size_t ctrl_buf_take(struct ctrl_buf *b, uint8_t *out, size_t cap);
+void ctrl_buf_clear(struct ctrl_buf *b);
+void ctrl_buf_free(struct ctrl_buf *b);
+
+/* ---- numbers (ctrl_num.c) ------------------------------------------- */
+
+#define CTRL_FX_ONE 65536.0
+#define CTRL_FX_MAX 2147483647.99998474	/* $7FFFFFFF.FFFF */
+
+/* Format of one printed number: F (leading zeros), Z (none), $ (hex). */
+struct ctrl_fmt {
+	char kind;		/* 'F', 'Z', '$', 'S' */
+	int m;			/* digits left of the point (S: characters) */
+	int n;			/* digits right of the point */
+};
+
+double ctrl_fx(double v);
+int64_t ctrl_fx_raw(double v);
+double ctrl_fx_from_raw(int64_t raw);
+int ctrl_fmt_num(char *out, size_t cap, double v, const struct ctrl_fmt *f);
+int ctrl_fmt_int(char *out, size_t cap, double v);
+double ctrl_str_value(const char *s, size_t n);
+
+/* ---- names, variables and arrays (ctrl_var.c) ------------------------ */
+
+struct ctrl_var {
+	uint64_t key;		/* packed name, 0 = free slot */
+	double v;
+};
+
+struct ctrl_array {
+	uint64_t key;		/* 0 = free */
+	int n;			/* elements */
+	double *v;
+};
+
+struct ctrl_vars {
+	struct ctrl_var slot[CTRL_VAR_SLOTS];
+	int count;
+	struct ctrl_array arr[CTRL_ARRAYS];
+	int arr_used;		/* elements allocated in total */
+};
+
+size_t ctrl_ident_len(const char *s);
+int ctrl_name_key(const char *s, size_t n, uint64_t *key);
+void ctrl_key_name(uint64_t key, char out[CTRL_NAME_MAX + 1]);
+int ctrl_var_find(const struct ctrl_vars *vs, uint64_t key);
+int ctrl_var_set(struct ctrl_vars *vs, uint64_t key, double v, int *slot);
+struct ctrl_array *ctrl_array_find(struct ctrl_vars *vs, uint64_t key);
+int ctrl_array_dim(struct ctrl_vars *vs, uint64_t key, int n);
+int ctrl_array_free(struct ctrl_vars *vs, uint64_t key);
+void ctrl_vars_clear(struct ctrl_vars *vs);
+int ctrl_vars_copy(struct ctrl_vars *dst, const struct ctrl_vars *src);
+
+/* ---- program memory (ctrl_prog.c) ----------------------------------- */
+
+enum ctrl_flow {
+	CTRL_FLOW_NONE,
+	CTRL_FLOW_IF,
+	CTRL_FLOW_ELSE,
+	CTRL_FLOW_ENDIF,
+};
+
+struct ctrl_stmt {
+	int line;		/* 0-based program line */
+	uint8_t off, len;	/* text within the line */
+	int text;		/* the text, NUL-terminated, in pool[] */
+	uint8_t flow;		/* enum ctrl_flow */
+	int match;		/* IF -> its ELSE/ENDIF, ELSE -> ENDIF, or -1 */
+};
+
+struct ctrl_label {
+	uint64_t key;
+	int line;
+};
+
+struct ctrl_prog {
+	int nlines;
+	char (*line)[CTRL_LINE_MAX + 1];
+	int *first;		/* first statement of each line */
+	int nstmts;
+	struct ctrl_stmt *stmt;
+	int nlabels;
+	struct ctrl_label *label;	/* sorted by key */
+	char *pool;		/* statement texts */
+	size_t pool_len, pool_cap;
+};
+
+int ctrl_prog_load(struct ctrl_prog *p, const char *text, size_t len,
+		   int *bad_line, int *tc);
+void ctrl_prog_free(struct ctrl_prog *p);
+int ctrl_prog_copy(struct ctrl_prog *dst, const struct ctrl_prog *src);
+int ctrl_prog_label(const struct ctrl_prog *p, uint64_t key);
+int ctrl_prog_stmt_text(const struct ctrl_prog *p, int i, char *out,
+			size_t cap);
+const char *ctrl_prog_stmt(const struct ctrl_prog *p, int i);
+
+/* ---- threads and automatic subroutines ------------------------------ */
+
+enum ctrl_wait_kind {
+	CTRL_W_NONE,
+	CTRL_W_UNTIL,		/* WT / AT: TIME >= until */
+	CTRL_W_AM,		/* profilers of mask idle */
+	CTRL_W_MC,		/* AM plus encoder in position, TW timeout */
+	CTRL_W_MF,		/* _TP of axis >= pos */
+	CTRL_W_MR,		/* _TP of axis <= pos */
+	CTRL_W_AI,		/* input at level */
+	CTRL_W_RETRY,		/* statement retried (MG into a full FIFO) */
+};
+
+struct ctrl_wait {
+	int kind;
+	int64_t until;		/* sample number (W_UNTIL; W_MC timeout) */
+	unsigned mask;		/* axes */
+	int axis, input, level;
+	double pos;
+};
+
+enum ctrl_autosub {
+	CTRL_AS_CMDERR,
+	CTRL_AS_POSERR,
+	CTRL_AS_LIMSWI,
+	CTRL_AS_AMPERR,
+	CTRL_AS_MCTIME,
+	CTRL_AS_TCPERR,
+	CTRL_AS_N,
+};
+
+enum ctrl_frame_kind {
+	CTRL_FR_JS,
+	CTRL_FR_AUTO,
+};
+
+struct ctrl_frame {
+	int ret_pc;		/* statement to return to, -1 = end thread */
+	int kind;		/* enum ctrl_frame_kind */
+	int autosub;		/* enum ctrl_autosub for CTRL_FR_AUTO */
+	struct ctrl_wait saved;	/* interrupted trippoint (RE1/EN1) */
+	double par[CTRL_NPARAM];	/* ^a..^h of the called routine */
+	int16_t ref[CTRL_NPARAM];	/* variable slot when passed by &ref */
+	int npar;
+};
+
+struct ctrl_thread {
+	int running;
+	int pc;			/* next statement */
+	int depth;
+	struct ctrl_frame stack[CTRL_STACK_DEPTH];
+	struct ctrl_wait wait;
+	int64_t at_ref;		/* AT reference, sample number */
+	double js_ret;		/* _JS */
+	double par0[CTRL_NPARAM];	/* ^a..^h outside any subroutine */
+	int next_pc;		/* set while a statement runs */
+	int line;		/* _XQn: line of the current statement */
+};
+
+/* ---- axes ----------------------------------------------------------- */
+
+enum ctrl_mode {
+	CTRL_MODE_PR,
+	CTRL_MODE_PA,
+	CTRL_MODE_JG,
+	CTRL_MODE_PT,
+};
+
+/* Parameters BN burns (with the motor state). */
+struct ctrl_axis_par {
+	double sp, ac, dc, sd;	/* counts/s, counts/s^2 */
+	double kp, ki, kd, tl, il, of, ov;	/* gains; volts */
+	double er;		/* counts, -1 = off */
+	double fl, bl;		/* soft limits, counts */
+	int oe, oa, ot, ld;
+	double tw;		/* MC timeout, ms (-1 = off) */
+	int motor_off;
+};
+
+struct ctrl_axis {
+	struct ctrl_axis_par p;
+	/* staged motion */
+	double jg, pr, pa;
+	int next_mode;		/* enum ctrl_mode for the next BG */
+	int pt;			/* position tracking on */
+	double za;		/* ZA user field */
+	double pa_last;		/* _PA: where motion last stopped */
+	/* profiler */
+	int profiling, stopping, mode;
+	double ref, vel, target, stop_dec;
+	/* feedback */
+	double enc, offset;	/* controller counts = plant + offset */
+	int lim_f, lim_r;	/* switch active, after CN and LD */
+	int stop_code;
+	/* servo and protection */
+	double err_prev, integ, torque;
+	int poserr;		/* |TE| > ER latched until back below */
+	int amp_fault;		/* amplifier fault seen while enabled */
+	int oa_cnt;
+	double oa_enc0;
+	double tv_ring[CTRL_TV_SAMPLES];
+	int tv_i;
+};
+
+/* ---- host handles ---------------------------------------------------- */
+
+enum ctrl_hmode {
+	CTRL_H_CMD,
+	CTRL_H_DL,
+};
+
+struct ctrl_handle {
+	int open;
+	int close_wanted;
+	int mode;		/* enum ctrl_hmode */
+	char line[CTRL_LINE_MAX + 1];
+	size_t len;		/* characters in line */
+	int overflow;		/* line longer than CTRL_LINE_MAX */
+	int semis;		/* ';' seen in an overflowing line */
+	struct ctrl_buf dl;	/* download text */
+	int dl_err;		/* TC of the first bad line, 0 */
+	int dl_lines;
+	size_t dl_linelen;
+	struct ctrl_buf out;	/* bytes for the host */
+	int local_port, peer_port;
+	uint32_t peer_ip;
+};
+
+/* ---- what BN / BP / BV keep over a power cycle ----------------------- */
+
+struct ctrl_flash {
+	int have_prog;
+	struct ctrl_prog prog;
+	int have_par;
+	struct ctrl_axis_par ax[CTRL_AXES];
+	int cw_hibit, cw_drop, cn0, sample_us, vf_m, vf_n, pf_m, pf_n, lz;
+	uint32_t outputs;
+	int have_vars;
+	struct ctrl_vars vars;
+};
+
+/* ---- the controller --------------------------------------------------- */
+
+struct ctrl {
+	struct ctrl_cfg cfg;
+	char model[64];
+	int sample_us;		/* TM */
+	int64_t time;		/* TIME, samples since power-up */
+	int lines_per_sample;
+
+	struct ctrl_axis ax[CTRL_AXES];
+	struct ctrl_sense in;
+	int zero_pending;	/* define encoder zero at the next sample */
+	uint32_t outputs;
+	int amp_ok;		/* motor power present */
+	uint8_t ta0;		/* _TA0 amplifier status */
+	int cn0;		/* CN limit polarity: -1 active low */
+
+	struct ctrl_prog prog;
+	struct ctrl_vars vars;
+	struct ctrl_thread th[CTRL_THREADS];
+	int autosub_pend[CTRL_AS_N];
+	int auto_pending;	/* start #AUTO at the next sample */
+
+	int tc;			/* TC and _TC: last error; TC clears it */
+	int ed_line, ed_thread;	/* _ED, _ED1 */
+
+	int cf;			/* unsolicited handle 0..7 or CTRL_SERIAL */
+	int cw_hibit, cw_drop;	/* CW 1 / CW ,1 */
+	int vf_m, vf_n, pf_m, pf_n, lz;
+	int ia4;		/* _IA4: handle that lost communication */
+	double axdes[8];	/* ~a .. ~h: axis numbers */
+	int edepth;		/* expression nesting, bounded */
+
+	struct ctrl_handle h[CTRL_NHANDLES];
+	struct ctrl_buf serial;	/* output routed to the serial port */
+	struct ctrl_buf tmp;	/* output of the running statement */
+	struct ctrl_flash flash;
+};
+
+/* Context of one statement: where it came from, where output goes. */
+struct ctrl_xc {
+	struct ctrl *c;
+	int thread;		/* 0..7, or -1 for a host command */
+	int handle;		/* host handle, -1 from a program */
+	int stmt;		/* statement index (program), else -1 */
+	int route;		/* MG {Ex}: handle, CTRL_SERIAL, or -2 default */
+	int binary;		/* output is binary (QR): no high bit */
+	int dl;			/* DL was accepted: enter download mode */
+};
+
+#define CTRL_ROUTE_DEFAULT (-2)
+
+/* ---- expressions (ctrl_expr.c) ---------------------------------------- */
+
+int ctrl_expr(struct ctrl_xc *x, const char **p, double *out);
+int ctrl_operand(struct ctrl_xc *x, const char **p, double *out);
+int ctrl_expr_end(struct ctrl_xc *x, const char *s, double *out);
+const char *ctrl_skip(const char *s);
+double *ctrl_param_ptr(struct ctrl_xc *x, int i);
+int ctrl_axis_letter(char ch);
+int ctrl_axis_desig(struct ctrl_xc *x, const char **p, int *axis);
+
+/* ---- statements and threads (ctrl_exec.c, ctrl_flow.c) ---------------- */
+
+int ctrl_exec(struct ctrl_xc *x, const char *s);
+void ctrl_threads_run(struct ctrl *c);
+void ctrl_thread_start(struct ctrl *c, int t, int pc);
+void ctrl_thread_halt(struct ctrl *c, int t, const char *why);
+void ctrl_threads_halt_all(struct ctrl *c, const char *why);
+int ctrl_thread_line(const struct ctrl *c, int t);
+int ctrl_thread_waiting(const struct ctrl *c, int t);
+void ctrl_autosub_raise(struct ctrl *c, int which);
+int ctrl_autosub_label(const struct ctrl *c, int which);
+int ctrl_wait_done(struct ctrl *c, struct ctrl_thread *t);
+int ctrl_goto_line(struct ctrl_xc *x, double line);
+int ctrl_any_running(const struct ctrl *c);
+const char *ctrl_tc_text(int tc);
+
+/* command handlers shared through the table in ctrl_cmd.c */
+typedef int (*ctrl_cmd_fn)(struct ctrl_xc *x, const char *name,
+			   const char *a);
+int ctrl_cmd_dispatch(struct ctrl_xc *x, const char *name, const char *a);
+int ctrl_cmd_assignable(const char *name);
+
+int ctrl_flow_cmd(struct ctrl_xc *x, const char *name, const char *a);
+int ctrl_axis_cmd(struct ctrl_xc *x, const char *name, const char *a);
+int ctrl_axis_param_get(const struct ctrl *c, const char *name, int axis,
+			double *v);
+int ctrl_axis_operand(struct ctrl *c, const char *name, int axis, double *v);
+int ctrl_mg(struct ctrl_xc *x, const char *a);
+
+/* arguments: "n,n,n" with '?' queries and "X=n" single axis forms */
+struct ctrl_args {
+	int n;			/* fields present (0..CTRL_AXES) */
+	int set[CTRL_AXES];	/* 1 value, 2 query, 0 empty */
+	double v[CTRL_AXES];
+};
+int ctrl_parse_axis_args(struct ctrl_xc *x, const char *a,
+			 struct ctrl_args *out);
+int ctrl_parse_mask(struct ctrl_xc *x, const char *a, unsigned *mask);
+int ctrl_num_list(struct ctrl_xc *x, const char *a, double *v, int max,
+		  unsigned *present);
+#define CTRL_NUM_VF 0	/* variable format (VF, LZ) */
+#define CTRL_NUM_PF 1	/* position format (PF) */
+#define CTRL_NUM_INT 2	/* integer */
+#define CTRL_NUM_GAIN 3	/* 4 decimals */
+int ctrl_put_num(struct ctrl_xc *x, double v, int how);
+
+/* ---- output (ctrl_proto.c) -------------------------------------------- */
+
+int ctrl_unsol_send(struct ctrl *c, int route, const uint8_t *p, size_t n);
+void ctrl_event(struct ctrl *c, const char *fmt, ...)
+	__attribute__((format(printf, 2, 3)));
+void ctrl_proto_reset(struct ctrl *c);
+int ctrl_proto_host(struct ctrl *c, int h, const char *line);
+
+/* ---- motion (ctrl_motion.c) ------------------------------------------- */
+
+void ctrl_motion_sample(struct ctrl *c);
+void ctrl_motion_sense(struct ctrl *c, const struct ctrl_sense *in);
+void ctrl_motion_drive(struct ctrl *c, struct ctrl_drive *out);
+int ctrl_motion_begin(struct ctrl *c, int axis, int dry_run);
+void ctrl_motion_stop(struct ctrl *c, int axis, int code, double dec);
+void ctrl_motion_abort(struct ctrl *c, int axis);
+void ctrl_motion_off(struct ctrl *c, int axis, int code, const char *why);
+int ctrl_motion_pt_target(struct ctrl *c, int axis, double target);
+double ctrl_axis_tv(const struct ctrl_axis *a, double dt);
+double ctrl_dt(const struct ctrl *c);
+int ctrl_blocked_dir(const struct ctrl_axis *a, int dir);
+
+/* ---- data record (ctrl_rec.c) ----------------------------------------- */
+
+int ctrl_record(struct ctrl *c, uint8_t *buf, size_t cap);
+
+/* ---- life cycle helpers (ctrl.c) -------------------------------------- */
+
+void ctrl_axis_defaults(struct ctrl_axis_par *p);
+int ctrl_burn_program(struct ctrl *c);
+void ctrl_burn_params(struct ctrl *c);
+int ctrl_burn_vars(struct ctrl *c);
+int ctrl_samples(const struct ctrl *c, double ms);
+int ctrl_load_program(struct ctrl *c, const char *text, size_t len,
+		      int *bad_line);
+
+#endif /* SIM_CTRL_INT_H */

@@ -1,0 +1,260 @@
+/*
+ * sim.c - the simulator facade: controller + plant + relay stepped together
+ * in simulated time, the event log, and the control-port requests.
+ *
+ * Time is counted in whole microseconds of simulated time (samples of
+ * ctrl_sample_ms() each), so long runs do not drift.
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl_err.h"
+#include "sim.h"
+#include "sim_plant.h"
+#include "sim_relay.h"
+#include "sim_int.h"
+
+/* ---- events ----------------------------------------------------------- */
+
+static void event_put(struct sim *s, const char *text)
+{
+	struct sim_evt *e;
+
+	if (s->ev_count == SIM_EVENTS_MAX) {
+		s->ev_head = (s->ev_head + 1) % SIM_EVENTS_MAX;
+		s->ev_count--;
+		s->ev_lost++;
+	}
+	e = &s->ev[(s->ev_head + s->ev_count) % SIM_EVENTS_MAX];
+	e->t_us = s->time_us;
+	snprintf(e->text, sizeof(e->text), "%s", text);
+	s->ev_count++;
+	if (s->hook)
+		s->hook(s->hook_ud, s->time_us / 1000.0, e->text);
+}
+
+void sim_event(struct sim *s, const char *fmt, ...)
+{
+	char text[SIM_EVENT_LEN];
+	va_list ap;
+
+	va_start(ap, fmt);
+	vsnprintf(text, sizeof(text), fmt, ap);
+	va_end(ap);
+	event_put(s, text);
+}
+
+static void event_cb(void *ud, const char *line)
+{
+	event_put(ud, line);
+}
+
+void sim_set_event_hook(struct sim *s,
+			void (*fn)(void *ud, double t_ms, const char *text),
+			void *ud)
+{
+	s->hook = fn;
+	s->hook_ud = ud;
+}
+
+/* ---- life cycle ------------------------------------------------------- */
+
+static int make_parts(struct sim *s, const struct sim_plant_cfg *pc)
+{
+	struct ctrl_cfg cc = {
+	    .model = SIM_MODEL,
+	    .serial = SIM_SERIAL,
+	    .sample_us = SIM_SAMPLE_US,
+	    .event = event_cb,
+	    .event_ud = s,
+	};
+	int rc = sim_plant_new(&s->plant, pc);
+
+	if (rc < 0)
+		return rc;
+	rc = sim_relay_new(&s->relay, SIM_RELAY_DEVANTECH, event_cb, s);
+	if (rc < 0)
+		return rc;
+	s->ctrl = ctrl_new(&cc);
+	return s->ctrl ? 0 : GL_ERR_NOMEM;
+}
+
+int sim_new(struct sim **out, const char *plant_file, char *err, size_t errlen)
+{
+	struct sim_plant_cfg pc;
+	struct sim *s;
+	int rc;
+
+	*out = NULL;
+	sim_plant_cfg_default(&pc);
+	if (plant_file && sim_plant_cfg_load(&pc, plant_file, err, errlen) < 0)
+		return GL_ERR_CONFIG;
+	s = calloc(1, sizeof(*s));
+	if (!s)
+		return GL_ERR_NOMEM;
+	s->ev = calloc(SIM_EVENTS_MAX, sizeof(*s->ev));
+	rc = s->ev ? make_parts(s, &pc) : GL_ERR_NOMEM;
+	if (rc < 0) {
+		snprintf(err, errlen, "cannot create the simulator: %s",
+			 gl_strerror(rc));
+		sim_free(s);
+		return rc;
+	}
+	sim_plant_sense(s->plant, 0, &s->sense);
+	*out = s;
+	return 0;
+}
+
+void sim_free(struct sim *s)
+{
+	if (!s)
+		return;
+	if (s->ctrl)
+		ctrl_free(s->ctrl);
+	sim_relay_free(s->relay);
+	sim_plant_free(s->plant);
+	free(s->ev);
+	free(s);
+}
+
+struct ctrl *sim_ctrl(struct sim *s)
+{
+	return s->ctrl;
+}
+
+struct sim_plant *sim_get_plant(struct sim *s)
+{
+	return s->plant;
+}
+
+struct sim_relay *sim_get_relay(struct sim *s)
+{
+	return s->relay;
+}
+
+void sim_seed(struct sim *s, unsigned long seed)
+{
+	sim_plant_seed(s->plant, seed);
+}
+
+int sim_attach_relay(struct sim *s, const char *protocol, const char *link_path,
+		     char *err, size_t errlen)
+{
+	enum sim_relay_proto proto;
+	struct sim_relay *r;
+	int rc;
+
+	if (sim_relay_proto_parse(protocol, &proto) < 0) {
+		snprintf(err, errlen,
+			 "unknown relay protocol '%s' (devantech, "
+			 "icstation, lcus, kmtronic)",
+			 protocol);
+		return GL_ERR_ARG;
+	}
+	rc = sim_relay_new(&r, proto, event_cb, s);
+	if (rc < 0) {
+		snprintf(err, errlen, "%s", gl_strerror(rc));
+		return rc;
+	}
+	rc = sim_relay_attach(r, link_path, err, errlen);
+	if (rc < 0) {
+		sim_relay_free(r);
+		return rc;
+	}
+	sim_relay_free(s->relay);
+	s->relay = r;
+	return 0;
+}
+
+/* ---- time ------------------------------------------------------------- */
+
+/*
+ * The physical limit switches, as events. (The controller's own events
+ * report its reactions: motor off and why, limit stops, threads started
+ * and stopped, program errors.)
+ */
+static void watch_changes(struct sim *s)
+{
+	for (int i = 0; i < CTRL_AXES; i++) {
+		char a = (char)('A' + i);
+
+		if (s->sense.fwd_limit[i] != s->prev_lf[i])
+			sim_event(s, "%c forward limit switch %s", a,
+				  s->sense.fwd_limit[i] ? "active"
+							: "released");
+		if (s->sense.rev_limit[i] != s->prev_lr[i])
+			sim_event(s, "%c reverse limit switch %s", a,
+				  s->sense.rev_limit[i] ? "active"
+							: "released");
+		s->prev_lf[i] = s->sense.fwd_limit[i];
+		s->prev_lr[i] = s->sense.rev_limit[i];
+	}
+}
+
+void sim_step(struct sim *s)
+{
+	int power = sim_relay_power(s->relay);
+	double dt_ms = ctrl_sample_ms(s->ctrl);
+
+	sim_plant_sense(s->plant, power, &s->sense);
+	ctrl_step(s->ctrl, &s->sense, &s->drive);
+	sim_plant_move(s->plant, &s->drive, power, dt_ms);
+	watch_changes(s);
+	s->time_us += (int64_t)llround(dt_ms * 1000);
+}
+
+void sim_advance_ms(struct sim *s, double ms)
+{
+	int64_t end = s->time_us + (int64_t)llround(ms * 1000);
+
+	while (s->time_us < end)
+		sim_step(s);
+}
+
+double sim_time_ms(const struct sim *s)
+{
+	return s->time_us / 1000.0;
+}
+
+void sim_fmt_ms(char *buf, size_t cap, int64_t t_us)
+{
+	if (t_us % 1000 == 0)
+		snprintf(buf, cap, "%lld", (long long)(t_us / 1000));
+	else
+		snprintf(buf, cap, "%.3f", t_us / 1000.0);
+}
+
+void sim_power_cycle(struct sim *s)
+{
+	if (s->disconnect)
+		s->disconnect(s->disconnect_ud);
+	sim_event(s, "controller power cycle");
+	sim_plant_zero_encoders(s->plant);
+	ctrl_power_cycle(s->ctrl);
+}
+
+int sim_power(const struct sim *s)
+{
+	return sim_relay_power(s->relay);
+}
+
+enum sim_link sim_link(const struct sim *s, double *delay_ms)
+{
+	if (delay_ms)
+		*delay_ms = s->link_delay_ms;
+	return s->link;
+}
+
+void sim_set_disconnect(struct sim *s, void (*fn)(void *ud), void *ud)
+{
+	s->disconnect = fn;
+	s->disconnect_ud = ud;
+}
+
+int sim_quit_requested(const struct sim *s)
+{
+	return s->quit;
+}

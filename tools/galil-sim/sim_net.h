@@ -1,0 +1,66 @@
+/*
+ * sim_net.h - galil-sim in real time: the controller's TCP command port (up
+ * to 8 connections, each an Ethernet handle of the controller), the
+ * control port (text requests of sim_control()), and the virtual relay's
+ * pty, served by one thread that steps the simulator against the wall
+ * clock.
+ *
+ * Timing model: a timerfd on CLOCK_MONOTONIC with absolute expiries fires
+ * every servo sample; one poll() waits for it and for every socket. Each
+ * wake-up steps as many samples as are due (a late wake-up catches up, at
+ * most NET_CATCHUP_SAMPLES per pass so that I/O is still served), then
+ * moves bytes. Commands are executed as they arrive, between samples, as
+ * the controller's command interpreter does. Both ports bind 127.0.0.1
+ * only. Nothing here prints.
+ */
+#ifndef SIM_NET_H
+#define SIM_NET_H
+
+#include <signal.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sim.h"
+
+#define SIM_NET_CONTROL_CLIENTS 4 /* simultaneous control connections */
+
+struct sim_net;
+
+struct sim_net_stats {
+	uint64_t samples;      /* servo samples stepped */
+	uint64_t late_wakeups; /* wake-ups that found > 1 sample due */
+	uint64_t max_due;      /* most samples due at one wake-up */
+	uint64_t refused;      /* command connections refused (all 8 busy,
+				* or link dropped) */
+};
+
+/*
+ * sim_net_open() - bind the command port @port and the control port
+ * @control_port on 127.0.0.1 (0 = any free port) and listen.
+ * @s: the simulator served (not owned).
+ * @err: [out] e.g. "cannot bind 127.0.0.1:23023: Address already in use".
+ * Return: 0, GL_ERR_SYS, GL_ERR_NOMEM.
+ */
+int sim_net_open(struct sim_net **out, struct sim *s, int port,
+		 int control_port, char *err, size_t errlen);
+
+/* sim_net_free() - close every socket. NULL is a no-op. */
+void sim_net_free(struct sim_net *n);
+
+/* sim_net_port() / sim_net_control_port() - the bound port numbers. */
+int sim_net_port(const struct sim_net *n);
+int sim_net_control_port(const struct sim_net *n);
+
+/*
+ * sim_net_run() - serve in real time until the "quit" request or until
+ * *@stop becomes non-zero (set it from a signal handler).
+ * @err: [out] the reason on failure.
+ * Return: 0, or GL_ERR_SYS (poll or the timer failed).
+ */
+int sim_net_run(struct sim_net *n, volatile sig_atomic_t *stop, char *err,
+		size_t errlen);
+
+/* sim_net_stats() - loop figures since sim_net_open(). */
+void sim_net_stats(const struct sim_net *n, struct sim_net_stats *out);
+
+#endif /* SIM_NET_H */

@@ -1,0 +1,202 @@
+/*
+ * sim_plant.h - the simulated RoboELF robot behind galil-sim's controller:
+ * three axes between hard limit switches, motors that servo on their
+ * encoders, potentiometers on analog inputs, 12 joystick switches on digital
+ * inputs, and motor power switched by the E-stop relay.
+ *
+ * The plant is sampled once per servo sample: sim_plant_sense() produces
+ * what the controller reads (struct ctrl_sense), then sim_plant_move()
+ * applies what the controller commands (struct ctrl_drive) for one sample.
+ * Positions are in encoder counts measured from the centre of travel, speeds
+ * in counts/s, voltages in volts. Nothing here prints.
+ */
+#ifndef SIM_PLANT_H
+#define SIM_PLANT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "ctrl.h"
+
+#define SIM_PLANT_AXES	   3  /* A, B, C */
+#define SIM_PLANT_SWITCHES 12 /* 6 commands x 2 redundant channels */
+
+enum sim_plant_noise {
+	SIM_PLANT_NOISE_GAUSSIAN, /* sigma = noise_v / 3, clipped at noise_v */
+	SIM_PLANT_NOISE_UNIFORM,  /* uniform in [-noise_v, +noise_v] */
+};
+
+/* Potentiometer of one axis. */
+struct sim_plant_pot_cfg {
+	int input;	    /* analog input 1..8 */
+	double rev_v;	    /* volts at the reverse limit switch */
+	double fwd_v;	    /* volts at the forward limit switch (> rev_v) */
+	double nonlinear_v; /* amplitude of the sine bow, volts */
+	double noise_v;	    /* noise bound, volts (>= 0) */
+	enum sim_plant_noise noise;
+	double open_v; /* reading with the wiper open, volts */
+};
+
+/* One axis. */
+struct sim_plant_axis_cfg {
+	int rotary;	  /* 1 rotary, 0 linear (informational) */
+	double rev_limit; /* reverse limit switch position, counts */
+	double fwd_limit; /* forward limit switch position, counts */
+	double end_stop;  /* mechanical end beyond each switch, counts */
+	double start;	  /* position at start-up, counts */
+	double max_speed; /* fastest the motor turns, counts/s */
+	double lag_ms;	  /* servo first-order lag, ms (0 = none) */
+	struct sim_plant_pot_cfg pot;
+};
+
+/*
+ * The whole robot. Joystick switch j = 2k + c (command k: 0 A fwd, 1 A rev,
+ * 2 B fwd, 3 B rev, 4 C fwd, 5 C rev; channel c: 0 a, 1 b), the numbering
+ * of docs/dmc-interface.md.
+ */
+struct sim_plant_cfg {
+	struct sim_plant_axis_cfg axis[SIM_PLANT_AXES];
+	int joy_input[SIM_PLANT_SWITCHES]; /* digital input 1..32 */
+	int joy_closed_level; /* @IN level of a closed switch: 1 or 0 */
+	unsigned long seed;   /* noise generator seed */
+};
+
+enum sim_plant_pot_fault {
+	SIM_PLANT_POT_OK,
+	SIM_PLANT_POT_OFFSET, /* reading + offset volts */
+	SIM_PLANT_POT_STUCK,  /* frozen at the reading when injected */
+	SIM_PLANT_POT_OPEN,   /* wiper open: reads open_v, no noise */
+};
+
+enum sim_plant_enc_fault {
+	SIM_PLANT_ENC_OK,
+	SIM_PLANT_ENC_STUCK, /* count frozen at the value when injected */
+	SIM_PLANT_ENC_SLIP,  /* count = position + slip counts */
+};
+
+enum sim_plant_dir {
+	SIM_PLANT_NEUTRAL,
+	SIM_PLANT_FWD,
+	SIM_PLANT_REV,
+};
+
+/* Snapshot of one axis. */
+struct sim_plant_axis_state {
+	double pos;   /* true mechanical position, counts from centre */
+	double vel;   /* true velocity over the last sample, counts/s */
+	double enc;   /* encoder count register */
+	double pot_v; /* last potentiometer reading, volts */
+	int fwd_limit, rev_limit; /* switch active */
+	int blocked;		  /* mechanical jam injected */
+	enum sim_plant_pot_fault pot_fault;
+	enum sim_plant_enc_fault enc_fault;
+};
+
+struct sim_plant;
+
+/* sim_plant_cfg_default() - the built-in default robot (config/plant.yaml). */
+void sim_plant_cfg_default(struct sim_plant_cfg *cfg);
+
+/*
+ * sim_plant_cfg_parse() - override @cfg with the YAML plant text @buf.
+ * @cfg: [in,out] usually the defaults; left untouched on error.
+ * @name: file name used in messages.
+ * @err: [out] "NAME:LINE:COLUMN: message" on error.
+ * Unknown keys, duplicate keys, an empty document, wrong types and values
+ * out of range are errors. Return: 0 or GL_ERR_CONFIG.
+ */
+int sim_plant_cfg_parse(struct sim_plant_cfg *cfg, const char *buf, size_t len,
+			const char *name, char *err, size_t errlen);
+
+/*
+ * sim_plant_cfg_load() - sim_plant_cfg_parse() on the contents of @path.
+ * Return: 0 or GL_ERR_CONFIG ("PATH:0:0: cannot read ..." when unreadable).
+ */
+int sim_plant_cfg_load(struct sim_plant_cfg *cfg, const char *path, char *err,
+		       size_t errlen);
+
+/*
+ * sim_plant_cfg_check() - range checks of a whole configuration.
+ * @err: [out] a message naming the field. Return: 0 or GL_ERR_CONFIG.
+ */
+int sim_plant_cfg_check(const struct sim_plant_cfg *cfg, char *err,
+			size_t errlen);
+
+/*
+ * sim_plant_new() - a robot at its start positions, joysticks neutral, no
+ * fault, encoders reading 0 at the centre of travel.
+ * Return: 0, GL_ERR_CONFIG (cfg fails sim_plant_cfg_check), GL_ERR_NOMEM.
+ */
+int sim_plant_new(struct sim_plant **out, const struct sim_plant_cfg *cfg);
+void sim_plant_free(struct sim_plant *p);
+
+/* sim_plant_cfg() - the configuration in use. */
+const struct sim_plant_cfg *sim_plant_get_cfg(const struct sim_plant *p);
+
+/* sim_plant_seed() - restart the noise generator from @seed. */
+void sim_plant_seed(struct sim_plant *p, unsigned long seed);
+
+/*
+ * sim_plant_sense() - what the controller reads now: encoders, limit
+ * switches, analog inputs (pots + forced values), digital inputs (joystick
+ * switches + forced levels), and @power as amp_power. Draws new noise.
+ */
+void sim_plant_sense(struct sim_plant *p, int power, struct ctrl_sense *out);
+
+/*
+ * sim_plant_move() - one sample of @dt_ms under the controller's @drive.
+ * An axis moves only with its motor on, @power present and no jam: the
+ * motor servos its encoder count onto drive->ref with the configured lag
+ * (velocity = error / lag), limited to max_speed and to the end stops.
+ */
+void sim_plant_move(struct sim_plant *p, const struct ctrl_drive *drive,
+		    int power, double dt_ms);
+
+/*
+ * sim_plant_pot_volts() - the noiseless potentiometer curve of @ax at
+ * position @pos_counts: linear from rev_v at the reverse switch to fwd_v at
+ * the forward switch plus nonlinear_v * sin(pi * u), u = 0..1 over that
+ * travel, clamped to +-10 V. Monotonic when |nonlinear_v| * pi < fwd_v -
+ * rev_v (enforced by sim_plant_cfg_check()).
+ */
+double sim_plant_pot_volts(const struct sim_plant_axis_cfg *ax,
+			   double pos_counts);
+
+/*
+ * Faults and operator inputs. @axis is 0..2; functions taking an index
+ * return 0 or GL_ERR_ARG for an index or value out of range.
+ */
+int sim_plant_set_pot_fault(struct sim_plant *p, int axis,
+			    enum sim_plant_pot_fault f, double offset_v);
+int sim_plant_set_pot_noise(struct sim_plant *p, int axis, double noise_v);
+int sim_plant_set_enc_fault(struct sim_plant *p, int axis,
+			    enum sim_plant_enc_fault f, double slip_counts);
+int sim_plant_set_block(struct sim_plant *p, int axis, int blocked);
+
+/*
+ * sim_plant_set_joy() - set the switches of @axis: @dir with channel mask
+ * @chan (bit 0 = a, bit 1 = b; 3 = both) closed, every other switch of that
+ * axis open. SIM_PLANT_NEUTRAL opens all four.
+ */
+int sim_plant_set_joy(struct sim_plant *p, int axis, enum sim_plant_dir dir,
+		      unsigned chan);
+
+/* sim_plant_force_input() - digital input n (1..32) forced to @level. */
+int sim_plant_force_input(struct sim_plant *p, int n, int level);
+int sim_plant_release_input(struct sim_plant *p, int n);
+/* sim_plant_force_analog() - analog input n (1..8) forced to @volts. */
+int sim_plant_force_analog(struct sim_plant *p, int n, double volts);
+int sim_plant_release_analog(struct sim_plant *p, int n);
+
+/*
+ * sim_plant_zero_encoders() - the controller powered up: every encoder
+ * count register restarts at 0 at the current position (a stuck encoder
+ * stays stuck, at 0; a slip offset is kept).
+ */
+void sim_plant_zero_encoders(struct sim_plant *p);
+
+/* sim_plant_axis() - state of axis 0..2. Return 0 or GL_ERR_ARG. */
+int sim_plant_axis(const struct sim_plant *p, int axis,
+		   struct sim_plant_axis_state *out);
+
+#endif /* SIM_PLANT_H */
