@@ -44,7 +44,7 @@ SAN = -fsanitize=$(SANITIZE) -fno-sanitize-recover=$(SANITIZE) -fno-omit-frame-p
 endif
 
 ALL_CFLAGS = $(WARN) $(CFLAGS) $(SAN) -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE \
-             -Ipc -Itools/galil-sim -Itools/galil-load -Itests/harness $(PKG_CFLAGS) -MMD -MP
+             -Ipc -Itools/galil-sim -Itools/galil-load -Itests/harness -Itests/stub $(PKG_CFLAGS) -MMD -MP
 ALL_LDFLAGS = $(LDFLAGS) $(SAN)
 LIBS = $(PKG_LIBS) -lpthread -lm
 
@@ -62,7 +62,7 @@ LIB_RE := $(BUILD)/lib/libre.a
 LIB_SIM := $(BUILD)/lib/libsim.a
 LIB_LOAD := $(BUILD)/lib/libload.a
 LIB_HARN := $(BUILD)/lib/libharness.a
-LINK_LIBS := $(LIB_LOAD) $(LIB_SIM) $(LIB_RE) $(LIB_HARN) $(LIB_GL)
+LINK_LIBS := $(LIB_HARN) $(LIB_LOAD) $(LIB_SIM) $(LIB_RE) $(LIB_GL)
 
 BINS := $(if $(wildcard pc/roboelf.c),$(BUILD)/bin/roboelf) \
         $(if $(wildcard tools/galil-load/main.c),$(BUILD)/bin/galil-load) \
@@ -138,7 +138,7 @@ lint:
 		pc tools tests
 
 # ---- dependencies ------------------------------------------------------------
-DEB_PKGS = gcc make pkg-config libserialport-dev libyaml-dev libcmocka-dev \
+DEB_PKGS = gcc make pkg-config libserialport-dev libyaml-dev libcmocka-dev gnuplot-nox \
            clang-format cppcheck
 deps:
 	@missing=""; for p in $(DEB_PKGS); do \

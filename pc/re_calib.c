@@ -14,14 +14,14 @@
 #include "re_super.h"
 
 #define NS_PER_MS 1000000LL
-#define AXES "ABC"
+#define AXES	  "ABC"
 
 enum phase {
-	PH_START,	/* nothing sent yet */
-	PH_TO_REV,	/* bounded move onto the reverse switch */
-	PH_BACK_REV,	/* backing off it: then table point 0 */
-	PH_SWEEP,	/* bounded move onto the forward switch, sampling */
-	PH_BACK_FWD,	/* backing off it: the forward soft limit */
+	PH_START,    /* nothing sent yet */
+	PH_TO_REV,   /* bounded move onto the reverse switch */
+	PH_BACK_REV, /* backing off it: then table point 0 */
+	PH_SWEEP,    /* bounded move onto the forward switch, sampling */
+	PH_BACK_FWD, /* backing off it: the forward soft limit */
 	PH_DONE,
 };
 
@@ -34,7 +34,9 @@ struct acc {
 struct cal_axis {
 	enum phase ph;
 	int64_t t_phase_ns;
-	double start;		/* table point 0 = reverse soft limit */
+	double edge; /* encoder where the switch was first seen */
+	int have_edge;
+	double start; /* table point 0 = reverse soft limit */
 	double soft_fwd;
 	struct acc acc[RE_CAL_MAX_POINTS];
 };
@@ -83,8 +85,8 @@ void re_calib_cfg_from(const struct re_config *cfg, const char *const *names,
 		o->check.noise_margin_v = a->monotonic_margin_v;
 		o->check.expected_range_v = a->analog.expected_range_v;
 		o->check.range_tol = a->analog.range_tolerance;
-		o->check.min_points = lo / a->step_counts > 2 ?
-				      (int)(lo / a->step_counts) : 2;
+		o->check.min_points =
+		    lo / a->step_counts > 2 ? (int)(lo / a->step_counts) : 2;
 		o->check.max_points = (int)(hi / a->step_counts) + 1;
 		if (o->check.max_points > RE_CAL_MAX_POINTS)
 			o->check.max_points = RE_CAL_MAX_POINTS;
@@ -94,10 +96,11 @@ void re_calib_cfg_from(const struct re_config *cfg, const char *const *names,
 	}
 }
 
-/* ---- faults ---------------------------------------------------------------- */
+/* ---- faults ----------------------------------------------------------------
+ */
 
 static int abort_axis(struct re_fault *f, int axis, const char *fmt, ...)
-	__attribute__((format(printf, 3, 4)));
+    __attribute__((format(printf, 3, 4)));
 
 static int abort_axis(struct re_fault *f, int axis, const char *fmt, ...)
 {
@@ -117,7 +120,8 @@ static int comm_fault(struct re_fault *f, const char *what, int rc)
 	return RE_FAULT;
 }
 
-/* ---- I/O ------------------------------------------------------------------ */
+/* ---- I/O ------------------------------------------------------------------
+ */
 
 static int send(struct re_calib *c, const struct re_io *io,
 		const struct re_calib_cfg *cfg, struct re_fault *f)
@@ -181,7 +185,8 @@ static int sample_x(struct re_calib *c, const struct re_io *io,
 		return RE_FAULT;
 	}
 	if (re_check_motors(&c->rec, cfg->n_axes, motors_on, f) == RE_FAULT)
-		return abort_axis(f, f->axis, "the controller switched the "
+		return abort_axis(f, f->axis,
+				  "the controller switched the "
 				  "motor off: %s (stop code %d)",
 				  re_stop_reason((int)f->i[0]), (int)f->i[0]);
 	return GL_OK;
@@ -222,14 +227,36 @@ static int fwd_switch(const struct re_calib *c, int i)
 	return !(c->rec.axis[i].switches & GL_AXSW_FLS);
 }
 
-/* ---- the per-axis steps ---------------------------------------------------- */
+/* ---- the per-axis steps ----------------------------------------------------
+ */
 
 static int enter(struct re_calib *c, const struct re_io *io, int i,
 		 enum phase ph)
 {
 	c->ax[i].ph = ph;
 	c->ax[i].t_phase_ns = now_ns(io);
+	c->ax[i].have_edge = 0;
 	return GL_OK;
+}
+
+/* Remember where a switch first showed active: the axis stops past it by
+ * its deceleration distance, and "just off the limit" is measured from
+ * the switch, not from where the axis came to rest. */
+static void note_edge(struct re_calib *c, int i, int active)
+{
+	if (active && !c->ax[i].have_edge) {
+		c->ax[i].edge = enc_of(c, i);
+		c->ax[i].have_edge = 1;
+	}
+}
+
+/* An absolute move of axis i at its maximum velocity. */
+static int move_abs(struct re_calib *c, const struct re_io *io,
+		    const struct re_calib_cfg *cfg, int i, double target,
+		    struct re_fault *f)
+{
+	return sendf(c, io, cfg, f, "SP%c=%d;PA%c=%.0f;BG%c", AXES[i],
+		     cfg->axis[i].vmax_cps, AXES[i], target, AXES[i]);
 }
 
 /* A bounded relative move of axis i at its maximum velocity. */
@@ -251,9 +278,10 @@ static int stopped_badly(const struct re_calib *c, int i, const char *where,
 {
 	int sc = c->rec.axis[i].stop_code;
 
-	return abort_axis(f, i, "stopped before the %s: %s (stop code %d, "
-			  "encoder %.0f)", where, re_stop_reason(sc), sc,
-			  enc_of(c, i));
+	return abort_axis(f, i,
+			  "stopped before the %s: %s (stop code %d, "
+			  "encoder %.0f)",
+			  where, re_stop_reason(sc), sc, enc_of(c, i));
 }
 
 static int step_start(struct re_calib *c, const struct re_io *io,
@@ -262,8 +290,9 @@ static int step_start(struct re_calib *c, const struct re_io *io,
 	const struct re_calib_axis_cfg *a = &cfg->axis[i];
 	int rc;
 
-	if (rev_switch(c, i)) {		/* already on it: just back off */
-		rc = move_rel(c, io, cfg, i, a->backoff_counts, f);
+	if (rev_switch(c, i)) { /* already on it: just back off */
+		rc = move_abs(c, io, cfg, i, enc_of(c, i) + a->backoff_counts,
+			      f);
 		return rc ? rc : enter(c, io, i, PH_BACK_REV);
 	}
 	rc = move_rel(c, io, cfg, i, -sweep_counts(a), f);
@@ -275,16 +304,21 @@ static int step_to_rev(struct re_calib *c, const struct re_io *io,
 		       struct re_fault *f)
 {
 	const struct re_calib_axis_cfg *a = &cfg->axis[i];
+	double edge;
 	int rc;
 
+	note_edge(c, i, rev_switch(c, i));
 	if (moving(c, i))
 		return GL_OK;
 	if (c->rec.axis[i].stop_code == 1 && !rev_switch(c, i))
-		return abort_axis(f, i, "the reverse limit switch never came "
-				  "within %.0f counts", sweep_counts(a));
+		return abort_axis(f, i,
+				  "the reverse limit switch never came "
+				  "within %.0f counts",
+				  sweep_counts(a));
 	if (!rev_switch(c, i))
 		return stopped_badly(c, i, "reverse limit switch", f);
-	rc = move_rel(c, io, cfg, i, a->backoff_counts, f);
+	edge = c->ax[i].edge;
+	rc = move_abs(c, io, cfg, i, edge + a->backoff_counts, f);
 	return rc ? rc : enter(c, io, i, PH_BACK_REV);
 }
 
@@ -298,7 +332,8 @@ static int step_back_rev(struct re_calib *c, const struct re_io *io,
 	if (moving(c, i))
 		return GL_OK;
 	if (rev_switch(c, i))
-		return abort_axis(f, i, "still on the reverse limit switch "
+		return abort_axis(f, i,
+				  "still on the reverse limit switch "
 				  "after backing off %d counts",
 				  cfg->axis[i].backoff_counts);
 	if (c->rec.axis[i].stop_code != 1)
@@ -332,21 +367,25 @@ static void accumulate(struct re_calib *c, const struct re_calib_cfg *cfg,
 }
 
 static int step_sweep(struct re_calib *c, const struct re_io *io,
-		      const struct re_calib_cfg *cfg, int i,
-		      struct re_fault *f)
+		      const struct re_calib_cfg *cfg, int i, struct re_fault *f)
 {
 	const struct re_calib_axis_cfg *a = &cfg->axis[i];
+	double edge;
 	int rc;
 
 	accumulate(c, cfg, i);
+	note_edge(c, i, fwd_switch(c, i));
 	if (moving(c, i))
 		return GL_OK;
 	if (c->rec.axis[i].stop_code == 1 && !fwd_switch(c, i))
-		return abort_axis(f, i, "the forward limit switch never came "
-				  "within %.0f counts", sweep_counts(a));
+		return abort_axis(f, i,
+				  "the forward limit switch never came "
+				  "within %.0f counts",
+				  sweep_counts(a));
 	if (!fwd_switch(c, i))
 		return stopped_badly(c, i, "forward limit switch", f);
-	rc = move_rel(c, io, cfg, i, -a->backoff_counts, f);
+	edge = c->ax[i].edge;
+	rc = move_abs(c, io, cfg, i, edge - a->backoff_counts, f);
 	return rc ? rc : enter(c, io, i, PH_BACK_FWD);
 }
 
@@ -357,7 +396,8 @@ static int step_back_fwd(struct re_calib *c, const struct re_io *io,
 	if (moving(c, i))
 		return GL_OK;
 	if (fwd_switch(c, i))
-		return abort_axis(f, i, "still on the forward limit switch "
+		return abort_axis(f, i,
+				  "still on the forward limit switch "
 				  "after backing off %d counts",
 				  cfg->axis[i].backoff_counts);
 	if (c->rec.axis[i].stop_code != 1)
@@ -373,7 +413,8 @@ static int axis_step(struct re_calib *c, const struct re_io *io,
 
 	if (c->ax[i].ph != PH_START && c->ax[i].ph != PH_DONE &&
 	    age > (int64_t)cfg->move_timeout_ms * NS_PER_MS)
-		return abort_axis(f, i, "a calibration move did not end "
+		return abort_axis(f, i,
+				  "a calibration move did not end "
 				  "within %d ms (encoder %.0f)",
 				  cfg->move_timeout_ms, enc_of(c, i));
 	switch (c->ax[i].ph) {
@@ -386,7 +427,8 @@ static int axis_step(struct re_calib *c, const struct re_io *io,
 	}
 }
 
-/* ---- tables ---------------------------------------------------------------- */
+/* ---- tables ----------------------------------------------------------------
+ */
 
 /* The value at a point: the least-squares line through its samples, read
  * at the point; the mean when the samples do not spread. */
@@ -419,21 +461,25 @@ static int build_table(struct re_calib *c, const struct re_calib_cfg *cfg,
 		double x = ax->start + (double)j * a->step_counts;
 
 		if (ax->acc[j].n == 0)
-			return abort_axis(f, i, "no potentiometer sample near "
-					  "point %d (encoder %.0f)", j, x);
-		t->pot_v[j] = point_value(&ax->acc[j], a->step_counts,
-					  &enc_off);
-		if (j > 0 && re_cal_check_point(&a->check, i, j,
-			a->step_counts, prev_enc, x + enc_off,
-			t->pot_v[j - 1], t->pot_v[j], f) == RE_FAULT)
+			return abort_axis(f, i,
+					  "no potentiometer sample near "
+					  "point %d (encoder %.0f)",
+					  j, x);
+		t->pot_v[j] =
+		    point_value(&ax->acc[j], a->step_counts, &enc_off);
+		if (j > 0 &&
+		    re_cal_check_point(&a->check, i, j, a->step_counts,
+				       prev_enc, x + enc_off, t->pot_v[j - 1],
+				       t->pot_v[j], f) == RE_FAULT)
 			return RE_FAULT;
 		prev_enc = x + enc_off;
 	}
-	return re_cal_check_table(&a->check, i, t, f) == RE_FAULT ? RE_FAULT :
-								  GL_OK;
+	return re_cal_check_table(&a->check, i, t, f) == RE_FAULT ? RE_FAULT
+								  : GL_OK;
 }
 
-/* ---- to the centre, checking the pot against the tables -------------------- */
+/* ---- to the centre, checking the pot against the tables --------------------
+ */
 
 static int check_encpot(struct re_calib *c, const struct re_calib_cfg *cfg,
 			const struct re_calset *set, struct re_fault *f)
@@ -442,13 +488,13 @@ static int check_encpot(struct re_calib *c, const struct re_calib_cfg *cfg,
 		struct re_encpot_result r;
 		double enc = enc_of(c, i), pot = pot_of(c, cfg, i);
 
-		if (re_check_encpot(&set->axis[i], &cfg->axis[i].encpot, i,
-				    enc, pot, &c->encpot[i], &r,
-				    f) != RE_FAULT)
+		if (re_check_encpot(&set->axis[i], &cfg->axis[i].encpot, i, enc,
+				    pot, &c->encpot[i], &r, f) != RE_FAULT)
 			continue;
-		return abort_axis(f, i, "potentiometer %.3f V at encoder %.0f,"
-				  " table expects %.3f V +- %.3f V", pot, enc,
-				  r.exp.pot_v, r.tol_v);
+		return abort_axis(f, i,
+				  "potentiometer %.3f V at encoder %.0f,"
+				  " table expects %.3f V +- %.3f V",
+				  pot, enc, r.exp.pot_v, r.tol_v);
 	}
 	return GL_OK;
 }
@@ -470,8 +516,8 @@ static int to_centre(struct re_calib *c, const struct re_io *io,
 	int rc;
 
 	for (int i = 0; i < RE_AXES; i++)
-		tgt[i] = lround((set->axis[i].soft_rev +
-				 set->axis[i].soft_fwd) / 2);
+		tgt[i] =
+		    lround((set->axis[i].soft_rev + set->axis[i].soft_fwd) / 2);
 	memset(c->encpot, 0, sizeof(c->encpot));
 	rc = sendf(c, io, cfg, f, "SP %d,%d,%d;PA %ld,%ld,%ld;BG ABC",
 		   cfg->axis[0].vmax_cps, cfg->axis[1].vmax_cps,
@@ -486,11 +532,14 @@ static int to_centre(struct re_calib *c, const struct re_io *io,
 	} while (rc == GL_OK && now_ns(io) < deadline);
 	if (rc != GL_OK)
 		return rc;
-	return abort_axis(f, -1, "the move to the centre did not end within "
-			  "%d ms", cfg->move_timeout_ms);
+	return abort_axis(f, -1,
+			  "the move to the centre did not end within "
+			  "%d ms",
+			  cfg->move_timeout_ms);
 }
 
-/* ---- the procedures -------------------------------------------------------- */
+/* ---- the procedures --------------------------------------------------------
+ */
 
 static int sweep_all(struct re_calib *c, const struct re_io *io,
 		     const struct re_calib_cfg *cfg, struct re_fault *f)
@@ -555,11 +604,13 @@ static int check_position(struct re_calib *c, const struct re_calib_cfg *cfg,
 		    RE_FAULT)
 			continue;
 		if (r.exp.where == RE_TPOS_OUTSIDE)
-			return abort_axis(f, i, "encoder %.0f is outside the "
+			return abort_axis(f, i,
+					  "encoder %.0f is outside the "
 					  "file's travel %.0f..%.0f (encoder "
-					  "origin lost?)", enc, t->soft_rev,
-					  t->soft_fwd);
-		return abort_axis(f, i, "the file does not match the robot: "
+					  "origin lost?)",
+					  enc, t->soft_rev, t->soft_fwd);
+		return abort_axis(f, i,
+				  "the file does not match the robot: "
 				  "pot %.3f V at encoder %.0f, table %.3f V",
 				  pot, enc, r.exp.pot_v);
 	}

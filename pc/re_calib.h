@@ -43,25 +43,25 @@
 #include "re_config.h"
 #include "re_io.h"
 
-#define RE_CALIB_SAMPLE_MS 10	/* record period while calibrating */
+#define RE_CALIB_SAMPLE_MS 10 /* record period while calibrating */
 
 struct re_calib_axis_cfg {
-	int vmax_cps;			/* move and sweep velocity */
-	int step_counts;		/* table step */
-	int travel_counts;		/* expected switch-to-switch travel */
-	double travel_tol;		/* fraction */
+	int vmax_cps;	   /* move and sweep velocity */
+	int step_counts;   /* table step */
+	int travel_counts; /* expected switch-to-switch travel */
+	double travel_tol; /* fraction */
 	int backoff_counts;
-	int pot_input;			/* analog input 1..8 */
+	int pot_input; /* analog input 1..8 */
 	struct re_calcheck_cfg check;
-	struct re_encpot_cfg encpot;	/* for the move to the centre */
+	struct re_encpot_cfg encpot; /* for the move to the centre */
 };
 
 struct re_calib_cfg {
-	int n_axes;			/* RE_AXES */
-	const char *const *names;	/* axis names */
+	int n_axes;		  /* RE_AXES */
+	const char *const *names; /* axis names */
 	struct re_calib_axis_cfg axis[RE_AXES];
-	int move_timeout_ms;		/* deadline of each calibration move */
-	int cmd_timeout_ms;		/* deadline of a reply */
+	int move_timeout_ms; /* deadline of each calibration move */
+	int cmd_timeout_ms;  /* deadline of a reply */
 	/* optional: when it becomes non-zero (SIGTERM, Ctrl-C) the procedure
 	 * stops at the next sample and returns GL_ERR_AGAIN */
 	const volatile sig_atomic_t *stop;

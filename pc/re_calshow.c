@@ -27,11 +27,12 @@ static void print_axis(const struct re_calset *s, int a, double allowed,
 {
 	const struct re_caltable *t = &s->axis[a];
 
-	fprintf(out, "axis %s: %d points, start %.0f, step %.0f counts, soft "
+	fprintf(out,
+		"axis %s: %d points, start %.0f, step %.0f counts, soft "
 		"limits %.0f..%.0f counts, pot %.4f..%.4f V, band (1 + %.2f) x "
-		"step\n", s->name[a], t->n, t->start_counts, t->step_counts,
-		t->soft_rev, t->soft_fwd, t->pot_v[0], t->pot_v[t->n - 1],
-		allowed);
+		"step\n",
+		s->name[a], t->n, t->start_counts, t->step_counts, t->soft_rev,
+		t->soft_fwd, t->pot_v[0], t->pot_v[t->n - 1], allowed);
 	fprintf(out, "  point   encoder    pot V   +-tol V\n");
 	for (int i = 0; i < t->n; i++)
 		fprintf(out, "  %5d %9.0f %8.4f %9.4f\n", i,
@@ -57,6 +58,38 @@ static int have_gnuplot(void)
 	return 0;
 }
 
+/* Straight line through the end points: the residual shows wear. */
+static double chord(const struct re_caltable *t, int i)
+{
+	return t->pot_v[0] +
+	       (t->pot_v[t->n - 1] - t->pot_v[0]) * i / (t->n - 1);
+}
+
+/* One inline data block: x, y - @off, and the band around it. */
+static void plot_data(FILE *gp, const struct re_caltable *t, double allowed,
+		      int residual)
+{
+	for (int pass = 0; pass < 2; pass++) {
+		for (int i = 0; i < t->n; i++) {
+			double x = t->start_counts + i * t->step_counts;
+			double y = t->pot_v[i] - (residual ? chord(t, i) : 0);
+			double b = band_v(t, i, allowed);
+
+			if (pass == 0)
+				fprintf(gp, "%.0f %.5f %.5f\n", x, y - b,
+					y + b);
+			else
+				fprintf(gp, "%.0f %.5f\n", x, y);
+		}
+		fprintf(gp, "e\n");
+	}
+}
+
+static const char plot_cmd[] =
+    "plot '-' using 1:2:3 with filledcurves fs transparent solid 0.3 "
+    "title 'tolerance band', '-' using 1:2 with linespoints pt 7 ps 0.5 "
+    "title '%s'\n";
+
 static int plot_axis(const char *path, const struct re_calset *s, int a,
 		     double allowed, FILE *out, FILE *err)
 {
@@ -70,25 +103,18 @@ static int plot_axis(const char *path, const struct re_calset *s, int a,
 		fprintf(err, "roboelf: warning: cannot run gnuplot\n");
 		return -1;
 	}
-	fprintf(gp, "set terminal png size 900,600\nset output '%s'\n"
-		"set title 'axis %s: potentiometer against encoder'\n"
-		"set xlabel 'encoder, counts'\nset ylabel 'potentiometer, V'\n"
-		"plot '-' using 1:2:3 with filledcurves fs transparent solid "
-		"0.3 title 'tolerance band', '-' using 1:2 with linespoints "
-		"pt 7 ps 0.5 title 'table'\n", png, s->name[a]);
-	for (int pass = 0; pass < 2; pass++) {
-		for (int i = 0; i < t->n; i++) {
-			double x = t->start_counts + i * t->step_counts;
-			double b = band_v(t, i, allowed);
-
-			if (pass == 0)
-				fprintf(gp, "%.0f %.5f %.5f\n", x,
-					t->pot_v[i] - b, t->pot_v[i] + b);
-			else
-				fprintf(gp, "%.0f %.5f\n", x, t->pot_v[i]);
-		}
-		fprintf(gp, "e\n");
-	}
+	fprintf(gp,
+		"set terminal png size 900,900\nset output '%s'\n"
+		"set multiplot layout 2,1 title 'axis %s: potentiometer "
+		"against encoder'\nset xlabel 'encoder, counts'\n"
+		"set ylabel 'potentiometer, V'\n",
+		png, s->name[a]);
+	fprintf(gp, plot_cmd, "table");
+	plot_data(gp, t, allowed, 0);
+	fprintf(gp, "set ylabel 'V minus the straight line'\n");
+	fprintf(gp, plot_cmd, "deviation from the end-point line");
+	plot_data(gp, t, allowed, 1);
+	fprintf(gp, "unset multiplot\n");
 	if (pclose(gp) != 0) {
 		fprintf(err, "roboelf: warning: gnuplot failed for '%s'\n",
 			png);
@@ -110,9 +136,11 @@ int re_calshow_print(const char *path, const double *allowed_error, int n,
 		fprintf(err, "roboelf: error: %s\n", msg);
 		return rc;
 	}
-	fprintf(out, "calibration '%s': controller serial %s, %s, config hash "
-		"%016llX, %d axes\n", path, set.serial, set.date,
-		(unsigned long long)set.config_hash, set.n_axes);
+	fprintf(out,
+		"calibration '%s': controller serial %s, %s, config hash "
+		"%016llX, %d axes\n",
+		path, set.serial, set.date, (unsigned long long)set.config_hash,
+		set.n_axes);
 	plot = have_gnuplot();
 	for (int a = 0; a < set.n_axes; a++) {
 		double allowed = a < n ? allowed_error[a] : DEFAULT_ALLOWED;

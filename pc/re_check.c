@@ -62,6 +62,9 @@ static const struct re_fault_msg re_fault_table[] = {
 	{RE_F_CTRL_AMPERR, RE_FC_MOTION,
 	 "axis {a}: amplifier fault, motor power lost (stop code {i0})",
 	 "keep the E-stop pressed, check the amplifier and motor cable of axis {a} and the motor power supply, then restart roboelf"},
+	{RE_F_CTRL_POWER, RE_FC_ESTOP,
+	 "motor power lost on every axis (E-stop button, relay or power supply); the controller switched the motors off",
+	 "keep the E-stop pressed; if nobody pressed it, check the relay, its USB cable and the motor power supply, then restart roboelf"},
 	{RE_F_CTRL_MOTOROFF, RE_FC_MOTION,
 	 "axis {a}: the controller found the motor off while armed: {s} (stop code {i0})",
 	 "keep the E-stop pressed, check that axis {a} moves freely and nothing blocks it, check its motor and encoder cables, then restart roboelf"},
@@ -593,6 +596,9 @@ int re_ctrl_fault(const struct re_za *za, long long fdet,
 	if (!za || !fault)
 		return GL_ERR_ARG;
 	id = re_ctrl_fault_id(za->fcode);
+	/* AMPERR on no single axis: every amplifier lost power at once. */
+	if (id == RE_F_CTRL_AMPERR && re_faxis(za->faxis) < 0)
+		id = RE_F_CTRL_POWER;
 	re_fault_set(fault, id, re_faxis(za->faxis));
 	fault->i[0] = fdet;
 	if (id == RE_F_CTRL_UNKNOWN) {

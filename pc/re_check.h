@@ -87,7 +87,8 @@ enum re_fclass {
  * MOTION
  *   RE_F_MOTOR_OFF       a; i0 stop code; s: re_stop_reason()
  *   RE_F_CTRL_POSERR     a; i0 position error counts (fault 4)
- *   RE_F_CTRL_AMPERR     a; i0 stop code (fault 8)
+ *   RE_F_CTRL_AMPERR     a; i0 stop code (fault 8, one axis)
+ *   RE_F_CTRL_POWER      (fault 8 on every axis: motor power cut)
  *   RE_F_CTRL_MOTOROFF   a; i0 stop code; s: re_stop_reason() (fault 10)
  * INPUT
  *   RE_F_CTRL_INPUT      i0 raw switch word jraw (fault 3)
@@ -151,6 +152,7 @@ enum re_fault_id {
 	RE_F_THREAD,
 	RE_F_STATE,
 	RE_F_PROGRAM_ID,
+	RE_F_CTRL_POWER,
 	RE_F_COUNT
 };
 

@@ -860,6 +860,17 @@ static int check_axis(struct pctx *c, const struct re_config_axis *a)
 		    "'accel_window_ms' end (%d) must be after its "
 		    "start (%d) and at most 60000",
 		    a->accel_end_ms, a->accel_start_ms);
+	/* With position tracking the target is one step ahead of the
+	 * encoder, so a jammed axis never builds an error above the step: ER
+	 * at or above it would never trip (the DMC refuses it too, check 7). */
+	if (a->position_error_limit_counts >= a->step_counts)
+		return fail_at(
+		    c,
+		    later_mark(c, &a->position_error_limit_counts,
+			       &a->step_counts),
+		    "'position_error_limit_counts' (%d) must be below "
+		    "'step_counts' (%d)",
+		    a->position_error_limit_counts, a->step_counts);
 	if (a->travel_counts / a->step_counts < 4 ||
 	    a->travel_counts / a->step_counts > RE_CONFIG_POINTS_MAX)
 		return fail_at(
@@ -1078,7 +1089,7 @@ static void axis_defaults(struct re_config_axis *a, int i)
 	a->ki = 0.0;
 	a->kd = 64.0;
 	a->torque_limit_v = 5.0;
-	a->position_error_limit_counts = 2000;
+	a->position_error_limit_counts = 500;
 	a->off_on_error = true;
 	a->encoder_failure.enabled = true;
 	a->encoder_failure.time_samples = 100;

@@ -11,14 +11,14 @@
 #include <string.h>
 #include <unistd.h>
 
-#define BAR_WIDTH 20
-#define ANSI_RED "\033[1;31m"
-#define ANSI_GREEN "\033[32m"
+#define BAR_WIDTH   12
+#define ANSI_RED    "\033[1;31m"
+#define ANSI_GREEN  "\033[32m"
 #define ANSI_YELLOW "\033[33m"
-#define ANSI_OFF "\033[0m"
+#define ANSI_OFF    "\033[0m"
 
 static const char *const cmd_names[7] = {
-	"none", "A fwd", "A rev", "B fwd", "B rev", "C fwd", "C rev",
+    "none", "A fwd", "A rev", "B fwd", "B rev", "C fwd", "C rev",
 };
 
 int re_console_open(struct re_console *c, FILE *out, int in_fd)
@@ -32,8 +32,8 @@ int re_console_open(struct re_console *c, FILE *out, int in_fd)
 	c->in_fd = in_fd;
 	c->tty_out = isatty(c->out_fd);
 	c->tty_in = in_fd >= 0 && isatty(in_fd);
-	c->color = c->tty_out && !(nc && nc[0]) &&
-		   !(term && !strcmp(term, "dumb"));
+	c->color =
+	    c->tty_out && !(nc && nc[0]) && !(term && !strcmp(term, "dumb"));
 	return 0;
 }
 
@@ -164,10 +164,13 @@ int re_console_format_line(const struct re_status *st, char *buf, size_t cap)
 	size_t n;
 
 	ctrl_text(st, ctl, sizeof(ctl));
-	n = (size_t)snprintf(buf, cap, "status %.1fs mode=%s relay=%s link=%s"
-			     " ctrl=\"%s\"", st->uptime_s, st->mode_name,
-			     st->relay == RE_RELAY_ON ? "on" :
-			     st->relay == RE_RELAY_OFF ? "off" : "unknown",
+	n = (size_t)snprintf(buf, cap,
+			     "status %.1fs mode=%s relay=%s link=%s"
+			     " ctrl=\"%s\"",
+			     st->uptime_s, st->mode_name,
+			     st->relay == RE_RELAY_ON	 ? "on"
+			     : st->relay == RE_RELAY_OFF ? "off"
+							 : "unknown",
 			     st->link_ok ? "ok" : "down", ctl);
 	for (int i = 0; i < st->n_axes && n < cap; i++) {
 		const struct re_axis_status *a = &st->axis[i];
@@ -181,14 +184,14 @@ int re_console_format_line(const struct re_status *st, char *buf, size_t cap)
 					      a->pot_expected_v, a->margin_v);
 		if (n < cap)
 			n += (size_t)snprintf(buf + n, cap - n,
-					      " vel=%.0f %s lim=%s",
-					      a->vel_cps, motion_text(a),
-					      limit_text(a));
+					      " vel=%.0f %s lim=%s", a->vel_cps,
+					      motion_text(a), limit_text(a));
 	}
 	if (n < cap)
-		n += (size_t)snprintf(buf + n, cap - n, " wd=%.1f/%.1fms "
-				      "overruns=%llu%s", st->wd_last_ms,
-				      st->wd_worst_ms,
+		n += (size_t)snprintf(buf + n, cap - n,
+				      " wd=%.1f/%.1fms "
+				      "overruns=%llu%s",
+				      st->wd_last_ms, st->wd_worst_ms,
 				      (unsigned long long)st->overruns,
 				      st->latched ? " LATCHED" : "");
 	return (int)n;
@@ -212,19 +215,18 @@ static const char *col(const struct re_console *c, const char *code)
 	return c->color ? code : "";
 }
 
-static void board_axis(struct re_console *c, const struct re_status *st,
-		       int i)
+static void board_axis(struct re_console *c, const struct re_status *st, int i)
 {
 	const struct re_axis_status *a = &st->axis[i];
-	char b[BAR_WIDTH + 3], exp[48] = "      -        -";
+	char b[BAR_WIDTH + 3], exp[48] = "    -      -";
 
 	bar(b, a->pos_pct);
 	if (a->have_expect)
-		snprintf(exp, sizeof(exp), "%6.3f %s%+8.3f%s",
+		snprintf(exp, sizeof(exp), "%5.3f %s%+6.3f%s",
 			 a->pot_expected_v,
 			 col(c, a->margin_v < 0 ? ANSI_RED : ""), a->margin_v,
 			 col(c, a->margin_v < 0 ? ANSI_OFF : ""));
-	fprintf(c->out, "%-3s %8d %s %5.1f%% %6.3f %s %7.0f %-7s %-3s %s\n",
+	fprintf(c->out, "%-2.2s %7d %s %3.0f%% %5.3f %s %6.0f %-7s %-3s %s\n",
 		st->axis_names[i], (int)a->enc_counts, b,
 		a->pos_pct < 0 ? 0.0 : a->pos_pct, a->pot_v, exp, a->vel_cps,
 		motion_text(a), limit_text(a), a->motor_off ? "off" : "on");
@@ -242,13 +244,14 @@ static void board_draw(struct re_console *c, const struct re_status *st)
 		col(c, st->relay == RE_RELAY_ON ? ANSI_GREEN : ANSI_YELLOW),
 		relay_text(st->relay), col(c, ANSI_OFF),
 		st->link_ok ? "ok" : "DOWN");
-	fprintf(c->out, "ax   encoder position               %%      pot V "
-			"expect   margin   vel/s state   lim motor\n");
+	fprintf(c->out, "ax encoder position         pot V expect margin"
+			"  vel/s state   lim mot\n");
 	n += 2;
 	for (int i = 0; i < st->n_axes; i++, n++)
 		board_axis(c, st, i);
-	fprintf(c->out, "watchdog %.1f ms (worst %.1f, warnings %llu)  period "
-			"%.0f ms  late %.1f/%.1f ms  overruns %llu\n",
+	fprintf(c->out,
+		"watchdog %.1f ms (worst %.1f, warn %llu) period "
+		"%.0f ms late %.1f/%.1f ms overruns %llu\n",
 		st->wd_last_ms, st->wd_worst_ms,
 		(unsigned long long)st->wd_warnings, st->period_ms,
 		st->late_last_ms, st->late_worst_ms,
@@ -281,7 +284,8 @@ void re_console_status(struct re_console *c, const struct re_status *st,
 	fflush(c->out);
 }
 
-/* ---- questions ------------------------------------------------------------ */
+/* ---- questions ------------------------------------------------------------
+ */
 
 /* Read one answer line from the keyboard (cooked mode). */
 static int read_answer(struct re_console *c, char *buf, size_t cap)
@@ -317,8 +321,7 @@ enum re_calib_choice re_console_ask_calibration(struct re_console *c)
 			return RE_CALIB_ASK;
 		if (!strcmp(a, "f") || !strcmp(a, "full"))
 			return RE_CALIB_FULL;
-		if (!strcmp(a, "l") || !strcmp(a, "load") ||
-		    !strcmp(a, "file"))
+		if (!strcmp(a, "l") || !strcmp(a, "load") || !strcmp(a, "file"))
 			return RE_CALIB_FILE;
 		re_console_msg(c, "invalid answer '%s': type f or l", a);
 	}

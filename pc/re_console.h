@@ -26,21 +26,21 @@
 
 #include "re_super.h"
 
-#define RE_CONSOLE_BOARD_NS 100000000LL	/* >= 100 ms between redraws */
-#define RE_CONSOLE_LINE_NS 1000000000LL	/* 1 s between status lines */
+#define RE_CONSOLE_BOARD_NS 100000000LL	 /* >= 100 ms between redraws */
+#define RE_CONSOLE_LINE_NS  1000000000LL /* 1 s between status lines */
 
 struct re_console {
-	FILE *out;		/* stdout */
+	FILE *out; /* stdout */
 	int out_fd;
-	int in_fd;		/* keyboard, -1 when none */
-	int tty_out;		/* @out is a terminal: status board */
-	int tty_in;		/* @in_fd is a terminal: raw keys, questions */
+	int in_fd;   /* keyboard, -1 when none */
+	int tty_out; /* @out is a terminal: status board */
+	int tty_in;  /* @in_fd is a terminal: raw keys, questions */
 	int color;
-	int raw;		/* termios changed; restore on close */
-	int board_lines;	/* lines of the board now on screen */
+	int raw;	 /* termios changed; restore on close */
+	int board_lines; /* lines of the board now on screen */
 	int64_t last_draw_ns;
 	int drawn;
-	struct termios saved;	/* the terminal before raw mode */
+	struct termios saved; /* the terminal before raw mode */
 };
 
 enum re_calib_choice {
@@ -75,7 +75,7 @@ void re_console_close(struct re_console *c);
  * warnings, "RoboELF Ready for Use"). A trailing newline is added.
  */
 void re_console_msg(struct re_console *c, const char *fmt, ...)
-	__attribute__((format(printf, 2, 3)));
+    __attribute__((format(printf, 2, 3)));
 
 /*
  * re_console_fault() - the FAULT line, exactly as given, on one line (in

@@ -13,17 +13,17 @@
 #include "gl_err.h"
 #include "gl_ident.h"
 
-#define NS_PER_MS 1000000LL
-#define LINE_MAX_CHARS GL_LINE_MAX
-#define POLL_MS 10
-#define PROGRAM_WAIT_MS 1000	/* XQ #AUTO,0 -> state 0, heartbeat */
-#define ARM_WAIT_MS 1000	/* armreq=1 -> state 1 (dmc-interface.md) */
-#define AXES "ABC"
+#define NS_PER_MS	1000000LL
+#define LINE_MAX_CHARS	GL_LINE_MAX
+#define POLL_MS		10
+#define PROGRAM_WAIT_MS 1000 /* XQ #AUTO,0 -> state 0, heartbeat */
+#define ARM_WAIT_MS	1000 /* armreq=1 -> state 1 (dmc-interface.md) */
+#define AXES		"ABC"
 
 /* ---- small helpers ------------------------------------------------------- */
 
 static void seterr(char *err, size_t errlen, const char *fmt, ...)
-	__attribute__((format(printf, 3, 4)));
+    __attribute__((format(printf, 3, 4)));
 
 static void seterr(char *err, size_t errlen, const char *fmt, ...)
 {
@@ -122,7 +122,7 @@ static void pause_ms(const struct re_io *io, int ms)
 int re_ctl_stop(const struct re_io *io, int timeout_ms)
 {
 	char resp[64];
-	int rc = io->ops->command(io->ud, "ST ABC;MO ABC", resp, sizeof(resp),
+	int rc = io->ops->command(io->ud, "AB 1;MO ABC", resp, sizeof(resp),
 				  timeout_ms);
 
 	return rc < 0 ? rc : GL_OK;
@@ -140,18 +140,22 @@ static int check_program(gl_link *l, struct re_ctl_info *info, char *err,
 		return GL_ERR_NOMEM;
 	n = gl_link_upload(l, buf, RE_CTL_UPLOAD_MAX, 0);
 	if (n < 0) {
-		seterr(err, errlen, "cannot upload the controller's program: "
-		       "%s", gl_strerror(n));
+		seterr(err, errlen,
+		       "cannot upload the controller's program: "
+		       "%s",
+		       gl_strerror(n));
 		free(buf);
 		return n;
 	}
 	rc = gl_ident_verify(buf, (size_t)n, &info->program_id);
 	free(buf);
 	if (rc == GL_ERR_FORMAT)
-		seterr(err, errlen, "the controller holds no program stamped "
+		seterr(err, errlen,
+		       "the controller holds no program stamped "
 		       "by galil-load: run galil-load with dmc/ first");
 	else if (rc == GL_ERR_MISMATCH)
-		seterr(err, errlen, "the controller's program was changed "
+		seterr(err, errlen,
+		       "the controller's program was changed "
 		       "after galil-load stamped it (id %016llX): run "
 		       "galil-load with dmc/ again",
 		       (unsigned long long)info->program_id);
@@ -173,16 +177,20 @@ int re_ctl_identify(gl_link *l, const struct re_config *cfg,
 		return rc;
 	}
 	if (!strstr(info->model, cfg->controller.model)) {
-		seterr(err, errlen, "controller '%s' is not the configured "
-		       "model '%s'", info->model, cfg->controller.model);
+		seterr(err, errlen,
+		       "controller '%s' is not the configured "
+		       "model '%s'",
+		       info->model, cfg->controller.model);
 		return GL_ERR_MISMATCH;
 	}
 	/* close every other handle before opening our message handle */
 	rc = gl_link_command(l, "IHT=>-3", resp, sizeof(resp), 0);
 	if (rc < 0) {
-		seterr(err, errlen, "cannot close the controller's other "
-		       "connections (IHT=>-3): %s", rc == GL_ERR_CTRL ?
-		       gl_link_ctrl_error(l, NULL) : gl_strerror(rc));
+		seterr(err, errlen,
+		       "cannot close the controller's other "
+		       "connections (IHT=>-3): %s",
+		       rc == GL_ERR_CTRL ? gl_link_ctrl_error(l, NULL)
+					 : gl_strerror(rc));
 		return rc;
 	}
 	rc = gl_link_open_messages(l, 0);
@@ -194,13 +202,14 @@ int re_ctl_identify(gl_link *l, const struct re_config *cfg,
 	return check_program(l, info, err, errlen);
 }
 
-/* ---- configuration -------------------------------------------------------- */
+/* ---- configuration --------------------------------------------------------
+ */
 
 struct setting {
-	const char *name;	/* command and operand, e.g. "KP" */
+	const char *name; /* command and operand, e.g. "KP" */
 	double v[RE_AXES];
 	int integer;
-	double res;		/* the controller's resolution, 0: none */
+	double res; /* the controller's resolution, 0: none */
 };
 
 /* DMC-40x0 command reference: AC and DC are kept in steps of 1024
@@ -218,14 +227,14 @@ static double resolution(const char *name)
 static int fill_settings(const struct re_config *cfg, struct setting *s)
 {
 	static const char *const names[] = {
-		"KP", "KI", "KD", "TL", "ER", "OE", "OA", "OT", "OV", "AC",
-		"DC", "FL", "BL",
+	    "KP", "KI", "KD", "TL", "ER", "OE", "OA",
+	    "OT", "OV", "AC", "DC", "FL", "BL",
 	};
 	int n = (int)(sizeof(names) / sizeof(names[0]));
 
 	for (int k = 0; k < n; k++) {
 		s[k].name = names[k];
-		s[k].integer = k >= 4 && k != 8;	/* TL, OV, gains: real */
+		s[k].integer = k >= 4 && k != 8; /* TL, OV, gains: real */
 		s[k].res = resolution(names[k]);
 	}
 	for (int i = 0; i < RE_AXES; i++) {
@@ -265,8 +274,10 @@ static int write_setting(const struct re_io *io, const struct setting *s,
 		snprintf(op, sizeof(op), "_%s%c", s->name, AXES[i]);
 		rc = read_err(io, op, &got, err, errlen);
 		if (rc == GL_OK && !same(s->v[i], got, s->integer, s->res)) {
-			seterr(err, errlen, "read-back of %s%c differs: wrote "
-			       "%s, read %g", s->name, AXES[i], num[i], got);
+			seterr(err, errlen,
+			       "read-back of %s%c differs: wrote "
+			       "%s, read %g",
+			       s->name, AXES[i], num[i], got);
 			rc = GL_ERR_MISMATCH;
 		}
 	}
@@ -285,9 +296,11 @@ static int write_co(const struct re_io *io, const struct re_config *cfg,
 	if (rc == GL_ERR_CTRL) {
 		io->ops->ctrl_error(io->ud, &code);
 		if (code == 1 && cfg->mode == RE_MODE_DEVELOPMENT) {
-			re_io_logf(io, RE_LOG_WARN, "controller: %s; extended "
+			re_io_logf(io, RE_LOG_WARN,
+				   "controller: %s; extended "
 				   "I/O left at its default (development "
-				   "mode)", err);
+				   "mode)",
+				   err);
 			return GL_OK;
 		}
 	}
@@ -310,7 +323,7 @@ int re_ctl_configure(const struct re_io *io, const struct re_config *cfg,
 
 	rc = cmd(io, "HX", err, errlen);
 	if (rc == GL_OK)
-		rc = cmd(io, "ST ABC;MO ABC", err, errlen);
+		rc = cmd(io, "AB 1;MO ABC", err, errlen);
 	if (rc == GL_OK)
 		rc = write_co(io, cfg, err, errlen);
 	n = fill_settings(cfg, s);
@@ -342,16 +355,16 @@ int re_ctl_set_limits(const struct re_io *io, const struct re_calset *cal,
 /* ---- arming ------------------------------------------------------------- */
 
 struct param {
-	const char *name;	/* variable or array name */
-	int n;			/* 0: plain variable, else elements */
+	const char *name; /* variable or array name */
+	int n;		  /* 0: plain variable, else elements */
 	double v[RE_JOY_INPUTS];
 };
 
-static int fill_params(const struct re_config *cfg,
-		       const struct re_calset *cal, struct param *p)
+static int fill_params(const struct re_config *cfg, const struct re_calset *cal,
+		       struct param *p)
 {
 	static const char *const arrays[] = {
-		"vmin", "vmax", "wst", "wen", "stp", "srev", "sfwd",
+	    "vmin", "vmax", "wst", "wen", "stp", "srev", "sfwd",
 	};
 
 	for (int k = 0; k < 7; k++) {
@@ -375,8 +388,8 @@ static int fill_params(const struct re_config *cfg,
 	p[8] = (struct param){"jval", 6, {3, 12, 48, 192, 768, 3072}};
 	p[9] = (struct param){"jpol", 0, {cfg->joystick.active_low ? 1 : 0}};
 	p[10] = (struct param){"jto", 0, {cfg->joystick.invalid_timeout_ms}};
-	p[11] = (struct param){"wdto", 0,
-			       {cfg->watchdog.controller_timeout_ms}};
+	p[11] =
+	    (struct param){"wdto", 0, {cfg->watchdog.controller_timeout_ms}};
 	return 12;
 }
 
@@ -389,8 +402,8 @@ static void param_ref(const struct param *p, int i, char *buf, size_t cap)
 }
 
 /* Assignments joined with ';' into lines of at most 80 characters. */
-static int write_param(const struct re_io *io, const struct param *p,
-		       char *err, size_t errlen)
+static int write_param(const struct re_io *io, const struct param *p, char *err,
+		       size_t errlen)
 {
 	char line[LINE_MAX_CHARS + 1] = "", item[48], ref[16], num[24];
 	int count = p->n ? p->n : 1, rc = GL_OK;
@@ -398,8 +411,8 @@ static int write_param(const struct re_io *io, const struct param *p,
 	for (int i = 0; rc == GL_OK && i < count; i++) {
 		param_ref(p, i, ref, sizeof(ref));
 		fmt_num(num, sizeof(num), p->v[i]);
-		snprintf(item, sizeof(item), "%s%s=%s", line[0] ? ";" : "",
-			 ref, num);
+		snprintf(item, sizeof(item), "%s%s=%s", line[0] ? ";" : "", ref,
+			 num);
 		if (strlen(line) + strlen(item) > LINE_MAX_CHARS) {
 			rc = cmd(io, line, err, errlen);
 			snprintf(item, sizeof(item), "%s=%s", ref, num);
@@ -412,8 +425,8 @@ static int write_param(const struct re_io *io, const struct param *p,
 	return rc;
 }
 
-static int check_param(const struct re_io *io, const struct param *p,
-		       char *err, size_t errlen)
+static int check_param(const struct re_io *io, const struct param *p, char *err,
+		       size_t errlen)
 {
 	char ref[16];
 	double got;
@@ -423,8 +436,10 @@ static int check_param(const struct re_io *io, const struct param *p,
 		param_ref(p, i, ref, sizeof(ref));
 		rc = read_err(io, ref, &got, err, errlen);
 		if (rc == GL_OK && !same(p->v[i], got, 1, 0)) {
-			seterr(err, errlen, "read-back of %s differs: wrote "
-			       "%g, read %g", ref, p->v[i], got);
+			seterr(err, errlen,
+			       "read-back of %s differs: wrote "
+			       "%g, read %g",
+			       ref, p->v[i], got);
 			rc = GL_ERR_MISMATCH;
 		}
 	}
@@ -450,7 +465,8 @@ static int wait_program(const struct re_io *io, struct re_ctl_info *info,
 			break;
 	} while (now_ns(io) < deadline && (rc == GL_OK || rc == GL_ERR_CTRL));
 	if (!(state == 0 && hb != hb0)) {
-		seterr(err, errlen, "the controller's program did not start "
+		seterr(err, errlen,
+		       "the controller's program did not start "
 		       "(state %g, heartbeat %g): run galil-load again",
 		       state, hb);
 		return GL_ERR_TIMEOUT;
@@ -479,8 +495,9 @@ static int wait_armed(const struct re_io *io, long *hbpc,
 			       gl_strerror(rc));
 			return rc;
 		}
-		if (rec.n_axes < 3 || re_za_decode(rec.axis[0].za,
-			rec.axis[1].za, rec.axis[2].za, &za) != GL_OK)
+		if (rec.n_axes < 3 ||
+		    re_za_decode(rec.axis[0].za, rec.axis[1].za, rec.axis[2].za,
+				 &za) != GL_OK)
 			continue;
 		if (za.state == RE_DMC_ARMED && za.fcode == 0)
 			return GL_OK;

@@ -23,15 +23,15 @@
 #include "re_config.h"
 #include "re_io.h"
 
-#define RE_CTL_ERR_MAX 256
-#define RE_CTL_UPLOAD_MAX (4000 * 82 + 1024)	/* 4000 lines of 80 + CR LF */
-#define RE_CTL_SOFT_OPEN 2147483647	/* FL/BL "no soft limit", counts */
+#define RE_CTL_ERR_MAX	  256
+#define RE_CTL_UPLOAD_MAX (4000 * 82 + 1024) /* 4000 lines of 80 + CR LF */
+#define RE_CTL_SOFT_OPEN  2147483647	     /* FL/BL "no soft limit", counts */
 
 struct re_ctl_info {
-	char model[64];		/* ^R^V, e.g. "DMC4030 Rev 1.2h-sim" */
-	long serial;		/* MG _BN */
-	uint64_t program_id;	/* the stamp galil-load wrote */
-	int mainms;		/* the program's #MAIN period, ms */
+	char model[64];	     /* ^R^V, e.g. "DMC4030 Rev 1.2h-sim" */
+	long serial;	     /* MG _BN */
+	uint64_t program_id; /* the stamp galil-load wrote */
+	int mainms;	     /* the program's #MAIN period, ms */
 };
 
 /*

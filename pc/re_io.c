@@ -106,8 +106,8 @@ static int64_t real_now_ns(void *ud)
 static void real_sleep_until(void *ud, int64_t t_ns)
 {
 	struct timespec ts = {
-		.tv_sec = (time_t)(t_ns / 1000000000),
-		.tv_nsec = (long)(t_ns % 1000000000),
+	    .tv_sec = (time_t)(t_ns / 1000000000),
+	    .tv_nsec = (long)(t_ns % 1000000000),
 	};
 
 	(void)ud;
@@ -117,16 +117,16 @@ static void real_sleep_until(void *ud, int64_t t_ns)
 }
 
 static const struct re_io_ops real_ops = {
-	.record = real_record,
-	.command = real_command,
-	.ctrl_error = real_ctrl_error,
-	.message = real_message,
-	.relay_check = real_relay_check,
-	.relay_off = real_relay_off,
-	.relay_state = real_relay_state,
-	.log = real_log,
-	.now_ns = real_now_ns,
-	.sleep_until = real_sleep_until,
+    .record = real_record,
+    .command = real_command,
+    .ctrl_error = real_ctrl_error,
+    .message = real_message,
+    .relay_check = real_relay_check,
+    .relay_off = real_relay_off,
+    .relay_state = real_relay_state,
+    .log = real_log,
+    .now_ns = real_now_ns,
+    .sleep_until = real_sleep_until,
 };
 
 void re_io_bind(struct re_io *io, struct re_io_real *real)
@@ -135,8 +135,8 @@ void re_io_bind(struct re_io *io, struct re_io_real *real)
 	io->ud = real;
 }
 
-int re_io_logf(const struct re_io *io, enum re_log_level lvl,
-	       const char *fmt, ...)
+int re_io_logf(const struct re_io *io, enum re_log_level lvl, const char *fmt,
+	       ...)
 {
 	char text[RE_LOG_LINE_MAX];
 	va_list ap;

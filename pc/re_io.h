@@ -71,7 +71,7 @@ int64_t re_io_now_ns(void);
  * re_io_logf() - printf-style log event through @io (INFO, WARN or FAULT).
  * Formats into a stack buffer; no allocation. Return: as ops->log.
  */
-int re_io_logf(const struct re_io *io, enum re_log_level lvl,
-	       const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+int re_io_logf(const struct re_io *io, enum re_log_level lvl, const char *fmt,
+	       ...) __attribute__((format(printf, 3, 4)));
 
 #endif /* RE_IO_H */

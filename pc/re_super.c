@@ -12,8 +12,12 @@
 #include "gl_err.h"
 
 #define NS_PER_MS 1000000LL
-#define HBPC_WRAP 1000000	/* hbpc stays a short decimal number */
-#define STOP_ALL "ST ABC;MO ABC"
+#define HBPC_WRAP 1000000 /* hbpc stays a short decimal number */
+/* Abort the motion only (AB 1: a bare AB would also abort the program) and
+ * switch the motors off. Not "ST ABC;MO ABC": the controller refuses MO
+ * (TC 7) while an axis is still decelerating from ST, which would leave the
+ * motors on. The DMC's own #FAULT uses the same two commands. */
+#define STOP_ALL  "AB 1;MO ABC"
 #define FAULT_CMD STOP_ALL ";pcflt=1"
 
 static int64_t now_ns(const struct re_super *s)
@@ -56,7 +60,7 @@ int re_super_init(struct re_super *s, const struct re_io *io,
 		s->table[i] = tables[i];
 	s->armed = armed;
 	s->t0_ns = now_ns(s);
-	s->deadline_ns = s->t0_ns + cfg->period_ns;	/* no previous cycle */
+	s->deadline_ns = s->t0_ns + cfg->period_ns; /* no previous cycle */
 	s->last_good_ns = s->t0_ns;
 	re_alive_reset(&s->alive);
 	return GL_OK;
@@ -97,39 +101,126 @@ int64_t re_super_wait(struct re_super *s)
 	s->late_last_ns = late;
 	if (late > s->late_worst_ns)
 		s->late_worst_ns = late;
+	s->late_hist[late / (RE_LATE_BIN_US * 1000) < RE_LATE_BINS - 1
+			 ? late / (RE_LATE_BIN_US * 1000)
+			 : RE_LATE_BINS - 1]++;
 	s->deadline_ns += s->cfg.period_ns;
 	return late;
 }
 
 /* ---- fault reaction ------------------------------------------------------ */
 
-/* Re-read the controller's fault detail (MG fdet) for a CTRL fault. */
-static void ctrl_fault_detail(struct re_super *s, struct re_fault *f)
-{
-	int rc;
-
-	if (!s->have_za || s->za.fcode == 0)
-		return;
-	rc = s->io.ops->command(s->io.ud, "MG fdet", s->resp, sizeof(s->resp),
-				s->cfg.fault_cmd_timeout_ms);
-	if (rc >= 0)
-		re_ctrl_fault(&s->za, strtoll(s->resp, NULL, 10), f);
-}
-
 static int is_ctrl_fault(enum re_fault_id id)
 {
 	switch (id) {
-	case RE_F_CTRL_ENCODER: case RE_F_CTRL_WATCHDOG:
-	case RE_F_CTRL_POSERR: case RE_F_CTRL_AMPERR:
-	case RE_F_CTRL_MOTOROFF: case RE_F_CTRL_INPUT:
-	case RE_F_CTRL_TCPERR: case RE_F_CTRL_PARAM:
-	case RE_F_CTRL_LIMIT: case RE_F_CTRL_CMDERR:
-	case RE_F_CTRL_THREAD: case RE_F_CTRL_SUPERVISOR:
-	case RE_F_CTRL_UNKNOWN:
-		return 1;
-	default:
-		return 0;
+	case RE_F_CTRL_ENCODER:
+	case RE_F_CTRL_WATCHDOG:
+	case RE_F_CTRL_POSERR:
+	case RE_F_CTRL_AMPERR:
+	case RE_F_CTRL_POWER:
+	case RE_F_CTRL_MOTOROFF:
+	case RE_F_CTRL_INPUT:
+	case RE_F_CTRL_TCPERR:
+	case RE_F_CTRL_PARAM:
+	case RE_F_CTRL_LIMIT:
+	case RE_F_CTRL_CMDERR:
+	case RE_F_CTRL_THREAD:
+	case RE_F_CTRL_SUPERVISOR:
+	case RE_F_CTRL_UNKNOWN: return 1;
+	default: return 0;
 	}
+}
+
+/* "MG <name>" as a number. */
+static int read_num(struct re_super *s, const char *name, double *v)
+{
+	char cmd[32], *end;
+	int rc;
+
+	snprintf(cmd, sizeof(cmd), "MG %s", name);
+	rc = s->io.ops->command(s->io.ud, cmd, s->resp, sizeof(s->resp),
+				s->cfg.fault_cmd_timeout_ms);
+	if (rc < 0)
+		return rc;
+	*v = strtod(s->resp, &end);
+	return end == s->resp ? GL_ERR_PROTO : GL_OK;
+}
+
+/* Re-read the controller's fault detail (MG fdet) for a CTRL fault. */
+static void ctrl_fault_detail(struct re_super *s, struct re_fault *f)
+{
+	double fdet;
+
+	if (s->have_za && s->za.fcode != 0 &&
+	    read_num(s, "fdet", &fdet) == GL_OK)
+		re_ctrl_fault(&s->za, (long long)fdet, f);
+}
+
+/* Faults that may be the program's own fault seen half-way (motors off by
+ * #JINV before #MAIN latched INPUT, thread 1 halted by #FAULT ...). */
+static int may_settle(const struct re_super *s, enum re_fault_id id)
+{
+	return s->cfg.settle_ms > 0 &&
+	       (id == RE_F_MOTOR_OFF || id == RE_F_THREAD || id == RE_F_STATE);
+}
+
+/* Poll the program's fault code for up to settle_ms; when it latched
+ * one, that is the fault to report (with its axis and detail). */
+static void program_verdict(struct re_super *s, struct re_fault *f)
+{
+	int64_t t0 = now_ns(s);
+	int64_t end = t0 + (int64_t)s->cfg.settle_ms * NS_PER_MS;
+	double code = 0, axis = 0, det = 0;
+	struct re_za za;
+	int rc;
+
+	do {
+		rc = read_num(s, "fcode", &code);
+		if (rc != GL_OK) {
+			snprintf(s->verdict, sizeof(s->verdict),
+				 "program fault code unreadable: %s",
+				 gl_strerror(rc));
+			return;
+		}
+		if (code > 0 && code < 100) {
+			snprintf(s->verdict, sizeof(s->verdict),
+				 "program fault %d after %.1f ms", (int)code,
+				 ns_to_ms(now_ns(s) - t0));
+			read_num(s, "faxis", &axis);
+			read_num(s, "fdet", &det);
+			memset(&za, 0, sizeof(za));
+			za.state = RE_DMC_FAULT;
+			za.fcode = (int)code;
+			za.faxis = axis >= 0 && axis <= 3 ? (int)axis : 0;
+			re_ctrl_fault(&za, (long long)det, f);
+			return;
+		}
+		s->io.ops->sleep_until(s->io.ud, now_ns(s) + 2 * NS_PER_MS);
+	} while (now_ns(s) < end);
+	snprintf(s->verdict, sizeof(s->verdict),
+		 "no program fault within %d ms", s->cfg.settle_ms);
+}
+
+/* Stop and switch off through the controller and tell the program
+ * (pcflt) - after its own verdict when it may be latching one. */
+static int stop_controller(struct re_super *s, struct re_fault *f)
+{
+	int rc;
+
+	if (!may_settle(s, f->id)) {
+		rc = s->io.ops->command(s->io.ud, FAULT_CMD, s->resp,
+					sizeof(s->resp),
+					s->cfg.fault_cmd_timeout_ms);
+		if (is_ctrl_fault(f->id))
+			ctrl_fault_detail(s, f);
+		return rc;
+	}
+	rc = s->io.ops->command(s->io.ud, STOP_ALL, s->resp, sizeof(s->resp),
+				s->cfg.fault_cmd_timeout_ms);
+	program_verdict(s, f);
+	s->io.ops->command(s->io.ud, "pcflt=1", s->resp, sizeof(s->resp),
+			   s->cfg.fault_cmd_timeout_ms);
+	return rc;
 }
 
 /* Append the axes of the last record to the log text. */
@@ -142,17 +233,18 @@ static size_t snapshot(const struct re_super *s, char *buf, size_t cap)
 
 		n += (size_t)snprintf(buf + n, cap - n,
 				      "; %s enc=%d ref=%d err=%d sc=%d mo=%d"
-				      " an=%.4fV", s->cfg.axis_names[i],
-				      (int)a->motor_pos, (int)a->ref_pos,
-				      (int)a->pos_err, a->stop_code,
+				      " an=%.4fV",
+				      s->cfg.axis_names[i], (int)a->motor_pos,
+				      (int)a->ref_pos, (int)a->pos_err,
+				      a->stop_code,
 				      a->status & GL_AXST_MOTOR_OFF ? 1 : 0,
 				      re_pot_volts(a->analog_in));
 	}
 	if (n < cap && s->have_za)
 		n += (size_t)snprintf(buf + n, cap - n,
 				      "; dmc state=%d fcode=%d faxis=%d "
-				      "hbdmc=%d jraw=%d", s->za.state,
-				      s->za.fcode, s->za.faxis,
+				      "hbdmc=%d jraw=%d",
+				      s->za.state, s->za.fcode, s->za.faxis,
 				      (int)s->za.hbdmc, s->za.jraw);
 	return n < cap ? n : cap;
 }
@@ -162,13 +254,14 @@ static void log_fault(struct re_super *s, int relay_rc, int cmd_rc)
 	char *t = s->text;
 	size_t cap = sizeof(s->text), n;
 
-	n = (size_t)snprintf(t, cap, "%s | relay off: %s | controller "
-			     "'" FAULT_CMD "': %s | cycle %llu, reply age "
-			     "%.1f ms", s->fault_line,
-			     relay_rc == GL_OK ? "confirmed" : "NOT confirmed",
-			     cmd_rc >= 0 ? "ok" : gl_strerror(cmd_rc),
-			     (unsigned long long)s->cycles,
-			     ns_to_ms(s->age_last_ns));
+	n = (size_t)snprintf(
+	    t, cap,
+	    "%s | relay off: %s | controller stop: %s%s%s | "
+	    "cycle %llu, reply age %.1f ms",
+	    s->fault_line, relay_rc == GL_OK ? "confirmed" : "NOT confirmed",
+	    cmd_rc >= 0 ? "ok" : gl_strerror(cmd_rc), s->verdict[0] ? "; " : "",
+	    s->verdict, (unsigned long long)s->cycles,
+	    ns_to_ms(s->age_last_ns));
 	if (n < cap)
 		snapshot(s, t + n, cap - n);
 	s->io.ops->log(s->io.ud, RE_LOG_FAULT, t);
@@ -184,21 +277,19 @@ int re_super_fault(struct re_super *s, const struct re_fault *f)
 		re_io_logf(&s->io, RE_LOG_WARN, "while latched: %s", s->msg);
 		return RE_OK;
 	}
+	s->verdict[0] = '\0';
 	/* 1. cut motor power; 2. stop and switch off through the controller */
 	relay_rc = s->io.ops->relay_off(s->io.ud);
-	cmd_rc = s->io.ops->command(s->io.ud, FAULT_CMD, s->resp,
-				    sizeof(s->resp),
-				    s->cfg.fault_cmd_timeout_ms);
+	cmd_rc = stop_controller(s, &fault);
 	s->latched = 1;
 	s->armed = 0;
-	if (is_ctrl_fault(fault.id))
-		ctrl_fault_detail(s, &fault);
 	s->fault = fault;
 	if (re_fault_format(&fault, s->cfg.axis_names, s->fault_line,
 			    sizeof(s->fault_line)) == GL_ERR_ARG)
 		snprintf(s->fault_line, sizeof(s->fault_line),
 			 "FAULT PROGRAM: unknown fault %d. Recovery: quit, "
-			 "note the log and call service", (int)fault.id);
+			 "note the log and call service",
+			 (int)fault.id);
 	/* 3. the log entry on disk before anyone reports the relay open */
 	log_fault(s, relay_rc, cmd_rc);
 	return RE_FAULT;
@@ -263,7 +354,8 @@ static int exchange(struct re_super *s, struct re_fault *f)
 static void warn_watchdog(struct re_super *s)
 {
 	s->wd_warnings++;
-	re_io_logf(&s->io, RE_LOG_WARN, "watchdog: reply after %.1f ms "
+	re_io_logf(&s->io, RE_LOG_WARN,
+		   "watchdog: reply after %.1f ms "
 		   "(non-critical limit %.1f ms, critical %.1f ms)",
 		   ns_to_ms(s->age_last_ns), ns_to_ms(s->noncrit_ns),
 		   ns_to_ms(s->crit_ns));
@@ -280,6 +372,16 @@ static int check_relay(struct re_super *s, struct re_fault *f)
 	return RE_FAULT;
 }
 
+/* A check that cannot run is a fault, never a pass (fail safe). */
+static int check_error(struct re_fault *f, enum re_fault_id id, int axis,
+		       const char *what, int err)
+{
+	re_fault_set(f, id, axis);
+	snprintf(f->s, sizeof(f->s), "%s could not run: %s", what,
+		 gl_strerror(err));
+	return RE_FAULT;
+}
+
 static int check_encpot(struct re_super *s, struct re_fault *f)
 {
 	for (int i = 0; i < s->cfg.n_axes; i++) {
@@ -290,10 +392,11 @@ static int check_encpot(struct re_super *s, struct re_fault *f)
 		if (!s->table[i])
 			continue;
 		v = re_check_encpot(s->table[i], &s->cfg.encpot[i], i,
-				    a->motor_pos, pot_of(s, i),
-				    &s->encpot[i], &s->encres[i], f);
+				    a->motor_pos, pot_of(s, i), &s->encpot[i],
+				    &s->encres[i], f);
 		if (v < 0)
-			continue;
+			return check_error(f, RE_F_CONFIG, i,
+					   "encoder/potentiometer check", v);
 		s->have_encres[i] = 1;
 		if (v == RE_FAULT)
 			return RE_FAULT;
@@ -319,10 +422,12 @@ static int check_record(struct re_super *s, struct re_fault *f)
 
 	v = re_check_record(&s->rec, s->cfg.n_axes, s->armed, &s->za, f);
 	s->have_za = v == RE_OK || f->id != RE_F_RECORD;
+	if (v < 0)
+		return check_error(f, RE_F_COMM, -1, "the record check", v);
 	if (v != RE_OK)
-		return v < 0 ? RE_OK : v;
-	v = re_check_alive(&s->cfg.alive, &s->alive, now_ns(s),
-			   s->za.hbdmc, s->rec.sample, f);
+		return v;
+	v = re_check_alive(&s->cfg.alive, &s->alive, now_ns(s), s->za.hbdmc,
+			   s->rec.sample, f);
 	if (v == RE_FAULT)
 		return v;
 	return check_encpot(s, f);
@@ -340,12 +445,20 @@ static int latched_cycle(struct re_super *s)
 		struct re_encpot_state st[RE_SUPER_AXES];
 
 		s->have_record = 1;
-		s->have_za = re_check_record(&s->rec, s->cfg.n_axes, 0,
-					     &s->za, &scratch) >= 0 &&
+		s->have_za = re_check_record(&s->rec, s->cfg.n_axes, 0, &s->za,
+					     &scratch) >= 0 &&
 			     scratch.id != RE_F_RECORD;
 		memcpy(st, s->encpot, sizeof(st));
 		check_encpot(s, &scratch);
 		memcpy(s->encpot, st, sizeof(st));
+	}
+	/* The relay stays checked while latched (it must stay off): a failure
+	 * is logged once, as the operator cannot be shown a second FAULT. */
+	if (!s->relay_lost_logged && check_relay(s, &scratch) == RE_FAULT) {
+		s->relay_lost_logged = 1;
+		re_fault_format(&scratch, s->cfg.axis_names, s->text,
+				sizeof(s->text));
+		re_io_logf(&s->io, RE_LOG_FAULT, "while latched: %s", s->text);
 	}
 	drain_messages(s);
 	return RE_OK;
@@ -433,11 +546,31 @@ void re_super_status(const struct re_super *s, struct re_status *st)
 	st->uptime_s = (double)(now_ns(s) - s->t0_ns) / 1e9;
 }
 
+double re_super_late_ms(const struct re_super *s, double pct)
+{
+	uint64_t n = 0, want, seen = 0;
+	int k;
+
+	for (k = 0; k < RE_LATE_BINS; k++)
+		n += s->late_hist[k];
+	if (n == 0)
+		return 0;
+	if (pct >= 100)
+		return ns_to_ms(s->late_worst_ns);
+	want = (uint64_t)ceil((double)n * pct / 100.0);
+	for (k = 0; k < RE_LATE_BINS - 1; k++) {
+		seen += s->late_hist[k];
+		if (seen >= want)
+			return (k + 1) * RE_LATE_BIN_US / 1000.0;
+	}
+	return ns_to_ms(s->late_worst_ns);
+}
+
 int re_super_shutdown(struct re_super *s)
 {
-	int rc = s->io.ops->command(s->io.ud, STOP_ALL, s->resp,
-				    sizeof(s->resp),
-				    s->cfg.fault_cmd_timeout_ms);
+	int rc =
+	    s->io.ops->command(s->io.ud, STOP_ALL, s->resp, sizeof(s->resp),
+			       s->cfg.fault_cmd_timeout_ms);
 	int relay_rc = s->io.ops->relay_off(s->io.ud);
 
 	s->armed = 0;

@@ -31,35 +31,41 @@
 #include "re_io.h"
 
 #define RE_SUPER_AXES 3
-#define RE_SUPER_LINE 256	/* FAULT line, bytes incl. NUL */
-#define RE_SUPER_MSGS 8		/* unsolicited lines drained per cycle */
+#define RE_SUPER_LINE 512 /* FAULT line, bytes incl. NUL */
+#define RE_SUPER_MSGS 8	  /* unsolicited lines drained per cycle */
 
 /* AQ2 (default): analog inputs read +-10 V as +-32768 counts. */
 #define RE_AN_COUNTS_PER_V 3276.8
 
 struct re_super_cfg {
-	int n_axes;			/* 1..RE_SUPER_AXES */
-	int64_t period_ns;		/* cycle period */
-	struct re_wdog_cfg wdog;	/* reply-age limits */
-	struct re_alive_cfg alive;	/* heartbeat / sample limits */
+	int n_axes;		   /* 1..RE_SUPER_AXES */
+	int64_t period_ns;	   /* cycle period */
+	struct re_wdog_cfg wdog;   /* reply-age limits */
+	struct re_alive_cfg alive; /* heartbeat / sample limits */
 	struct re_encpot_cfg encpot[RE_SUPER_AXES];
 	const char *axis_names[RE_SUPER_AXES];
-	int pot_input[RE_SUPER_AXES];	/* analog input 1..8; 0: axis + 1 */
-	int fault_cmd_timeout_ms;	/* "ST ABC;MO ABC;pcflt=1" deadline */
-	const char *mode_name;		/* "clinical" / "development" */
+	int pot_input[RE_SUPER_AXES]; /* analog input 1..8; 0: axis + 1 */
+	int fault_cmd_timeout_ms;     /* "ST ABC;MO ABC;pcflt=1" deadline */
+	/* A motor off, a stopped thread or a left state may be the first
+	 * sign of a fault the program is latching itself (its ZA fields
+	 * follow every mainms): after cutting power and stopping, wait up to
+	 * this long for the program's own fault code, the more specific
+	 * cause. 0: report at once. */
+	int settle_ms;
+	const char *mode_name; /* "clinical" / "development" */
 };
 
 /* Per-axis view for the status board. */
 struct re_axis_status {
 	int32_t enc_counts;
-	double pos_pct;		/* 0..100 between the soft limits; -1 unknown */
+	double pos_pct; /* 0..100 between the soft limits; -1 unknown */
 	double pot_v;
 	double pot_expected_v;
-	double margin_v;	/* tolerance - |pot - expected|; < 0 outside */
-	int have_expect;	/* a table is loaded and the values are valid */
-	double vel_cps;		/* counts/s */
+	double margin_v; /* tolerance - |pot - expected|; < 0 outside */
+	int have_expect; /* a table is loaded and the values are valid */
+	double vel_cps;	 /* counts/s */
 	int moving;
-	int fwd_limit;		/* switch active */
+	int fwd_limit; /* switch active */
 	int rev_limit;
 	int motor_off;
 	int stop_code;
@@ -72,40 +78,46 @@ struct re_status {
 	struct re_axis_status axis[RE_SUPER_AXES];
 	int have_record;
 	enum re_relay_state relay;
-	double wd_last_ms;	/* reply age at the last good reply */
+	double wd_last_ms; /* reply age at the last good reply */
 	double wd_worst_ms;
 	double period_ms;
-	double late_last_ms;	/* wake-up lateness of the last cycle */
+	double late_last_ms; /* wake-up lateness of the last cycle */
 	double late_worst_ms;
 	uint64_t cycles;
 	uint64_t overruns;
-	uint64_t wd_warnings;	/* non-critical watchdog events */
+	uint64_t wd_warnings; /* non-critical watchdog events */
 	int armed;
-	int link_ok;		/* last round trip succeeded */
-	struct re_za za;	/* program fields (valid when have_za) */
+	int link_ok;	 /* last round trip succeeded */
+	struct re_za za; /* program fields (valid when have_za) */
 	int have_za;
 	const char *mode_name;
 	int latched;
-	const char *fault_line;	/* "" when none */
+	const char *fault_line; /* "" when none */
 	double uptime_s;
 };
+
+#define RE_LATE_BIN_US 50   /* lateness histogram resolution, us */
+#define RE_LATE_BINS   2001 /* 0 .. 100 ms, then one overflow bin */
 
 struct re_super {
 	struct re_io io;
 	struct re_super_cfg cfg;
-	const struct re_caltable *table[RE_SUPER_AXES];	/* NULL: no check */
-	int armed;			/* the program is armed: motors on */
+	const struct re_caltable *table[RE_SUPER_AXES]; /* NULL: no check */
+	int armed; /* the program is armed: motors on */
 	/* schedule */
 	int64_t t0_ns;
-	int64_t deadline_ns;		/* start of the next cycle */
+	int64_t deadline_ns; /* start of the next cycle */
 	int64_t late_last_ns, late_worst_ns;
 	uint64_t cycles, overruns;
+	/* wake-up lateness histogram: RE_LATE_BIN_US bins, the last one
+	 * counts everything later (for the exit statistics; no allocation) */
+	uint32_t late_hist[RE_LATE_BINS];
 	/* watchdog */
 	int64_t noncrit_ns, crit_ns;
 	int64_t last_good_ns;
 	int64_t age_last_ns, age_worst_ns;
 	uint64_t wd_warnings;
-	long hbpc;			/* heartbeat value last written */
+	long hbpc; /* heartbeat value last written */
 	struct re_alive_state alive;
 	/* the last record and its checks */
 	struct gl_record rec;
@@ -120,12 +132,14 @@ struct re_super {
 	int latched;
 	struct re_fault fault;
 	char fault_line[RE_SUPER_LINE];
-	int fault_printed;		/* set by the caller once shown */
+	int fault_printed;     /* set by the caller once shown */
+	int relay_lost_logged; /* relay failure while latched, logged once */
 	/* scratch, preallocated */
 	char prefix[32];
 	char resp[128];
+	char verdict[64]; /* what the settle wait found, for the log */
 	char msg[RE_SUPER_LINE];
-	char text[512];
+	char text[1536];
 };
 
 /*
@@ -200,5 +214,13 @@ int re_super_shutdown(struct re_super *s);
 
 /* re_pot_volts() - analog input counts (AQ2) to volts. */
 double re_pot_volts(int32_t analog_in);
+
+/*
+ * re_super_late_ms() - wake-up lateness percentile over every cycle so far.
+ * @pct: 0 < pct <= 100 (50 for the median, 99, 100 for the maximum).
+ * Return: ms, to the histogram's RE_LATE_BIN_US resolution (the upper edge
+ *         of the bin); the worst lateness for pct 100; 0 with no cycle.
+ */
+double re_super_late_ms(const struct re_super *s, double pct);
 
 #endif /* RE_SUPER_H */

@@ -42,9 +42,9 @@
 #include "re_relay.h"
 #include "re_super.h"
 
-#define EXIT_USAGE 2
-#define EXIT_CONNECT 3
-#define EXIT_FAULT 4
+#define EXIT_USAGE     2
+#define EXIT_CONNECT   3
+#define EXIT_FAULT     4
 #define DEFAULT_CONFIG "config/roboelf.yaml"
 
 struct opts {
@@ -53,7 +53,7 @@ struct opts {
 	const char *relay;
 	const char *log;
 	const char *show_cal;
-	int period_ms;		/* 0: from the configuration */
+	int period_ms; /* 0: from the configuration */
 	enum re_calib_choice calib;
 };
 
@@ -99,26 +99,28 @@ static void install_signals(void)
 
 static void usage(FILE *f)
 {
-	fprintf(f,
-		"usage: roboelf [-c FILE] [--galil HOST[:PORT]] [--relay PORT]\n"
-		"               [--calibration full|file] [--period MS] "
-		"[--log FILE]\n"
-		"       roboelf --show-calibration FILE\n"
-		"\n"
-		"  -c, --config FILE        configuration (default %s)\n"
-		"      --galil HOST[:PORT]  controller address (overrides the "
-		"file)\n"
-		"      --relay PORT         E-stop relay port for this mode\n"
-		"      --calibration MODE   full: calibrate now; file: load "
-		"the tables\n"
-		"      --period MS          supervisor period, 2..100 ms\n"
-		"      --log FILE           failure log\n"
-		"      --show-calibration FILE  print a calibration file (and "
-		"plot it)\n"
-		"  -h, --help               this text\n"
-		"\n"
-		"exit: 0 quit, 2 usage/config, 3 no relay/controller, "
-		"4 fault latched\n", DEFAULT_CONFIG);
+	fprintf(
+	    f,
+	    "usage: roboelf [-c FILE] [--galil HOST[:PORT]] [--relay PORT]\n"
+	    "               [--calibration full|file] [--period MS] "
+	    "[--log FILE]\n"
+	    "       roboelf --show-calibration FILE\n"
+	    "\n"
+	    "  -c, --config FILE        configuration (default %s)\n"
+	    "      --galil HOST[:PORT]  controller address (overrides the "
+	    "file)\n"
+	    "      --relay PORT         E-stop relay port for this mode\n"
+	    "      --calibration MODE   full: calibrate now; file: load "
+	    "the tables\n"
+	    "      --period MS          supervisor period, 2..100 ms\n"
+	    "      --log FILE           failure log\n"
+	    "      --show-calibration FILE  print a calibration file (and "
+	    "plot it)\n"
+	    "  -h, --help               this text\n"
+	    "\n"
+	    "exit: 0 quit, 2 usage/config, 3 no relay/controller, "
+	    "4 fault latched\n",
+	    DEFAULT_CONFIG);
 }
 
 static int parse_period(const char *s, int *out)
@@ -156,18 +158,20 @@ static int opt_value(struct opts *o, int c, const char *arg)
 	case 'p':
 		if (parse_period(arg, &o->period_ms) == 0)
 			return 0;
-		fprintf(stderr, "roboelf: error: invalid period '%s': must be "
-			"2..100 ms\n", arg);
+		fprintf(stderr,
+			"roboelf: error: invalid period '%s': must be "
+			"2..100 ms\n",
+			arg);
 		return -1;
 	case 'k':
 		if (parse_calib(arg, &o->calib) == 0)
 			return 0;
-		fprintf(stderr, "roboelf: error: invalid calibration '%s': "
-			"use full or file\n", arg);
+		fprintf(stderr,
+			"roboelf: error: invalid calibration '%s': "
+			"use full or file\n",
+			arg);
 		return -1;
-	default:
-		usage(stderr);
-		return -1;
+	default: usage(stderr); return -1;
 	}
 }
 
@@ -175,15 +179,15 @@ static int opt_value(struct opts *o, int c, const char *arg)
 static int parse_opts(int argc, char **argv, struct opts *o)
 {
 	static const struct option lo[] = {
-		{"config", required_argument, NULL, 'c'},
-		{"galil", required_argument, NULL, 'g'},
-		{"relay", required_argument, NULL, 'r'},
-		{"calibration", required_argument, NULL, 'k'},
-		{"period", required_argument, NULL, 'p'},
-		{"log", required_argument, NULL, 'l'},
-		{"show-calibration", required_argument, NULL, 's'},
-		{"help", no_argument, NULL, 'h'},
-		{NULL, 0, NULL, 0},
+	    {"config", required_argument, NULL, 'c'},
+	    {"galil", required_argument, NULL, 'g'},
+	    {"relay", required_argument, NULL, 'r'},
+	    {"calibration", required_argument, NULL, 'k'},
+	    {"period", required_argument, NULL, 'p'},
+	    {"log", required_argument, NULL, 'l'},
+	    {"show-calibration", required_argument, NULL, 's'},
+	    {"help", no_argument, NULL, 'h'},
+	    {NULL, 0, NULL, 0},
 	};
 	int c;
 
@@ -210,8 +214,8 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 static void apply_overrides(struct app *a)
 {
 	struct re_config *c = &a->cfg;
-	char *port = c->mode == RE_MODE_CLINICAL ? c->relay.port_clinical :
-						   c->relay.port_development;
+	char *port = c->mode == RE_MODE_CLINICAL ? c->relay.port_clinical
+						 : c->relay.port_development;
 
 	if (a->o.galil)
 		snprintf(c->controller.address, sizeof(c->controller.address),
@@ -228,7 +232,8 @@ static int check_analog(const struct re_config *c, char *err, size_t len)
 {
 	for (int i = 0; i < RE_AXES; i++) {
 		if (c->axes[i].analog.input > RE_AXES) {
-			snprintf(err, len, "axis '%s': analog input %d is not "
+			snprintf(err, len,
+				 "axis '%s': analog input %d is not "
 				 "in the DMC-4030 data record (use 1..%d)",
 				 c->axes[i].name, c->axes[i].analog.input,
 				 RE_AXES);
@@ -240,8 +245,8 @@ static int check_analog(const struct re_config *c, char *err, size_t len)
 
 static int load_config(struct app *a)
 {
-	if (re_config_load_file(a->o.config, &a->cfg, a->err,
-				sizeof(a->err)) != GL_OK) {
+	if (re_config_load_file(a->o.config, &a->cfg, a->err, sizeof(a->err)) !=
+	    GL_OK) {
 		fprintf(stderr, "%s\n", a->err);
 		return -1;
 	}
@@ -268,8 +273,8 @@ static int open_log(struct app *a)
 	rc = re_log_open(&a->log, a->cfg.log.path, &lc);
 	if (rc != GL_OK) {
 		fprintf(stderr, "roboelf: error: cannot open log '%s': %s\n",
-			a->cfg.log.path, rc == GL_ERR_SYS ? strerror(errno) :
-			gl_strerror(rc));
+			a->cfg.log.path,
+			rc == GL_ERR_SYS ? strerror(errno) : gl_strerror(rc));
 		return -1;
 	}
 	re_log_msg(&a->log, RE_LOG_INFO, "start: roboelf, config '%s'",
@@ -282,7 +287,7 @@ static int open_log(struct app *a)
 /* ---- start-up ------------------------------------------------------------ */
 
 static void progress(struct app *a, const char *fmt, ...)
-	__attribute__((format(printf, 2, 3)));
+    __attribute__((format(printf, 2, 3)));
 
 static void progress(struct app *a, const char *fmt, ...)
 {
@@ -313,8 +318,10 @@ static int start_relay(struct app *a)
 		return fail(a, a->err);
 	a->real.relay = a->relay;
 	if (re_relay_on(a->relay) != GL_OK) {
-		snprintf(a->err, sizeof(a->err), "cannot switch motor power "
-			 "on: %s", re_relay_errmsg(a->relay));
+		snprintf(a->err, sizeof(a->err),
+			 "cannot switch motor power "
+			 "on: %s",
+			 re_relay_errmsg(a->relay));
 		return fail(a, a->err);
 	}
 	progress(a, "motor power on (relay closed)");
@@ -357,13 +364,13 @@ static int init_super(struct app *a)
 	sc.wdog.period_ns = sc.period_ns;
 	sc.wdog.noncrit_factor = a->cfg.watchdog.noncritical_factor;
 	sc.wdog.crit_factor = a->cfg.watchdog.critical_factor;
-	sc.alive.sample_limit_ns = (int64_t)(sc.wdog.crit_factor *
-					     (double)sc.period_ns);
+	sc.alive.sample_limit_ns =
+	    (int64_t)(sc.wdog.crit_factor * (double)sc.period_ns);
 	sc.alive.hb_limit_ns = sc.alive.sample_limit_ns;
 	for (int i = 0; i < RE_AXES; i++) {
 		sc.encpot[i].allowed_error = a->cfg.axes[i].allowed_error;
 		sc.encpot[i].persistence_cycles =
-			a->cfg.axes[i].persistence_cycles;
+		    a->cfg.axes[i].persistence_cycles;
 		sc.axis_names[i] = a->names[i];
 		sc.pot_input[i] = a->cfg.axes[i].analog.input;
 	}
@@ -375,15 +382,17 @@ static int init_super(struct app *a)
 	return 0;
 }
 
-/* The supervisor's heartbeat limit needs the program's own period. */
+/* The heartbeat limit and the settle time need the program's period. */
 static void set_hb_limit(struct app *a)
 {
 	int64_t mainms_ns = (int64_t)a->info.mainms * 1000000;
 	int64_t p = a->sup->cfg.period_ns;
 
-	a->sup->cfg.alive.hb_limit_ns = (int64_t)(
-		a->cfg.watchdog.critical_factor *
-		(double)(mainms_ns > p ? mainms_ns : p));
+	a->sup->cfg.alive.hb_limit_ns =
+	    (int64_t)(a->cfg.watchdog.critical_factor *
+		      (double)(mainms_ns > p ? mainms_ns : p));
+	/* the program publishes a fault within one mainms of latching it */
+	a->sup->cfg.settle_ms = 2 * a->info.mainms + 5;
 }
 
 static int latch(struct app *a, const struct re_fault *f)
@@ -400,23 +409,23 @@ static void log_calibration(struct app *a, const char *how, double secs)
 	for (int i = 0; i < a->cal->n_axes; i++) {
 		const struct re_caltable *t = &a->cal->axis[i];
 
-		re_log_msg(&a->log, RE_LOG_INFO, "calibration (%s) axis %s: "
+		re_log_msg(&a->log, RE_LOG_INFO,
+			   "calibration (%s) axis %s: "
 			   "%d points, start %.0f, step %.0f counts, soft "
-			   "limits %.0f..%.0f, pot %.3f..%.3f V", how,
-			   a->names[i], t->n, t->start_counts, t->step_counts,
-			   t->soft_rev, t->soft_fwd, t->pot_v[0],
-			   t->pot_v[t->n - 1]);
+			   "limits %.0f..%.0f, pot %.3f..%.3f V",
+			   how, a->names[i], t->n, t->start_counts,
+			   t->step_counts, t->soft_rev, t->soft_fwd,
+			   t->pot_v[0], t->pot_v[t->n - 1]);
 	}
-	re_log_msg(&a->log, RE_LOG_INFO, "calibration (%s) done in %.1f s",
-		   how, secs);
-	re_console_msg(&a->con, "roboelf: calibration (%s) done in %.1f s",
-		       how, secs);
+	re_log_msg(&a->log, RE_LOG_INFO, "calibration (%s) done in %.1f s", how,
+		   secs);
+	re_console_msg(&a->con, "roboelf: calibration (%s) done in %.1f s", how,
+		       secs);
 }
 
 static void stamp_calset(struct app *a)
 {
-	snprintf(a->cal->serial, sizeof(a->cal->serial), "%ld",
-		 a->info.serial);
+	snprintf(a->cal->serial, sizeof(a->cal->serial), "%ld", a->info.serial);
 	a->cal->config_hash = re_config_hash(&a->cfg);
 	re_calfile_date(time(NULL), a->cal->date, sizeof(a->cal->date));
 }
@@ -495,7 +504,7 @@ static int calib_file(struct app *a, struct re_calib *c,
 	if (rc)
 		return rc;
 	progress(a, "checking the robot against the file, moving to the "
-		 "centre");
+		    "centre");
 	rc = re_calib_check_robot(c, &a->io, cc, a->cal, &f);
 	if (rc == RE_FAULT)
 		return latch(a, &f);
@@ -519,14 +528,14 @@ static int calibrate(struct app *a)
 	int how = choose_calibration(a), rc;
 
 	if (how != RE_CALIB_FULL && how != RE_CALIB_FILE)
-		return EXIT_USAGE;
+		return quit_signal ? 0 : EXIT_USAGE;
 	a->cal = calloc(1, sizeof(*a->cal));
 	if (!a->cal || re_calib_new(&c) != GL_OK)
 		return fail(a, "out of memory");
 	re_calib_cfg_from(&a->cfg, a->names, &cc);
 	cc.stop = &quit_signal;
-	rc = how == RE_CALIB_FULL ? calib_full(a, c, &cc) :
-				    calib_file(a, c, &cc);
+	rc = how == RE_CALIB_FULL ? calib_full(a, c, &cc)
+				  : calib_file(a, c, &cc);
 	re_calib_free(c);
 	return rc;
 }
@@ -537,12 +546,11 @@ static int arm(struct app *a)
 	struct re_fault f;
 	int rc;
 
-	if (re_ctl_set_limits(&a->io, a->cal, a->err, sizeof(a->err)) !=
-	    GL_OK)
+	if (re_ctl_set_limits(&a->io, a->cal, a->err, sizeof(a->err)) != GL_OK)
 		goto out_config;
 	progress(a, "soft limits set and read back; arming");
-	rc = re_ctl_arm(&a->io, &a->cfg, a->cal, &a->info, &a->hbpc, &f,
-			a->err, sizeof(a->err));
+	rc = re_ctl_arm(&a->io, &a->cfg, a->cal, &a->info, &a->hbpc, &f, a->err,
+			sizeof(a->err));
 	if (rc == RE_FAULT)
 		return latch(a, &f);
 	if (rc != GL_OK)
@@ -578,7 +586,8 @@ static int startup(struct app *a)
 	return rc;
 }
 
-/* ---- run and cleanup ------------------------------------------------------ */
+/* ---- run and cleanup ------------------------------------------------------
+ */
 
 static const char *quit_reason(int key)
 {
@@ -590,6 +599,11 @@ static const char *quit_reason(int key)
 	case SIGHUP: return "SIGHUP";
 	default: return "signal";
 	}
+}
+
+static double ms_of_ns(int64_t ns)
+{
+	return (double)ns / 1e6;
 }
 
 /* Every period until the operator quits; a latched fault keeps the status
@@ -612,10 +626,21 @@ static void run(struct app *a)
 		key = 0;
 	}
 	re_log_msg(&a->log, RE_LOG_INFO, "stop: %s", quit_reason(key));
+	re_log_msg(
+	    &a->log, RE_LOG_INFO,
+	    "stats: cycles=%llu overruns=%llu period=%.1f ms "
+	    "late p50=%.3f p99=%.3f max=%.3f ms; reply age worst=%.1f ms",
+	    (unsigned long long)a->sup->cycles,
+	    (unsigned long long)a->sup->overruns,
+	    ms_of_ns(a->sup->cfg.period_ns), re_super_late_ms(a->sup, 50),
+	    re_super_late_ms(a->sup, 99), re_super_late_ms(a->sup, 100),
+	    ms_of_ns(a->sup->age_worst_ns));
 }
 
-static void cleanup(struct app *a)
+/* Return: 1 when a fault was latched. */
+static int cleanup(struct app *a)
 {
+	int latched = a->sup && a->sup->latched;
 	int rc = GL_OK;
 
 	if (a->sup)
@@ -626,20 +651,23 @@ static void cleanup(struct app *a)
 		re_log_msg(&a->log, RE_LOG_WARN, "shutdown: %s",
 			   gl_strerror(rc));
 	if (a->relay && re_relay_close(a->relay) != GL_OK)
-		re_log_msg(&a->log, RE_LOG_WARN, "relay off not confirmed at "
+		re_log_msg(&a->log, RE_LOG_WARN,
+			   "relay off not confirmed at "
 			   "close");
 	a->relay = a->real.relay = NULL;
 	gl_link_close(a->link);
 	a->link = a->real.link = NULL;
 	re_console_msg(&a->con, "roboelf: motors off, motor power off; %s",
-		       a->sup && a->sup->latched ? "a fault was latched" :
-						  "bye");
+		       latched ? "a fault was latched" : "bye");
 	re_log_msg(&a->log, RE_LOG_INFO, "stop: motors off, relay off%s",
-		   a->sup && a->sup->latched ? " (fault latched)" : "");
+		   latched ? " (fault latched)" : "");
 	re_console_close(&a->con);
 	re_log_close(&a->log);
 	free(a->sup);
 	free(a->cal);
+	a->sup = NULL;
+	a->cal = NULL;
+	return latched;
 }
 
 static int supervise(struct app *a)
@@ -649,8 +677,8 @@ static int supervise(struct app *a)
 	re_console_open(&a->con, stdout, STDIN_FILENO);
 	if (a->o.calib == RE_CALIB_ASK && !a->con.tty_in) {
 		fprintf(stderr, "roboelf: error: no terminal to ask full or "
-			"file calibration: use --calibration full or "
-			"--calibration file\n");
+				"file calibration: use --calibration full or "
+				"--calibration file\n");
 		re_log_close(&a->log);
 		return EXIT_USAGE;
 	}
@@ -660,10 +688,9 @@ static int supervise(struct app *a)
 	rc = startup(a);
 	if ((rc == 0 || rc == EXIT_FAULT) && a->sup)
 		run(a);
-	cleanup(a);
-	if (a->sup && a->sup->latched)
+	if (cleanup(a))
 		return EXIT_FAULT;
-	return rc == EXIT_FAULT ? EXIT_FAULT : rc;
+	return rc;
 }
 
 /* --show-calibration: the tables, and a plot per axis where gnuplot is
@@ -672,13 +699,15 @@ static int show_calibration(struct app *a)
 {
 	double allowed[RE_AXES];
 
-	if (re_config_load_file(a->o.config, &a->cfg, a->err,
-				sizeof(a->err)) != GL_OK)
+	if (re_config_load_file(a->o.config, &a->cfg, a->err, sizeof(a->err)) !=
+	    GL_OK)
 		re_config_defaults(&a->cfg);
 	for (int i = 0; i < RE_AXES; i++)
 		allowed[i] = a->cfg.axes[i].allowed_error;
 	return re_calshow_print(a->o.show_cal, allowed, RE_AXES, stdout,
-				stderr) == GL_OK ? 0 : EXIT_USAGE;
+				stderr) == GL_OK
+		   ? 0
+		   : EXIT_USAGE;
 }
 
 int main(int argc, char **argv)

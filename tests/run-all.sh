@@ -16,16 +16,26 @@ cd "$ROBOELF_TOP" || exit 1
 LOGDIR=$BUILD/test-logs
 mkdir -p "$LOGDIR"
 passed=0; failed=0; failures=""
+# Per-program deadline (s): a hung test fails with exit 124 instead of hanging
+# the run; system tests get more (ROBOELF_TEST_TIMEOUT overrides both).
+deadline() {
+	case $1 in
+	system/*) echo "${ROBOELF_TEST_TIMEOUT:-600}" ;;
+	*) echo "${ROBOELF_TEST_TIMEOUT:-180}" ;;
+	esac
+}
 run() { # run NAME KIND CMD... ; KIND = cmocka | script
 	name=$1; kind=$2; shift 2
 	log=$LOGDIR/$(echo "$name" | tr / _).log
 	echo "=== $name"
 	start=$(date +%s)
-	"$@" >"$log" 2>&1
+	timeout --kill-after=10 "$(deadline "$name")" "$@" >"$log" 2>&1
 	rc=$?
 	cat "$log"
 	res=ok
-	if [ "$rc" -ne 0 ]; then
+	if [ "$rc" -eq 124 ] || [ "$rc" -eq 137 ]; then
+		res="FAILED (timed out after $(deadline "$name") s)"
+	elif [ "$rc" -ne 0 ]; then
 		res="FAILED (exit $rc)"
 	elif grep -qE '^\[  (FAILED|ERROR)   ?\]' "$log"; then
 		res="FAILED (cmocka reported a failure)"

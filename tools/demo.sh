@@ -12,16 +12,27 @@
 # INTERACTIVE=1: no script; drive the joysticks and inject faults from the
 # keyboard (keys shown on start).
 set -u
+set -m # each background job in its own process group, stopped as a group
 BUILD=${BUILD:-build}
-BIN=${ROBOELF_BIN:-$BUILD/bin}
 TOP=$(cd "$(dirname "$0")/.." && pwd)
 cd "$TOP" || exit 1
+BIN=$(cd "${ROBOELF_BIN:-$BUILD/bin}" && pwd) || exit 1
 TMP=$(mktemp -d /tmp/roboelf-demo.XXXXXX)
 SIM_PID=""; RE_PID=""
 
+stop() { # stop PID: SIGTERM to its process group, SIGKILL after 5 s
+	local i
+	kill -TERM -- "-$1" 2>/dev/null || return 0
+	for i in $(seq 50); do
+		kill -0 "$1" 2>/dev/null || break
+		sleep 0.1
+	done
+	kill -KILL -- "-$1" 2>/dev/null
+	wait "$1" 2>/dev/null
+}
 cleanup() {
-	[ -n "$RE_PID" ] && kill -TERM "$RE_PID" 2>/dev/null && wait "$RE_PID" 2>/dev/null
-	[ -n "$SIM_PID" ] && kill -TERM "$SIM_PID" 2>/dev/null && wait "$SIM_PID" 2>/dev/null
+	[ -n "$RE_PID" ] && stop "$RE_PID"
+	[ -n "$SIM_PID" ] && stop "$SIM_PID"
 	rm -rf "$TMP"
 }
 trap cleanup EXIT
@@ -66,10 +77,14 @@ if [ "${INTERACTIVE:-}" = 1 ]; then
 	say "      p pot fault B, e encoder stuck A, j jam C, r relay unplug, q quit"
 fi
 
+# roboelf runs on a pseudo-terminal made by script(1), so that it shows its
+# live status board here while its output is also kept in a file to watch.
+# It runs in $TMP: the calibration table and the log go there.
 say "starting roboelf (full calibration)"
-"$BIN/roboelf" -c config/roboelf.yaml --galil "$addr" --relay "$TMP/relay" \
-	--calibration full --log "$TMP/roboelf.log" </dev/null | tee "$TMP/roboelf.out" &
-RE_PID=$(jobs -p | tail -n 1)
+(cd "$TMP" && exec script -qfec "exec '$BIN/roboelf' -c '$TOP/config/roboelf.yaml' \
+	--galil '$addr' --relay '$TMP/relay' --calibration full --log '$TMP/roboelf.log'" \
+	"$TMP/roboelf.out" </dev/null) &
+RE_PID=$!
 wait_line "$TMP/roboelf.out" 'RoboELF Ready for Use' 60 || die "roboelf did not become ready"
 
 if [ "${INTERACTIVE:-}" = 1 ]; then
@@ -101,14 +116,14 @@ for ax in A B C; do
 done
 say "joystick: axis B, only channel a closed for 0.2 s (a transient invalid state: must not trip)"
 ctl "joy B fwd a" >/dev/null; sleep 0.2; ctl "joy B neutral" >/dev/null; sleep 1
-grep -q '^FAULT' "$TMP/roboelf.out" && die "a transient invalid state tripped the system"
+grep -q 'FAULT [A-Z]*:' "$TMP/roboelf.out" && die "a transient invalid state tripped the system"
 
 say "injecting a potentiometer fault on axis B (offset +0.5 V): the E-stop must trip"
 ctl "joy B fwd" >/dev/null
 ctl "pot B offset 0.5" >/dev/null
-wait_line "$TMP/roboelf.out" '^FAULT ENCODER' 5 || die "the potentiometer fault did not trip"
+wait_line "$TMP/roboelf.out" 'FAULT ENCODER:' 5 || die "the potentiometer fault did not trip"
 [ "$(ctl relay)" = off ] || die "the relay is still on after the fault"
-say "relay: $(ctl relay); fault line: $(grep -m1 '^FAULT' "$TMP/roboelf.out")"
+say "relay: $(ctl relay); $(grep -o -m1 'FAULT ENCODER:.*' "$TMP/roboelf.out" | tr -d '\r')"
 sleep 2
 say "demo finished: stopping roboelf and galil-sim"
 exit 0

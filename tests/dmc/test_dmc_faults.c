@@ -220,7 +220,8 @@ static void test_cmderr(void **state)
 }
 
 /* Motor power lost (E-stop relay off) while armed: the motors go off; the
- * program latches fault 8 AMPERR. */
+ * program latches fault 8 AMPERR on all axes (axis 0: every axis lost its
+ * amplifier, stop code 15), detail 15. */
 static void test_power_lost(void **state)
 {
 	struct dmc_h *h = *state;
@@ -230,7 +231,8 @@ static void test_power_lost(void **state)
 	DMC_H_CHECK(h, dmc_h_control(h, "relay off"));
 	assert_true(dmc_h_wait_var(h, "state", 2, 100) >= 0);
 	dmc_h_advance(h, 20);
-	assert_fault(h, 8, 3);
+	assert_fault(h, 8, 0);
+	assert_true(dmc_h_var(h, "fdet") == 15);
 }
 
 /* Unarmed, motor power lost is only counted: nothing can move, and the

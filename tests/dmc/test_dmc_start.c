@@ -64,6 +64,29 @@ static void test_safe_start(void **state)
 	assert_int_equal(dmc_h_fault_lines(h, NULL, NULL, NULL), 0);
 }
 
+/* Power-up with the program burned (BP): #AUTO runs by itself, BOOT is
+ * sent, the motors stay off and the program waits unarmed. */
+static void test_power_up(void **state)
+{
+	struct dmc_h *h = *state;
+	double hb;
+
+	DMC_H_CHECK(h, dmc_h_open(h));
+	DMC_H_CHECK(h, dmc_h_cmd(h, "BP", NULL, 0));
+	DMC_H_CHECK(h, dmc_h_control(h, "power-cycle"));
+	ctrl_handle_open(h->ctrl, 0);
+	DMC_H_CHECK(h, dmc_h_cmd(h, "CF A", NULL, 0));
+	dmc_h_advance(h, 100);
+	assert_true(dmc_h_var(h, "state") == 0);
+	hb = dmc_h_var(h, "hbdmc");
+	assert_true(hb >= 5);
+	dmc_h_advance(h, 100);
+	assert_true(dmc_h_var(h, "hbdmc") > hb);
+	assert_int_equal(ctrl_threads(h->ctrl), 1u);
+	for (int i = 0; i < DMC_H_AXES; i++)
+		assert_int_equal(dmc_h_axis(h, i).motor_off, 1);
+}
+
 /* An arm request before any parameter: refused with fault 1, check 1
  * (vmax of axis A), motors stay off. */
 static void test_arm_without_parameters(void **state)
@@ -251,6 +274,8 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test_setup_teardown(test_safe_start, dmc_h_fx_new,
+					    dmc_h_fx_free),
+	    cmocka_unit_test_setup_teardown(test_power_up, dmc_h_fx_new,
 					    dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_arm_without_parameters,
 					    dmc_h_fx_new, dmc_h_fx_free),

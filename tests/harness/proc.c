@@ -57,6 +57,8 @@ static int buf_reserve(struct proc_buf *b, size_t more)
 
 	if (b->len + more + 1 <= cap)
 		return 0;
+	if (cap == 0)
+		return -1;
 	while (b->len + more + 1 > cap)
 		cap *= 2;
 	n = realloc(b->data, cap);
@@ -153,8 +155,8 @@ int proc_pump(struct proc *p, int timeout_ms)
 	int n = 0, map[2];
 
 	for (int i = 0; i < 2; i++) {
-		if (p->out[i].fd < 0)
-			continue;
+		if (!p->out[i].data || p->out[i].fd < 0)
+			continue; /* never spawned, or at EOF */
 		pfd[n].fd = p->out[i].fd;
 		pfd[n].events = POLLIN;
 		map[n++] = i;
@@ -170,8 +172,8 @@ int proc_pump(struct proc *p, int timeout_ms)
 }
 
 /* Search complete lines of @b from @from for @prefix; return the offset. */
-static long find_line(const struct proc_buf *b, size_t from,
-		      const char *prefix, size_t *end)
+static long find_line(const struct proc_buf *b, size_t from, const char *prefix,
+		      size_t *end)
 {
 	size_t plen = strlen(prefix);
 	size_t pos = from;
@@ -212,6 +214,8 @@ int proc_wait_line(struct proc *p, enum proc_stream s, const char *prefix,
 	long long deadline = proc_now_ms() + timeout_ms;
 	struct proc_buf *b = &p->out[s];
 
+	if (!b->data)
+		return -1;
 	for (;;) {
 		size_t end;
 		long at = find_line(b, b->cursor, prefix, &end);
@@ -223,13 +227,14 @@ int proc_wait_line(struct proc *p, enum proc_stream s, const char *prefix,
 		}
 		if (b->fd < 0 || remaining_ms(deadline) == 0)
 			return -1;
-		proc_pump(p, remaining_ms(deadline) < 20 ?
-				     remaining_ms(deadline) : 20);
+		proc_pump(p, remaining_ms(deadline) < 20
+				 ? remaining_ms(deadline)
+				 : 20);
 	}
 }
 
-int proc_find_line(const struct proc *p, enum proc_stream s,
-		   const char *prefix, char *line, size_t cap)
+int proc_find_line(const struct proc *p, enum proc_stream s, const char *prefix,
+		   char *line, size_t cap)
 {
 	size_t end;
 	long at = find_line(&p->out[s], 0, prefix, &end);
@@ -277,12 +282,11 @@ int proc_wait_exit(struct proc *p, int timeout_ms, int *status)
 		if (remaining_ms(deadline) == 0)
 			return -1;
 		if (proc_pump(p, 10) < 0)
-			poll(NULL, 0, 5);	/* pipes closed: wait for exit */
+			poll(NULL, 0, 5); /* pipes closed: wait for exit */
 	}
-	while (proc_pump(p, 0) == 0 && (p->out[0].fd >= 0 ||
-					p->out[1].fd >= 0) &&
-	       remaining_ms(deadline) > 0)
-		proc_pump(p, 10);
+	/* the pipes' last bytes, until EOF or the deadline */
+	while (remaining_ms(deadline) > 0 && proc_pump(p, 10) == 0)
+		;
 	if (status)
 		*status = p->status;
 	return p->reaped ? 0 : -1;
@@ -323,16 +327,17 @@ static int sim_parse_ready(struct proc_sim *s, const char *line)
 {
 	char relay[256] = "";
 
-	if (sscanf(line, "galil-sim: listening on 127.0.0.1:%d control %d "
-			 "relay %255s", &s->port, &s->ctl_port, relay) < 2)
+	if (sscanf(line,
+		   "galil-sim: listening on 127.0.0.1:%d control %d "
+		   "relay %255s",
+		   &s->port, &s->ctl_port, relay) < 2)
 		return -1;
 	snprintf(s->relay, sizeof(s->relay), "%s", relay);
 	return 0;
 }
 
 int proc_sim_start(struct proc_sim *s, const char *bin_dir,
-		   const char *relay_link, char *const extra[],
-		   int timeout_ms)
+		   const char *relay_link, char *const extra[], int timeout_ms)
 {
 	char bin[512], line[512];
 	char *argv[32];

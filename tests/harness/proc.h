@@ -19,19 +19,19 @@ enum proc_stream {
 };
 
 struct proc_buf {
-	char *data;		/* everything read so far, NUL-terminated */
+	char *data; /* everything read so far, NUL-terminated */
 	size_t len;
 	size_t cap;
-	size_t cursor;		/* proc_wait_line() searches from here */
-	int fd;			/* read end of the pipe, -1 when at EOF */
+	size_t cursor; /* proc_wait_line() searches from here */
+	int fd;	       /* read end of the pipe, -1 when at EOF */
 };
 
 struct proc {
-	pid_t pid;		/* 0 when not running or already reaped */
-	int status;		/* waitpid() status once reaped */
+	pid_t pid;  /* 0 when not running or already reaped */
+	int status; /* waitpid() status once reaped */
 	int reaped;
 	int stdin_fd;		/* write end of the child's stdin, or -1 */
-	struct proc_buf out[2];	/* PROC_STDOUT, PROC_STDERR */
+	struct proc_buf out[2]; /* PROC_STDOUT, PROC_STDERR */
 };
 
 /*
@@ -63,8 +63,8 @@ int proc_wait_line(struct proc *p, enum proc_stream s, const char *prefix,
  * without waiting and without moving the cursor.
  * Return: 0 when found, -1 otherwise.
  */
-int proc_find_line(const struct proc *p, enum proc_stream s,
-		   const char *prefix, char *line, size_t cap);
+int proc_find_line(const struct proc *p, enum proc_stream s, const char *prefix,
+		   char *line, size_t cap);
 
 /* proc_output() - everything read from @s so far (NUL-terminated). */
 const char *proc_output(const struct proc *p, enum proc_stream s);
@@ -100,9 +100,9 @@ void proc_kill(struct proc *p);
 
 struct proc_sim {
 	struct proc p;
-	int port;		/* controller TCP port */
-	int ctl_port;		/* control port */
-	char relay[256];	/* relay pty path as printed */
+	int port;	 /* controller TCP port */
+	int ctl_port;	 /* control port */
+	char relay[256]; /* relay pty path as printed */
 };
 
 /*
@@ -113,8 +113,7 @@ struct proc_sim {
  * Return: 0, or -1 (the process is killed and reaped).
  */
 int proc_sim_start(struct proc_sim *s, const char *bin_dir,
-		   const char *relay_link, char *const extra[],
-		   int timeout_ms);
+		   const char *relay_link, char *const extra[], int timeout_ms);
 
 /* ---- galil-sim control port client ------------------------------------- */
 

@@ -24,14 +24,14 @@
 
 #include "re_config.h"
 
-#define READY_LINE "RoboELF Ready for Use"
-#define CTL_TIMEOUT_MS 2000
-#define EVT_BUF (512 * 1024)
-#define POLL_MS 10
+#define READY_LINE	"RoboELF Ready for Use"
+#define CTL_TIMEOUT_MS	2000
+#define EVT_BUF		(512 * 1024)
+#define POLL_MS		10
 #define LOAD_TIMEOUT_MS 60000
 
 static void seterr(char *err, const char *fmt, ...)
-	__attribute__((format(printf, 2, 3)));
+    __attribute__((format(printf, 2, 3)));
 
 static void seterr(char *err, const char *fmt, ...)
 {
@@ -56,7 +56,7 @@ static void sleep_ms(int ms)
 	poll(NULL, 0, ms);
 }
 
-/* ---- environment ----------------------------------------------------------- */
+/* ---- environment -------------------------------------------------------- */
 
 static void env_paths(struct sys_env *e)
 {
@@ -161,8 +161,10 @@ static int subst_write(FILE *f, const char *src, const struct sys_subst *base,
 	for (int l = 0; l < 2; l++)
 		for (int i = 0; s[l] && s[l][i].key; i++)
 			if (!done[l][i]) {
-				seterr(err, "config/roboelf.yaml has no key "
-				       "'%s' to replace", s[l][i].key);
+				seterr(err,
+				       "config/roboelf.yaml has no key "
+				       "'%s' to replace",
+				       s[l][i].key);
 				return -1;
 			}
 	return 0;
@@ -172,10 +174,12 @@ int sys_env_write_config(struct sys_env *e, const struct sys_subst *subst,
 			 const char *path)
 {
 	char src_path[SYS_PATH_MAX + 32], cal[SYS_PATH_MAX + 8],
-	     log[SYS_PATH_MAX + 16], ics[SYS_PATH_MAX + 16];
+	    log[SYS_PATH_MAX + 16], ics[SYS_PATH_MAX + 16];
 	struct sys_subst base[] = {
-		{"file", cal}, {"path", log}, {"icstation_state", ics},
-		{NULL, NULL},
+	    {"file", cal},
+	    {"path", log},
+	    {"icstation_state", ics},
+	    {NULL, NULL},
 	};
 	char *src;
 	size_t len;
@@ -231,8 +235,8 @@ static int env_figures(struct sys_env *e)
 	e->vmax_cps = a->vmax_cps;
 	e->step_counts = a->step_counts;
 	e->er_counts = a->position_error_limit_counts;
-	e->readback_timeout_ms = cfg->relay.readback ?
-					 cfg->relay.readback_timeout_ms : 0;
+	e->readback_timeout_ms =
+	    cfg->relay.readback ? cfg->relay.readback_timeout_ms : 0;
 	free(cfg);
 	return 0;
 }
@@ -255,14 +259,39 @@ int sys_env_init(struct sys_env *e)
 	return env_figures(e);
 }
 
+/* ROBOELF_SYS_CAL=FILE: reuse a calibration made earlier (development). */
+static int reuse_calibration(struct sys_env *e, const char *from)
+{
+	char *buf;
+	size_t len;
+	FILE *f;
+	int ok;
+
+	if (read_file(from, &buf, &len) < 0) {
+		seterr(e->err, "cannot read '%s': %s", from, strerror(errno));
+		return -1;
+	}
+	f = fopen(e->cal, "w");
+	ok = f && fwrite(buf, 1, len, f) == len;
+	if (f && fclose(f) != 0)
+		ok = 0;
+	free(buf);
+	if (!ok)
+		seterr(e->err, "cannot write '%s'", e->cal);
+	return ok ? 0 : -1;
+}
+
 int sys_env_calibrate(struct sys_env *e, int timeout_ms)
 {
 	struct sys_opts o = {.calibration = "full",
 			     .ready_timeout_ms = timeout_ms};
+	const char *reuse = getenv("ROBOELF_SYS_CAL");
 	struct sys_case c;
 	struct stat st;
 	int rc = -1, status;
 
+	if (reuse && *reuse)
+		return reuse_calibration(e, reuse);
 	if (sys_case_start(&c, e, &o) < 0) {
 		snprintf(e->err, sizeof(e->err), "%s", c.err);
 		return -1;
@@ -271,13 +300,15 @@ int sys_env_calibrate(struct sys_env *e, int timeout_ms)
 	proc_signal(&c.re, SIGTERM);
 	if (proc_wait_exit(&c.re, 10000, &status) < 0)
 		seterr(e->err, "roboelf did not exit within 10 s of SIGTERM "
-		       "after calibrating");
+			       "after calibrating");
 	else if (proc_exit_code(&c.re) != 0)
 		seterr(e->err, "roboelf exited with %d after calibrating: %s",
 		       proc_exit_code(&c.re), tail(&c.re, PROC_STDERR, 800));
 	else if (stat(e->cal, &st) < 0 || !S_ISREG(st.st_mode))
-		seterr(e->err, "no calibration file '%s' after a full "
-		       "calibration", e->cal);
+		seterr(e->err,
+		       "no calibration file '%s' after a full "
+		       "calibration",
+		       e->cal);
 	else
 		rc = 0;
 	sys_case_stop(&c);
@@ -305,7 +336,7 @@ void sys_env_cleanup(struct sys_env *e)
 	e->dir[0] = '\0';
 }
 
-/* ---- one case: start and stop ---------------------------------------------- */
+/* ---- one case: start and stop ------------------------------------------- */
 
 static int run_load(struct sys_case *c)
 {
@@ -362,7 +393,7 @@ static int start_roboelf(struct sys_case *c, const struct sys_opts *o)
 	for (int i = 0; o->re_args && o->re_args[i] && n < 46; i++)
 		argv[n++] = o->re_args[i];
 	argv[n] = NULL;
-	if (proc_spawn(&c->re, argv, NULL) < 0) {
+	if (proc_spawn(&c->re, argv, o->re_env) < 0) {
 		seterr(c->err, "cannot start '%s': %s", bin, strerror(errno));
 		return -1;
 	}
@@ -370,25 +401,41 @@ static int start_roboelf(struct sys_case *c, const struct sys_opts *o)
 	return 0;
 }
 
+/* Ready, or a FAULT line / exit first (then fail at once). */
 static int wait_ready(struct sys_case *c, const struct sys_opts *o)
 {
 	int full = o->calibration && !strcmp(o->calibration, "full");
-	int timeout = o->ready_timeout_ms ? o->ready_timeout_ms :
-					    full ? 150000 : 20000;
-	long long t0 = proc_now_ms();
+	int timeout = o->ready_timeout_ms ? o->ready_timeout_ms
+		      : full		  ? 150000
+					  : 20000;
+	long long t0 = proc_now_ms(), deadline = t0 + timeout;
+	const char *why = "timeout";
 
-	if (proc_wait_line(&c->re, PROC_STDOUT, READY_LINE, timeout, NULL,
-			   0) < 0) {
-		proc_wait_exit(&c->re, 200, NULL);
-		seterr(c->err, "no '%s' from roboelf within %d ms (exit %d)"
-		       "\n--- stdout:\n%s\n--- stderr:\n%s", READY_LINE,
-		       timeout, proc_exit_code(&c->re),
-		       tail(&c->re, PROC_STDOUT, 1500),
-		       tail(&c->re, PROC_STDERR, 800));
-		return -1;
+	for (;;) {
+		if (proc_wait_line(&c->re, PROC_STDOUT, READY_LINE, 20, NULL,
+				   0) == 0) {
+			c->ready_wall_s = (double)(proc_now_ms() - t0) / 1e3;
+			return 0;
+		}
+		if (proc_find_line(&c->re, PROC_STDOUT, "FAULT ", NULL, 0) ==
+		    0) {
+			why = "FAULT line";
+			break;
+		}
+		if (c->re.out[PROC_STDOUT].fd < 0) {
+			why = "exit";
+			break;
+		}
+		if (proc_now_ms() > deadline)
+			break;
 	}
-	c->ready_wall_s = (double)(proc_now_ms() - t0) / 1000.0;
-	return 0;
+	proc_wait_exit(&c->re, 300, NULL);
+	seterr(c->err,
+	       "no '%s' from roboelf after %lld ms (%s, exit %d)"
+	       "\n--- stdout:\n%s\n--- stderr:\n%s",
+	       READY_LINE, proc_now_ms() - t0, why, proc_exit_code(&c->re),
+	       tail(&c->re, PROC_STDOUT, 1500), tail(&c->re, PROC_STDERR, 800));
+	return -1;
 }
 
 /* At Ready: motor power on, every motor on, nothing moving. */
@@ -400,8 +447,10 @@ static int check_armed(struct sys_case *c)
 		return -1;
 	if (!strstr(st, " relay=on ") || !strstr(st, " A.mo=0 ") ||
 	    !strstr(st, " B.mo=0 ") || !strstr(st, " C.mo=0 ")) {
-		seterr(c->err, "at Ready the robot is not armed with power "
-		       "on: %s", st);
+		seterr(c->err,
+		       "at Ready the robot is not armed with power "
+		       "on: %s",
+		       st);
 		return -1;
 	}
 	return 0;
@@ -435,8 +484,8 @@ int sys_case_start(struct sys_case *c, struct sys_env *e,
 			goto fail;
 		}
 	}
-	if (proc_sim_start(&c->sim, e->bin, c->relay_link, o->sim_args,
-			   10000) < 0) {
+	if (proc_sim_start(&c->sim, e->bin, c->relay_link, o->sim_args, 10000) <
+	    0) {
 		seterr(c->err, "galil-sim did not start ('%s/galil-sim')",
 		       e->bin);
 		goto fail;
@@ -458,21 +507,38 @@ int sys_case_start(struct sys_case *c, struct sys_env *e,
 	if (c->t_ready_ms < 0 || sys_events(c) < 0 || check_armed(c) < 0)
 		goto fail;
 	return 0;
-fail:
-	{
-		char keep[SYS_ERR_MAX];
+fail : {
+	char keep[SYS_ERR_MAX];
 
-		snprintf(keep, sizeof(keep), "%s", c->err);
-		sys_case_stop(c);
-		snprintf(c->err, sizeof(c->err), "%s", keep);
-	}
+	snprintf(keep, sizeof(keep), "%s", c->err);
+	sys_case_stop(c);
+	snprintf(c->err, sizeof(c->err), "%s", keep);
+}
 	return -1;
+}
+
+/* Keep the events beside the log, for a person reading a failure. */
+static void dump_events(struct sys_case *c)
+{
+	char path[SYS_PATH_MAX + 16];
+	FILE *f;
+
+	if (c->ctl >= 0)
+		sys_events(c);
+	snprintf(path, sizeof(path), "%s/case-%d.events", c->env->dir, c->id);
+	f = fopen(path, "w");
+	for (size_t i = 0; f && i < c->nev; i++)
+		fprintf(f, "%.0f %s\n", c->ev[i].t_ms, c->ev[i].text);
+	if (f)
+		fclose(f);
 }
 
 void sys_case_stop(struct sys_case *c)
 {
 	if (!c->env)
 		return;
+	if (c->buf)
+		dump_events(c);
 	if (c->re_up)
 		proc_kill(&c->re);
 	c->re_up = 0;
@@ -494,11 +560,11 @@ void sys_case_stop(struct sys_case *c)
 	free(c->buf);
 	c->buf = NULL;
 	if (c->relay_link[0])
-		unlink(c->relay_link);	/* galil-sim's, if it was killed */
+		unlink(c->relay_link); /* galil-sim's, if it was killed */
 	c->env = NULL;
 }
 
-/* ---- control port ------------------------------------------------------ */
+/* ---- control port ------------------------------------------------------- */
 
 int sys_ctl_ask(struct sys_case *c, const char *req, char *resp, size_t cap)
 {
@@ -563,7 +629,7 @@ double sys_state_num(const char *state, const char *key)
 	return end == val ? NAN : v;
 }
 
-/* ---- events ------------------------------------------------------------ */
+/* ---- events ------------------------------------------------------------- */
 
 static int evt_add(struct sys_case *c, double t, const char *text)
 {
@@ -639,8 +705,10 @@ int sys_wait_event(struct sys_case *c, const char *prefix, double after_ms,
 			return 0;
 		}
 		if (proc_now_ms() > deadline) {
-			seterr(c->err, "no event '%s...' after %.0f ms within "
-			       "%d ms", prefix, after_ms, timeout_ms);
+			seterr(c->err,
+			       "no event '%s...' after %.0f ms within "
+			       "%d ms",
+			       prefix, after_ms, timeout_ms);
 			return -1;
 		}
 		if (c->re_up)
@@ -663,9 +731,10 @@ int sys_wait_sim(struct sys_case *c, double t_ms, int timeout_ms)
 		if (now >= t_ms)
 			return 0;
 		if (proc_now_ms() > deadline) {
-			seterr(c->err, "simulated time %.0f ms not reached "
-			       "within %d ms (now %.0f)", t_ms, timeout_ms,
-			       now);
+			seterr(c->err,
+			       "simulated time %.0f ms not reached "
+			       "within %d ms (now %.0f)",
+			       t_ms, timeout_ms, now);
 			return -1;
 		}
 		if (c->re_up)
@@ -688,8 +757,10 @@ int sys_wait_state(struct sys_case *c, const char *key, const char *value,
 		if (strstr(st, want))
 			return 0;
 		if (proc_now_ms() > deadline) {
-			seterr(c->err, "state never showed %s=%s within %d ms:"
-			       " %s", key, value, timeout_ms, st);
+			seterr(c->err,
+			       "state never showed %s=%s within %d ms:"
+			       " %s",
+			       key, value, timeout_ms, st);
 			return -1;
 		}
 		if (c->re_up)
@@ -717,9 +788,10 @@ int sys_wait_moving(struct sys_case *c, char axis, double counts,
 		if (fabs(x - x0) >= counts)
 			return 0;
 		if (proc_now_ms() > deadline) {
-			seterr(c->err, "axis %c moved %.0f counts, not %.0f, "
-			       "within %d ms: %s", axis, fabs(x - x0),
-			       counts, timeout_ms, st);
+			seterr(c->err,
+			       "axis %c moved %.0f counts, not %.0f, "
+			       "within %d ms: %s",
+			       axis, fabs(x - x0), counts, timeout_ms, st);
 			return -1;
 		}
 		if (c->re_up)
@@ -732,16 +804,24 @@ int sys_wait_stopped(struct sys_case *c, char axis, int timeout_ms,
 		     double *t_ms)
 {
 	long long deadline = proc_now_ms() + timeout_ms;
-	char st[2048], key[8];
+	char st[2048], kref[8], kvel[8];
+	double ref0 = NAN, t0 = -1;
 
-	snprintf(key, sizeof(key), "%c.vel", axis);
+	snprintf(kref, sizeof(kref), "%c.ref", axis);
+	snprintf(kvel, sizeof(kvel), "%c.vel", axis);
 	for (;;) {
+		double ref, vel;
+
 		if (sys_state(c, st, sizeof(st)) < 0)
 			return -1;
-		if (sys_state_num(st, key) == 0) {
-			*t_ms = sys_state_num(st, "time");
+		ref = sys_state_num(st, kref);
+		vel = sys_state_num(st, kvel);
+		if (ref == ref0 && fabs(vel) < SYS_STILL_CPS) {
+			*t_ms = t0;
 			return 0;
 		}
+		ref0 = ref;
+		t0 = sys_state_num(st, "time");
 		if (proc_now_ms() > deadline) {
 			seterr(c->err, "axis %c still moving after %d ms: %s",
 			       axis, timeout_ms, st);
@@ -753,16 +833,27 @@ int sys_wait_stopped(struct sys_case *c, char axis, int timeout_ms,
 	}
 }
 
+/* The first "axis X motor off" (controller) or "X motor off" (as
+ * docs/galil-sim.md words it) event of axis @a at or after @after_ms. */
+static int motor_off_event(const struct sys_case *c, int a, double after_ms)
+{
+	char p1[32], p2[32];
+	int i, j;
+
+	snprintf(p1, sizeof(p1), "axis %c motor off", 'A' + a);
+	snprintf(p2, sizeof(p2), "%c motor off", 'A' + a);
+	i = sys_event_find(c, p1, after_ms);
+	j = sys_event_find(c, p2, after_ms);
+	return i < 0 ? j : j < 0 ? i : i < j ? i : j;
+}
+
 double sys_motors_off_time(const struct sys_case *c, double after_ms)
 {
 	double last = -1;
 
 	for (int a = 0; a < 3; a++) {
-		char prefix[32];
-		int i;
+		int i = motor_off_event(c, a, after_ms);
 
-		snprintf(prefix, sizeof(prefix), "%c motor off", 'A' + a);
-		i = sys_event_find(c, prefix, after_ms);
 		if (i < 0)
 			return -1;
 		if (c->ev[i].t_ms > last)
@@ -771,12 +862,12 @@ double sys_motors_off_time(const struct sys_case *c, double after_ms)
 	return last;
 }
 
-/* ---- safe state ------------------------------------------------------------ */
+/* ---- safe state --------------------------------------------------------- */
 
 static int safe_now(struct sys_case *c, const char *st, int relay_may_be_on)
 {
-	if (!relay_may_be_on && (!strstr(st, " relay=off ") ||
-				 !strstr(st, " power=0 "))) {
+	if (!relay_may_be_on &&
+	    (!strstr(st, " relay=off ") || !strstr(st, " power=0 "))) {
 		seterr(c->err, "motor power is not cut: %s", st);
 		return -1;
 	}
@@ -813,32 +904,34 @@ int sys_check_safe(struct sys_case *c, int relay_may_be_on, int hold_ms)
 		x0 = sys_state_num(st0, key);
 		x1 = sys_state_num(st1, key);
 		if (isnan(x0) || x0 != x1) {
-			seterr(c->err, "axis %c moved from %.1f to %.1f "
+			seterr(c->err,
+			       "axis %c moved from %.1f to %.1f "
 			       "counts within %d ms after the safe state:\n"
-			       "%s\n%s", 'A' + a, x0, x1, hold_ms, st0, st1);
+			       "%s\n%s",
+			       'A' + a, x0, x1, hold_ms, st0, st1);
 			return -1;
 		}
 	}
 	return 0;
 }
 
-/* ---- roboelf's output and log ------------------------------------------------ */
+/* ---- roboelf's output and log ------------------------------------------- */
 
-int sys_wait_fault(struct sys_case *c, int timeout_ms, char *line,
-		   size_t cap)
+int sys_wait_fault(struct sys_case *c, int timeout_ms, char *line, size_t cap)
 {
 	if (proc_wait_line(&c->re, PROC_STDOUT, "FAULT ", timeout_ms, line,
 			   cap) == 0)
 		return 0;
-	seterr(c->err, "no FAULT line from roboelf within %d ms\n--- "
-	       "stdout:\n%s\n--- stderr:\n%s", timeout_ms,
-	       tail(&c->re, PROC_STDOUT, 1200),
+	seterr(c->err,
+	       "no FAULT line from roboelf within %d ms\n--- "
+	       "stdout:\n%s\n--- stderr:\n%s",
+	       timeout_ms, tail(&c->re, PROC_STDOUT, 1200),
 	       tail(&c->re, PROC_STDERR, 600));
 	return -1;
 }
 
-int sys_fault_expect(enum re_fault_id id, int axis, char *prefix,
-		     size_t pcap, char *recovery, size_t rcap)
+int sys_fault_expect(enum re_fault_id id, int axis, char *prefix, size_t pcap,
+		     char *recovery, size_t rcap)
 {
 	struct re_fault f;
 	const char *cls;
@@ -875,8 +968,8 @@ enum re_fault_id sys_fault_match(const char *line, int axis,
 	return RE_F_NONE;
 }
 
-int sys_log_find(struct sys_case *c, const char *a, const char *b,
-		 char *line, size_t cap)
+int sys_log_find(struct sys_case *c, const char *a, const char *b, char *line,
+		 size_t cap)
 {
 	char *buf, *p;
 	size_t len;
@@ -924,8 +1017,8 @@ int sys_log_time_ms(struct sys_case *c, const char *a, double *ms)
 		return -1;
 	memset(&tm, 0, sizeof(tm));
 	if (sscanf(line, "%4d-%2d-%2dT%2d:%2d:%2d.%3dZ", &tm.tm_year,
-		   &tm.tm_mon, &tm.tm_mday, &tm.tm_hour, &tm.tm_min,
-		   &tm.tm_sec, &msec) != 7) {
+		   &tm.tm_mon, &tm.tm_mday, &tm.tm_hour, &tm.tm_min, &tm.tm_sec,
+		   &msec) != 7) {
 		seterr(c->err, "no time stamp in the log line '%s'", line);
 		return -1;
 	}
@@ -935,7 +1028,7 @@ int sys_log_time_ms(struct sys_case *c, const char *a, double *ms)
 	return 0;
 }
 
-/* ---- a second host on the command port ------------------------------------- */
+/* ---- a second host on the command port ---------------------------------- */
 
 int sys_cmd_open(struct sys_case *c)
 {

@@ -33,37 +33,38 @@
 #include "proc.h"
 #include "re_check.h"
 
-#define SYS_PATH_MAX 512
-#define SYS_DIR_MAX 64		/* the temporary directory's path */
-#define SYS_ERR_MAX 1024
-#define SYS_EVT_TEXT 160
-#define SYS_SUBST_MAX 16	/* config substitutions per variant */
+#define SYS_PATH_MAX  512
+#define SYS_DIR_MAX   64 /* the temporary directory's path */
+#define SYS_ERR_MAX   1024
+#define SYS_EVT_TEXT  160
+#define SYS_SUBST_MAX 16   /* config substitutions per variant */
+#define SYS_STILL_CPS 1000 /* |velocity| of an axis at rest, counts/s */
 
 /* The default timing figures of config/roboelf.yaml and dmc/constants.dmc
  * (checked against the configuration by sys_env_init()). */
-#define SYS_MAINMS 10		/* DMC thread 0 period, ms */
-#define SYS_LOOPMS 10		/* DMC thread 1 period, ms */
+#define SYS_MAINMS 10 /* DMC thread 0 period, ms */
+#define SYS_LOOPMS 10 /* DMC thread 1 period, ms */
 
 struct sys_env {
-	char bin[SYS_PATH_MAX];		/* directory of the binaries */
-	char top[SYS_PATH_MAX];		/* repository root */
-	char dir[SYS_DIR_MAX];		/* temporary directory */
-	char cfg[SYS_PATH_MAX];		/* the test configuration */
-	char cal[SYS_PATH_MAX];		/* the calibration file */
-	int ncase;			/* cases started (unique names) */
-	double calib_s;			/* full calibration, wall s */
+	char bin[SYS_PATH_MAX]; /* directory of the binaries */
+	char top[SYS_PATH_MAX]; /* repository root */
+	char dir[SYS_DIR_MAX];	/* temporary directory */
+	char cfg[SYS_PATH_MAX]; /* the test configuration */
+	char cal[SYS_PATH_MAX]; /* the calibration file */
+	int ncase;		/* cases started (unique names) */
+	double calib_s;		/* full calibration, wall s */
 	/* figures read from the configuration (defaults if absent) */
-	int period_ms;			/* P */
+	int period_ms; /* P */
 	double noncrit_factor, crit_factor;
-	int wdto_ms;			/* controller_timeout_ms */
-	int jto_ms;			/* invalid_timeout_ms */
-	int persistence;		/* persistence_cycles of axis A */
-	double allowed_error;		/* of axis A */
-	int vmin_cps, vmax_cps;		/* axis A */
-	int step_counts;		/* axis A */
-	int er_counts;			/* position_error_limit_counts, A */
+	int wdto_ms;		/* controller_timeout_ms */
+	int jto_ms;		/* invalid_timeout_ms */
+	int persistence;	/* persistence_cycles of axis A */
+	double allowed_error;	/* of axis A */
+	int vmin_cps, vmax_cps; /* axis A */
+	int step_counts;	/* axis A */
+	int er_counts;		/* position_error_limit_counts, A */
 	int readback_timeout_ms;
-	int keep;			/* ROBOELF_KEEP set */
+	int keep; /* ROBOELF_KEEP set */
 	char err[SYS_ERR_MAX];
 };
 
@@ -75,17 +76,18 @@ struct sys_subst {
 };
 
 struct sys_opts {
-	const char *calibration;	/* "file" (default) or "full" */
-	const struct sys_subst *subst;	/* config variant, {NULL} ended */
-	int period_ms;			/* 0: the configuration's */
-	char *const *sim_args;		/* extra galil-sim args, or NULL */
-	char *const *re_args;		/* extra roboelf args, or NULL */
-	int ready_timeout_ms;		/* 0: 20 s ("file"), 150 s ("full") */
-	int no_ready;			/* don't wait for Ready */
+	const char *calibration;       /* "file" (default) or "full" */
+	const struct sys_subst *subst; /* config variant, {NULL} ended */
+	int period_ms;		       /* 0: the configuration's */
+	char *const *sim_args;	       /* extra galil-sim args, or NULL */
+	char *const *re_args;	       /* extra roboelf args, or NULL */
+	char *const *re_env;	       /* extra "NAME=value" for roboelf */
+	int ready_timeout_ms;	       /* 0: 20 s ("file"), 150 s ("full") */
+	int no_ready;		       /* don't wait for Ready */
 };
 
 struct sys_evt {
-	double t_ms;			/* simulated ms */
+	double t_ms; /* simulated ms */
 	char text[SYS_EVT_TEXT];
 };
 
@@ -94,17 +96,17 @@ struct sys_case {
 	int id;
 	struct proc_sim sim;
 	int sim_up;
-	int ctl;			/* control-port socket, -1 */
-	struct proc re;			/* roboelf */
+	int ctl;	/* control-port socket, -1 */
+	struct proc re; /* roboelf */
 	int re_up;
 	char relay_link[SYS_PATH_MAX];
 	char log[SYS_PATH_MAX];
-	char cfg[SYS_PATH_MAX];		/* env->cfg or a variant */
-	double t_ready_ms;		/* sim time when Ready was seen */
-	double ready_wall_s;		/* roboelf start to Ready, wall s */
-	struct sys_evt *ev;		/* events fetched so far */
+	char cfg[SYS_PATH_MAX]; /* env->cfg or a variant */
+	double t_ready_ms;	/* sim time when Ready was seen */
+	double ready_wall_s;	/* roboelf start to Ready, wall s */
+	struct sys_evt *ev;	/* events fetched so far */
 	size_t nev, capev;
-	char *buf;			/* control-port answer buffer */
+	char *buf; /* control-port answer buffer */
 	size_t bufcap;
 	char err[SYS_ERR_MAX];
 };
@@ -124,7 +126,8 @@ int sys_env_init(struct sys_env *e);
  * sys_env_calibrate() - one case with `--calibration full`: wait for Ready
  * (at most @timeout_ms), quit it with SIGTERM (exit 0 expected) and check
  * that the calibration file exists. e->calib_s gets the time from roboelf's
- * start to Ready.
+ * start to Ready. With ROBOELF_SYS_CAL=FILE set, FILE is copied instead
+ * (development shortcut; calib_s stays 0).
  * Return: 0, or -1 with e->err set.
  */
 int sys_env_calibrate(struct sys_env *e, int timeout_ms);
@@ -140,7 +143,7 @@ void sys_env_cleanup(struct sys_env *e);
 int sys_env_write_config(struct sys_env *e, const struct sys_subst *subst,
 			 const char *path);
 
-/* ---- one case ------------------------------------------------------------ */
+/* ---- one case ----------------------------------------------------------- */
 
 /*
  * sys_case_start() - galil-sim, galil-load, roboelf, Ready (see above).
@@ -162,7 +165,7 @@ void sys_case_stop(struct sys_case *c);
  * Return: 0, or -1 with c->err set.
  */
 int sys_ctl(struct sys_case *c, const char *fmt, ...)
-	__attribute__((format(printf, 2, 3)));
+    __attribute__((format(printf, 2, 3)));
 
 /*
  * sys_ctl_ask() - one control-port request and its one-line answer.
@@ -228,8 +231,10 @@ int sys_wait_moving(struct sys_case *c, char axis, double counts,
 		    int timeout_ms);
 
 /*
- * sys_wait_stopped() - poll `state` every 10 ms until axis @axis shows
- * X.vel=0. @t_ms: [out] the simulated time of that state line.
+ * sys_wait_stopped() - poll `state` every 10 ms until axis @axis has
+ * stopped: its reference position X.ref is the same in two state lines in
+ * a row and its true velocity is below SYS_STILL_CPS (the servo's dither
+ * around a count). @t_ms: [out] the simulated time of the first of the two.
  * Return: 0 or -1.
  */
 int sys_wait_stopped(struct sys_case *c, char axis, int timeout_ms,
@@ -237,7 +242,7 @@ int sys_wait_stopped(struct sys_case *c, char axis, int timeout_ms,
 
 /*
  * sys_motors_off_time() - the time by which every motor was off after
- * @after_ms: the latest of each axis's first "<X> motor off" event at or
+ * @after_ms: the latest of each axis's first "axis <X> motor off" event at or
  * after @after_ms, when each axis has one and the state line shows it off.
  * Return: that time, or -1 when some axis has no such event.
  */
@@ -255,8 +260,7 @@ int sys_check_safe(struct sys_case *c, int relay_may_be_on, int hold_ms);
  * sys_wait_fault() - wait for roboelf's "FAULT " line on stdout.
  * Return: 0 with @line filled, -1 on timeout (c->err set).
  */
-int sys_wait_fault(struct sys_case *c, int timeout_ms, char *line,
-		   size_t cap);
+int sys_wait_fault(struct sys_case *c, int timeout_ms, char *line, size_t cap);
 
 /*
  * sys_fault_expect() - the FAULT line's class and recovery of @id on axis
@@ -264,8 +268,8 @@ int sys_wait_fault(struct sys_case *c, int timeout_ms, char *line,
  * @prefix: [out] "FAULT <CLASS>: "; @recovery: [out] ". Recovery: <text>".
  * Return: 0 or -1.
  */
-int sys_fault_expect(enum re_fault_id id, int axis, char *prefix,
-		     size_t pcap, char *recovery, size_t rcap);
+int sys_fault_expect(enum re_fault_id id, int axis, char *prefix, size_t pcap,
+		     char *recovery, size_t rcap);
 
 /*
  * sys_fault_match() - which of @ids (ended by RE_F_NONE) @line is: the
@@ -280,8 +284,8 @@ enum re_fault_id sys_fault_match(const char *line, int axis,
  * @a and @b (@b may be NULL).
  * Return: 0 with @line filled (if not NULL), -1 when none.
  */
-int sys_log_find(struct sys_case *c, const char *a, const char *b,
-		 char *line, size_t cap);
+int sys_log_find(struct sys_case *c, const char *a, const char *b, char *line,
+		 size_t cap);
 
 /*
  * sys_log_time_ms() - the wall-clock time (ms since the epoch, UTC) of the

@@ -14,8 +14,8 @@
 
 #include "test_ctrl_util.h"
 
-#define CASES 1500
-#define HOST_LINES 3000
+#define CASES	   1500
+#define HOST_LINES 5000
 
 static uint64_t rng_state;
 
@@ -33,34 +33,162 @@ static int pick(int n)
 }
 
 static const char *const words[] = {
-	"#A", "#B", "#LOOP", "#AUTO", "#CMDERR", "#POSERR", "#LIMSWI",
-	"#AMPERR", "#TCPERR", "#MCTIME", "JP #A", "JP#LOOP,x<5", "JS #B",
-	"JS #B(1,&x,3)", "JS #B(", "EN", "EN,,x", "EN1", "RE", "RE1", "RI",
-	"ZS", "ZS1", "IF (x=1)", "IF(", "ELSE", "ENDIF", "WT 1", "WT 0",
-	"WT -1", "AT 0", "AT -3", "AT 2,1", "AM", "MC", "MF 10", "MRB=-5",
-	"AI 1", "AI -2", "XQ #B,1", "XQ #A,7", "XQ ,,1", "HX", "HX1", "HX9",
-	"MG x", "MG \"hi\",x{F5.2}", "MG {EA}\"x\"", "MG {N}{^65}", "MG",
-	"MG 1{Z", "x=x+1", "x=", "x=?", "y=(x*2)/3", "z=1/0", "x=$FF.8",
-	"DM a[10]", "DM a[0]", "a[3]=4", "a[-1]=1", "a[99]=1", "DA a[]",
-	"DA *", "^a=1", "^b", "~a=1", "~b=\"C\"", "~c=9", "SH", "SHA", "MO",
-	"MOB", "BG", "BGA", "ST", "STC", "AB", "AB1", "PR 1000,,-500",
-	"PRA=200", "PA 0", "PT 1", "PTA=0", "JG 1000", "JGB=-300",
-	"SP 5000", "AC 1024", "DC*=2048", "KP 1,2,3", "KI ?", "ER 100",
-	"OE 1,1,1", "OA 1", "OT 5", "OV 1", "TL 2", "FL 100", "BL -100",
-	"DP 0", "ZAA=x", "CB 1", "SB 3", "OB 2,x", "TP", "TE", "SC", "TS",
-	"TV", "TT", "RP", "TC1", "TC", "QR", "QZ", "TH", "WH", "CF A",
-	"CF S", "CW 1", "CW ,1", "CW 2", "LV", "LA", "LL", "BN", "BV", "BP",
-	"VF 5.2", "PF 8", "LZ 0", "TM 500", "IHT=>-3", "DL", "UL", "LS",
-	"NO comment", "' quote", "REM rem", "_TPA", "bg", "XX", "@ABS[1]",
-	"MG _XQ0,_HX1,_ED,_ED1,_TC,_NO,TIME,_TPA,_LFB,_ZAC,_TA0,_IA4",
-	"x=@SIN[x]+@COM[x]&$FF|@RND[-x]%3", "MG (((((1)))))", "x=-(-(-1))",
+    "#A",
+    "#B",
+    "#LOOP",
+    "#AUTO",
+    "#CMDERR",
+    "#POSERR",
+    "#LIMSWI",
+    "#AMPERR",
+    "#TCPERR",
+    "#MCTIME",
+    "JP #A",
+    "JP#LOOP,x<5",
+    "JS #B",
+    "JS #B(1,&x,3)",
+    "JS #B(",
+    "EN",
+    "EN,,x",
+    "EN1",
+    "RE",
+    "RE1",
+    "RI",
+    "ZS",
+    "ZS1",
+    "IF (x=1)",
+    "IF(",
+    "ELSE",
+    "ENDIF",
+    "WT 1",
+    "WT 0",
+    "WT -1",
+    "AT 0",
+    "AT -3",
+    "AT 2,1",
+    "AM",
+    "MC",
+    "MF 10",
+    "MRB=-5",
+    "AI 1",
+    "AI -2",
+    "XQ #B,1",
+    "XQ #A,7",
+    "XQ ,,1",
+    "HX",
+    "HX1",
+    "HX9",
+    "MG x",
+    "MG \"hi\",x{F5.2}",
+    "MG {EA}\"x\"",
+    "MG {N}{^65}",
+    "MG",
+    "MG 1{Z",
+    "x=x+1",
+    "x=",
+    "x=?",
+    "y=(x*2)/3",
+    "z=1/0",
+    "x=$FF.8",
+    "DM a[10]",
+    "DM a[0]",
+    "a[3]=4",
+    "a[-1]=1",
+    "a[99]=1",
+    "DA a[]",
+    "DA *",
+    "^a=1",
+    "^b",
+    "~a=1",
+    "~b=\"C\"",
+    "~c=9",
+    "SH",
+    "SHA",
+    "MO",
+    "MOB",
+    "BG",
+    "BGA",
+    "ST",
+    "STC",
+    "AB",
+    "AB1",
+    "PR 1000,,-500",
+    "PRA=200",
+    "PA 0",
+    "PT 1",
+    "PTA=0",
+    "JG 1000",
+    "JGB=-300",
+    "SP 5000",
+    "AC 1024",
+    "DC*=2048",
+    "KP 1,2,3",
+    "KI ?",
+    "ER 100",
+    "OE 1,1,1",
+    "OA 1",
+    "OT 5",
+    "OV 1",
+    "TL 2",
+    "FL 100",
+    "BL -100",
+    "DP 0",
+    "ZAA=x",
+    "CB 1",
+    "SB 3",
+    "OB 2,x",
+    "TP",
+    "TE",
+    "SC",
+    "TS",
+    "TV",
+    "TT",
+    "RP",
+    "TC1",
+    "TC",
+    "QR",
+    "QZ",
+    "TH",
+    "WH",
+    "CF A",
+    "CF S",
+    "CW 1",
+    "CW ,1",
+    "CW 2",
+    "LV",
+    "LA",
+    "LL",
+    "BN",
+    "BV",
+    "BP",
+    "VF 5.2",
+    "PF 8",
+    "LZ 0",
+    "TM 500",
+    "IHT=>-3",
+    "DL",
+    "UL",
+    "LS",
+    "NO comment",
+    "' quote",
+    "REM rem",
+    "_TPA",
+    "bg",
+    "XX",
+    "@ABS[1]",
+    "MG _XQ0,_HX1,_ED,_ED1,_TC,_NO,TIME,_TPA,_LFB,_ZAC,_TA0,_IA4",
+    "x=@SIN[x]+@COM[x]&$FF|@RND[-x]%3",
+    "MG (((((1)))))",
+    "x=-(-(-1))",
 };
 
 static const char *const junk[] = {
-	"(", ")", "[", "]", "{", "}", "\"", "'", ";", ",", "=", "<", ">",
-	"<=", ">=", "<>", "+", "-", "*", "/", "%", "&", "|", "@", "_", "^",
-	"~", "#", "$", "?", " ", "9999999999", "-2147483648", "0.00001",
-	"abcdefghij", "TIME", "\\", "\x1a", "\x12\x16",
+    "(",    ")",  "[",	  "]",		"{",	       "}",	  "\"",
+    "'",    ";",  ",",	  "=",		"<",	       ">",	  "<=",
+    ">=",   "<>", "+",	  "-",		"*",	       "/",	  "%",
+    "&",    "|",  "@",	  "_",		"^",	       "~",	  "#",
+    "$",    "?",  " ",	  "9999999999", "-2147483648", "0.00001", "abcdefghij",
+    "TIME", "\\", "\x1a", "\x12\x16",
 };
 
 static void add(char *line, size_t cap, const char *s)
@@ -80,13 +208,13 @@ static void random_line(char *line, size_t cap)
 		if (i)
 			add(line, cap, pick(4) ? ";" : "");
 		if (pick(5))
-			add(line, cap, words[pick(sizeof(words) /
-						  sizeof(words[0]))]);
+			add(line, cap,
+			    words[pick(sizeof(words) / sizeof(words[0]))]);
 		else
-			add(line, cap, junk[pick(sizeof(junk) /
-						 sizeof(junk[0]))]);
+			add(line, cap,
+			    junk[pick(sizeof(junk) / sizeof(junk[0]))]);
 	}
-	if (!pick(20)) {	/* random bytes */
+	if (!pick(20)) { /* random bytes */
 		size_t k = strlen(line), m = (size_t)pick(12);
 
 		while (m-- && k + 1 < cap)
@@ -117,12 +245,10 @@ static void mutate(char *buf, size_t *len, size_t cap)
 	int i, n = 1 + pick(6);
 	size_t at;
 
-	for (i = 0; i < n && *len > 0; i++) {
+	for (i = 0; i<n && * len> 0; i++) {
 		at = (size_t)pick((int)*len);
 		switch (pick(3)) {
-		case 0:
-			buf[at] = (char)pick(128);
-			break;
+		case 0: buf[at] = (char)pick(128); break;
 		case 1:
 			if (*len + 1 < cap) {
 				memmove(buf + at + 1, buf + at, *len - at);
@@ -166,9 +292,9 @@ static void drain(struct tplant *p)
 }
 
 static const char base_prog[] =
-	"EN\r#AUTO\rXQ #B,1;n=0\r#LOOP;n=n+1;IF (n>3);JS #S(n,2)\rELSE\r"
-	"MG \"n\",n{Z3.0}\rENDIF;WT 2;JP #LOOP,n<20\rEN\r#B\rSH;PR 100,-50\r"
-	"BG;AM;MO;EN\r#S\rEN,,^a*^b\r#CMDERR\re=_ED;EN\r#POSERR\rRE\r";
+    "EN\r#AUTO\rXQ #B,1;n=0\r#LOOP;n=n+1;IF (n>3);JS #S(n,2)\rELSE\r"
+    "MG \"n\",n{Z3.0}\rENDIF;WT 2;JP #LOOP,n<20\rEN\r#B\rSH;PR 100,-50\r"
+    "BG;AM;MO;EN\r#S\rEN,,^a*^b\r#CMDERR\re=_ED;EN\r#POSERR\rRE\r";
 
 /* Random and mutated programs: download, start, run. */
 static void test_fuzz_programs(void **state)
@@ -195,8 +321,9 @@ static void test_fuzz_programs(void **state)
 		ctrl_download(p.c, prog, len, &bad);
 		for (k = 0; k < 3; k++) {
 			snprintf(line, sizeof(line), "XQ %s,%d",
-				 (const char *[]){ "#AUTO", "#LOOP", "0",
-						   "#A" }[pick(4)], pick(8));
+				 (const char *[]){"#AUTO", "#LOOP", "0",
+						  "#A"}[pick(4)],
+				 pick(8));
 			tp_cmd(&p, line, resp, sizeof(resp));
 		}
 		p.in.amp_power = pick(8) != 0;
@@ -260,8 +387,8 @@ static void test_fuzz_host(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test(test_fuzz_programs),
-		cmocka_unit_test(test_fuzz_host),
+	    cmocka_unit_test(test_fuzz_programs),
+	    cmocka_unit_test(test_fuzz_host),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -93,7 +93,7 @@ static void test_functions(void **state)
 	expect_reply(p, "MG {$8.0} @COM[0]", "$FFFFFFFF\r\n");
 	expect_reply(p, "MG @FLOT[2.5] {$8.0}", "$40200000\r\n");
 	expect_reply(p, "MG @REAL[$40200000]", " 2.5000\r\n");
-	p->in.inputs = 0x5;	/* inputs 1 and 3 high */
+	p->in.inputs = 0x5; /* inputs 1 and 3 high */
 	p->in.an_v[1] = 1.25;
 	tp_step(p, 1);
 	expect_reply(p, "MG @IN[1],@IN[2],@IN[3],@AN[2]",
@@ -137,7 +137,9 @@ static void test_variables(void **state)
 	expect_reply(p, "x=", " 5.0000\r\n");
 	expect_reply(p, "apple = 10-4", "");
 	expect_reply(p, "MG apple - 1", " 5.0000\r\n");
-	expect_reply(p, "Abc=1;abc=2;MG Abc,abc", "::\x20" "1.0000 2.0000\r\n");
+	expect_reply(p, "Abc=1;abc=2;MG Abc,abc",
+		     "::\x20"
+		     "1.0000 2.0000\r\n");
 	expect_reply(p, "CD0=7;MG CD0", ": 7.0000\r\n");
 	expect_error(p, "MG nosuch", 1);
 	expect_error(p, "abcdefghi=1", 9);
@@ -181,7 +183,7 @@ static void test_bad_commands(void **state)
 	expect_error(p, "ZZ", 1);
 	expect_error(p, "_TPA", 1);
 	expect_error(p, "#LABEL", 1);
-	expect_error(p, "JP #A", 2);	/* program only */
+	expect_error(p, "JP #A", 2); /* program only */
 	expect_error(p, "WT 10", 2);
 	/* TC1 gives code and text, and reading TC clears it */
 	assert_int_equal(tp_cmd(p, "bg", resp, sizeof(resp)), GL_ERR_CTRL);
@@ -204,20 +206,19 @@ static void load_run(struct tplant *p, const char *prog, const char *xq,
 static void test_nested_if(void **state)
 {
 	struct tplant *p = *state;
-	const char *prog =
-		"#A\r"
-		"r=0\r"
-		"IF (a=1)\r"
-		" IF (b=1)\r"
-		"  r=11\r"
-		" ELSE\r"
-		"  r=10\r"
-		" ENDIF\r"
-		"ELSE\r"
-		" IF (b=1);r=1;ELSE;r=0.5;ENDIF\r"
-		"ENDIF\r"
-		"EN\r";
-	static const double want[4] = { 0.5, 1, 10, 11 };
+	const char *prog = "#A\r"
+			   "r=0\r"
+			   "IF (a=1)\r"
+			   " IF (b=1)\r"
+			   "  r=11\r"
+			   " ELSE\r"
+			   "  r=10\r"
+			   " ENDIF\r"
+			   "ELSE\r"
+			   " IF (b=1);r=1;ELSE;r=0.5;ENDIF\r"
+			   "ENDIF\r"
+			   "EN\r";
+	static const double want[4] = {0.5, 1, 10, 11};
 	char line[32];
 	int i;
 
@@ -244,23 +245,22 @@ static void test_if_without_endif(void **state)
 static void test_js_params(void **state)
 {
 	struct tplant *p = *state;
-	const char *prog =
-		"#ADD\r"
-		"JS#SUM(1,2,3,4,5,6,7,8)\r"
-		"s=_JS\r"
-		"v=9\r"
-		"JS #SQ2(&v)\r"
-		"JS #SQ(3),(v>1)\r"
-		"q=_JS\r"
-		"JS #SQ(5),(v<1)\r"
-		"EN\r"
-		"#SUM\r"
-		"EN,,^a+^b+^c+^d+^e+^f+^g+^h\r"
-		"#SQ\r"
-		"EN ,,(^a*^a)\r"
-		"#SQ2\r"
-		"^a=^a*^a\r"
-		"EN\r";
+	const char *prog = "#ADD\r"
+			   "JS#SUM(1,2,3,4,5,6,7,8)\r"
+			   "s=_JS\r"
+			   "v=9\r"
+			   "JS #SQ2(&v)\r"
+			   "JS #SQ(3),(v>1)\r"
+			   "q=_JS\r"
+			   "JS #SQ(5),(v<1)\r"
+			   "EN\r"
+			   "#SUM\r"
+			   "EN,,^a+^b+^c+^d+^e+^f+^g+^h\r"
+			   "#SQ\r"
+			   "EN ,,(^a*^a)\r"
+			   "#SQ2\r"
+			   "^a=^a*^a\r"
+			   "EN\r";
 
 	load_run(p, prog, "XQ #ADD", 10);
 	assert_int_equal(ctrl_threads(p->c), 0);
@@ -294,18 +294,17 @@ static void test_wt_timing(void **state)
 static void test_at_timing(void **state)
 {
 	struct tplant *p = *state;
-	const char *prog =
-		"#A\r"
-		"DM t[6];i=0\r"
-		"AT 0;t0=TIME\r"
-		"#L\r"
-		"AT -20\r"
-		"t[i]=TIME-t0;i=i+1\r"
-		"WT 7\r"		/* work inside the period */
-		"JP #L,i<5\r"
-		"AT 150\r"		/* 150 from the reference (100) */
-		"t[5]=TIME-t0\r"
-		"EN\r";
+	const char *prog = "#A\r"
+			   "DM t[6];i=0\r"
+			   "AT 0;t0=TIME\r"
+			   "#L\r"
+			   "AT -20\r"
+			   "t[i]=TIME-t0;i=i+1\r"
+			   "WT 7\r" /* work inside the period */
+			   "JP #L,i<5\r"
+			   "AT 150\r" /* 150 from the reference (100) */
+			   "t[5]=TIME-t0\r"
+			   "EN\r";
 	char name[16];
 	int i;
 
@@ -322,19 +321,18 @@ static void test_at_timing(void **state)
 static void test_threads(void **state)
 {
 	struct tplant *p = *state;
-	const char *prog =
-		"EN\r"
-		"#A\r"
-		"WT 1000\r"
-		"EN\r"
-		"#B;n=n+1;JP #B\r";
+	const char *prog = "EN\r"
+			   "#A\r"
+			   "WT 1000\r"
+			   "EN\r"
+			   "#B;n=n+1;JP #B\r";
 	char resp[64];
 
 	load_run(p, prog, "n=0;XQ #A,1", 2);
 	assert_int_equal(ctrl_threads(p->c), 1u << 1);
 	assert_true(tp_mg(p, "_XQ1") == 2);
 	assert_true(tp_mg(p, "_XQ0") == -1);
-	assert_true(tp_mg(p, "_HX1") == 2);	/* at a trippoint */
+	assert_true(tp_mg(p, "_HX1") == 2); /* at a trippoint */
 	expect_error(p, "XQ #A,1", 19);
 	expect_reply(p, "HX1", "");
 	assert_true(tp_mg(p, "_XQ1") == -1);
@@ -376,26 +374,25 @@ static void test_line_budget(void **state)
 static void test_cmderr(void **state)
 {
 	struct tplant *p = *state;
-	const char *prog =
-		"#MAIN\r"		/* 0 */
-		"XQ #ERR,1\r"		/* 1 */
-		"#LOOP;k=k+1\r"		/* 2 */
-		"WT 10;JP #LOOP\r"	/* 3 */
-		"#ERR\r"		/* 4 */
-		"WT 5\r"		/* 5 */
-		"XX123\r"		/* 6: invalid command */
-		"EN\r"			/* 7 */
-		"#CMDERR\r"		/* 8 */
-		"tc=_TC;ed=_ED;th=_ED1;n=n+1\r"
-		"EN\r";
+	const char *prog = "#MAIN\r"	      /* 0 */
+			   "XQ #ERR,1\r"      /* 1 */
+			   "#LOOP;k=k+1\r"    /* 2 */
+			   "WT 10;JP #LOOP\r" /* 3 */
+			   "#ERR\r"	      /* 4 */
+			   "WT 5\r"	      /* 5 */
+			   "XX123\r"	      /* 6: invalid command */
+			   "EN\r"	      /* 7 */
+			   "#CMDERR\r"	      /* 8 */
+			   "tc=_TC;ed=_ED;th=_ED1;n=n+1\r"
+			   "EN\r";
 
 	load_run(p, prog, "k=0;n=0;XQ #MAIN", 40);
 	assert_true(tp_mg(p, "tc") == 1);
 	assert_true(tp_mg(p, "ed") == 6);
 	assert_true(tp_mg(p, "th") == 1);
 	assert_true(tp_mg(p, "n") == 1);
-	assert_int_equal(ctrl_threads(p->c), 1u);	/* thread 1 halted */
-	assert_true(tp_mg(p, "k") >= 3);		/* thread 0 goes on */
+	assert_int_equal(ctrl_threads(p->c), 1u); /* thread 1 halted */
+	assert_true(tp_mg(p, "k") >= 3);	  /* thread 0 goes on */
 	assert_true(tp_has_event(p, "program error thread 1 line 6 TC 1"));
 	expect_reply(p, "HX", "");
 }
@@ -404,14 +401,13 @@ static void test_cmderr(void **state)
 static void test_cmderr_thread0(void **state)
 {
 	struct tplant *p = *state;
-	const char *prog =
-		"#A\r"
-		"a=1;MG nosuch;a=2\r"
-		"a=3\r"
-		"EN\r"
-		"#CMDERR\r"
-		"e=_ED;c=_TC\r"
-		"EN\r";
+	const char *prog = "#A\r"
+			   "a=1;MG nosuch;a=2\r"
+			   "a=3\r"
+			   "EN\r"
+			   "#CMDERR\r"
+			   "e=_ED;c=_TC\r"
+			   "EN\r";
 
 	load_run(p, prog, "XQ #A", 10);
 	assert_true(tp_mg(p, "a") == 3);
@@ -446,10 +442,10 @@ static void test_error_lines(void **state)
 		const char *stmt;
 		int tc;
 	} cases[] = {
-		{ "x=(1+2", 59 }, { "x=arr[1]", 57 }, { "x=1+", 1 },
-		{ "MG \"abc", 52 }, { "JP 9999", 11 }, { "ELSE", 63 },
-		{ "EN 1,2,3,4", 4 }, { "DM q[0]", 6 }, { "x=\"TOOLONG\"", 52 },
-		{ "^z=1", 1 }, { "SHD", 6 }, { "PR 1,2,3,4", 6 },
+	    {"x=(1+2", 59},    {"x=arr[1]", 57}, {"x=1+", 1},
+	    {"MG \"abc", 52},  {"JP 9999", 11},	 {"ELSE", 63},
+	    {"EN 1,2,3,4", 4}, {"DM q[0]", 6},	 {"x=\"TOOLONG\"", 52},
+	    {"^z=1", 1},       {"SHD", 6},	 {"PR 1,2,3,4", 6},
 	};
 	char prog[128];
 	size_t i;
@@ -463,37 +459,138 @@ static void test_error_lines(void **state)
 	}
 }
 
+/*
+ * EN1 at the end of #CMDERR restores the trippoint thread 0 was waiting
+ * in (WT 100 runs to its end); EN clears it (thread 0 goes on at once).
+ */
+static void test_trippoint_restore(void **state)
+{
+	struct tplant *p = *state;
+	static const char fmt[] = "#A\r"
+				  "XQ #B,1\r"
+				  "t0=TIME;WT 100;t1=TIME\r"
+				  "EN\r"
+				  "#B;WT 5;XX\r"
+				  "#CMDERR\r"
+				  "%s\r";
+	char prog[128];
+
+	snprintf(prog, sizeof(prog), fmt, "EN1");
+	load_run(p, prog, "XQ #A", 150);
+	assert_true(tp_mg(p, "t1-t0") == 100);
+	snprintf(prog, sizeof(prog), fmt, "EN");
+	load_run(p, prog, "XQ #A", 150);
+	assert_true(tp_mg(p, "t1-t0") >= 5);
+	assert_true(tp_mg(p, "t1-t0") <= 7);
+}
+
+/* ZS clears the stack so an error routine can jump instead of return. */
+static void test_zs(void **state)
+{
+	struct tplant *p = *state;
+	const char *prog = "#A\r"
+			   "JS #S\r"
+			   "EN\r"
+			   "#S;MG nosuch;EN\r"
+			   "#CMDERR\r"
+			   "d=_ZS0;ZS;JP #GO\r"
+			   "#GO\r"
+			   "z=_ZS0;done=1\r"
+			   "EN\r";
+
+	load_run(p, prog, "done=0;XQ #A", 10);
+	assert_true(tp_mg(p, "d") == 2); /* JS + #CMDERR */
+	assert_true(tp_mg(p, "z") == 0);
+	assert_true(tp_mg(p, "done") == 1);
+	assert_int_equal(ctrl_threads(p->c), 0);
+}
+
+/* ~a axis designators in commands and operands. */
+static void test_axis_designators(void **state)
+{
+	struct tplant *p = *state;
+
+	expect_reply(p, "~a=2;~b=\"B\";MG ~a,~b", ":: 2.0000 1.0000\r\n");
+	expect_reply(p, "KP~a=7;MG _KP~a,_KPC", ": 7.0000 7.0000\r\n");
+	expect_reply(p, "ZA~b=5;MG _ZAB", ": 5.0000\r\n");
+	expect_error(p, "~a=9", 6);
+	expect_reply(p, "~a=3", ""); /* no axis D: an error when used */
+	expect_error(p, "SH~a", 6);
+}
+
+/* Listing, deallocation, formats and the small general commands. */
+static void test_misc_commands(void **state)
+{
+	struct tplant *p = *state;
+	char resp[256];
+
+	expect_reply(p, "zeta=1;alpha=2.5;DM beta[3]", "::");
+	expect_reply(p, "LV", "alpha = 2.5000\r\nzeta = 1.0000\r\n");
+	expect_reply(p, "LA", "beta[3]\r\n");
+	expect_reply(p, "MG _UL,_DM,_DA", " 508.0000 23997.0000 29.0000\r\n");
+	expect_reply(p, "DA zeta;MG _UL", ": 509.0000\r\n");
+	expect_error(p, "MG zeta", 1);
+	expect_reply(p, "MG alpha", " 2.5000\r\n");
+	expect_reply(p, "DA *,*[];MG _UL,_DA", ": 510.0000 30.0000\r\n");
+	expect_reply(p, "DM ?", " 24000\r\n");
+	expect_reply(p, "OP 5;MG _OP0,@OUT[1],@OUT[2],@OUT[3]",
+		     ": 5.0000 1.0000 0.0000 1.0000\r\n");
+	p->in.inputs = 0x0201;
+	tp_step(p, 1);
+	expect_reply(p, "TI 0;TI 1", " 1\r\n: 2\r\n");
+	expect_reply(p, "MG _TI0,_TI1", " 1.0000 2.0000\r\n");
+	expect_reply(p, "TA 0;MG _TA0", " 0\r\n: 0.0000\r\n");
+	expect_reply(p, "MG _BV,_TM,_QZ1,_QZ3",
+		     " 3.0000 1000.0000 52.0000 "
+		     "36.0000\r\n");
+	expect_reply(p, "VF 3.1;MG 2.25,-1234", ": 2.3-999.9\r\n");
+	expect_reply(p, "LZ 0;MG 2.25;x=7;x=?", ": 002.3\r\n:: 007.0\r\n");
+	expect_reply(p, "VF 10.4;LZ 1;PF 5.2;DP 7;TP A", ":::: 7.00\r\n");
+	expect_reply(p, "VF ?", "10.4\r\n");
+	expect_error(p, "VF 11.0", 6);
+	assert_int_equal(tp_cmd(p, "CW ?", resp, sizeof(resp)), GL_OK);
+	assert_non_null(strstr(resp, "Copyright"));
+	expect_error(p, "CW 3", 6);
+	expect_error(p, "CF I", 6); /* the private port is not a handle */
+	expect_error(p, "CF Q", 6);
+	expect_reply(p, "CN 1;MG _CN0;CN -1", ": 1.0000\r\n:");
+	expect_error(p, "CN 2", 6);
+	expect_reply(p, "TB", " 0\r\n");
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test_setup_teardown(test_left_to_right, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_fixed_point, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_functions, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_mg_formats, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_variables, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_arrays, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_bad_commands, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_nested_if, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_if_without_endif, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_js_params, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_js_depth, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_wt_timing, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_at_timing, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_threads, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_line_budget, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_cmderr, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_cmderr_thread0, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_error_stops_all, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_error_lines, setup,
-						teardown),
+	    cmocka_unit_test_setup_teardown(test_left_to_right, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_fixed_point, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_functions, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_mg_formats, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_variables, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_arrays, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_bad_commands, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_nested_if, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_if_without_endif, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_js_params, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_js_depth, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_wt_timing, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_at_timing, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_threads, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_line_budget, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_cmderr, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_cmderr_thread0, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_error_stops_all, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_error_lines, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_trippoint_restore, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_zs, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_axis_designators, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_misc_commands, setup,
+					    teardown),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -57,7 +57,7 @@ static void test_pr_profile(void **state)
 	long t;
 
 	ok(p, "AC 100000");
-	assert_true(tp_mg(p, "_ACA") == 99328);	/* rounded down to 1024s */
+	assert_true(tp_mg(p, "_ACA") == 99328); /* rounded down to 1024s */
 	ok(p, "SHA;SPA=10000;ACA=102400;DCA=102400;PRA=10000;BGA");
 	tp_step(p, 500);
 	assert_true(tp_mg(p, "_BGA") == 1);
@@ -87,7 +87,7 @@ static void test_jog_stop(void **state)
 	tp_step(p, 500);
 	assert_true(fabs(tp_mg(p, "_TVB") + 5000) < 50);
 	assert_true(tp_mg(p, "_SCB") == 0);
-	ok(p, "JG ,-8000");	/* new speed while jogging */
+	ok(p, "JG ,-8000"); /* new speed while jogging */
 	tp_step(p, 300);
 	assert_true(fabs(tp_mg(p, "_TVB") + 8000) < 50);
 	ok(p, "STB");
@@ -107,16 +107,16 @@ static void test_pt_retarget(void **state)
 	at = tp_mg(p, "_TPA");
 	assert_true(at > 3000 && at < 10000);
 	assert_true(tp_mg(p, "_BGA") == 1);
-	ok(p, "PAA=2000");	/* behind the axis: brake, reverse, arrive */
+	ok(p, "PAA=2000"); /* behind the axis: brake, reverse, arrive */
 	assert_true(tp_until(p, "_BGA=0", 3000) > 0);
 	assert_true(tp_mg(p, "_TPA") == 2000);
 	assert_true(tp_mg(p, "_SCA") == 1);
 	ok(p, "PAA=2500");
 	tp_step(p, 200);
 	assert_true(tp_mg(p, "_TPA") == 2500);
-	refused(p, "BGA", 7);	/* only PA moves a PT axis */
+	refused(p, "BGA", 7); /* only PA moves a PT axis */
 	ok(p, "STA");
-	assert_true(tp_mg(p, "_PTA") == 0);	/* ST leaves PT mode */
+	assert_true(tp_mg(p, "_PTA") == 0); /* ST leaves PT mode */
 	ok(p, "MOA;PTA=1");
 	refused(p, "PAA=100", 20);
 }
@@ -131,7 +131,7 @@ static void test_oe_trip(void **state)
 	assert_int_equal(tp_load(p, "EN\r#POSERR\rpe=pe+1;ax=_MOA\rRE\r"),
 			 GL_OK);
 	ok(p, "pe=0;ax=0;SHA;ERA=1000;OEA=1;PRA=50000;BGA");
-	p->frozen[0] = 1;		/* encoder stuck: jam or broken */
+	p->frozen[0] = 1; /* encoder stuck: jam or broken */
 	t = tp_until(p, "_MOA=1", 500);
 	/* the reference passes 1000 counts at sqrt(2*1000/256000) s */
 	assert_true(t >= 86 && t <= 92);
@@ -159,7 +159,7 @@ static void test_oa_trip(void **state)
 	long t;
 
 	ok(p, "SHA;ERA=-1;OAA=1;OTA=30;JGA=10000;BGA");
-	tp_step(p, 1000);	/* a healthy encoder: no trip */
+	tp_step(p, 1000); /* a healthy encoder: no trip */
 	assert_true(tp_mg(p, "_MOA") == 0);
 	p->frozen[0] = 1;
 	t = tp_until(p, "_MOA=1", 200);
@@ -172,7 +172,7 @@ static void test_oa_trip(void **state)
 	p->frozen[0] = 1;
 	tp_step(p, 300);
 	assert_true(tp_mg(p, "_MOA") == 0);
-	assert_true(tp_mg(p, "_TTA") == 9.9982);	/* torque at TL */
+	assert_true(tp_mg(p, "_TTA") == 9.9982); /* torque at TL */
 }
 
 /* Hardware limits: stop (2 forward, 3 reverse), #LIMSWI, BG refused. */
@@ -181,7 +181,8 @@ static void test_hw_limits(void **state)
 	struct tplant *p = *state;
 
 	assert_int_equal(tp_load(p, "#MAIN;WT 10;JP #MAIN\r"
-				    "#LIMSWI\rls=ls+1;lf=_LFA\rRE\r"), GL_OK);
+				    "#LIMSWI\rls=ls+1;lf=_LFA\rRE\r"),
+			 GL_OK);
 	ok(p, "ls=0;XQ #MAIN;SHA;JGA=5000;BGA");
 	tp_step(p, 100);
 	p->in.fwd_limit[0] = 1;
@@ -192,11 +193,11 @@ static void test_hw_limits(void **state)
 	tp_step(p, 2);
 	assert_true(tp_mg(p, "ls") == 1);
 	assert_true(tp_mg(p, "lf") == 0);
-	assert_int_equal(ctrl_threads(p->c), 1u);	/* #MAIN goes on */
+	assert_int_equal(ctrl_threads(p->c), 1u); /* #MAIN goes on */
 	refused(p, "BGA", 22);
 	ok(p, "PRA=100");
 	refused(p, "BGA", 22);
-	ok(p, "JGA=-5000;BGA");		/* away from the switch is fine */
+	ok(p, "JGA=-5000;BGA"); /* away from the switch is fine */
 	tp_step(p, 50);
 	p->in.fwd_limit[0] = 0;
 	p->in.rev_limit[0] = 1;
@@ -218,7 +219,7 @@ static void test_soft_limits(void **state)
 	ok(p, "SHC;FLC=2000;BLC=-1000;JGC=5000;BGC");
 	assert_true(tp_until(p, "_BGC=0", 2000) > 0);
 	at = tp_mg(p, "_TPC");
-	assert_true(at > 2000 && at < 2000 + 60);	/* v^2/2SD = 49 */
+	assert_true(at > 2000 && at < 2000 + 60); /* v^2/2SD = 49 */
 	assert_true(tp_mg(p, "_SCC") == 2);
 	refused(p, "BGC", 22);
 	ok(p, "PAC=-5000;BGC");
@@ -257,20 +258,20 @@ static void test_refusals(void **state)
 {
 	struct tplant *p = *state;
 
-	refused(p, "BGA", 20);		/* motor off */
+	refused(p, "BGA", 20); /* motor off */
 	ok(p, "SHA;JGA=2000;BGA");
 	tp_step(p, 10);
 	refused(p, "BGA", 21);
-	refused(p, "MOA", 7);		/* MO not valid while moving */
+	refused(p, "MOA", 7); /* MO not valid while moving */
 	refused(p, "SHA", 7);
 	refused(p, "PRA=5", 7);
 	refused(p, "DPA=0", 7);
-	ok(p, "DCA=512000");	/* DC may change while jogging */
+	ok(p, "DCA=512000"); /* DC may change while jogging */
 	ok(p, "STA");
 	tp_step(p, 20);
 	ok(p, "PRA=100000;BGA");
 	tp_step(p, 5);
-	refused(p, "DCA=256000", 7);	/* but not during PR/PA */
+	refused(p, "DCA=256000", 7); /* but not during PR/PA */
 }
 
 static void test_abort(void **state)
@@ -280,13 +281,13 @@ static void test_abort(void **state)
 	assert_int_equal(tp_load(p, "#A;WT 10;JP #A\r"), GL_OK);
 	ok(p, "XQ #A;SHA;JGA=2000;BGA");
 	tp_step(p, 20);
-	ok(p, "AB 1");		/* motion only */
+	ok(p, "AB 1"); /* motion only */
 	assert_true(tp_mg(p, "_SCA") == 7);
 	assert_true(tp_mg(p, "_BGA") == 0);
 	assert_int_equal(ctrl_threads(p->c), 1u);
 	ok(p, "OEA=1;JGA=2000;BGA");
 	tp_step(p, 5);
-	ok(p, "AB");		/* motion and program; OE: motor off */
+	ok(p, "AB"); /* motion and program; OE: motor off */
 	assert_int_equal(ctrl_threads(p->c), 0);
 	assert_true(tp_mg(p, "_MOA") == 1);
 	/* a bare ST from a host stops the program too, ST A does not */
@@ -316,25 +317,83 @@ static void test_gains(void **state)
 	assert_string_equal(resp, " 16384, 16384\r\n");
 }
 
+/* MF/MR (encoder crosses), AM (profile done), MC (in position), AI. */
+static void test_trippoints(void **state)
+{
+	struct tplant *p = *state;
+	const char *prog = "#A\r"
+			   "SHA;PRA=2000;BGA\r"
+			   "MFA=1000;t1=_TPA\r"
+			   "AMA;t2=_TPA\r"
+			   "PRA=-1500;BGA\r"
+			   "MRA=1200;t3=_TPA\r"
+			   "MCA;t4=_TPA;t5=_BGA\r"
+			   "AI 3;t6=TIME\r"
+			   "AI -3;t7=TIME\r"
+			   "EN\r";
+	double t1, t3;
+
+	assert_int_equal(tp_load(p, prog), GL_OK);
+	ok(p, "t6=0;t7=0;XQ #A");
+	tp_step(p, 2000);
+	t1 = tp_mg(p, "t1");
+	t3 = tp_mg(p, "t3");
+	assert_true(t1 >= 1000 && t1 < 1040);
+	assert_true(tp_mg(p, "t2") == 2000);
+	assert_true(t3 <= 1200 && t3 > 1160);
+	assert_true(tp_mg(p, "t4") == 500);
+	assert_true(tp_mg(p, "t5") == 0);
+	assert_true(tp_mg(p, "t6") == 0); /* still waiting for input 3 */
+	p->in.inputs = 1u << 2;
+	tp_step(p, 2);
+	assert_true(tp_mg(p, "t6") > 0);
+	assert_true(tp_mg(p, "t7") == 0);
+	p->in.inputs = 0;
+	tp_step(p, 2);
+	assert_true(tp_mg(p, "t7") > tp_mg(p, "t6"));
+	assert_int_equal(ctrl_threads(p->c), 0);
+}
+
+/* MC with the encoder short of the target: TW timeout, SC 99, #MCTIME. */
+static void test_mc_timeout(void **state)
+{
+	struct tplant *p = *state;
+	const char *prog = "#A\r"
+			   "SHA;TWA=100;PRA=500;BGA\r"
+			   "WT 20\r"
+			   "MCA;t=TIME\r"
+			   "EN\r"
+			   "#MCTIME\r"
+			   "mct=_SCA\r"
+			   "EN\r";
+
+	assert_int_equal(tp_load(p, prog), GL_OK);
+	ok(p, "mct=0;t=0;XQ #A");
+	tp_step(p, 10);
+	p->frozen[0] = 1; /* the motor stops following */
+	tp_step(p, 400);
+	assert_true(tp_mg(p, "mct") == 99);
+	assert_true(tp_mg(p, "_SCA") == 99);
+	assert_true(tp_mg(p, "t") > 100);
+	assert_true(tp_has_event(p, "MC timeout"));
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test_setup_teardown(test_pr_profile, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_jog_stop, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_pt_retarget, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_oe_trip, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_oa_trip, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_hw_limits, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_soft_limits, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_amp_power, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_refusals, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_abort, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_gains, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_pr_profile, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_jog_stop, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_pt_retarget, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_oe_trip, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_oa_trip, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_hw_limits, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_soft_limits, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_amp_power, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_refusals, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_abort, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_gains, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_trippoints, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_mc_timeout, setup, teardown),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

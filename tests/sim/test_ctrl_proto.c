@@ -69,7 +69,7 @@ static void test_line_limit(void **state)
 	char line[128];
 
 	memset(line, ' ', 80);
-	memcpy(line + 76, "MG 1\r", 6);	/* exactly 80 characters */
+	memcpy(line + 76, "MG 1\r", 6); /* exactly 80 characters */
 	exchange(p, 0, line, " 1.0000\r\n:");
 	memset(line, ' ', 90);
 	memcpy(line, "x=1;y=2;", 8);
@@ -97,12 +97,24 @@ static void test_identification(void **state)
 	exchange(p, 0, "MG _IHA2,_IHF2\r", " 2.0000 0.0000\r\n:");
 }
 
-static const char prog_text[] =
-	"#AUTO\r"
-	"n=0\r"
-	"#LOOP;n=n+1;WT 10\r"
-	"JP #LOOP\r"
-	"EN\r";
+/* CO: extended I/O configuration 0..15 stored and read back; out of range
+ * refused with TC 6 (number out of range). */
+static void test_extended_io(void **state)
+{
+	struct tplant *p = *state;
+
+	exchange(p, 0, "CO 3\r", ":");
+	exchange(p, 0, "MG _CO\r", " 3.0000\r\n:");
+	exchange(p, 0, "CO 0;CO ?\r", ": 0\r\n:");
+	exchange(p, 0, "CO 16\r", "?");
+	exchange(p, 0, "TC\r", " 6\r\n:");
+}
+
+static const char prog_text[] = "#AUTO\r"
+				"n=0\r"
+				"#LOOP;n=n+1;WT 10\r"
+				"JP #LOOP\r"
+				"EN\r";
 
 /* DL: silent, then "::" after '\'; UL gives it back, CR LF, ^Z, ':'. */
 static void test_dl_ul(void **state)
@@ -146,6 +158,7 @@ static void test_dl_bad(void **state)
 {
 	struct tplant *p = *state;
 	char line[100];
+	int i;
 
 	exchange(p, 0, "DL\r#A\rEN\r\\", "::");
 	memset(line, 'x', 85);
@@ -162,6 +175,18 @@ static void test_dl_bad(void **state)
 	exchange(p, 0, "DL\r#TOOLONGX\r\\", ":?");
 	exchange(p, 0, "DL\r#ok_no\r\\", ":?");
 	exchange(p, 0, "TC\r", " 61\r\n:");
+	/* 4000 lines fit, line 4001 does not */
+	exchange(p, 0, "DL\r", "");
+	for (i = 0; i < 4000; i++)
+		exchange(p, 0, "NO\r", "");
+	exchange(p, 0, "\\", "::");
+	exchange(p, 0, "MG _DL\r", " 510.0000\r\n:");
+	exchange(p, 0, "DL\r", "");
+	for (i = 0; i < 4000; i++)
+		exchange(p, 0, "NO\r", "");
+	exchange(p, 0, "NO\r", "?");
+	exchange(p, 0, "\\", ":?");
+	exchange(p, 0, "TC\r", " 60\r\n:");
 }
 
 /*
@@ -201,7 +226,8 @@ static void test_unsolicited_full(void **state)
 
 	exchange(p, 0,
 		 "DL\r#A;i=i+1;MG \"0123456789012345678901234567890\";"
-		 "JP #A\r\\", "::");
+		 "JP #A\r\\",
+		 "::");
 	exchange(p, 0, "i=0;CF B;XQ #A\r", ":::");
 	tp_step(p, 20);
 	n = tp_out(p, 1, buf, sizeof(buf));
@@ -268,7 +294,7 @@ static void test_power_cycle(void **state)
 	exchange(p, 0, "KP 10,,2;BN;keep=5;BV;lost=1;BP\r", "::::::");
 	exchange(p, 0, "XQ #AUTO\r", ":");
 	tp_step(p, 5);
-	exchange(p, 0, "BP\r", "?");	/* TC 17 while running */
+	exchange(p, 0, "BP\r", "?"); /* TC 17 while running */
 	ctrl_power_cycle(p->c);
 	assert_true(ctrl_handle_close_wanted(p->c, 0));
 	ctrl_handle_close(p->c, 0);
@@ -286,30 +312,46 @@ static void test_power_cycle(void **state)
 	ctrl_power_cycle(p->c);
 	ctrl_handle_close(p->c, 0);
 	ctrl_handle_open(p->c, 0);
-	exchange(p, 0, "UL\r", "#AUTO\r\nn=0\r\n#LOOP;n=n+1;WT 10\r\n"
+	exchange(p, 0, "UL\r",
+		 "#AUTO\r\nn=0\r\n#LOOP;n=n+1;WT 10\r\n"
 		 "JP #LOOP\r\nEN\r\n\x1a:");
+}
+
+/* A lost TCP handle: #TCPERR with _IA4 = the handle, TC 123. */
+static void test_tcperr(void **state)
+{
+	struct tplant *p = *state;
+
+	exchange(p, 0, "DL\r#A;WT 1000;EN\r#TCPERR\rh=_IA4;c=_TC\rRE1\r\\",
+		 "::");
+	exchange(p, 0, "h=-1;c=0;XQ #A\r", ":::");
+	tp_step(p, 2);
+	ctrl_handle_lost(p->c, 3);
+	tp_step(p, 2);
+	exchange(p, 0, "MG h,c,_IHD2\r", " 3.0000 123.0000 0.0000\r\n:");
+	assert_int_equal(ctrl_threads(p->c), 1u); /* RE1: still in WT */
+	exchange(p, 0, "HX\r", ":");
 }
 
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test_setup_teardown(test_framing, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_line_limit, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_identification, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_dl_ul, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_dl_refused_running, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_dl_bad, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_unsolicited, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_unsolicited_full, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_qr, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_ih_close, setup, teardown),
-		cmocka_unit_test_setup_teardown(test_power_cycle, setup,
-						teardown),
+	    cmocka_unit_test_setup_teardown(test_framing, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_line_limit, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_identification, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_extended_io, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_dl_ul, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_dl_refused_running, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_dl_bad, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_unsolicited, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_unsolicited_full, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_qr, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_ih_close, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_power_cycle, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_tcperr, setup, teardown),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

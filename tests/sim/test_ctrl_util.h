@@ -19,7 +19,7 @@ struct tplant {
 	struct ctrl *c;
 	struct ctrl_sense in;
 	struct ctrl_drive out;
-	int frozen[CTRL_AXES];	/* encoder stuck */
+	int frozen[CTRL_AXES]; /* encoder stuck */
 	char events[TP_EVENTS][200];
 	int nevents;
 	long samples;

@@ -51,21 +51,37 @@ static const char *bin_dir(void)
 	return b;
 }
 
+static int teardown(void **state);
+
+/* On any failure here the fixture is undone at once: cmocka does not call
+ * teardown after a failed setup. */
 static int setup(void **state)
 {
+	const char *bin = getenv("ROBOELF_BIN");
 	struct fx *f = calloc(1, sizeof(*f));
 
-	assert_non_null(f);
-	snprintf(f->dir, sizeof(f->dir), "/tmp/test_sim_net.XXXXXX");
-	assert_non_null(mkdtemp(f->dir));
-	snprintf(f->link, sizeof(f->link), "%s/relay", f->dir);
-	f->ctl = -1;
+	if (!f)
+		return -1;
 	*state = f;
-	if (proc_sim_start(&f->sim, bin_dir(), f->link, NULL, START_MS) < 0)
-		fail_msg("galil-sim did not start");
-	f->ctl = proc_ctl_connect(f->sim.ctl_port, REPLY_MS);
-	assert_true(f->ctl >= 0);
-	return 0;
+	f->ctl = -1;
+	snprintf(f->dir, sizeof(f->dir), "/tmp/test_sim_net.XXXXXX");
+	if (!mkdtemp(f->dir)) {
+		free(f);
+		return -1;
+	}
+	snprintf(f->link, sizeof(f->link), "%s/relay", f->dir);
+	if (!bin) {
+		fprintf(stderr, "ROBOELF_BIN is not set (run through "
+				"tests/run-all.sh)\n");
+	} else if (proc_sim_start(&f->sim, bin, f->link, NULL, START_MS) < 0) {
+		fprintf(stderr, "galil-sim did not start\n");
+	} else {
+		f->ctl = proc_ctl_connect(f->sim.ctl_port, REPLY_MS);
+		if (f->ctl >= 0)
+			return 0;
+	}
+	teardown(state);
+	return -1;
 }
 
 static int teardown(void **state)
@@ -400,35 +416,46 @@ static void test_sigterm(void **state)
 
 /* ---- start-up errors (no fixture) -------------------------------------- */
 
-/* Run galil-sim with @args; expect exit @code and @err on stderr. */
-static void run_expect(char *const *args, int code, const char *err)
+/* Run galil-sim with @args; its exit code (or -1) and stderr in @err. */
+static int run_galil_sim(char *const *args, char *err, size_t cap)
 {
 	char bin[512], *argv[16];
 	struct proc p;
-	int n = 0, st;
+	int n = 0, st, code = -1;
 
 	snprintf(bin, sizeof(bin), "%s/galil-sim", bin_dir());
 	argv[n++] = bin;
 	for (int i = 0; args[i]; i++)
 		argv[n++] = args[i];
 	argv[n] = NULL;
-	assert_int_equal(proc_spawn(&p, argv, NULL), 0);
-	if (proc_wait_exit(&p, START_MS, &st) < 0) {
-		proc_kill(&p);
-		fail_msg("galil-sim did not exit");
+	err[0] = '\0';
+	if (proc_spawn(&p, argv, NULL) < 0)
+		return -1;
+	if (proc_wait_exit(&p, START_MS, &st) == 0 &&
+	    proc_output(&p, PROC_STDOUT)[0] == '\0') {
+		code = proc_exit_code(&p);
+		snprintf(err, cap, "%s", proc_output(&p, PROC_STDERR));
 	}
-	assert_int_equal(proc_exit_code(&p), code);
-	if (strcmp(proc_output(&p, PROC_STDERR), err))
-		fail_msg("stderr '%s', want '%s'", proc_output(&p, PROC_STDERR),
-			 err);
-	assert_string_equal(proc_output(&p, PROC_STDOUT), "");
 	proc_kill(&p);
+	return code;
+}
+
+/* Run galil-sim with @args; expect exit @code and @err on stderr. */
+static void run_expect(char *const *args, int code, const char *err)
+{
+	char got[1024];
+
+	assert_int_equal(run_galil_sim(args, got, sizeof(got)), code);
+	if (strcmp(got, err))
+		fail_msg("stderr '%s', want '%s'", got, err);
 }
 
 static void test_bad_plant_file(void **state)
 {
 	char dir[] = "/tmp/test_sim_net.XXXXXX", path[96], want[256];
+	char got[1024];
 	FILE *fp;
+	int code;
 
 	(void)state;
 	assert_non_null(mkdtemp(dir));
@@ -439,11 +466,13 @@ static void test_bad_plant_file(void **state)
 	fclose(fp);
 	snprintf(want, sizeof(want), "%s:4:5: unknown key 'lag' in axes.A\n",
 		 path);
-	run_expect((char *const[]){(char *)"--plant", path,
-				   (char *)"--no-relay-link", NULL},
-		   2, want);
+	code = run_galil_sim((char *const[]){(char *)"--plant", path,
+					     (char *)"--no-relay-link", NULL},
+			     got, sizeof(got));
 	unlink(path);
 	rmdir(dir);
+	assert_int_equal(code, 2);
+	assert_string_equal(got, want);
 }
 
 static void test_usage_errors(void **state)
@@ -458,6 +487,38 @@ static void test_usage_errors(void **state)
 		   "galil-sim: bad port '70000'\ntry 'galil-sim --help'\n");
 	run_expect((char *const[]){(char *)"extra", NULL}, 2,
 		   "galil-sim: unexpected argument 'extra'\n");
+}
+
+/* A relay link path holding a regular file is refused: exit 1, the file
+ * left alone. */
+static void test_link_not_symlink(void **state)
+{
+	char dir[] = "/tmp/test_sim_net.XXXXXX", path[96], want[256];
+	char got[1024];
+	struct stat st;
+	FILE *fp;
+	int code, regular;
+
+	(void)state;
+	assert_non_null(mkdtemp(dir));
+	snprintf(path, sizeof(path), "%s/relay", dir);
+	fp = fopen(path, "w");
+	assert_non_null(fp);
+	fclose(fp);
+	snprintf(want, sizeof(want),
+		 "galil-sim: refusing to replace '%s': not a symbolic link\n",
+		 path);
+	code =
+	    run_galil_sim((char *const[]){(char *)"--port", (char *)"0",
+					  (char *)"--control-port", (char *)"0",
+					  (char *)"--relay-link", path, NULL},
+			  got, sizeof(got));
+	regular = stat(path, &st) == 0 && S_ISREG(st.st_mode);
+	unlink(path);
+	rmdir(dir);
+	assert_int_equal(code, 1);
+	assert_string_equal(got, want);
+	assert_true(regular);
 }
 
 /* A port in use: exit 1 with the reason. */
@@ -502,6 +563,7 @@ int main(void)
 	    T(test_sigterm),
 	    cmocka_unit_test(test_bad_plant_file),
 	    cmocka_unit_test(test_usage_errors),
+	    cmocka_unit_test(test_link_not_symlink),
 	    cmocka_unit_test(test_port_in_use),
 	};
 

@@ -65,21 +65,32 @@ static int open_host(const char *path)
 	return fd;
 }
 
+static int teardown(void **state);
+
+/* On failure the fixture is undone here: cmocka skips teardown then. */
 static int setup_proto(void **state, enum sim_relay_proto proto)
 {
 	struct fx *f = calloc(1, sizeof(*f));
 	char err[256];
 
-	assert_non_null(f);
-	snprintf(f->dir, sizeof(f->dir), "/tmp/test_sim_relay.XXXXXX");
-	assert_non_null(mkdtemp(f->dir));
-	snprintf(f->link, sizeof(f->link), "%s/relay", f->dir);
-	assert_int_equal(sim_relay_new(&f->r, proto, on_event, f), 0);
-	assert_int_equal(sim_relay_attach(f->r, f->link, err, sizeof(err)), 0);
-	f->fd = open_host(f->link);
-	assert_true(f->fd >= 0);
+	if (!f)
+		return -1;
 	*state = f;
-	return 0;
+	f->fd = -1;
+	snprintf(f->dir, sizeof(f->dir), "/tmp/test_sim_relay.XXXXXX");
+	if (!mkdtemp(f->dir)) {
+		free(f);
+		return -1;
+	}
+	snprintf(f->link, sizeof(f->link), "%s/relay", f->dir);
+	if (sim_relay_new(&f->r, proto, on_event, f) == 0 &&
+	    sim_relay_attach(f->r, f->link, err, sizeof(err)) == 0) {
+		f->fd = open_host(f->link);
+		if (f->fd >= 0)
+			return 0;
+	}
+	teardown(state);
+	return -1;
 }
 
 static int setup_devantech(void **state)

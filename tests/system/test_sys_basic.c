@@ -25,10 +25,10 @@
 
 #include "proc.h"
 
-#define START_MS 10000		/* galil-sim, galil-load */
-#define READY_MS 60000		/* roboelf to "RoboELF Ready for Use" */
-#define FAULT_MS 3000		/* an injected fault to its FAULT line */
-#define EXIT_MS 5000
+#define START_MS 10000 /* galil-sim, galil-load */
+#define READY_MS 60000 /* roboelf to "RoboELF Ready for Use" */
+#define FAULT_MS 3000  /* an injected fault to its FAULT line */
+#define EXIT_MS	 5000
 
 static char bin[512];
 static char tmp[256];
@@ -45,7 +45,8 @@ struct rig {
 
 static struct rig rig;
 
-/* ---- helpers --------------------------------------------------------------- */
+/* ---- helpers ---------------------------------------------------------------
+ */
 
 static void path(char *out, size_t cap, const char *name)
 {
@@ -79,9 +80,13 @@ static int slurp(const char *p, char *buf, size_t cap)
 static int write_config(struct rig *r, int port, const char *relay,
 			const char *calfile)
 {
+	/* ER 800 < step 1000 (the program's arm check 7); OT 1000 samples so
+	 * that a jam at jog speed trips the position error (0.4 s at the
+	 * 2000 counts/s start velocity) before the encoder-failure check */
 	static const char axis_fmt[] =
-		"  - {name: %s, travel_counts: %d, position_error_limit_counts:"
-		" 800, step_counts: 1000}\n";
+	    "  - {name: %s, travel_counts: %d, position_error_limit_counts:"
+	    " 800, step_counts: 1000,\n"
+	    "     encoder_failure: {time_samples: 1000}}\n";
 	char text[4096];
 	int n;
 
@@ -90,12 +95,10 @@ static int write_config(struct rig *r, int port, const char *relay,
 		     "controller: {address: \"127.0.0.1:%d\"}\n"
 		     "relay: {port_development: \"%s\", readback: true}\n"
 		     "calibration: {file: \"%s\"}\n"
-		     "log: {path: \"%s\"}\naxes:\n", port, relay, calfile,
-		     r->log);
-	n += snprintf(text + n, sizeof(text) - (size_t)n, axis_fmt, "A",
-		      20000);
-	n += snprintf(text + n, sizeof(text) - (size_t)n, axis_fmt, "B",
-		      20000);
+		     "log: {path: \"%s\"}\naxes:\n",
+		     port, relay, calfile, r->log);
+	n += snprintf(text + n, sizeof(text) - (size_t)n, axis_fmt, "A", 20000);
+	n += snprintf(text + n, sizeof(text) - (size_t)n, axis_fmt, "B", 20000);
 	snprintf(text + n, sizeof(text) - (size_t)n, axis_fmt, "C", 16000);
 	return write_file(r->cfg, text);
 }
@@ -141,7 +144,8 @@ static int galil_load(const struct rig *r)
 static int rob_start(struct rig *r, const char *calib)
 {
 	char exe[600];
-	char *argv[] = {exe, (char *)"-c", r->cfg, (char *)"--calibration",
+	char *argv[] = {exe,	       (char *)"-c",
+			r->cfg,	       (char *)"--calibration",
 			(char *)calib, NULL};
 
 	snprintf(exe, sizeof(exe), "%s/roboelf", bin);
@@ -233,7 +237,8 @@ static void expect_fault(const char *prefix)
 	assert_int_equal(quit_rob(SIGTERM), 4);
 }
 
-/* ---- fixtures -------------------------------------------------------------- */
+/* ---- fixtures --------------------------------------------------------------
+ */
 
 static int group_setup(void **state)
 {
@@ -246,16 +251,15 @@ static int group_setup(void **state)
 		return -1;
 	}
 	snprintf(bin, sizeof(bin), "%s", b);
-	snprintf(tmp, sizeof(tmp), "/tmp/roboelf-sys-XXXXXX");
+	snprintf(tmp, sizeof(tmp), "/tmp/roboelf-basic-XXXXXX");
 	if (!mkdtemp(tmp))
 		return -1;
 	path(plant, sizeof(plant), "plant.yaml");
 	path(cal_file, sizeof(cal_file), "calibration.txt");
-	return write_file(plant,
-			  "axes:\n"
-			  "  A: {rev_limit: -10000, fwd_limit: 10000}\n"
-			  "  B: {rev_limit: -10000, fwd_limit: 10000}\n"
-			  "  C: {rev_limit: -8000, fwd_limit: 8000}\n");
+	return write_file(plant, "axes:\n"
+				 "  A: {rev_limit: -10000, fwd_limit: 10000}\n"
+				 "  B: {rev_limit: -10000, fwd_limit: 10000}\n"
+				 "  C: {rev_limit: -8000, fwd_limit: 8000}\n");
 }
 
 static int group_teardown(void **state)
@@ -314,28 +318,36 @@ static int teardown(void **state)
 	return 0;
 }
 
-/* ---- tests ----------------------------------------------------------------- */
+/* ---- tests -----------------------------------------------------------------
+ */
 
 /* Full calibration to Ready (saves the file the other tests load), status
  * lines, then SIGTERM: exit 0, relay off, motors off, logged. */
 static void test_sys_full_calibration_ready_quit(void **state)
 {
 	char logbuf[65536], line[512];
+	const char *p;
+	int points = 0;
 
 	(void)state;
 	assert_ready();
-	assert_int_equal(proc_wait_line(&rig.rob, PROC_STDOUT, "status ",
-					3000, line, sizeof(line)), 0);
+	assert_int_equal(proc_wait_line(&rig.rob, PROC_STDOUT, "status ", 3000,
+					line, sizeof(line)),
+			 0);
 	assert_non_null(strstr(line, "relay=on"));
 	assert_non_null(strstr(line, "ctrl=\"armed\""));
 	assert_int_equal(quit_rob(SIGTERM), 0);
 	assert_relay_off();
 	assert_true(motors_off(1000));
-	assert_int_equal(proc_find_line(&rig.rob, PROC_STDOUT, "FAULT", NULL,
-					0), -1);
+	assert_int_equal(
+	    proc_find_line(&rig.rob, PROC_STDOUT, "FAULT", NULL, 0), -1);
 	assert_true(slurp(rig.log, logbuf, sizeof(logbuf)) > 0);
 	assert_non_null(strstr(logbuf, "INFO RoboELF Ready for Use"));
-	assert_non_null(strstr(logbuf, "calibration (full) axis A: 19 points"));
+	p = strstr(logbuf, "calibration (full) axis A: ");
+	assert_non_null(p);
+	assert_int_equal(
+	    sscanf(p, "calibration (full) axis A: %d points", &points), 1);
+	assert_true(points >= 19 && points <= 20); /* 19000 counts */
 	assert_non_null(strstr(logbuf, "INFO stop: SIGTERM"));
 	assert_true(access(cal_file, R_OK) == 0);
 }
@@ -418,14 +430,14 @@ static void test_sys_no_terminal(void **state)
 	path(rig.log, sizeof(rig.log), "roboelf.log");
 	path(rig.cfg, sizeof(rig.cfg), "roboelf.yaml");
 	snprintf(cfg, sizeof(cfg), "%s", rig.cfg);
-	assert_int_equal(write_config(&rig, 1, "/nonexistent/relay",
-				      cal_file), 0);
+	assert_int_equal(write_config(&rig, 1, "/nonexistent/relay", cal_file),
+			 0);
 	snprintf(exe, sizeof(exe), "%s/roboelf", bin);
 	assert_int_equal(proc_spawn(&p, argv, NULL), 0);
 	assert_int_equal(proc_wait_exit(&p, EXIT_MS, NULL), 0);
 	assert_int_equal(proc_exit_code(&p), 2);
-	assert_non_null(strstr(proc_output(&p, PROC_STDERR),
-			       "no terminal to ask"));
+	assert_non_null(
+	    strstr(proc_output(&p, PROC_STDERR), "no terminal to ask"));
 	proc_kill(&p);
 }
 
@@ -437,13 +449,13 @@ static void test_sys_no_relay(void **state)
 	rig.ctl = -1;
 	path(rig.log, sizeof(rig.log), "roboelf.log");
 	path(rig.cfg, sizeof(rig.cfg), "roboelf.yaml");
-	assert_int_equal(write_config(&rig, 1, "/tmp/roboelf-no-such-relay",
-				      cal_file), 0);
+	assert_int_equal(
+	    write_config(&rig, 1, "/tmp/roboelf-no-such-relay", cal_file), 0);
 	assert_int_equal(rob_start(&rig, "file"), 0);
 	assert_int_equal(proc_wait_exit(&rig.rob, EXIT_MS, NULL), 0);
 	assert_int_equal(proc_exit_code(&rig.rob), 3);
-	assert_non_null(strstr(proc_output(&rig.rob, PROC_STDOUT),
-			       "roboelf: error: "));
+	assert_non_null(
+	    strstr(proc_output(&rig.rob, PROC_STDOUT), "roboelf: error: "));
 	assert_non_null(strstr(proc_output(&rig.rob, PROC_STDOUT),
 			       "roboelf-no-such-relay"));
 }
@@ -453,13 +465,13 @@ static void test_sys_no_relay(void **state)
 static void test_sys_no_program(void **state)
 {
 	(void)state;
-	assert_int_equal(write_config(&rig, rig.sim.port, rig.relay,
-				      cal_file), 0);
+	assert_int_equal(write_config(&rig, rig.sim.port, rig.relay, cal_file),
+			 0);
 	assert_int_equal(rob_start(&rig, "file"), 0);
 	assert_int_equal(proc_wait_exit(&rig.rob, EXIT_MS, NULL), 0);
 	assert_int_equal(proc_exit_code(&rig.rob), 3);
-	assert_non_null(strstr(proc_output(&rig.rob, PROC_STDOUT),
-			       "galil-load"));
+	assert_non_null(
+	    strstr(proc_output(&rig.rob, PROC_STDOUT), "galil-load"));
 	assert_relay_off();
 }
 
@@ -471,8 +483,8 @@ static void test_sys_no_controller(void **state)
 	assert_int_equal(rob_start(&rig, "file"), 0);
 	assert_int_equal(proc_wait_exit(&rig.rob, EXIT_MS, NULL), 0);
 	assert_int_equal(proc_exit_code(&rig.rob), 3);
-	assert_non_null(strstr(proc_output(&rig.rob, PROC_STDOUT),
-			       "cannot connect"));
+	assert_non_null(
+	    strstr(proc_output(&rig.rob, PROC_STDOUT), "cannot connect"));
 	assert_relay_off();
 }
 
@@ -498,33 +510,30 @@ static void test_sys_missing_calibration_file(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test_setup_teardown(
-			test_sys_full_calibration_ready_quit, setup_full,
-			teardown),
-		cmocka_unit_test_setup_teardown(
-			test_sys_file_calibration_sigint, setup_file,
-			teardown),
-		cmocka_unit_test_setup_teardown(test_sys_fault_encoder,
-						setup_file, teardown),
-		cmocka_unit_test_setup_teardown(test_sys_fault_watchdog,
-						setup_file, teardown),
-		cmocka_unit_test_setup_teardown(test_sys_fault_comm,
-						setup_file, teardown),
-		cmocka_unit_test_setup_teardown(test_sys_fault_estop,
-						setup_file, teardown),
-		cmocka_unit_test_setup_teardown(test_sys_fault_motion,
-						setup_file, teardown),
-		cmocka_unit_test_setup_teardown(test_sys_fault_input,
-						setup_file, teardown),
-		cmocka_unit_test(test_sys_no_terminal),
-		cmocka_unit_test_teardown(test_sys_no_relay, teardown),
-		cmocka_unit_test_setup_teardown(test_sys_no_program,
-						setup_sim_only, teardown),
-		cmocka_unit_test_setup_teardown(test_sys_no_controller,
-						setup_sim_only, teardown),
-		cmocka_unit_test_setup_teardown(
-			test_sys_missing_calibration_file, setup_sim_only,
-			teardown),
+	    cmocka_unit_test_setup_teardown(
+		test_sys_full_calibration_ready_quit, setup_full, teardown),
+	    cmocka_unit_test_setup_teardown(test_sys_file_calibration_sigint,
+					    setup_file, teardown),
+	    cmocka_unit_test_setup_teardown(test_sys_fault_encoder, setup_file,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_sys_fault_watchdog, setup_file,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_sys_fault_comm, setup_file,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_sys_fault_estop, setup_file,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_sys_fault_motion, setup_file,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_sys_fault_input, setup_file,
+					    teardown),
+	    cmocka_unit_test(test_sys_no_terminal),
+	    cmocka_unit_test_teardown(test_sys_no_relay, teardown),
+	    cmocka_unit_test_setup_teardown(test_sys_no_program, setup_sim_only,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_sys_no_controller,
+					    setup_sim_only, teardown),
+	    cmocka_unit_test_setup_teardown(test_sys_missing_calibration_file,
+					    setup_sim_only, teardown),
 	};
 
 	return cmocka_run_group_tests(tests, group_setup, group_teardown);

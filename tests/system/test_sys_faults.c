@@ -13,8 +13,10 @@
  *  - the safe state: relay off (motor power cut), every motor off, and no
  *    axis moving over the following 300 ms of simulated time;
  *  - the reaction time, from the simulator's events (simulated ms from the
- *    injection to "relay off" and to the last "<X> motor off"), within the
- *    deadline of docs/safety.md ("Deadlines") plus SLACK_MS;
+ *    injection to "relay off" and to the last "axis <X> motor off"), within
+ *    the deadline of docs/safety.md ("Deadlines") plus SLACK_MS;
+ *  - that the controller obeyed the supervisor's stop command (the log
+ *    entry does not say "rejected"), where the controller is reachable;
  *  - roboelf exits 4 (fault latched) on SIGTERM afterwards.
  *
  * Environment: ROBOELF_REPEAT=N repeats each case N times (make bench);
@@ -37,16 +39,16 @@
 #include "re_calfile.h"
 #include "sys_h.h"
 
-#define SLACK_MS 25		/* scheduling allowance on a busy 2-core box */
-#define HOLD_MS 300		/* no motion over this after the safe state */
-#define FAULT_WAIT_MS 8000	/* FAULT line, beyond the deadline */
-#define EXIT_WAIT_MS 5000
+#define SLACK_MS      25   /* scheduling allowance on a busy 2-core box */
+#define HOLD_MS	      300  /* no motion over this after the safe state */
+#define FAULT_WAIT_MS 8000 /* FAULT line, beyond the deadline */
+#define EXIT_WAIT_MS  5000
 
 static struct sys_env env;
 static int env_ok;
 static struct sys_case cs;
 
-/* ---- deadlines (docs/safety.md, "Deadlines") ------------------------------ */
+/* ---- deadlines (docs/safety.md, "Deadlines") ---------------------------- */
 
 static double P(void)
 {
@@ -86,20 +88,21 @@ static double d_ctrl_to_relay(void)
 	return SYS_MAINMS + 2.0 * P();
 }
 
-/* ---- the common assertion ---------------------------------------------------- */
+/* ---- the common assertion ----------------------------------------------- */
 
 struct expect {
 	const char *name;
-	enum re_fault_id ids[4];	/* allowed faults, RE_F_NONE ended */
-	int axis;			/* 0..2, -1 none */
-	double t_inj;			/* simulated ms of the injection */
-	double d_relay;			/* deadline to relay off, ms; < 0 none */
-	double d_motors;		/* deadline to all motors off; < 0 none */
+	enum re_fault_id ids[4]; /* allowed faults, RE_F_NONE ended */
+	int axis;		 /* 0..2, -1 none */
+	double t_inj;		 /* simulated ms of the injection */
+	double d_relay;		 /* deadline to relay off, ms; < 0 none */
+	double d_motors;	 /* deadline to all motors off; < 0 none */
 	int relay_may_be_on;
+	int link_down; /* the controller cannot be reached (link faults) */
 };
 
 struct measured {
-	double relay_ms;		/* -1: not measured */
+	double relay_ms; /* -1: not measured */
 	double motors_ms;
 };
 
@@ -138,25 +141,39 @@ static double wait_motors_off(struct sys_case *c, double after, int ms)
 	}
 }
 
-static void check_fault_line(struct sys_case *c, const struct expect *x,
-			     char *line, size_t cap)
+/* The FAULT line must be one of x->ids, name its axis, and be logged. */
+static void match_fault_line(struct sys_case *c, const struct expect *x,
+			     const char *line)
 {
 	char logline[4096];
 
-	if (sys_wait_fault(c, FAULT_WAIT_MS, line, cap) < 0)
-		fail_msg("%s: %s", x->name, c->err);
 	if (sys_fault_match(line, x->axis, x->ids) == RE_F_NONE) {
 		char pre[64], rec[512];
 
 		sys_fault_expect(x->ids[0], x->axis, pre, sizeof(pre), rec,
 				 sizeof(rec));
 		fail_msg("%s: unexpected FAULT line\n  got:      %s\n  "
-			 "expected: %s...%s", x->name, line, pre, rec);
+			 "expected: %s...%s",
+			 x->name, line, pre, rec);
 	}
+	if (strstr(line, "axis ?") || strstr(line, "unknown"))
+		fail_msg("%s: the FAULT line does not name its axis or value: "
+			 "%s",
+			 x->name, line);
 	if (sys_log_find(c, " FAULT ", line, logline, sizeof(logline)) < 0)
 		fail_msg("%s: %s", x->name, c->err);
+	/* the stop and motors-off command must have been obeyed */
+	if (!x->link_down && strstr(logline, "rejected"))
+		fail_msg("%s: the controller rejected the supervisor's stop "
+			 "command:\n%s",
+			 x->name, logline);
 }
 
+/*
+ * Wait for the FAULT line, measure and record the reaction (also when the
+ * line turns out wrong, so that make bench has the figure), then assert
+ * the line, the log, the safe state and the deadlines.
+ */
 static void expect_fault(struct sys_case *c, const struct expect *x,
 			 struct measured *m)
 {
@@ -164,7 +181,8 @@ static void expect_fault(struct sys_case *c, const struct expect *x,
 	double t;
 
 	m->relay_ms = m->motors_ms = -1;
-	check_fault_line(c, x, line, sizeof(line));
+	if (sys_wait_fault(c, FAULT_WAIT_MS, line, sizeof(line)) < 0)
+		fail_msg("%s: %s", x->name, c->err);
 	if (!x->relay_may_be_on) {
 		if (sys_wait_event(c, "relay off", x->t_inj, 3000, &t) < 0)
 			fail_msg("%s: %s", x->name, c->err);
@@ -173,18 +191,21 @@ static void expect_fault(struct sys_case *c, const struct expect *x,
 	t = wait_motors_off(c, x->t_inj, 3000);
 	if (t < 0)
 		fail_msg("%s: not every motor was switched off (no "
-			 "'<X> motor off' event for each axis)", x->name);
+			 "'axis <X> motor off' event for each axis)",
+			 x->name);
 	m->motors_ms = t - x->t_inj;
+	record(x, m);
+	match_fault_line(c, x, line);
 	if (sys_check_safe(c, x->relay_may_be_on, HOLD_MS) < 0)
 		fail_msg("%s: %s", x->name, c->err);
-	record(x, m);
 	if (x->d_relay >= 0 && m->relay_ms > x->d_relay + SLACK_MS)
 		fail_msg("%s: relay off after %.0f ms, deadline %.0f ms "
-			 "(+%d)", x->name, m->relay_ms, x->d_relay, SLACK_MS);
+			 "(+%d)",
+			 x->name, m->relay_ms, x->d_relay, SLACK_MS);
 	if (x->d_motors >= 0 && m->motors_ms > x->d_motors + SLACK_MS)
 		fail_msg("%s: motors off after %.0f ms, deadline %.0f ms "
-			 "(+%d)", x->name, m->motors_ms, x->d_motors,
-			 SLACK_MS);
+			 "(+%d)",
+			 x->name, m->motors_ms, x->d_motors, SLACK_MS);
 }
 
 /* After a fault: the operator quits; a latched fault exits 4. */
@@ -199,7 +220,7 @@ static void quit_latched(struct sys_case *c, const char *name)
 	assert_int_equal(proc_exit_code(&c->re), 4);
 }
 
-/* ---- fixtures ------------------------------------------------------------- */
+/* ---- fixtures ----------------------------------------------------------- */
 
 static int group_setup(void **state)
 {
@@ -207,8 +228,9 @@ static int group_setup(void **state)
 	if (sys_env_init(&env) == 0 && sys_env_calibrate(&env, 150000) == 0)
 		env_ok = 1;
 	print_message("[   INFO   ] full calibration %s in %.1f s (P %d ms, "
-		      "%s)\n", env_ok ? "done" : "FAILED", env.calib_s,
-		      env.period_ms, env.dir);
+		      "%s)\n",
+		      env_ok ? "done" : "FAILED", env.calib_s, env.period_ms,
+		      env.dir);
 	return 0;
 }
 
@@ -247,7 +269,8 @@ static int repeats(void)
 /* Inject @req (a control request) and return the simulated time of its
  * event ("inject: ..." or "input: ..."). */
 static double inject(struct sys_case *c, const char *evt_prefix,
-		     const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+		     const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
 
 static double inject(struct sys_case *c, const char *evt_prefix,
 		     const char *fmt, ...)
@@ -279,13 +302,17 @@ static double joy(struct sys_case *c, const char *req)
 
 #define FOR_REPEATS(i) for (int i = 0; i < repeats(); i++)
 
-/* ---- potentiometer ------------------------------------------------------- */
+/* ---- potentiometer ------------------------------------------------------ */
 
 static void pot_at_rest(const char *name, const char *req, int axis)
 {
-	FOR_REPEATS(i) {
-		struct expect x = {name, {RE_F_ENCPOT, RE_F_NONE}, axis,
-				   0, d_encpot(), d_encpot() + SYS_MAINMS, 0};
+	FOR_REPEATS(i)
+	{
+		struct expect x = {.name = name,
+				   .ids = {RE_F_ENCPOT, RE_F_NONE},
+				   .axis = axis,
+				   .d_relay = d_encpot(),
+				   .d_motors = d_encpot() + SYS_MAINMS};
 		struct measured m;
 
 		start(&cs, NULL);
@@ -313,10 +340,14 @@ static void test_pot_open(void **state)
 static void test_pot_stuck(void **state)
 {
 	(void)state;
-	FOR_REPEATS(i) {
+	FOR_REPEATS(i)
+	{
 		double d = t_tolerance() + d_encpot();
-		struct expect x = {"pot stuck", {RE_F_ENCPOT, RE_F_NONE}, 1,
-				   0, d, d + SYS_MAINMS, 0};
+		struct expect x = {.name = "pot stuck",
+				   .ids = {RE_F_ENCPOT, RE_F_NONE},
+				   .axis = 1,
+				   .d_relay = d,
+				   .d_motors = d + SYS_MAINMS};
 		struct measured m;
 
 		start(&cs, NULL);
@@ -328,18 +359,22 @@ static void test_pot_stuck(void **state)
 	}
 }
 
-/* ---- encoder --------------------------------------------------------------- */
+/* ---- encoder ------------------------------------------------------------ */
 
 /* A dead encoder on a free axis: the servo runs the motor away; the
  * potentiometer disagrees first (or the controller's OA). */
 static void test_enc_stuck(void **state)
 {
 	(void)state;
-	FOR_REPEATS(i) {
+	FOR_REPEATS(i)
+	{
 		double d = t_tolerance() + d_encpot();
-		struct expect x = {"encoder stuck", {RE_F_ENCPOT,
-				   RE_F_CTRL_ENCODER, RE_F_MOTOR_OFF,
-				   RE_F_NONE}, 0, 0, d, d + SYS_MAINMS, 0};
+		struct expect x = {.name = "encoder stuck",
+				   .ids = {RE_F_ENCPOT, RE_F_CTRL_ENCODER,
+					   RE_F_MOTOR_OFF, RE_F_NONE},
+				   .axis = 0,
+				   .d_relay = d,
+				   .d_motors = d + SYS_MAINMS};
 		struct measured m;
 
 		start(&cs, NULL);
@@ -356,12 +391,15 @@ static void test_enc_stuck(void **state)
 static void test_enc_slip(void **state)
 {
 	(void)state;
-	FOR_REPEATS(i) {
+	FOR_REPEATS(i)
+	{
 		double tol = (1.0 + env.allowed_error) * env.step_counts;
 		int stepc = (int)(tol * 0.3);
-		struct expect x = {"encoder slip", {RE_F_ENCPOT, RE_F_NONE},
-				   1, 0, d_encpot(), d_encpot() + SYS_MAINMS,
-				   0};
+		struct expect x = {.name = "encoder slip",
+				   .ids = {RE_F_ENCPOT, RE_F_NONE},
+				   .axis = 1,
+				   .d_relay = d_encpot(),
+				   .d_motors = d_encpot() + SYS_MAINMS};
 		struct measured m;
 		char req[64];
 
@@ -373,14 +411,14 @@ static void test_enc_slip(void **state)
 			t = inject_fault(&cs, req);
 			if (sys_wait_sim(&cs, t + 3 * P() + 50, 5000) < 0)
 				fail_msg("%s", cs.err);
-			if (proc_find_line(&cs.re, PROC_STDOUT, "FAULT ",
-					   NULL, 0) == 0)
+			if (proc_find_line(&cs.re, PROC_STDOUT, "FAULT ", NULL,
+					   0) == 0)
 				fail_msg("encoder slip of %d counts (%.0f %% "
 					 "of the tolerance) tripped: %s",
 					 k * stepc, 30.0 * k,
 					 proc_output(&cs.re, PROC_STDOUT));
 		}
-		snprintf(req, sizeof(req), "enc B slip %d", 4 * stepc + stepc);
+		snprintf(req, sizeof(req), "enc B slip %d", 4 * stepc);
 		x.t_inj = inject_fault(&cs, req);
 		expect_fault(&cs, &x, &m);
 		quit_latched(&cs, x.name);
@@ -388,7 +426,7 @@ static void test_enc_slip(void **state)
 	}
 }
 
-/* ---- motion ------------------------------------------------------------------ */
+/* ---- motion ------------------------------------------------------------- */
 
 /*
  * A jammed axis: the reference runs ahead of a motor that cannot move until
@@ -402,19 +440,22 @@ static double d_jam_motors(void)
 {
 	double t_er = 1000.0 * env.step_counts / env.vmin_cps;
 
-	return 2 * SYS_LOOPMS + 1000.0 * env.vmin_cps / (10.0 *
-	       env.vmax_cps) + t_er;
+	return 2 * SYS_LOOPMS + 1000.0 * env.vmin_cps / (10.0 * env.vmax_cps) +
+	       t_er;
 }
 
 static void test_jam(void **state)
 {
 	(void)state;
-	FOR_REPEATS(i) {
+	FOR_REPEATS(i)
+	{
 		double dm = d_jam_motors();
-		struct expect x = {"jammed axis", {RE_F_CTRL_POSERR,
-				   RE_F_CTRL_ENCODER, RE_F_MOTOR_OFF,
-				   RE_F_NONE}, 2, 0, dm + d_ctrl_to_relay(),
-				   dm, 0};
+		struct expect x = {.name = "jammed axis",
+				   .ids = {RE_F_CTRL_POSERR, RE_F_CTRL_ENCODER,
+					   RE_F_MOTOR_OFF, RE_F_NONE},
+				   .axis = 2,
+				   .d_relay = dm + d_ctrl_to_relay(),
+				   .d_motors = dm};
 		struct measured m;
 
 		start(&cs, NULL);
@@ -436,19 +477,23 @@ static void test_jam(void **state)
 static void test_encoder_failure_oa(void **state)
 {
 	static const struct sys_subst oa[] = {
-		{"time_samples", "20"}, {NULL, NULL},
+	    {"time_samples", "20"},
+	    {NULL, NULL},
 	};
 	struct sys_opts o = {.subst = oa};
 
 	(void)state;
-	FOR_REPEATS(i) {
+	FOR_REPEATS(i)
+	{
 		double e_ov = 2.0 / (4.0 * 6.0 * 10.0 / 32768.0);
-		double dm = 2 * SYS_LOOPMS + 1000.0 * e_ov / env.vmin_cps +
-			    20 + 1000.0 * env.vmin_cps / (10.0 * env.vmax_cps);
-		struct expect x = {"encoder failure (OA)",
-				   {RE_F_CTRL_ENCODER, RE_F_MOTOR_OFF,
-				    RE_F_NONE}, 0, 0, dm + d_ctrl_to_relay(),
-				   dm, 0};
+		double dm = 2 * SYS_LOOPMS + 1000.0 * e_ov / env.vmin_cps + 20 +
+			    1000.0 * env.vmin_cps / (10.0 * env.vmax_cps);
+		struct expect x = {
+		    .name = "encoder failure (OA)",
+		    .ids = {RE_F_CTRL_ENCODER, RE_F_MOTOR_OFF, RE_F_NONE},
+		    .axis = 0,
+		    .d_relay = dm + d_ctrl_to_relay(),
+		    .d_motors = dm};
 		struct measured m;
 
 		start(&cs, &o);
@@ -458,7 +503,8 @@ static void test_encoder_failure_oa(void **state)
 		expect_fault(&cs, &x, &m);
 		if (!strstr(proc_output(&cs.re, PROC_STDOUT), "stop code 12"))
 			fail_msg("OA: the FAULT line does not name stop code "
-				 "12: %s", proc_output(&cs.re, PROC_STDOUT));
+				 "12: %s",
+				 proc_output(&cs.re, PROC_STDOUT));
 		quit_latched(&cs, x.name);
 		sys_case_stop(&cs);
 	}
@@ -497,9 +543,13 @@ static void test_limit_switch(void **state)
 	(void)state;
 	write_wide_calibration(path, sizeof(path));
 	snprintf(quoted, sizeof(quoted), "\"%s\"", path);
-	FOR_REPEATS(i) {
-		struct expect x = {"limit switch", {RE_F_CTRL_LIMIT,
-				   RE_F_NONE}, 2, 0, 0, SYS_MAINMS, 0};
+	FOR_REPEATS(i)
+	{
+		struct expect x = {.name = "limit switch",
+				   .ids = {RE_F_CTRL_LIMIT, RE_F_NONE},
+				   .axis = 2,
+				   .d_relay = 0,
+				   .d_motors = SYS_MAINMS};
 		struct measured m;
 
 		x.d_relay = SYS_MAINMS + d_ctrl_to_relay();
@@ -516,7 +566,7 @@ static void test_limit_switch(void **state)
 	}
 }
 
-/* ---- joystick --------------------------------------------------------------- */
+/* ---- joystick ----------------------------------------------------------- */
 
 /* An invalid state: motion stops within a DMC loop; held past the timeout
  * J, thread 1 switches the motors off within J + 2 loops; the program
@@ -525,14 +575,19 @@ static void expect_input_fault(struct sys_case *c, const char *name,
 			       double t_inj)
 {
 	double dm = env.jto_ms + 2 * SYS_LOOPMS;
-	struct expect x = {name, {RE_F_CTRL_INPUT, RE_F_NONE}, -1, t_inj,
-			   dm + d_ctrl_to_relay(), dm, 0};
+	struct expect x = {.name = name,
+			   .ids = {RE_F_CTRL_INPUT, RE_F_NONE},
+			   .axis = -1,
+			   .t_inj = t_inj,
+			   .d_relay = dm + d_ctrl_to_relay(),
+			   .d_motors = dm};
 	struct measured m;
 
 	expect_fault(c, &x, &m);
 	if (m.motors_ms < env.jto_ms - SYS_LOOPMS)
 		fail_msg("%s: motors off after %.0f ms, before the invalid-"
-			 "input timeout %d ms", name, m.motors_ms, env.jto_ms);
+			 "input timeout %d ms",
+			 name, m.motors_ms, env.jto_ms);
 	quit_latched(c, name);
 }
 
@@ -540,7 +595,8 @@ static void expect_input_fault(struct sys_case *c, const char *name,
 static void test_joy_stuck_channel(void **state)
 {
 	(void)state;
-	FOR_REPEATS(i) {
+	FOR_REPEATS(i)
+	{
 		start(&cs, NULL);
 		expect_input_fault(&cs, "joystick channel stuck",
 				   inject_fault(&cs, "in 1 1"));
@@ -552,19 +608,21 @@ static void test_joy_stuck_channel(void **state)
  * the state held past the timeout is an INPUT fault. */
 static void stopped_within(struct sys_case *c, char axis, double t_inj)
 {
-	double t, d = 2 * SYS_LOOPMS + 1000.0 / 10.0;	/* loop + decel */
+	double t, d = 2 * SYS_LOOPMS + 1000.0 / 10.0; /* loop + decel */
 
 	if (sys_wait_stopped(c, axis, 3000, &t) < 0)
 		fail_msg("%s", c->err);
 	if (t - t_inj > d + SLACK_MS)
 		fail_msg("axis %c stopped %.0f ms after the invalid state, "
-			 "deadline %.0f ms", axis, t - t_inj, d);
+			 "deadline %.0f ms",
+			 axis, t - t_inj, d);
 }
 
 static void test_joy_invalid_timeout(void **state)
 {
 	(void)state;
-	FOR_REPEATS(i) {
+	FOR_REPEATS(i)
+	{
 		double t;
 
 		start(&cs, NULL);
@@ -582,7 +640,8 @@ static void test_joy_invalid_timeout(void **state)
 static void test_joy_two_directions(void **state)
 {
 	(void)state;
-	FOR_REPEATS(i) {
+	FOR_REPEATS(i)
+	{
 		double t;
 
 		start(&cs, NULL);
@@ -597,16 +656,31 @@ static void test_joy_two_directions(void **state)
 	}
 }
 
-/* ---- supervisor and link ----------------------------------------------------- */
+/* ---- supervisor and link ------------------------------------------------ */
 
 /* SIGKILL mid-motion: nobody writes the heartbeat; the controller's own
  * watchdog stops the robot and switches the motors off within wdto +
  * mainms (+ one sample) of the last heartbeat. The relay stays as it was
  * (nobody is left to switch it): the hard-wired E-stop's job. */
+static void sigkill_record(double t_kill, double t_off, double dm)
+{
+	struct expect x = {.name = "supervisor killed",
+			   .ids = {RE_F_NONE},
+			   .axis = -1,
+			   .t_inj = t_kill,
+			   .d_relay = -1,
+			   .d_motors = dm,
+			   .relay_may_be_on = 1};
+	struct measured m = {-1, t_off - t_kill};
+
+	record(&x, &m);
+}
+
 static void test_sigkill(void **state)
 {
 	(void)state;
-	FOR_REPEATS(i) {
+	FOR_REPEATS(i)
+	{
 		double t_kill, t, dm = env.wdto_ms + SYS_MAINMS + 1;
 		char st[2048];
 
@@ -623,27 +697,19 @@ static void test_sigkill(void **state)
 		if (t < 0)
 			fail_msg("SIGKILL: the controller did not switch every "
 				 "motor off");
-		print_message("[ MEASURE  ] supervisor killed: motors off %.0f "
-			      "ms (deadline %.0f)\n", t - t_kill, dm);
-		{
-			struct expect x = {"supervisor killed", {RE_F_NONE},
-					   -1, t_kill, -1, dm, 1};
-			struct measured m = {-1, t - t_kill};
-
-			record(&x, &m);
-		}
-		if (sys_check_safe(&cs, 1, HOLD_MS) < 0)
-			fail_msg("%s", cs.err);
-		if (sys_state(&cs, st, sizeof(st)) < 0)
+		sigkill_record(t_kill, t, dm);
+		if (sys_check_safe(&cs, 1, HOLD_MS) < 0 ||
+		    sys_state(&cs, st, sizeof(st)) < 0)
 			fail_msg("%s", cs.err);
 		if (sys_state_num(st, "var.fcode") != 2)
 			fail_msg("the program did not latch WATCHDOG (2): %s",
 				 st);
 		if (t - t_kill > dm + SLACK_MS)
 			fail_msg("motors off %.0f ms after SIGKILL, deadline "
-				 "%.0f ms", t - t_kill, dm);
-		if (sys_log_find(&cs, "RoboELF Ready for Use", NULL, NULL,
-				 0) < 0)
+				 "%.0f ms",
+				 t - t_kill, dm);
+		if (sys_log_find(&cs, "RoboELF Ready for Use", NULL, NULL, 0) <
+		    0)
 			fail_msg("%s", cs.err);
 		sys_case_stop(&cs);
 	}
@@ -651,14 +717,19 @@ static void test_sigkill(void **state)
 
 /* A lost link: the supervisor cuts motor power (COMM: the connection is
  * gone; WATCHDOG: no reply within the critical limit C). */
-static void link_fault(const char *name, const char *req,
-		       enum re_fault_id id, double d_relay)
+static void link_fault(const char *name, const char *req, enum re_fault_id id,
+		       double d_relay)
 {
-	FOR_REPEATS(i) {
-		struct expect x = {name, {id, RE_F_NONE}, -1, 0, d_relay,
-				   d_relay + SYS_MAINMS, 0};
+	FOR_REPEATS(i)
+	{
+		struct expect x = {.name = name,
+				   .ids = {id, RE_F_NONE},
+				   .axis = -1,
+				   .d_relay = d_relay,
+				   .d_motors = d_relay + SYS_MAINMS};
 		struct measured m;
 
+		x.link_down = 1;
 		start(&cs, NULL);
 		joy(&cs, "B fwd");
 		if (sys_wait_moving(&cs, 'B', 200, 5000) < 0)
@@ -691,32 +762,45 @@ static void test_link_latency(void **state)
 	link_fault("link latency", req, RE_F_WDOG_REPLY, C() + P());
 }
 
-/* ---- relay ------------------------------------------------------------------ */
+/* ---- relay -------------------------------------------------------------- */
 
 /*
  * The relay board fails: the simulator cuts motor power itself (relay off
- * at the injection), the controller switches the motors off (amplifier
- * fault); the supervisor must notice the lost relay and report ESTOP. Its
- * reaction is measured on the wall clock: injection to the log's FAULT
- * entry, deadline @d_pc_ms.
+ * at the injection) and the controller switches the motors off (amplifier
+ * fault). The supervisor must notice the lost relay: its reaction is
+ * measured on the wall clock, from the injection to the log's first entry
+ * naming the ESTOP fault (the FAULT entry, or "while latched" when the
+ * controller's amplifier fault was latched first), deadline @d_pc_ms.
  */
-static void relay_fault(const char *name, const char *req, double d_pc_ms)
+static void relay_fault(const char *name, const char *req,
+			const enum re_fault_id *ids, double d_pc_ms)
 {
-	FOR_REPEATS(i) {
-		struct expect x = {name, {RE_F_ESTOP_LOST, RE_F_NONE}, -1, 0,
-				   0, SYS_MAINMS, 0};
+	FOR_REPEATS(i)
+	{
+		struct expect x = {.name = name,
+				   .ids = {RE_F_NONE},
+				   .axis = -1,
+				   .d_relay = 0,
+				   .d_motors = SYS_MAINMS};
 		struct measured m;
 		double w0, w1;
 
+		memcpy(x.ids, ids, sizeof(x.ids));
 		start(&cs, NULL);
 		w0 = sys_wall_ms();
 		x.t_inj = inject_fault(&cs, req);
 		expect_fault(&cs, &x, &m);
-		if (sys_log_time_ms(&cs, " FAULT ", &w1) < 0)
-			fail_msg("%s", cs.err);
-		print_message("[ MEASURE  ] %s: supervisor's FAULT entry %.0f "
-			      "ms after the injection (deadline %.0f)\n", name,
-			      w1 - w0, d_pc_ms);
+		if (sys_wait_sim(&cs, x.t_inj + d_pc_ms + SLACK_MS, 5000) < 0 ||
+		    sys_log_time_ms(&cs,
+				    "FAULT ESTOP: the E-stop relay stopped "
+				    "answering",
+				    &w1) < 0)
+			fail_msg("%s: %s", name, cs.err);
+		print_message(
+		    "[ MEASURE  ] %s: the supervisor logged the ESTOP "
+		    "fault %.0f ms after the injection (deadline "
+		    "%.0f)\n",
+		    name, w1 - w0, d_pc_ms);
 		{
 			struct expect y = x;
 			struct measured pc = {w1 - w0, m.motors_ms};
@@ -728,27 +812,40 @@ static void relay_fault(const char *name, const char *req, double d_pc_ms)
 			record(&y, &pc);
 		}
 		if (w1 - w0 > d_pc_ms + SLACK_MS)
-			fail_msg("%s: FAULT logged %.0f ms after the injection,"
-				 " deadline %.0f ms", name, w1 - w0, d_pc_ms);
+			fail_msg("%s: ESTOP logged %.0f ms after the injection,"
+				 " deadline %.0f ms",
+				 name, w1 - w0, d_pc_ms);
 		quit_latched(&cs, name);
 		sys_case_stop(&cs);
 	}
 }
 
+/* Unplugged: the device node vanishes; the next cycle's check sees it. */
 static void test_relay_unplug(void **state)
 {
+	static const enum re_fault_id ids[4] = {RE_F_ESTOP_LOST, RE_F_NONE};
+
 	(void)state;
-	relay_fault("relay unplugged", "relayfault unplug", 2 * P());
+	relay_fault("relay unplugged", "relayfault unplug", ids, 2 * P());
 }
 
+/* The board swallows every byte: only the Devantech state query notices,
+ * after its answer timeout; the amplifier fault comes first. */
 static void test_relay_writefail(void **state)
 {
+	/* The relay drops motor power without the PC's write failing: the
+	 * program sees every amplifier lose power (CTRL_POWER) unless the
+	 * relay read-back finds it first (ESTOP_LOST); the read-back failure
+	 * is logged either way (as the fault, or "while latched"). */
+	static const enum re_fault_id ids[4] = {RE_F_ESTOP_LOST,
+						RE_F_CTRL_POWER, RE_F_NONE};
+
 	(void)state;
-	relay_fault("relay write failing", "relayfault writefail",
+	relay_fault("relay write failing", "relayfault writefail", ids,
 		    env.readback_timeout_ms + 2 * P());
 }
 
-/* ---- controller ------------------------------------------------------------- */
+/* ---- controller --------------------------------------------------------- */
 
 /* Thread 1 halted by another host (HX1) while A moves: the program latches
  * THREAD within mainms and switches the motors off; the axis stops by
@@ -756,11 +853,15 @@ static void test_relay_writefail(void **state)
 static void test_thread_halted(void **state)
 {
 	(void)state;
-	FOR_REPEATS(i) {
+	FOR_REPEATS(i)
+	{
 		double dm = SYS_MAINMS + 1;
-		struct expect x = {"motion thread halted", {RE_F_CTRL_THREAD,
-				   RE_F_THREAD, RE_F_NONE}, -1, 0,
-				   d_ctrl_to_relay(), dm, 0};
+		struct expect x = {
+		    .name = "motion thread halted",
+		    .ids = {RE_F_CTRL_THREAD, RE_F_THREAD, RE_F_NONE},
+		    .axis = -1,
+		    .d_relay = d_ctrl_to_relay(),
+		    .d_motors = dm};
 		struct measured m;
 		char st[2048];
 		double a0, a1;
@@ -779,8 +880,8 @@ static void test_thread_halted(void **state)
 		if (sys_cmd(fd, "HX1", 2000) != 0)
 			fail_msg("the controller refused HX1");
 		close(fd);
-		if (sys_wait_event(&cs, "thread 1 stopped", cs.t_ready_ms,
-				   2000, &x.t_inj) < 0)
+		if (sys_wait_event(&cs, "thread 1 stopped", cs.t_ready_ms, 2000,
+				   &x.t_inj) < 0)
 			fail_msg("%s", cs.err);
 		expect_fault(&cs, &x, &m);
 		if (sys_state(&cs, st, sizeof(st)) < 0)
@@ -798,45 +899,72 @@ static void test_thread_halted(void **state)
 static void test_power_cycle(void **state)
 {
 	(void)state;
-	FOR_REPEATS(i) {
-		struct expect x = {"controller power cycle", {RE_F_COMM,
-				   RE_F_WDOG_REPLY, RE_F_NONE}, -1, 0,
-				   C() + P(), -1, 0};
+	FOR_REPEATS(i)
+	{
+		struct expect x = {
+		    .name = "controller power cycle",
+		    .ids = {RE_F_COMM, RE_F_WDOG_REPLY, RE_F_NONE},
+		    .axis = -1,
+		    .d_relay = C() + P(),
+		    .d_motors = -1};
 		struct measured m;
 		char line[1024];
 		double t;
 
+		x.link_down = 1;
 		start(&cs, NULL);
 		joy(&cs, "C rev");
 		if (sys_wait_moving(&cs, 'C', 200, 5000) < 0)
 			fail_msg("%s", cs.err);
 		x.t_inj = inject_fault(&cs, "power-cycle");
-		check_fault_line(&cs, &x, line, sizeof(line));
-		if (sys_wait_event(&cs, "relay off", x.t_inj, 3000, &t) < 0)
+		if (sys_wait_fault(&cs, FAULT_WAIT_MS, line, sizeof(line)) <
+			0 ||
+		    sys_wait_event(&cs, "relay off", x.t_inj, 3000, &t) < 0)
 			fail_msg("%s", cs.err);
 		m.relay_ms = t - x.t_inj;
 		m.motors_ms = -1;
+		record(&x, &m);
+		match_fault_line(&cs, &x, line);
 		if (sys_check_safe(&cs, 0, HOLD_MS) < 0)
 			fail_msg("%s", cs.err);
-		record(&x, &m);
 		if (m.relay_ms > x.d_relay + SLACK_MS)
 			fail_msg("relay off %.0f ms after the power cycle, "
-				 "deadline %.0f ms", m.relay_ms, x.d_relay);
+				 "deadline %.0f ms",
+				 m.relay_ms, x.d_relay);
 		quit_latched(&cs, x.name);
 		sys_case_stop(&cs);
 	}
 }
 
-/* ---- the operator quits during motion ---------------------------------------- */
+/* On a quit the supervisor switches the motors off through the
+ * controller before it cuts motor power: no motor may go off by the
+ * amplifier fault that the power cut causes. */
+static void motors_by_command(struct sys_case *c, double after)
+{
+	for (size_t i = 0; i < c->nev; i++)
+		if (c->ev[i].t_ms >= after &&
+		    !strncmp(c->ev[i].text, "axis ", 5) &&
+		    strstr(c->ev[i].text, "motor off: amplifier fault"))
+			fail_msg("quit: the motors were not switched off "
+				 "before the relay: %s",
+				 c->ev[i].text);
+}
+
+/* ---- the operator quits during motion ----------------------------------- */
 
 static void test_operator_quit(void **state)
 {
 	(void)state;
-	FOR_REPEATS(i) {
+	FOR_REPEATS(i)
+	{
 		double t_q, t, d = 2 * P();
-		struct expect x = {"operator quit", {RE_F_NONE}, -1, 0, d, d,
-				   0};
+		struct expect x = {.name = "operator quit",
+				   .ids = {RE_F_NONE},
+				   .axis = -1,
+				   .d_relay = d,
+				   .d_motors = d};
 		struct measured m;
+		char line[2048];
 		int status;
 
 		start(&cs, NULL);
@@ -847,10 +975,10 @@ static void test_operator_quit(void **state)
 		proc_signal(&cs.re, SIGTERM);
 		if (proc_wait_exit(&cs.re, EXIT_WAIT_MS, &status) < 0)
 			fail_msg("roboelf did not exit within %d ms of "
-				 "SIGTERM", EXIT_WAIT_MS);
+				 "SIGTERM",
+				 EXIT_WAIT_MS);
 		assert_int_equal(proc_exit_code(&cs.re), 0);
-		if (proc_find_line(&cs.re, PROC_STDOUT, "FAULT ", NULL, 0) ==
-		    0)
+		if (proc_find_line(&cs.re, PROC_STDOUT, "FAULT ", NULL, 0) == 0)
 			fail_msg("a FAULT line on a clean quit: %s",
 				 proc_output(&cs.re, PROC_STDOUT));
 		if (sys_wait_event(&cs, "relay off", t_q, 3000, &t) < 0)
@@ -864,12 +992,16 @@ static void test_operator_quit(void **state)
 			fail_msg("%s", cs.err);
 		if (sys_log_find(&cs, "stop: ", "SIGTERM", NULL, 0) < 0)
 			fail_msg("%s", cs.err);
+		if (sys_log_find(&cs, "shutdown:", NULL, line, sizeof(line)) ==
+		    0)
+			fail_msg("quit: the stop command failed: %s", line);
+		motors_by_command(&cs, t_q);
 		x.t_inj = t_q;
 		record(&x, &m);
 		if (m.relay_ms > d + SLACK_MS || m.motors_ms > d + SLACK_MS)
 			fail_msg("quit: relay off %.0f ms, motors off %.0f ms "
-				 "after SIGTERM, deadline %.0f ms", m.relay_ms,
-				 m.motors_ms, d);
+				 "after SIGTERM, deadline %.0f ms",
+				 m.relay_ms, m.motors_ms, d);
 		sys_case_stop(&cs);
 	}
 }
@@ -879,26 +1011,16 @@ static void test_operator_quit(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		T(test_pot_offset),
-		T(test_pot_stuck),
-		T(test_pot_open),
-		T(test_enc_stuck),
-		T(test_enc_slip),
-		T(test_jam),
-		T(test_encoder_failure_oa),
-		T(test_limit_switch),
-		T(test_joy_stuck_channel),
-		T(test_joy_invalid_timeout),
-		T(test_joy_two_directions),
-		T(test_sigkill),
-		T(test_link_drop),
-		T(test_link_stall),
-		T(test_link_latency),
-		T(test_relay_unplug),
-		T(test_relay_writefail),
-		T(test_thread_halted),
-		T(test_power_cycle),
-		T(test_operator_quit),
+	    T(test_pot_offset),		T(test_pot_stuck),
+	    T(test_pot_open),		T(test_enc_stuck),
+	    T(test_enc_slip),		T(test_jam),
+	    T(test_encoder_failure_oa), T(test_limit_switch),
+	    T(test_joy_stuck_channel),	T(test_joy_invalid_timeout),
+	    T(test_joy_two_directions), T(test_sigkill),
+	    T(test_link_drop),		T(test_link_stall),
+	    T(test_link_latency),	T(test_relay_unplug),
+	    T(test_relay_writefail),	T(test_thread_halted),
+	    T(test_power_cycle),	T(test_operator_quit),
 	};
 	const char *filter = getenv("ROBOELF_SYS_FILTER");
 

@@ -24,22 +24,22 @@
 #include "re_calib.h"
 #include "re_super.h"
 
-#define MS 1000000LL
+#define MS    1000000LL
 #define LIMIT 50000.0
 
 struct fax {
 	double pos, target, v, sp;
 	int moving, stop_code, motor_on;
-	int no_fwd_switch;	/* the switch never closes */
-	double enc_offset;	/* encoder origin shift */
+	int no_fwd_switch; /* the switch never closes */
+	double enc_offset; /* encoder origin shift */
 };
 
 static struct {
 	int64_t now, last_step;
 	struct fax ax[3];
-	double gain[3];		/* pot volts per full travel */
-	double dip_at, dip_v;	/* non-monotonic stretch on axis C */
-	int trip_axis;		/* motor off (stop code 8) at trip_pos */
+	double gain[3];	      /* pot volts per full travel */
+	double dip_at, dip_v; /* non-monotonic stretch on axis C */
+	int trip_axis;	      /* motor off (stop code 8) at trip_pos */
 	double trip_pos;
 	int relay_bad;
 	int n_records;
@@ -135,6 +135,8 @@ static int one_cmd(const char *c)
 		fk.ax[i].sp = atof(c + 4);
 	} else if (!strncmp(c, "PR", 2) && c[3] == '=' && i >= 0) {
 		fk.ax[i].target = fk.ax[i].pos + atof(c + 4);
+	} else if (!strncmp(c, "PA", 2) && c[3] == '=' && i >= 0) {
+		fk.ax[i].target = atof(c + 4) - fk.ax[i].enc_offset;
 	} else if (!strncmp(c, "BG", 2) && i >= 0 && c[3] == '\0') {
 		begin(i);
 	} else if (!strncmp(c, "SP ", 3)) {
@@ -194,8 +196,8 @@ static int f_record(void *ud, const char *prefix, struct gl_record *rec,
 		r->stop_code = (uint8_t)a->stop_code;
 		r->switches = (uint8_t)((fwd_active(a) ? 0 : GL_AXSW_FLS) |
 					(a->pos <= -LIMIT ? 0 : GL_AXSW_RLS));
-		r->analog_in = (int32_t)lround(pot_volts(i, a->pos) *
-					       RE_AN_COUNTS_PER_V);
+		r->analog_in =
+		    (int32_t)lround(pot_volts(i, a->pos) * RE_AN_COUNTS_PER_V);
 	}
 	return GL_OK;
 }
@@ -259,8 +261,8 @@ static void f_sleep_until(void *ud, int64_t t)
 }
 
 static const struct re_io_ops ops = {
-	f_record, f_command, f_ctrl_error, f_message, f_relay_check,
-	f_relay_off, f_relay_state, f_log, f_now, f_sleep_until,
+    f_record,	 f_command,	f_ctrl_error, f_message, f_relay_check,
+    f_relay_off, f_relay_state, f_log,	      f_now,	 f_sleep_until,
 };
 
 static const struct re_io io = {&ops, NULL};
@@ -277,7 +279,7 @@ static int setup(void **state)
 	fk.now = fk.last_step = 1000 * MS;
 	for (int i = 0; i < 3; i++) {
 		fk.gain[i] = 4.0;
-		fk.ax[i].pos = i * 10000.0 - 10000;	/* anywhere */
+		fk.ax[i].pos = i * 10000.0 - 10000; /* anywhere */
 	}
 	memset(&cfg, 0, sizeof(cfg));
 	cfg.n_axes = 3;
@@ -322,8 +324,7 @@ static void test_calib_clean(void **state)
 	double secs = 0;
 
 	(void)state;
-	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, &secs),
-			 GL_OK);
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, &secs), GL_OK);
 	assert_int_equal(set.n_axes, 3);
 	for (int i = 0; i < 3; i++) {
 		const struct re_caltable *t = &set.axis[i];
@@ -333,8 +334,10 @@ static void test_calib_clean(void **state)
 		assert_true(fabs(t->soft_fwd - 49500) <= 1);
 		assert_true(fabs(t->soft_rev - t->start_counts) < 0.5);
 		for (int j = 0; j < t->n; j++)
-			assert_true(fabs(t->pot_v[j] - pot_volts(i,
-				t->start_counts + j * 1000.0)) < 0.0005);
+			assert_true(
+			    fabs(t->pot_v[j] -
+				 pot_volts(i, t->start_counts + j * 1000.0)) <
+			    0.0005);
 		assert_true(fabs(fk.ax[i].pos) <= 1);
 		assert_string_equal(set.name[i], names[i]);
 	}
@@ -369,7 +372,7 @@ static void test_calib_nonmonotonic(void **state)
 			 RE_FAULT);
 	assert_int_equal(f.id, RE_F_CAL_NONMONO);
 	assert_int_equal(f.axis, 2);
-	assert_int_equal(f.i[0], 58);	/* point at +8500 counts */
+	assert_int_equal(f.i[0], 58); /* point at +8500 counts */
 }
 
 /* A's potentiometer spans 3 V instead of 4 V +- 10 %. */
@@ -440,7 +443,7 @@ static void test_calib_check_robot(void **state)
 	assert_int_equal(re_calib_check_robot(cal, &io, &cfg, &saved, &f),
 			 GL_OK);
 	assert_true(fabs(fk.ax[0].pos) <= 1);
-	fk.ax[1].enc_offset = 20000;	/* encoders restarted elsewhere */
+	fk.ax[1].enc_offset = 20000; /* encoders restarted elsewhere */
 	assert_int_equal(re_calib_check_robot(cal, &io, &cfg, &saved, &f),
 			 RE_FAULT);
 	assert_int_equal(f.id, RE_F_CAL_ABORT);
@@ -451,22 +454,21 @@ static void test_calib_check_robot(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test_setup_teardown(test_calib_clean, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_calib_switch_never_comes,
-						setup, teardown),
-		cmocka_unit_test_setup_teardown(test_calib_nonmonotonic, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_calib_wrong_range, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_calib_motor_off, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_calib_relay_lost, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_calib_stop_flag, setup,
-						teardown),
-		cmocka_unit_test_setup_teardown(test_calib_check_robot, setup,
-						teardown),
+	    cmocka_unit_test_setup_teardown(test_calib_clean, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_calib_switch_never_comes,
+					    setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_calib_nonmonotonic, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_calib_wrong_range, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_calib_motor_off, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_calib_relay_lost, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_calib_stop_flag, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_calib_check_robot, setup,
+					    teardown),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

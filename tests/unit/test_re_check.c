@@ -491,6 +491,12 @@ static void test_ctrl_fault_mapping(void **state)
 	z.faxis = 0;
 	re_ctrl_fault(&z, 77, &f);
 	assert_int_equal(f.axis, -1);
+	/* AMPERR on no single axis (faxis 0): every amplifier lost power. */
+	z.fcode = 8;
+	assert_int_equal(re_ctrl_fault(&z, 15, &f), GL_OK);
+	assert_int_equal(f.id, RE_F_CTRL_POWER);
+	assert_int_equal(re_fault_class(f.id), RE_FC_ESTOP);
+	assert_int_equal(f.axis, -1);
 }
 
 static void test_ctrl_fault_texts(void **state)

@@ -69,6 +69,9 @@ static const struct bad_case bad_cases[] = {
     {"bad_er_huge.yaml", 4, 34,
      "'position_error_limit_counts' must be between 1 and 2147483647, got "
      "99999999999"},
+    {"bad_er_above_step.yaml", 5, 34,
+     "'position_error_limit_counts' (1000) must be below 'step_counts' "
+     "(1000)"},
     {"bad_inputs_count.yaml", 3, 11,
      "'inputs' must list exactly 12 inputs, got 11"},
     {"bad_inputs_duplicate.yaml", 3, 48,
@@ -224,7 +227,7 @@ static void test_defaults_documented(void **state)
 		assert_true(a->travel_tolerance == 0.1);
 		assert_true(a->kp == 6.0 && a->ki == 0.0 && a->kd == 64.0);
 		assert_true(a->torque_limit_v == 5.0);
-		assert_int_equal(a->position_error_limit_counts, 2000);
+		assert_int_equal(a->position_error_limit_counts, 500);
 		assert_true(a->off_on_error);
 		assert_true(a->encoder_failure.enabled);
 		assert_int_equal(a->encoder_failure.time_samples, 100);
@@ -456,7 +459,7 @@ static void changed(struct re_config *c)
 		a->ki = 0.25;
 		a->kd = 100.125;
 		a->torque_limit_v = 3.3;
-		a->position_error_limit_counts = 1500 + i;
+		a->position_error_limit_counts = 300 + i;
 		a->off_on_error = false;
 		a->encoder_failure.enabled = false;
 		a->encoder_failure.time_samples = 250;

@@ -2,7 +2,7 @@
  * test_re_super.c - the supervisor cycle (re_super) against a fake
  * controller, relay, log and clock behind struct re_io: no sockets, no
  * sleeping. Covers one round trip per cycle, every fault path and its
- * reaction order (relay off, then "ST ABC;MO ABC;pcflt=1", then the fsync'ed
+ * reaction order (relay off, then "AB 1;MO ABC;pcflt=1", then the fsync'ed
  * log entry), the latch, the watchdog levels, the schedule (overruns) and
  * that the cycle allocates nothing.
  */
@@ -20,7 +20,7 @@
 #include "gl_err.h"
 #include "re_super.h"
 
-#define MS 1000000LL
+#define MS	  1000000LL
 #define PERIOD_MS 50
 
 /* ---- allocation counter (linked with --wrap, see .ldflags) --------------- */
@@ -54,10 +54,10 @@ void *__wrap_realloc(void *p, size_t n)
 /* ---- the fake world ------------------------------------------------------ */
 
 struct fake {
-	int64_t now;			/* fake CLOCK_MONOTONIC */
-	struct gl_record rec;		/* what the next QR returns */
-	int record_rc;			/* GL_OK or an error to return */
-	int64_t delay_ns;		/* round-trip time */
+	int64_t now;	      /* fake CLOCK_MONOTONIC */
+	struct gl_record rec; /* what the next QR returns */
+	int record_rc;	      /* GL_OK or an error to return */
+	int64_t delay_ns;     /* round-trip time */
 	int freeze_hb, freeze_sample;
 	int n_records;
 	char last_prefix[64];
@@ -65,13 +65,16 @@ struct fake {
 	int relay_check_rc;
 	int relay_off_rc;
 	int n_relay_off;
-	char commands[8][96];
+	char commands[24][96];
 	int n_commands;
-	char mg_fdet[32];		/* answer to "MG fdet" */
+	char mg_fdet[32]; /* answer to "MG fdet" */
+	int fcode_after;  /* "MG fcode" answers 0 this many times, */
+	int fcode_val;	  /* then this */
+	int n_fcode;
 	char logs[16][1024];
 	int log_level[16];
 	int n_logs;
-	char seq[512];			/* order of reactions */
+	char seq[512]; /* order of reactions */
 	const char *msgs[4];
 	int n_msgs;
 };
@@ -116,11 +119,18 @@ static int f_command(void *ud, const char *cmd, char *resp, size_t cap,
 
 	(void)ud;
 	(void)timeout_ms;
-	if (fk.n_commands < 8)
+	if (fk.n_commands < 24)
 		snprintf(fk.commands[fk.n_commands++], 96, "%s", cmd);
 	snprintf(s, sizeof(s), "cmd:%s", cmd);
 	seq_add(s);
-	snprintf(resp, cap, "%s", strcmp(cmd, "MG fdet") ? "" : fk.mg_fdet);
+	if (!strcmp(cmd, "MG fcode"))
+		snprintf(resp, cap, " %d.0000",
+			 fk.n_fcode++ < fk.fcode_after ? 0 : fk.fcode_val);
+	else if (!strcmp(cmd, "MG faxis"))
+		snprintf(resp, cap, " 0.0000");
+	else
+		snprintf(resp, cap, "%s",
+			 strcmp(cmd, "MG fdet") ? "" : fk.mg_fdet);
 	return (int)strlen(resp);
 }
 
@@ -188,8 +198,8 @@ static void f_sleep_until(void *ud, int64_t t)
 }
 
 static const struct re_io_ops fake_ops = {
-	f_record, f_command, f_ctrl_error, f_message, f_relay_check, f_relay_off,
-	f_relay_state, f_log, f_now, f_sleep_until,
+    f_record,	 f_command,	f_ctrl_error, f_message, f_relay_check,
+    f_relay_off, f_relay_state, f_log,	      f_now,	 f_sleep_until,
 };
 
 /* ---- fixtures ------------------------------------------------------------ */
@@ -206,15 +216,15 @@ static void make_table(void)
 	table.start_counts = -50000;
 	table.step_counts = 1000;
 	for (int i = 0; i < table.n; i++)
-		table.pot_v[i] = 0.5 + 0.04 * i;	/* 2.5 V at 0 */
+		table.pot_v[i] = 0.5 + 0.04 * i; /* 2.5 V at 0 */
 	table.soft_rev = -50000;
 	table.soft_fwd = 50000;
 }
 
 static void set_pot(int axis, double volts)
 {
-	fk.rec.axis[axis].analog_in = (int32_t)(volts * RE_AN_COUNTS_PER_V +
-						(volts < 0 ? -0.5 : 0.5));
+	fk.rec.axis[axis].analog_in =
+	    (int32_t)(volts * RE_AN_COUNTS_PER_V + (volts < 0 ? -0.5 : 0.5));
 }
 
 static void make_record(void)
@@ -229,8 +239,8 @@ static void make_record(void)
 		r->axis[i].switches = GL_AXSW_FLS | GL_AXSW_RLS;
 		set_pot(i, 2.5);
 	}
-	r->axis[1].za = 1;		/* ZAB: armed, no fault */
-	r->axis[2].za = 4096;		/* ZAC: jcmd 0 */
+	r->axis[1].za = 1;    /* ZAB: armed, no fault */
+	r->axis[2].za = 4096; /* ZAC: jcmd 0 */
 }
 
 static struct re_super_cfg make_cfg(void)
@@ -317,14 +327,13 @@ static void test_super_encpot_fault_order(void **state)
 {
 	(void)state;
 	assert_int_equal(run(3), RE_OK);
-	set_pot(1, 2.5 + 0.1);	/* tolerance is 1.5 x 0.04 V = 0.06 V */
-	assert_int_equal(step(), RE_OK);	/* persistence 1: tolerated */
+	set_pot(1, 2.5 + 0.1); /* tolerance is 1.5 x 0.04 V = 0.06 V */
+	assert_int_equal(step(), RE_OK); /* persistence 1: tolerated */
 	assert_int_equal(fk.n_relay_off, 0);
 	assert_int_equal(step(), RE_FAULT);
-	assert_string_equal(fk.seq, "relay_off,cmd:ST ABC;MO ABC;pcflt=1,"
+	assert_string_equal(fk.seq, "relay_off,cmd:AB 1;MO ABC;pcflt=1,"
 				    "log:FAULT");
-	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT ENCODER: ",
-			     15));
+	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT ENCODER: ", 15));
 	assert_non_null(strstr(re_super_fault_line(&sup), "Recovery: "));
 	assert_non_null(strstr(fault_log(), re_super_fault_line(&sup)));
 	assert_non_null(strstr(fault_log(), "relay off: confirmed"));
@@ -365,9 +374,9 @@ static void test_super_watchdog_critical(void **state)
 	assert_int_equal(run(2), RE_OK);
 	fk.record_rc = GL_ERR_TIMEOUT;
 	assert_int_equal(step(), RE_FAULT);
-	assert_int_equal(fk.last_timeout_ms, 76);	/* 125 - 49.9 */
-	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT WATCHDOG: ",
-			     16));
+	assert_int_equal(fk.last_timeout_ms, 76); /* 125 - 49.9 */
+	assert_true(
+	    !strncmp(re_super_fault_line(&sup), "FAULT WATCHDOG: ", 16));
 	assert_int_equal(fk.n_relay_off, 1);
 }
 
@@ -378,8 +387,8 @@ static void test_super_comm_fault(void **state)
 	fk.record_rc = GL_ERR_CLOSED;
 	assert_int_equal(step(), RE_FAULT);
 	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT COMM: ", 12));
-	assert_non_null(strstr(re_super_fault_line(&sup),
-			       gl_strerror(GL_ERR_CLOSED)));
+	assert_non_null(
+	    strstr(re_super_fault_line(&sup), gl_strerror(GL_ERR_CLOSED)));
 }
 
 /* Relay lost: ESTOP; the motors are switched off through the controller
@@ -392,7 +401,7 @@ static void test_super_relay_lost(void **state)
 	fk.relay_off_rc = GL_ERR_RELAY;
 	assert_int_equal(step(), RE_FAULT);
 	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT ESTOP: ", 13));
-	assert_string_equal(fk.commands[0], "ST ABC;MO ABC;pcflt=1");
+	assert_string_equal(fk.commands[0], "AB 1;MO ABC;pcflt=1");
 	assert_non_null(strstr(fault_log(), "relay off: NOT confirmed"));
 }
 
@@ -406,13 +415,12 @@ static void test_super_controller_fault(void **state)
 	fk.rec.axis[1].status |= GL_AXST_MOTOR_OFF;
 	snprintf(fk.mg_fdet, sizeof(fk.mg_fdet), " 5012.0000");
 	assert_int_equal(step(), RE_FAULT);
-	assert_string_equal(fk.commands[0], "ST ABC;MO ABC;pcflt=1");
+	assert_string_equal(fk.commands[0], "AB 1;MO ABC;pcflt=1");
 	assert_string_equal(fk.commands[1], "MG fdet");
 	assert_int_equal(sup.fault.id, RE_F_CTRL_POSERR);
 	assert_int_equal(sup.fault.axis, 1);
 	assert_int_equal(sup.fault.i[0], 5012);
-	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT MOTION: ",
-			     14));
+	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT MOTION: ", 14));
 }
 
 /* A motor the controller switched off, seen before the program latched. */
@@ -426,6 +434,53 @@ static void test_super_motor_off(void **state)
 	assert_int_equal(sup.fault.id, RE_F_MOTOR_OFF);
 	assert_int_equal(sup.fault.axis, 2);
 	assert_non_null(strstr(re_super_fault_line(&sup), "encoder failure"));
+}
+
+/* Motors found off before the program published its own verdict (here
+ * INPUT: #JINV stops and switches off in thread 1, #MAIN latches a few ms
+ * later): power cut and motors off at once, then the program's fault code
+ * is awaited (settle_ms) and reported, then pcflt. */
+static void test_super_settle_program_verdict(void **state)
+{
+	(void)state;
+	sup.cfg.settle_ms = 25;
+	assert_int_equal(run(2), RE_OK);
+	for (int i = 0; i < 3; i++) {
+		fk.rec.axis[i].status |= GL_AXST_MOTOR_OFF;
+		fk.rec.axis[i].stop_code = 4;
+	}
+	fk.fcode_after = 3;
+	fk.fcode_val = 3;
+	snprintf(fk.mg_fdet, sizeof(fk.mg_fdet), " 1.0000");
+	assert_int_equal(step(), RE_FAULT);
+	assert_string_equal(fk.seq, "relay_off,cmd:AB 1;MO ABC,cmd:MG fcode,"
+				    "cmd:MG fcode,cmd:MG fcode,cmd:MG fcode,"
+				    "cmd:MG faxis,cmd:MG fdet,cmd:pcflt=1,"
+				    "log:FAULT");
+	assert_int_equal(sup.fault.id, RE_F_CTRL_INPUT);
+	assert_int_equal(sup.fault.i[0], 1);
+	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT INPUT: ", 13));
+	assert_non_null(strstr(fault_log(), "; program fault 3 after "));
+}
+
+/* Nothing from the program within settle_ms: our own finding stands. */
+static void test_super_settle_timeout(void **state)
+{
+	int64_t t;
+
+	(void)state;
+	sup.cfg.settle_ms = 25;
+	assert_int_equal(run(2), RE_OK);
+	fk.rec.axis[0].status |= GL_AXST_MOTOR_OFF;
+	fk.rec.axis[0].stop_code = 8;
+	fk.fcode_after = 1000;
+	t = fk.now;
+	assert_int_equal(step(), RE_FAULT);
+	assert_int_equal(sup.fault.id, RE_F_MOTOR_OFF);
+	assert_true(fk.now - t >= 25 * MS && fk.now - t < 80 * MS);
+	assert_string_equal(fk.commands[fk.n_commands - 1], "pcflt=1");
+	assert_non_null(strstr(re_super_fault_line(&sup), "position error"));
+	assert_non_null(strstr(fault_log(), "no program fault within 25 ms"));
 }
 
 /* The motion thread stopped while armed. */
@@ -445,11 +500,11 @@ static void test_super_heartbeat_frozen(void **state)
 	(void)state;
 	assert_int_equal(run(2), RE_OK);
 	fk.freeze_hb = 1;
-	assert_int_equal(run(2), RE_OK);	/* 100 ms frozen < 125 ms */
-	assert_int_equal(step(), RE_FAULT);	/* 150 ms */
+	assert_int_equal(run(2), RE_OK);    /* 100 ms frozen < 125 ms */
+	assert_int_equal(step(), RE_FAULT); /* 150 ms */
 	assert_int_equal(sup.fault.id, RE_F_WDOG_HEARTBEAT);
-	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT WATCHDOG: ",
-			     16));
+	assert_true(
+	    !strncmp(re_super_fault_line(&sup), "FAULT WATCHDOG: ", 16));
 }
 
 /* The record's sample number frozen (stale data from a live TCP stack). */
@@ -497,11 +552,11 @@ static void test_super_schedule_overrun(void **state)
 	assert_int_equal(run(4), RE_OK);
 	t = fk.now;
 	assert_int_equal(sup.overruns, 0);
-	fk.now += 120 * MS;		/* the process was held up */
+	fk.now += 120 * MS; /* the process was held up */
 	re_super_wait(&sup);
 	assert_int_equal(sup.overruns, 1);
 	t = fk.now;
-	re_super_wait(&sup);		/* the next one is a full period on */
+	re_super_wait(&sup); /* the next one is a full period on */
 	assert_int_equal(fk.now - t, PERIOD_MS * MS);
 	assert_int_equal(sup.overruns, 1);
 }
@@ -512,7 +567,7 @@ static void test_super_shutdown(void **state)
 	(void)state;
 	assert_int_equal(run(2), RE_OK);
 	assert_int_equal(re_super_shutdown(&sup), GL_OK);
-	assert_string_equal(fk.seq, "cmd:ST ABC;MO ABC,relay_off");
+	assert_string_equal(fk.seq, "cmd:AB 1;MO ABC,relay_off");
 }
 
 /* Status snapshot: position %, pot against expected, limits, margin. */
@@ -523,7 +578,7 @@ static void test_super_status(void **state)
 	(void)state;
 	fk.rec.axis[0].motor_pos = 25000;
 	set_pot(0, 3.5);
-	fk.rec.axis[0].switches = GL_AXSW_RLS;	/* forward limit active */
+	fk.rec.axis[0].switches = GL_AXSW_RLS; /* forward limit active */
 	assert_int_equal(step(), RE_OK);
 	re_super_status(&sup, &st);
 	assert_int_equal(st.axis[0].enc_counts, 25000);
@@ -567,28 +622,51 @@ static void test_super_no_alloc(void **state)
 	assert_int_equal(after.uordblks, before.uordblks);
 }
 
+/* The lateness percentiles of the exit statistics: upper bin edges, the
+ * worst value for 100 %, 0 with no cycle. */
+static void test_super_late_percentiles(void **state)
+{
+	static struct re_super s; /* zeroed; only the histogram is used */
+
+	(void)state;
+	memset(&s, 0, sizeof(s));
+	assert_true(re_super_late_ms(&s, 50) == 0.0);
+	s.late_hist[0] = 90; /* 90 cycles late by less than 50 us */
+	s.late_hist[4] = 9;  /* 9 cycles at 200..250 us */
+	s.late_hist[RE_LATE_BINS - 1] = 1; /* one beyond 100 ms */
+	s.late_worst_ns = 123456789;
+	assert_true(re_super_late_ms(&s, 50) == 0.05);
+	assert_true(re_super_late_ms(&s, 90) == 0.05);
+	assert_true(re_super_late_ms(&s, 91) == 0.25);
+	assert_true(re_super_late_ms(&s, 99) == 0.25);
+	assert_true(re_super_late_ms(&s, 99.5) == 123.456789);
+	assert_true(re_super_late_ms(&s, 100) == 123.456789);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test_setup(test_super_healthy_one_round_trip,
-				       setup),
-		cmocka_unit_test_setup(test_super_encpot_fault_order, setup),
-		cmocka_unit_test_setup(test_super_encpot_transient, setup),
-		cmocka_unit_test_setup(test_super_watchdog_noncritical, setup),
-		cmocka_unit_test_setup(test_super_watchdog_critical, setup),
-		cmocka_unit_test_setup(test_super_comm_fault, setup),
-		cmocka_unit_test_setup(test_super_relay_lost, setup),
-		cmocka_unit_test_setup(test_super_controller_fault, setup),
-		cmocka_unit_test_setup(test_super_motor_off, setup),
-		cmocka_unit_test_setup(test_super_thread_missing, setup),
-		cmocka_unit_test_setup(test_super_heartbeat_frozen, setup),
-		cmocka_unit_test_setup(test_super_sample_frozen, setup),
-		cmocka_unit_test_setup(test_super_latch, setup),
-		cmocka_unit_test_setup(test_super_schedule_overrun, setup),
-		cmocka_unit_test_setup(test_super_shutdown, setup),
-		cmocka_unit_test_setup(test_super_status, setup),
-		cmocka_unit_test_setup(test_super_messages_logged, setup),
-		cmocka_unit_test_setup(test_super_no_alloc, setup),
+	    cmocka_unit_test_setup(test_super_healthy_one_round_trip, setup),
+	    cmocka_unit_test_setup(test_super_encpot_fault_order, setup),
+	    cmocka_unit_test_setup(test_super_encpot_transient, setup),
+	    cmocka_unit_test_setup(test_super_watchdog_noncritical, setup),
+	    cmocka_unit_test_setup(test_super_watchdog_critical, setup),
+	    cmocka_unit_test_setup(test_super_comm_fault, setup),
+	    cmocka_unit_test_setup(test_super_relay_lost, setup),
+	    cmocka_unit_test_setup(test_super_controller_fault, setup),
+	    cmocka_unit_test_setup(test_super_motor_off, setup),
+	    cmocka_unit_test_setup(test_super_settle_program_verdict, setup),
+	    cmocka_unit_test_setup(test_super_settle_timeout, setup),
+	    cmocka_unit_test_setup(test_super_thread_missing, setup),
+	    cmocka_unit_test_setup(test_super_heartbeat_frozen, setup),
+	    cmocka_unit_test_setup(test_super_sample_frozen, setup),
+	    cmocka_unit_test_setup(test_super_latch, setup),
+	    cmocka_unit_test_setup(test_super_schedule_overrun, setup),
+	    cmocka_unit_test_setup(test_super_shutdown, setup),
+	    cmocka_unit_test_setup(test_super_status, setup),
+	    cmocka_unit_test_setup(test_super_messages_logged, setup),
+	    cmocka_unit_test_setup(test_super_no_alloc, setup),
+	    cmocka_unit_test(test_super_late_percentiles),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

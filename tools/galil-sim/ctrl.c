@@ -43,7 +43,7 @@ void ctrl_axis_defaults(struct ctrl_axis_par *p)
 	p->bl = -2147483648.0;
 	p->ot = 30;
 	p->tw = 32766;
-	p->motor_off = 1;	/* simulator choice: see the docs */
+	p->motor_off = 1; /* simulator choice: see the docs */
 }
 
 static void settings_defaults(struct ctrl *c)
@@ -55,8 +55,9 @@ static void settings_defaults(struct ctrl *c)
 	c->cw_hibit = f->have_par ? f->cw_hibit : 0;
 	c->cw_drop = f->have_par ? f->cw_drop : 0;
 	c->cn0 = f->have_par ? f->cn0 : -1;
-	c->sample_us = f->have_par ? f->sample_us :
-		       c->cfg.sample_us > 0 ? c->cfg.sample_us : 1000;
+	c->sample_us = f->have_par	      ? f->sample_us
+		       : c->cfg.sample_us > 0 ? c->cfg.sample_us
+					      : 1000;
 	c->vf_m = f->have_par ? f->vf_m : 10;
 	c->vf_n = f->have_par ? f->vf_n : 4;
 	c->pf_m = f->have_par ? f->pf_m : 10;
@@ -256,9 +257,10 @@ int ctrl_load_program(struct ctrl *c, const char *text, size_t len,
 	if (rc) {
 		tc = rc < 0 ? 60 : tc;
 		c->tc = tc;
-		ctrl_event(c, "download refused: line %d TC %d %s (program "
-			      "memory erased)", *bad_line, tc,
-			   ctrl_tc_text(tc));
+		ctrl_event(c,
+			   "download refused: line %d TC %d %s (program "
+			   "memory erased)",
+			   *bad_line, tc, ctrl_tc_text(tc));
 		return tc;
 	}
 	c->prog = np;
@@ -329,8 +331,8 @@ static double *var_ref(struct ctrl *c, const char *name, int create)
 	if (name[n] == '[') {
 		arr = ctrl_array_find(&c->vars, key);
 		i = strtol(name + n + 1, &end, 10);
-		if (!arr || end == name + n + 1 || strcmp(end, "]") ||
-		    i < 0 || i >= arr->n)
+		if (!arr || end == name + n + 1 || strcmp(end, "]") || i < 0 ||
+		    i >= arr->n)
 			return NULL;
 		return &arr->v[i];
 	}

@@ -15,18 +15,18 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define CTRL_AXES 3		/* DMC-4030: A, B, C */
-#define CTRL_HANDLES 8		/* Ethernet handles A..H */
+#define CTRL_AXES    3 /* DMC-4030: A, B, C */
+#define CTRL_HANDLES 8 /* Ethernet handles A..H */
 #define CTRL_THREADS 8
-#define CTRL_INPUTS 32		/* digital inputs 1..32 (bit n-1) */
-#define CTRL_ANALOG 8		/* analog inputs 1..8 */
+#define CTRL_INPUTS  32 /* digital inputs 1..32 (bit n-1) */
+#define CTRL_ANALOG  8	/* analog inputs 1..8 */
 
 struct ctrl;
 
 struct ctrl_cfg {
-	const char *model;	/* ^R^V text, e.g. "DMC4030 Rev 1.2h-sim" */
-	long serial;		/* MG _BN */
-	int sample_us;		/* TM, servo sample period in us (1000) */
+	const char *model; /* ^R^V text, e.g. "DMC4030 Rev 1.2h-sim" */
+	long serial;	   /* MG _BN */
+	int sample_us;	   /* TM, servo sample period in us (1000) */
 	/* called for each event (motor off and why, limit reached, thread
 	 * stopped, program error ...): one line, no CR LF. May be NULL. */
 	void (*event)(void *ud, const char *line);
@@ -35,27 +35,27 @@ struct ctrl_cfg {
 
 /* What the plant reports to the controller each sample. */
 struct ctrl_sense {
-	double enc[CTRL_AXES];		/* main encoder, counts */
-	int fwd_limit[CTRL_AXES];	/* 1 = forward limit switch active */
-	int rev_limit[CTRL_AXES];	/* 1 = reverse limit switch active */
-	double an_v[CTRL_ANALOG];	/* analog inputs 1..8, volts */
-	uint32_t inputs;		/* digital inputs, bit n-1 = input n, 1 = high */
-	int amp_power;			/* 1 = motor power present (E-stop relay on) */
+	double enc[CTRL_AXES];	  /* main encoder, counts */
+	int fwd_limit[CTRL_AXES]; /* 1 = forward limit switch active */
+	int rev_limit[CTRL_AXES]; /* 1 = reverse limit switch active */
+	double an_v[CTRL_ANALOG]; /* analog inputs 1..8, volts */
+	uint32_t inputs; /* digital inputs, bit n-1 = input n, 1 = high */
+	int amp_power;	 /* 1 = motor power present (E-stop relay on) */
 };
 
 /* What the controller commands each sample. */
 struct ctrl_drive {
-	double ref[CTRL_AXES];		/* reference position from the profiler, counts */
-	int motor_on[CTRL_AXES];	/* 1 = servo enabled (SH), 0 = MO */
-	double torque_v[CTRL_AXES];	/* servo output, volts (+-TL) */
-	uint32_t outputs;		/* digital outputs, bit n-1 = output n */
+	double ref[CTRL_AXES];	    /* profiler reference position, counts */
+	int motor_on[CTRL_AXES];    /* 1 = servo enabled (SH), 0 = MO */
+	double torque_v[CTRL_AXES]; /* servo output, volts (+-TL) */
+	uint32_t outputs;	    /* digital outputs, bit n-1 = output n */
 };
 
 /* Snapshot of one axis for tests and the control port. */
 struct ctrl_axis_info {
-	double ref, enc, vel;		/* counts, counts, counts/s (profiler) */
+	double ref, enc, vel; /* counts, counts, counts/s (profiler) */
 	int motor_off, moving, stop_code;
-	int fwd_limit, rev_limit;	/* switch active */
+	int fwd_limit, rev_limit; /* switch active */
 };
 
 /*

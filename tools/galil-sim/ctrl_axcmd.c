@@ -14,45 +14,41 @@
 
 struct par_desc {
 	char name[3];
-	size_t off;		/* in struct ctrl_axis_par */
 	double lo, hi;
-	double step;		/* resolution: values are rounded down to it */
-	int fmt;		/* CTRL_NUM_* for queries */
-	int in_motion;		/* may change while the axis profiles */
+	double step;   /* resolution: values are cut to it (to zero) */
+	int fmt;       /* CTRL_NUM_* for queries */
+	int in_motion; /* may change while the axis profiles */
 };
 
-#define P(f) offsetof(struct ctrl_axis_par, f)
 static const struct par_desc par_table[] = {
-	{ "AC", P(ac), 1024, 1073740800, 1024, CTRL_NUM_INT, 1 },
-	{ "BL", P(bl), -2147483648.0, 2147483647, 1, CTRL_NUM_PF, 1 },
-	{ "DC", P(dc), 1024, 1073740800, 1024, CTRL_NUM_INT, 0 },
-	{ "ER", P(er), -1, 2147483647, 1, CTRL_NUM_INT, 1 },
-	{ "FL", P(fl), -2147483648.0, 2147483647, 1, CTRL_NUM_PF, 1 },
-	{ "IL", P(il), -9.9982, 9.9982, 0, CTRL_NUM_GAIN, 1 },
-	{ "KD", P(kd), 0, 4095.875, 0.125, CTRL_NUM_GAIN, 1 },
-	{ "KI", P(ki), 0, 255.999, 0, CTRL_NUM_GAIN, 1 },
-	{ "KP", P(kp), 0, 1023.875, 0.125, CTRL_NUM_GAIN, 1 },
-	{ "OF", P(of), -9.9982, 9.9982, 0, CTRL_NUM_GAIN, 1 },
-	{ "OV", P(ov), 0, 9.9982, 0, CTRL_NUM_GAIN, 1 },
-	{ "SD", P(sd), 1024, 1073740800, 1024, CTRL_NUM_INT, 1 },
-	{ "SP", P(sp), 0, 15000000, 2, CTRL_NUM_INT, 1 },
-	{ "TL", P(tl), 0, 9.9982, 0, CTRL_NUM_GAIN, 1 },
-	{ "TW", P(tw), -1, 32767, 1, CTRL_NUM_INT, 1 },
+    {"AC", 1024, 1073740800, 1024, CTRL_NUM_INT, 1},
+    {"BL", -2147483648.0, 2147483647, 1, CTRL_NUM_PF, 1},
+    {"DC", 1024, 1073740800, 1024, CTRL_NUM_INT, 0},
+    {"ER", -1, 2147483647, 1, CTRL_NUM_INT, 1},
+    {"FL", -2147483648.0, 2147483647, 1, CTRL_NUM_PF, 1},
+    {"IL", -9.9982, 9.9982, 0, CTRL_NUM_GAIN, 1},
+    {"KD", 0, 4095.875, 0.125, CTRL_NUM_GAIN, 1},
+    {"KI", 0, 255.999, 0, CTRL_NUM_GAIN, 1},
+    {"KP", 0, 1023.875, 0.125, CTRL_NUM_GAIN, 1},
+    {"OF", -9.9982, 9.9982, 0, CTRL_NUM_GAIN, 1},
+    {"OV", 0, 9.9982, 0, CTRL_NUM_GAIN, 1},
+    {"SD", 1024, 1073740800, 1024, CTRL_NUM_INT, 1},
+    {"SP", 0, 15000000, 2, CTRL_NUM_INT, 1},
+    {"TL", 0, 9.9982, 0, CTRL_NUM_GAIN, 1},
+    {"TW", -1, 32767, 1, CTRL_NUM_INT, 1},
 };
-#undef P
 
 /* Integer parameters kept as int in struct ctrl_axis_par. */
 struct ipar_desc {
 	char name[3];
-	size_t off;
 	int lo, hi;
 };
 
 static const struct ipar_desc ipar_table[] = {
-	{ "LD", offsetof(struct ctrl_axis_par, ld), 0, 3 },
-	{ "OA", offsetof(struct ctrl_axis_par, oa), 0, 1 },
-	{ "OE", offsetof(struct ctrl_axis_par, oe), 0, 3 },
-	{ "OT", offsetof(struct ctrl_axis_par, ot), 1, 32000 },
+    {"LD", 0, 3},
+    {"OA", 0, 1},
+    {"OE", 0, 3},
+    {"OT", 1, 32000},
 };
 
 static const struct par_desc *par_find(const char *name)
@@ -75,14 +71,36 @@ static const struct ipar_desc *ipar_find(const char *name)
 	return NULL;
 }
 
+/* The parameter of @d in @p (every table entry has a case). */
 static double *par_ptr(struct ctrl_axis_par *p, const struct par_desc *d)
 {
-	return (double *)((char *)p + d->off);
+	switch (d->name[0] << 8 | d->name[1]) {
+	case 'A' << 8 | 'C': return &p->ac;
+	case 'B' << 8 | 'L': return &p->bl;
+	case 'D' << 8 | 'C': return &p->dc;
+	case 'E' << 8 | 'R': return &p->er;
+	case 'F' << 8 | 'L': return &p->fl;
+	case 'I' << 8 | 'L': return &p->il;
+	case 'K' << 8 | 'D': return &p->kd;
+	case 'K' << 8 | 'I': return &p->ki;
+	case 'K' << 8 | 'P': return &p->kp;
+	case 'O' << 8 | 'F': return &p->of;
+	case 'O' << 8 | 'V': return &p->ov;
+	case 'S' << 8 | 'D': return &p->sd;
+	case 'S' << 8 | 'P': return &p->sp;
+	case 'T' << 8 | 'L': return &p->tl;
+	default: return &p->tw;
+	}
 }
 
 static int *ipar_ptr(struct ctrl_axis_par *p, const struct ipar_desc *d)
 {
-	return (int *)((char *)p + d->off);
+	switch (d->name[0] << 8 | d->name[1]) {
+	case 'L' << 8 | 'D': return &p->ld;
+	case 'O' << 8 | 'A': return &p->oa;
+	case 'O' << 8 | 'E': return &p->oe;
+	default: return &p->ot;
+	}
 }
 
 /* Print the queried fields: " 1, 2\r\n". */
@@ -107,11 +125,10 @@ static void put_queries(struct ctrl_xc *x, const struct ctrl_args *a,
  * Generic "XX n,n,n" for a value per axis: range check all, then store.
  * @get/@set read and write one axis; @fmt for queries.
  */
-static int axis_values(struct ctrl_xc *x, const char *a, double lo,
-		       double hi, double step, int fmt,
-		       double *(*slot)(struct ctrl *c, int axis,
-				       const void *ud),
-		       const void *ud)
+static int
+axis_values(struct ctrl_xc *x, const char *a, double lo, double hi, double step,
+	    int fmt, double *(*slot)(struct ctrl *c, int axis, const void *ud),
+	    const void *ud)
 {
 	struct ctrl_args args;
 	double cur[CTRL_AXES];
@@ -127,8 +144,8 @@ static int axis_values(struct ctrl_xc *x, const char *a, double lo,
 	for (i = 0; i < CTRL_AXES; i++) {
 		if (args.set[i] != 1)
 			continue;
-		*slot(x->c, i, ud) = step > 0 ?
-			trunc(args.v[i] / step) * step : args.v[i];
+		*slot(x->c, i, ud) =
+		    step > 0 ? trunc(args.v[i] / step) * step : args.v[i];
 	}
 	put_queries(x, &args, cur, fmt);
 	return 0;
@@ -165,8 +182,7 @@ static int cmd_par(struct ctrl_xc *x, const struct par_desc *d, const char *a)
 	return axis_values(x, a, d->lo, d->hi, d->step, d->fmt, par_slot, d);
 }
 
-static int cmd_ipar(struct ctrl_xc *x, const struct ipar_desc *d,
-		    const char *a)
+static int cmd_ipar(struct ctrl_xc *x, const struct ipar_desc *d, const char *a)
 {
 	struct ctrl_args args;
 	double cur[CTRL_AXES];
@@ -176,8 +192,9 @@ static int cmd_ipar(struct ctrl_xc *x, const struct ipar_desc *d,
 		return rc;
 	for (i = 0; i < CTRL_AXES; i++) {
 		cur[i] = *ipar_ptr(&x->c->ax[i].p, d);
-		if (args.set[i] == 1 && (args.v[i] != (int)args.v[i] ||
-					 args.v[i] < d->lo || args.v[i] > d->hi))
+		if (args.set[i] == 1 &&
+		    (args.v[i] != (int)args.v[i] || args.v[i] < d->lo ||
+		     args.v[i] > d->hi))
 			return 6;
 	}
 	for (i = 0; i < CTRL_AXES; i++)
@@ -235,8 +252,8 @@ static int cmd_pr(struct ctrl_xc *x, const char *a)
 	for (i = 0; i < CTRL_AXES; i++) {
 		struct ctrl_axis *ax = &c->ax[i];
 
-		cur[i] = ax->next_mode == CTRL_MODE_PA ? ax->pa - ax->ref :
-							 ax->pr;
+		cur[i] =
+		    ax->next_mode == CTRL_MODE_PA ? ax->pa - ax->ref : ax->pr;
 		if (args.set[i] != 1)
 			continue;
 		if (fabs(args.v[i]) > 2147483647)
@@ -446,7 +463,7 @@ static int switches(const struct ctrl *c, int i, int ts)
 {
 	const struct ctrl_axis *ax = &c->ax[i];
 	double te = round(ax->ref) - round(ax->enc);
-	int v = 0x02;		/* home input: not wired, reads 1 */
+	int v = 0x02; /* home input: not wired, reads 1 */
 
 	if (!ax->lim_f)
 		v |= 0x08;
@@ -527,8 +544,9 @@ static int cmd_report(struct ctrl_xc *x, const char *name, const char *a)
 
 	if (rc)
 		return rc;
-	fmt = strchr("PEDR", name[1]) && name[0] != 'S' ? CTRL_NUM_PF :
-	      !strcmp(name, "TT") ? CTRL_NUM_GAIN : CTRL_NUM_INT;
+	fmt = strchr("PEDR", name[1]) && name[0] != 'S' ? CTRL_NUM_PF
+	      : !strcmp(name, "TT")			? CTRL_NUM_GAIN
+							: CTRL_NUM_INT;
 	for (i = 0; i < CTRL_AXES; i++) {
 		if (!(mask & (1u << i)))
 			continue;
@@ -540,12 +558,6 @@ static int cmd_report(struct ctrl_xc *x, const char *name, const char *a)
 	}
 	ctrl_buf_puts(&x->c->tmp, "\r\n");
 	return 0;
-}
-
-int ctrl_axis_param_get(const struct ctrl *c, const char *name, int axis,
-			double *v)
-{
-	return ctrl_axis_operand((struct ctrl *)c, name, axis, v);
 }
 
 /* ctrl_axis_cmd() - the axis commands of the command table. */

@@ -13,9 +13,9 @@
 #include "ctrl_int.h"
 #include "gl_record.h"
 
-#define F_PROG 1u	/* program only: TC 2 from a host */
-#define F_HOST 2u	/* host only: TC 3 in a program */
-#define F_ASSIGN 4u	/* takes the "XXa=n" single-axis form */
+#define F_PROG	 1u /* program only: TC 2 from a host */
+#define F_HOST	 2u /* host only: TC 3 in a program */
+#define F_ASSIGN 4u /* takes the "XXa=n" single-axis form */
 
 static int cmd_general(struct ctrl_xc *x, const char *name, const char *a);
 static int cmd_mg(struct ctrl_xc *x, const char *name, const char *a);
@@ -29,39 +29,99 @@ struct cmd_ent {
 #define AX ctrl_axis_cmd
 #define FL ctrl_flow_cmd
 #define GE cmd_general
+/* clang-format off */
 static const struct cmd_ent cmd_table[] = {
-	{ "AB", AX, 0 },	{ "AC", AX, F_ASSIGN }, { "AI", FL, F_PROG },
-	{ "AM", FL, F_PROG },	{ "AT", FL, F_PROG },	{ "BG", AX, 0 },
-	{ "BL", AX, F_ASSIGN }, { "BN", GE, 0 },	{ "BP", GE, 0 },
-	{ "BV", GE, 0 },	{ "CB", GE, 0 },	{ "CF", GE, 0 },
-	{ "CN", GE, 0 },	{ "CW", GE, 0 },	{ "DA", GE, 0 },
-	{ "DC", AX, F_ASSIGN }, { "DL", GE, F_HOST },	{ "DM", GE, 0 },
-	{ "DP", AX, F_ASSIGN }, { "EN", FL, F_PROG },	{ "EO", GE, 0 },
-	{ "ER", AX, F_ASSIGN }, { "FL", AX, F_ASSIGN }, { "HX", FL, 0 },
-	{ "IF", FL, F_PROG },	{ "IH", GE, F_ASSIGN }, { "IL", AX, F_ASSIGN },
-	{ "JG", AX, F_ASSIGN }, { "JP", FL, F_PROG },	{ "JS", FL, F_PROG },
-	{ "KD", AX, F_ASSIGN }, { "KI", AX, F_ASSIGN }, { "KP", AX, F_ASSIGN },
-	{ "LA", GE, 0 },	{ "LD", AX, F_ASSIGN }, { "LL", GE, 0 },
-	{ "LS", GE, F_HOST },	{ "LV", GE, 0 },	{ "LZ", GE, 0 },
-	{ "MC", FL, F_PROG },	{ "MF", FL, F_PROG | F_ASSIGN },
-	{ "MG", cmd_mg, 0 },	{ "MO", AX, 0 },
-	{ "MR", FL, F_PROG | F_ASSIGN },		{ "NO", GE, 0 },
-	{ "OA", AX, F_ASSIGN }, { "OB", GE, 0 },	{ "OE", AX, F_ASSIGN },
-	{ "OF", AX, F_ASSIGN }, { "OP", GE, 0 },	{ "OT", AX, F_ASSIGN },
-	{ "OV", AX, F_ASSIGN }, { "PA", AX, F_ASSIGN }, { "PF", GE, 0 },
-	{ "PR", AX, F_ASSIGN }, { "PT", AX, F_ASSIGN }, { "QR", GE, 0 },
-	{ "QZ", GE, 0 },	{ "RE", FL, F_PROG },	{ "RI", FL, F_PROG },
-	{ "RP", AX, 0 },	{ "SB", GE, 0 },	{ "SC", AX, 0 },
-	{ "SD", AX, F_ASSIGN }, { "SH", AX, 0 },	{ "SP", AX, F_ASSIGN },
-	{ "ST", AX, 0 },	{ "TA", GE, 0 },	{ "TB", GE, 0 },
-	{ "TC", GE, 0 },	{ "TD", AX, 0 },	{ "TE", AX, 0 },
-	{ "TH", GE, 0 },	{ "TI", GE, 0 },	{ "TL", AX, F_ASSIGN },
-	{ "TM", GE, 0 },	{ "TP", AX, 0 },	{ "TS", AX, 0 },
-	{ "TT", AX, 0 },	{ "TV", AX, 0 },	{ "TW", AX, F_ASSIGN },
-	{ "UL", GE, F_HOST },	{ "VF", GE, 0 },	{ "WH", GE, F_HOST },
-	{ "WT", FL, F_PROG },	{ "XQ", FL, 0 },	{ "ZA", AX, F_ASSIGN },
-	{ "ZS", FL, F_PROG },
+    {"AB", AX, 0},
+    {"AC", AX, F_ASSIGN},
+    {"AI", FL, F_PROG},
+    {"AM", FL, F_PROG},
+    {"AT", FL, F_PROG},
+    {"BG", AX, 0},
+    {"BL", AX, F_ASSIGN},
+    {"BN", GE, 0},
+    {"BP", GE, 0},
+    {"BV", GE, 0},
+    {"CB", GE, 0},
+    {"CF", GE, 0},
+    {"CN", GE, 0},
+    {"CO", GE, 0},
+    {"CW", GE, 0},
+    {"DA", GE, 0},
+    {"DC", AX, F_ASSIGN},
+    {"DL", GE, F_HOST},
+    {"DM", GE, 0},
+    {"DP", AX, F_ASSIGN},
+    {"EN", FL, F_PROG},
+    {"EO", GE, 0},
+    {"ER", AX, F_ASSIGN},
+    {"FL", AX, F_ASSIGN},
+    {"HX", FL, 0},
+    {"IF", FL, F_PROG},
+    {"IH", GE, F_ASSIGN},
+    {"IL", AX, F_ASSIGN},
+    {"JG", AX, F_ASSIGN},
+    {"JP", FL, F_PROG},
+    {"JS", FL, F_PROG},
+    {"KD", AX, F_ASSIGN},
+    {"KI", AX, F_ASSIGN},
+    {"KP", AX, F_ASSIGN},
+    {"LA", GE, 0},
+    {"LD", AX, F_ASSIGN},
+    {"LL", GE, 0},
+    {"LS", GE, F_HOST},
+    {"LV", GE, 0},
+    {"LZ", GE, 0},
+    {"MC", FL, F_PROG},
+    {"MF", FL, F_PROG | F_ASSIGN},
+    {"MG", cmd_mg, 0},
+    {"MO", AX, 0},
+    {"MR", FL, F_PROG | F_ASSIGN},
+    {"NO", GE, 0},
+    {"OA", AX, F_ASSIGN},
+    {"OB", GE, 0},
+    {"OE", AX, F_ASSIGN},
+    {"OF", AX, F_ASSIGN},
+    {"OP", GE, 0},
+    {"OT", AX, F_ASSIGN},
+    {"OV", AX, F_ASSIGN},
+    {"PA", AX, F_ASSIGN},
+    {"PF", GE, 0},
+    {"PR", AX, F_ASSIGN},
+    {"PT", AX, F_ASSIGN},
+    {"QR", GE, 0},
+    {"QZ", GE, 0},
+    {"RE", FL, F_PROG},
+    {"RI", FL, F_PROG},
+    {"RP", AX, 0},
+    {"SB", GE, 0},
+    {"SC", AX, 0},
+    {"SD", AX, F_ASSIGN},
+    {"SH", AX, 0},
+    {"SP", AX, F_ASSIGN},
+    {"ST", AX, 0},
+    {"TA", GE, 0},
+    {"TB", GE, 0},
+    {"TC", GE, 0},
+    {"TD", AX, 0},
+    {"TE", AX, 0},
+    {"TH", GE, 0},
+    {"TI", GE, 0},
+    {"TL", AX, F_ASSIGN},
+    {"TM", GE, 0},
+    {"TP", AX, 0},
+    {"TS", AX, 0},
+    {"TT", AX, 0},
+    {"TV", AX, 0},
+    {"TW", AX, F_ASSIGN},
+    {"UL", GE, F_HOST},
+    {"VF", GE, 0},
+    {"WH", GE, F_HOST},
+    {"WT", FL, F_PROG},
+    {"XQ", FL, 0},
+    {"ZA", AX, F_ASSIGN},
+    {"ZS", FL, F_PROG},
 };
+/* clang-format on */
 #undef AX
 #undef FL
 #undef GE
@@ -73,7 +133,8 @@ static int ent_cmp(const void *k, const void *e)
 
 static const struct cmd_ent *cmd_find(const char *name)
 {
-	return bsearch(name, cmd_table, sizeof(cmd_table) / sizeof(cmd_table[0]),
+	return bsearch(name, cmd_table,
+		       sizeof(cmd_table) / sizeof(cmd_table[0]),
 		       sizeof(cmd_table[0]), ent_cmp);
 }
 
@@ -106,16 +167,16 @@ int ctrl_cmd_dispatch(struct ctrl_xc *x, const char *name, const char *a)
 /* ctrl_put_num() - one number into the output, CTRL_NUM_* format. */
 int ctrl_put_num(struct ctrl_xc *x, double v, int how)
 {
-	struct ctrl_fmt f = { x->c->lz ? 'Z' : 'F', x->c->vf_m, x->c->vf_n };
+	struct ctrl_fmt f = {x->c->lz ? 'Z' : 'F', x->c->vf_m, x->c->vf_n};
 	char num[48];
 
 	if (how == CTRL_NUM_PF) {
 		f.m = x->c->pf_m;
 		f.n = x->c->pf_n;
 	} else if (how == CTRL_NUM_INT) {
-		f = (struct ctrl_fmt){ 'Z', 10, 0 };
+		f = (struct ctrl_fmt){'Z', 10, 0};
 	} else if (how == CTRL_NUM_GAIN) {
-		f = (struct ctrl_fmt){ 'Z', 10, 4 };
+		f = (struct ctrl_fmt){'Z', 10, 4};
 	}
 	if (ctrl_fmt_num(num, sizeof(num), v, &f) < 0)
 		return 1;
@@ -277,17 +338,16 @@ static int cmd_th(struct ctrl_xc *x)
 	int h;
 
 	ctrl_buf_puts(&c->tmp, "CONTROLLER IP ADDRESS 127,0,0,1 "
-		      "ETHERNET ADDRESS 00-50-4C-20-31-32\r\n");
+			       "ETHERNET ADDRESS 00-50-4C-20-31-32\r\n");
 	for (h = 0; h < CTRL_HANDLES; h++) {
 		if (!c->h[h].open) {
 			ctrl_buf_printf(&c->tmp, "IH%c AVAILABLE\r\n", 'A' + h);
 			continue;
 		}
 		ip_text(c->h[h].peer_ip, ip, sizeof(ip));
-		ctrl_buf_printf(&c->tmp,
-				"IH%c TCP PORT %d TO IP ADDRESS %s PORT %d\r\n",
-				'A' + h, c->h[h].local_port, ip,
-				c->h[h].peer_port);
+		ctrl_buf_printf(
+		    &c->tmp, "IH%c TCP PORT %d TO IP ADDRESS %s PORT %d\r\n",
+		    'A' + h, c->h[h].local_port, ip, c->h[h].peer_port);
 	}
 	return 0;
 }
@@ -298,7 +358,7 @@ static int cmd_qr(struct ctrl_xc *x, const char *a)
 	int n;
 
 	if (*ctrl_skip(a))
-		return 1;	/* QR with block letters: not simulated */
+		return 1; /* QR with block letters: not simulated */
 	n = ctrl_record(x->c, rec, sizeof(rec));
 	if (n <= 0)
 		return 1;
@@ -306,7 +366,8 @@ static int cmd_qr(struct ctrl_xc *x, const char *a)
 	return ctrl_buf_put(&x->c->tmp, rec, (size_t)n) ? 1 : 0;
 }
 
-/* ---- CF CW IH ------------------------------------------------------------- */
+/* ---- CF CW IH -------------------------------------------------------------
+ */
 
 static int cmd_cf(struct ctrl_xc *x, const char *a)
 {
@@ -332,14 +393,14 @@ static int cmd_cf(struct ctrl_xc *x, const char *a)
 static int cmd_cw(struct ctrl_xc *x, const char *a)
 {
 	struct ctrl *c = x->c;
-	double v[2] = { 0, -1 };
+	double v[2] = {0, -1};
 	unsigned got = 0;
 	int rc;
 
 	a = ctrl_skip(a);
 	if (*a == '?' || *a == '\0') {
 		ctrl_buf_puts(&c->tmp, "Copyright (c) Galil Motion Control "
-			      "(galil-sim)\r\n");
+				       "(galil-sim)\r\n");
 		return 0;
 	}
 	rc = ctrl_num_list(x, a, v, 2, &got);
@@ -347,7 +408,7 @@ static int cmd_cw(struct ctrl_xc *x, const char *a)
 		return rc;
 	if ((got & 1) && v[0] == 0) {
 		ctrl_buf_puts(&c->tmp, "Copyright (c) Galil Motion Control "
-			      "(galil-sim)\r\n");
+				       "(galil-sim)\r\n");
 		return 0;
 	}
 	if (((got & 1) && v[0] != 1 && v[0] != 2) ||
@@ -371,17 +432,17 @@ static int cmd_ih(struct ctrl_xc *x, const char *a)
 	h = *a;
 	a = ctrl_skip(a + 1);
 	if (strncmp(a, "=>", 2))
-		return 1;	/* opening outgoing connections: not simulated */
+		return 1; /* opening outgoing connections: not simulated */
 	a = ctrl_skip(a + 2);
 	if (strcmp(a, "-1") && strcmp(a, "-2") && strcmp(a, "-3"))
 		return 6;
 	if (!strcmp(a, "-1"))
-		return 0;	/* UDP handles: the simulator has none */
+		return 0; /* UDP handles: the simulator has none */
 	for (i = 0; i < CTRL_HANDLES; i++) {
 		if (!c->h[i].open)
 			continue;
-		if ((h == 'T' && i != x->handle) || (h == 'S' && i == x->handle) ||
-		    h == 'A' + i)
+		if ((h == 'T' && i != x->handle) ||
+		    (h == 'S' && i == x->handle) || h == 'A' + i)
 			c->h[i].close_wanted = 1;
 	}
 	if (h != 'S' && h != 'T' && (h < 'A' || h >= 'A' + CTRL_HANDLES))
@@ -394,7 +455,7 @@ static int cmd_ih(struct ctrl_xc *x, const char *a)
 static int cmd_bit(struct ctrl_xc *x, const char *name, const char *a)
 {
 	uint32_t *o = &x->c->outputs;
-	double v[2] = { 0, 0 };
+	double v[2] = {0, 0};
 	unsigned got = 0;
 	int n, rc = ctrl_num_list(x, a, v, name[0] == 'O' ? 2 : 1, &got);
 
@@ -428,8 +489,8 @@ static int cmd_ti(struct ctrl_xc *x, const char *a, int amp)
 
 	if (rc)
 		return rc;
-	n = amp ? (n == 0 ? x->c->ta0 : 0) :
-		  (int)((x->c->in.inputs >> (8 * n)) & 0xFF);
+	n = amp ? (n == 0 ? x->c->ta0 : 0)
+		: (int)((x->c->in.inputs >> (8 * n)) & 0xFF);
 	ctrl_buf_printf(&x->c->tmp, " %d\r\n", n);
 	return 0;
 }
@@ -609,7 +670,7 @@ static int cmd_ls_ul(struct ctrl_xc *x, const char *a, int ul)
 	int i;
 
 	if (*ctrl_skip(a))
-		return ul ? 1 : 1;	/* LS n0,n1 / UL n: not simulated */
+		return ul ? 1 : 1; /* LS n0,n1 / UL n: not simulated */
 	for (i = 0; i < c->prog.nlines; i++) {
 		if (!ul)
 			ctrl_buf_printf(&c->tmp, "%d ", i);
@@ -624,11 +685,11 @@ static int cmd_ls_ul(struct ctrl_xc *x, const char *a, int ul)
 static int cmd_dl(struct ctrl_xc *x, const char *a)
 {
 	if (*ctrl_skip(a))
-		return 1;	/* DL n / DL #label partial downloads: no */
+		return 1; /* DL n / DL #label partial downloads: no */
 	if (ctrl_any_running(x->c))
 		return 17;
 	if (x->handle < 0 || x->handle == CTRL_PRIV_HANDLE)
-		return 1;	/* use ctrl_download() */
+		return 1; /* use ctrl_download() */
 	x->dl = 1;
 	return 0;
 }
@@ -655,7 +716,7 @@ static int cmd_burn(struct ctrl_xc *x, const char *name, const char *a)
 /* VF m.n, VF m,n (same for PF) */
 static int cmd_fmt(struct ctrl_xc *x, const char *a, int *m, int *n)
 {
-	double v[2] = { 0, -1 };
+	double v[2] = {0, -1};
 	unsigned got = 0;
 	int rc, mm, nn;
 
@@ -673,6 +734,24 @@ static int cmd_fmt(struct ctrl_xc *x, const char *a, int *m, int *n)
 		return 6;
 	*m = mm;
 	*n = nn;
+	return 0;
+}
+
+/* CO n: extended I/O configuration, n = 0..15 (a bit per bank of 8 from
+ * I/O 17; set = outputs). Stored and reported only: the simulated extended
+ * I/O are always inputs (docs/galil-sim-controller.md). */
+static int cmd_co(struct ctrl_xc *x, const char *a)
+{
+	int n, rc;
+
+	if (*ctrl_skip(a) == '?') {
+		ctrl_buf_printf(&x->c->tmp, " %d\r\n", x->c->co);
+		return 0;
+	}
+	rc = int_arg(x, a, 0, 15, -1, &n);
+	if (rc)
+		return rc;
+	x->c->co = n;
 	return 0;
 }
 
@@ -697,7 +776,7 @@ static int cmd_tm(struct ctrl_xc *x, const char *a)
 static int cmd_settings(struct ctrl_xc *x, const char *name, const char *a)
 {
 	struct ctrl *c = x->c;
-	double v[5] = { -1, 0, 0, 0, 0 };
+	double v[5] = {-1, 0, 0, 0, 0};
 	int n, rc;
 
 	if (!strcmp(name, "LZ")) {
@@ -707,7 +786,7 @@ static int cmd_settings(struct ctrl_xc *x, const char *name, const char *a)
 		return rc;
 	}
 	if (!strcmp(name, "EO"))
-		return int_arg(x, a, 0, 1, -1, &n);	/* no echo on TCP */
+		return int_arg(x, a, 0, 1, -1, &n); /* no echo on TCP */
 	/* CN n0,...: only the limit switch polarity n0 is simulated */
 	rc = ctrl_num_list(x, a, v, 5, NULL);
 	if (rc)
@@ -777,6 +856,7 @@ static int cmd_general(struct ctrl_xc *x, const char *name, const char *a)
 	case 'B' << 8 | 'V': return cmd_burn(x, name, a);
 	case 'N' << 8 | 'O': return 0;
 	case 'T' << 8 | 'M': return cmd_tm(x, a);
+	case 'C' << 8 | 'O': return cmd_co(x, a);
 	case 'V' << 8 | 'F': return cmd_fmt(x, a, &x->c->vf_m, &x->c->vf_n);
 	case 'P' << 8 | 'F': return cmd_fmt(x, a, &x->c->pf_m, &x->c->pf_n);
 	case 'L' << 8 | 'Z':

@@ -28,44 +28,44 @@ static const struct {
 	int tc;
 	const char *text;
 } tc_table[] = {
-	{ 1, "Unrecognized command" },
-	{ 2, "Command only valid from program" },
-	{ 3, "Command not valid in program" },
-	{ 4, "Operand error" },
-	{ 5, "Input buffer full" },
-	{ 6, "Number out of range" },
-	{ 7, "Command not valid while running" },
-	{ 8, "Command not valid while not running" },
-	{ 9, "Variable error" },
-	{ 10, "Empty program line or undefined label" },
-	{ 11, "Invalid label or line number" },
-	{ 12, "Subroutine more than 16 deep" },
-	{ 13, "JG only valid when running in jog mode" },
-	{ 16, "IP incorrect sign during position move or IP given during "
-	      "forced deceleration" },
-	{ 17, "ED, BN and DL not valid while program running" },
-	{ 19, "Application strand already executing" },
-	{ 20, "Begin not valid with motor off" },
-	{ 21, "Begin not valid while running" },
-	{ 22, "Begin not possible due to Limit Switch" },
-	{ 50, "Not enough fields" },
-	{ 51, "Question mark not valid" },
-	{ 52, "Missing \" or string too long" },
-	{ 53, "Error in {}" },
-	{ 54, "Question mark part of string" },
-	{ 55, "Missing [ or []" },
-	{ 56, "Array index invalid or out of range" },
-	{ 57, "Bad function or array" },
-	{ 59, "Mismatched parentheses" },
-	{ 60, "Download error - line too long or too many lines" },
-	{ 61, "Duplicate or bad label" },
-	{ 62, "Too many labels" },
-	{ 63, "IF statement without ENDIF" },
-	{ 66, "Array space full" },
-	{ 67, "Too many arrays or variables" },
-	{ 123, "TCP lost sync" },
-	{ 126, "Closed Ethernet handle" },
-	{ 134, "All motors must be in MO for this command" },
+    {1, "Unrecognized command"},
+    {2, "Command only valid from program"},
+    {3, "Command not valid in program"},
+    {4, "Operand error"},
+    {5, "Input buffer full"},
+    {6, "Number out of range"},
+    {7, "Command not valid while running"},
+    {8, "Command not valid while not running"},
+    {9, "Variable error"},
+    {10, "Empty program line or undefined label"},
+    {11, "Invalid label or line number"},
+    {12, "Subroutine more than 16 deep"},
+    {13, "JG only valid when running in jog mode"},
+    {16, "IP incorrect sign during position move or IP given during "
+	 "forced deceleration"},
+    {17, "ED, BN and DL not valid while program running"},
+    {19, "Application strand already executing"},
+    {20, "Begin not valid with motor off"},
+    {21, "Begin not valid while running"},
+    {22, "Begin not possible due to Limit Switch"},
+    {50, "Not enough fields"},
+    {51, "Question mark not valid"},
+    {52, "Missing \" or string too long"},
+    {53, "Error in {}"},
+    {54, "Question mark part of string"},
+    {55, "Missing [ or []"},
+    {56, "Array index invalid or out of range"},
+    {57, "Bad function or array"},
+    {59, "Mismatched parentheses"},
+    {60, "Download error - line too long or too many lines"},
+    {61, "Duplicate or bad label"},
+    {62, "Too many labels"},
+    {63, "IF statement without ENDIF"},
+    {66, "Array space full"},
+    {67, "Too many arrays or variables"},
+    {123, "TCP lost sync"},
+    {126, "Closed Ethernet handle"},
+    {134, "All motors must be in MO for this command"},
 };
 
 const char *ctrl_tc_text(int tc)
@@ -82,7 +82,7 @@ const char *ctrl_tc_text(int tc)
 
 static int var_query(struct ctrl_xc *x, double v)
 {
-	struct ctrl_fmt f = { x->c->lz ? 'Z' : 'F', x->c->vf_m, x->c->vf_n };
+	struct ctrl_fmt f = {x->c->lz ? 'Z' : 'F', x->c->vf_m, x->c->vf_n};
 	char num[48];
 
 	if (ctrl_fmt_num(num, sizeof(num), v, &f) < 0)
@@ -111,7 +111,7 @@ static int array_stmt(struct ctrl_xc *x, uint64_t key, const char *s)
 
 	if (!arr)
 		return 57;
-	s = ctrl_skip(s) + 1;	/* '[' */
+	s = ctrl_skip(s) + 1; /* '[' */
 	rc = ctrl_expr(x, &s, &idx);
 	if (rc)
 		return rc;
@@ -246,16 +246,13 @@ int ctrl_exec(struct ctrl_xc *x, const char *s)
 	s = ctrl_skip(s);
 	switch (*s) {
 	case '\0':
-	case '\'':
-		return 0;
-	case '#':
-		return x->thread >= 0 ? 0 : 1;
+	case '\'': return 0;
+	case '#': return x->thread >= 0 ? 0 : 1;
 	case '^':
 		if (s[1] < 'a' || s[1] > 'h')
 			return 1;
 		return param_stmt(x, s);
-	case '~':
-		return axdes_stmt(x, s);
+	case '~': return axdes_stmt(x, s);
 	}
 	if (isalpha((unsigned char)*s))
 		return word_stmt(x, s);
@@ -323,7 +320,7 @@ int ctrl_thread_waiting(const struct ctrl *c, int t)
 /* ---- automatic subroutines ----------------------------------------- */
 
 static const char *const autosub_name[CTRL_AS_N] = {
-	"CMDERR", "POSERR", "LIMSWI", "AMPERR", "MCTIME", "TCPERR",
+    "CMDERR", "POSERR", "LIMSWI", "AMPERR", "MCTIME", "TCPERR",
 };
 
 /* ctrl_autosub_label() - line of #CMDERR etc. in the program, or -1. */
@@ -440,8 +437,8 @@ static void thread_error(struct ctrl *c, int t, int stmt, int tc)
 	c->tc = tc;
 	c->ed_line = line;
 	c->ed_thread = t;
-	ctrl_event(c, "program error thread %d line %d TC %d %s", t, line,
-		   tc, ctrl_tc_text(tc));
+	ctrl_event(c, "program error thread %d line %d TC %d %s", t, line, tc,
+		   ctrl_tc_text(tc));
 	snprintf(why, sizeof(why), "error TC %d at line %d in thread %d", tc,
 		 line, t);
 	if (ctrl_autosub_label(c, CTRL_AS_CMDERR) >= 0 &&
@@ -473,7 +470,7 @@ static void thread_end(struct ctrl *c, int t)
 static int run_stmt(struct ctrl *c, int t, int line)
 {
 	struct ctrl_thread *th = &c->th[t];
-	struct ctrl_xc x = { c, t, -1, th->pc, CTRL_ROUTE_DEFAULT, 0, 0 };
+	struct ctrl_xc x = {c, t, -1, th->pc, CTRL_ROUTE_DEFAULT, 0, 0};
 	const char *text = ctrl_prog_stmt(&c->prog, th->pc);
 	int i = th->pc, rc;
 

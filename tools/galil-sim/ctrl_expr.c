@@ -19,8 +19,8 @@
 
 #include "ctrl_int.h"
 
-#define EXPR_DEPTH 40		/* nested parentheses / unary signs */
-#define DEG (M_PI / 180.0)
+#define EXPR_DEPTH 40 /* nested parentheses / unary signs */
+#define DEG	   (M_PI / 180.0)
 
 const char *ctrl_skip(const char *s)
 {
@@ -113,10 +113,10 @@ static int num_hex(const char **p, double *out)
 				fp |= (uint64_t)hexval(*s) << (12 - 4 * k);
 	if (n == 0)
 		return 1;
-	raw = ip << 16 | fp;	/* 48 bits, two's complement */
-	*out = ctrl_fx_from_raw(raw & (1ull << 47) ?
-					(int64_t)raw - ((int64_t)1 << 48) :
-					(int64_t)raw);
+	raw = ip << 16 | fp; /* 48 bits, two's complement */
+	*out = ctrl_fx_from_raw(raw & (1ull << 47)
+				    ? (int64_t)raw - ((int64_t)1 << 48)
+				    : (int64_t)raw);
 	*p = s;
 	return 0;
 }
@@ -229,7 +229,7 @@ static int func_math(const char *f, double a, double *out)
 			return 6;
 		*out = (f[1] == 'S' ? asin(a) : acos(a)) / DEG;
 	} else if (!strcmp(f, "COM")) {
-		*out = (double)(int32_t)~(uint32_t)(int32_t)fx_int(a);
+		*out = (double)(int32_t) ~(uint32_t)(int32_t)fx_int(a);
 	} else if (!strcmp(f, "FLOT")) {
 		fl = (float)a;
 		memcpy(&i32, &fl, sizeof(i32));
@@ -252,7 +252,7 @@ static int func(struct ctrl_xc *x, const char **p, double *out)
 	double a;
 	int rc;
 
-	while (isupper((unsigned char)s[n]) && n < sizeof(name) - 1) {
+	while (n < sizeof(name) - 1 && isupper((unsigned char)s[n])) {
 		name[n] = s[n];
 		n++;
 	}
@@ -261,8 +261,7 @@ static int func(struct ctrl_xc *x, const char **p, double *out)
 	rc = bracket(x, &s, &a);
 	if (rc)
 		return rc;
-	if (!strcmp(name, "IN") || !strcmp(name, "OUT") ||
-	    !strcmp(name, "AN"))
+	if (!strcmp(name, "IN") || !strcmp(name, "OUT") || !strcmp(name, "AN"))
 		rc = func_io(x->c, name, a, out);
 	else
 		rc = func_math(name, a, out);
@@ -353,7 +352,7 @@ static int special(struct ctrl_xc *x, const char **p, double *out)
 		if (!pp)
 			return 1;
 		if (*ctrl_skip(s + 2) == '[')
-			return 57;	/* arrays passed on the stack: no */
+			return 57; /* arrays passed on the stack: no */
 		*out = *pp;
 		*p = s + 2;
 		return 0;
@@ -385,18 +384,13 @@ static int primary(struct ctrl_xc *x, const char **p, double *out)
 			return 59;
 		*p = s + 1;
 		return 0;
-	case '$':
-		return num_hex(p, out);
-	case '"':
-		return str_lit(p, out);
-	case '@':
-		return func(x, p, out);
-	case '_':
-		return ctrl_operand(x, p, out);
+	case '$': return num_hex(p, out);
+	case '"': return str_lit(p, out);
+	case '@': return func(x, p, out);
+	case '_': return ctrl_operand(x, p, out);
 	case '^':
 	case '~':
-	case '#':
-		return special(x, p, out);
+	case '#': return special(x, p, out);
 	}
 	if (isdigit((unsigned char)*s) || *s == '.')
 		return num_dec(p, out);
@@ -436,10 +430,14 @@ static int binop(const char **p)
 	int op = 0;
 
 	switch (*s) {
-	case '+': case '-': case '*': case '/': case '%':
-	case '&': case '|': case '=':
-		op = *s++;
-		break;
+	case '+':
+	case '-':
+	case '*':
+	case '/':
+	case '%':
+	case '&':
+	case '|':
+	case '=': op = *s++; break;
 	case '<':
 		s++;
 		op = *s == '=' ? (s++, 'l') : *s == '>' ? (s++, 'n') : '<';
@@ -465,7 +463,7 @@ static int apply(int op, double a, double b, double *out)
 	case '/':
 	case '%':
 		if (b == 0)
-			return 6;	/* UNCONFIRMED: firmware result of x/0 */
+			return 6; /* UNCONFIRMED: firmware result of x/0 */
 		*out = op == '/' ? a / b : fmod(a, b);
 		break;
 	case '&':

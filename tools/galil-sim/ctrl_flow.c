@@ -40,7 +40,7 @@ int ctrl_goto_line(struct ctrl_xc *x, double line)
  * @present: [out] optional, bit i set when field i was given.
  */
 int ctrl_num_list(struct ctrl_xc *x, const char *a, double *v, int max,
-		    unsigned *present)
+		  unsigned *present)
 {
 	unsigned got = 0;
 	int i = 0, rc;
@@ -116,7 +116,7 @@ static int jump_cond(struct ctrl_xc *x, const char *s, int *take)
 static int cmd_jp(struct ctrl_xc *x, const char *a)
 {
 	double line;
-	int rc, take;
+	int rc, take = 0;
 
 	rc = ctrl_expr(x, &a, &line);
 	if (!rc)
@@ -142,8 +142,8 @@ static int js_args(struct ctrl_xc *x, const char **p, struct ctrl_frame *f)
 			rc = ctrl_name_key(s + 1, n, &key);
 			if (rc)
 				return rc;
-			f->ref[f->npar] = (int16_t)ctrl_var_find(&x->c->vars,
-								 key);
+			f->ref[f->npar] =
+			    (int16_t)ctrl_var_find(&x->c->vars, key);
 			if (f->ref[f->npar] < 0)
 				return 1;
 			s += n + 1;
@@ -168,7 +168,7 @@ static int cmd_js(struct ctrl_xc *x, const char *a)
 	struct ctrl_thread *t = cur(x);
 	struct ctrl_frame f;
 	double line;
-	int rc, take;
+	int rc, take = 0;
 
 	memset(&f, 0, sizeof(f));
 	memset(f.ref, 0xff, sizeof(f.ref));
@@ -218,13 +218,13 @@ static int do_return(struct ctrl_xc *x, int restore, int has_ret, double ret)
 	}
 	t->next_pc = f->ret_pc;
 	if (f->kind == CTRL_FR_AUTO)
-		t->wait = restore ? f->saved : (struct ctrl_wait){ 0 };
+		t->wait = restore ? f->saved : (struct ctrl_wait){0};
 	return 0;
 }
 
 static int cmd_en(struct ctrl_xc *x, const char *a)
 {
-	double v[3] = { 0, 0, 0 };
+	double v[3] = {0, 0, 0};
 	unsigned got = 0;
 	int rc = ctrl_num_list(x, a, v, 3, &got);
 
@@ -263,7 +263,7 @@ static int cmd_zs(struct ctrl_xc *x, const char *a)
 static int cmd_xq(struct ctrl_xc *x, const char *a)
 {
 	struct ctrl *c = x->c;
-	double v[3] = { 0, 0, 0 };
+	double v[3] = {0, 0, 0};
 	int rc = ctrl_num_list(x, a, v, 3, NULL), t, line;
 
 	if (rc)
@@ -310,15 +310,15 @@ static void park(struct ctrl_xc *x, const struct ctrl_wait *w)
 	struct ctrl_thread *t = cur(x);
 
 	t->wait = *w;
-	ctrl_wait_done(x->c, t);	/* already satisfied? go on */
+	ctrl_wait_done(x->c, t); /* already satisfied? go on */
 }
 
 /* WT n[,1] and AT n[,1]: milliseconds, or samples with ",1". */
 static int cmd_time(struct ctrl_xc *x, const char *a, int at)
 {
 	struct ctrl_thread *t = cur(x);
-	struct ctrl_wait w = { CTRL_W_UNTIL, 0, 0, 0, 0, 0, 0 };
-	double v[2] = { 0, 0 };
+	struct ctrl_wait w = {CTRL_W_UNTIL, 0, 0, 0, 0, 0, 0};
+	double v[2] = {0, 0};
 	int64_t n;
 	int rc = ctrl_num_list(x, a, v, 2, NULL);
 
@@ -345,7 +345,7 @@ static int cmd_time(struct ctrl_xc *x, const char *a, int at)
 
 static int cmd_am(struct ctrl_xc *x, const char *a, int mc)
 {
-	struct ctrl_wait w = { mc ? CTRL_W_MC : CTRL_W_AM, -1, 0, 0, 0, 0, 0 };
+	struct ctrl_wait w = {mc ? CTRL_W_MC : CTRL_W_AM, -1, 0, 0, 0, 0, 0};
 	int rc = ctrl_parse_mask(x, a, &w.mask);
 
 	if (rc)
@@ -356,7 +356,7 @@ static int cmd_am(struct ctrl_xc *x, const char *a, int mc)
 
 static int cmd_mfr(struct ctrl_xc *x, const char *a, int fwd)
 {
-	struct ctrl_wait w = { fwd ? CTRL_W_MF : CTRL_W_MR, 0, 0, 0, 0, 0, 0 };
+	struct ctrl_wait w = {fwd ? CTRL_W_MF : CTRL_W_MR, 0, 0, 0, 0, 0, 0};
 	struct ctrl_args args;
 	int rc = ctrl_parse_axis_args(x, a, &args), i, n = 0;
 
@@ -379,7 +379,7 @@ static int cmd_mfr(struct ctrl_xc *x, const char *a, int fwd)
 
 static int cmd_ai(struct ctrl_xc *x, const char *a)
 {
-	struct ctrl_wait w = { CTRL_W_AI, 0, 0, 0, 0, 0, 0 };
+	struct ctrl_wait w = {CTRL_W_AI, 0, 0, 0, 0, 0, 0};
 	double v = 0;
 	int rc = ctrl_expr_end(x, a, &v);
 
@@ -395,6 +395,7 @@ static int cmd_ai(struct ctrl_xc *x, const char *a)
 
 static int mc_done(struct ctrl *c, struct ctrl_wait *w)
 {
+	double tw = -1;
 	int i, inpos = 1;
 
 	for (i = 0; i < CTRL_AXES; i++) {
@@ -408,12 +409,16 @@ static int mc_done(struct ctrl *c, struct ctrl_wait *w)
 		}
 		if (fabs(ax->ref - ax->enc) >= 1)
 			inpos = 0;
+		if (ax->p.tw > tw)
+			tw = ax->p.tw;
 	}
 	if (inpos)
 		return 1;
+	if (tw < 0)
+		return 0; /* TW -1: no timeout */
 	if (w->until < 0)
-		w->until = c->time + ctrl_samples(c, c->ax[0].p.tw);
-	if (c->time < w->until || c->ax[0].p.tw < 0)
+		w->until = c->time + ctrl_samples(c, tw);
+	if (c->time < w->until)
 		return 0;
 	for (i = 0; i < CTRL_AXES; i++)
 		if (w->mask & (1u << i))
@@ -431,23 +436,15 @@ int ctrl_wait_done(struct ctrl *c, struct ctrl_thread *t)
 
 	switch (w->kind) {
 	case CTRL_W_UNTIL:
-	case CTRL_W_RETRY:
-		done = c->time >= w->until;
-		break;
+	case CTRL_W_RETRY: done = c->time >= w->until; break;
 	case CTRL_W_AM:
 		for (i = 0; i < CTRL_AXES; i++)
 			if ((w->mask & (1u << i)) && c->ax[i].profiling)
 				done = 0;
 		break;
-	case CTRL_W_MC:
-		done = mc_done(c, w);
-		break;
-	case CTRL_W_MF:
-		done = c->ax[w->axis].enc >= w->pos;
-		break;
-	case CTRL_W_MR:
-		done = c->ax[w->axis].enc <= w->pos;
-		break;
+	case CTRL_W_MC: done = mc_done(c, w); break;
+	case CTRL_W_MF: done = c->ax[w->axis].enc >= w->pos; break;
+	case CTRL_W_MR: done = c->ax[w->axis].enc <= w->pos; break;
 	case CTRL_W_AI:
 		done = (int)((c->in.inputs >> (w->input - 1)) & 1) == w->level;
 		break;

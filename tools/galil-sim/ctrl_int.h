@@ -27,46 +27,46 @@
 #include "ctrl.h"
 
 /* Limits of a DMC-40x0 (galil-notes.md 3.4; DMC command reference). */
-#define CTRL_LINE_MAX 80	/* characters per line (host and program) */
-#define CTRL_PROG_LINES 4000	/* program lines */
-#define CTRL_LABELS 510		/* labels */
-#define CTRL_VARS 510		/* variables */
-#define CTRL_VAR_SLOTS 1024	/* hash slots, power of two > 2 * CTRL_VARS */
-#define CTRL_ARRAYS 30		/* arrays */
-#define CTRL_ARRAY_SPACE 24000	/* array elements in total */
-#define CTRL_STACK_DEPTH 16	/* JS nesting (TC 12) */
-#define CTRL_NAME_MAX 8		/* variable / array name characters */
-#define CTRL_LABEL_MAX 7	/* label characters after '#' */
-#define CTRL_NPARAM 8		/* ^a .. ^h */
+#define CTRL_LINE_MAX	 80    /* characters per line (host and program) */
+#define CTRL_PROG_LINES	 4000  /* program lines */
+#define CTRL_LABELS	 510   /* labels */
+#define CTRL_VARS	 510   /* variables */
+#define CTRL_VAR_SLOTS	 1024  /* hash slots, power of two > 2 * CTRL_VARS */
+#define CTRL_ARRAYS	 30    /* arrays */
+#define CTRL_ARRAY_SPACE 24000 /* array elements in total */
+#define CTRL_STACK_DEPTH 16    /* JS nesting (TC 12) */
+#define CTRL_NAME_MAX	 8     /* variable / array name characters */
+#define CTRL_LABEL_MAX	 7     /* label characters after '#' */
+#define CTRL_NPARAM	 8     /* ^a .. ^h */
 
 /* Model choices (documented in docs/galil-sim-controller.md). */
-#define CTRL_LINES_PER_SAMPLE 16	/* program lines per servo sample */
-#define CTRL_UNSOL_FIFO 1024	/* bytes pending on a handle = "FIFO full" */
-#define CTRL_OUT_MAX (4u << 20)	/* bytes pending on a handle before dropping */
-#define CTRL_SERIAL_MAX 65536	/* bytes kept for the (absent) serial port */
-#define CTRL_TV_SAMPLES 256	/* TV averaging window, samples (~0.25 s) */
+#define CTRL_LINES_PER_SAMPLE 16   /* program lines per servo sample */
+#define CTRL_UNSOL_FIFO	      1024 /* bytes pending on a handle = "FIFO full" */
+#define CTRL_OUT_MAX	      (4u << 20) /* bytes kept for a host, at most */
+#define CTRL_SERIAL_MAX	      65536 /* bytes kept for the (absent) serial port */
+#define CTRL_TV_SAMPLES	      256   /* TV averaging window, samples (~0.25 s) */
 
-#define CTRL_NHANDLES (CTRL_HANDLES + 1)
-#define CTRL_PRIV_HANDLE CTRL_HANDLES	/* ctrl_command()'s private port */
-#define CTRL_SERIAL (-1)		/* CF S */
+#define CTRL_NHANDLES	 (CTRL_HANDLES + 1)
+#define CTRL_PRIV_HANDLE CTRL_HANDLES /* ctrl_command()'s private port */
+#define CTRL_SERIAL	 (-1)	      /* CF S */
 
 /* Special statement results besides 0 (ok) and TC codes (> 0). */
-#define CTRL_RETRY (-1)		/* run the same statement again next sample */
-#define CTRL_STOP (-2)		/* the running thread was halted (HX, AB) */
+#define CTRL_RETRY (-1) /* run the same statement again next sample */
+#define CTRL_STOP  (-2) /* the running thread was halted (HX, AB) */
 
 /* ---- growable buffer (ctrl_buf.c) ------------------------------------- */
 
 struct ctrl_buf {
 	uint8_t *p;
-	size_t start;		/* first unread byte */
-	size_t len;		/* end of data */
+	size_t start; /* first unread byte */
+	size_t len;   /* end of data */
 	size_t cap;
 };
 
 int ctrl_buf_put(struct ctrl_buf *b, const void *data, size_t n);
 int ctrl_buf_puts(struct ctrl_buf *b, const char *s);
 int ctrl_buf_printf(struct ctrl_buf *b, const char *fmt, ...)
-	__attribute__((format(printf, 2, 3)));
+    __attribute__((format(printf, 2, 3)));
 size_t ctrl_buf_pending(const struct ctrl_buf *b);
 size_t ctrl_buf_take(struct ctrl_buf *b, uint8_t *out, size_t cap);
 void ctrl_buf_clear(struct ctrl_buf *b);
@@ -75,32 +75,31 @@ void ctrl_buf_free(struct ctrl_buf *b);
 /* ---- numbers (ctrl_num.c) ------------------------------------------- */
 
 #define CTRL_FX_ONE 65536.0
-#define CTRL_FX_MAX 2147483647.99998474	/* $7FFFFFFF.FFFF */
+#define CTRL_FX_MAX 2147483647.99998474 /* $7FFFFFFF.FFFF */
 
 /* Format of one printed number: F (leading zeros), Z (none), $ (hex). */
 struct ctrl_fmt {
-	char kind;		/* 'F', 'Z', '$', 'S' */
-	int m;			/* digits left of the point (S: characters) */
-	int n;			/* digits right of the point */
+	char kind; /* 'F', 'Z', '$', 'S' */
+	int m;	   /* digits left of the point (S: characters) */
+	int n;	   /* digits right of the point */
 };
 
 double ctrl_fx(double v);
 int64_t ctrl_fx_raw(double v);
 double ctrl_fx_from_raw(int64_t raw);
 int ctrl_fmt_num(char *out, size_t cap, double v, const struct ctrl_fmt *f);
-int ctrl_fmt_int(char *out, size_t cap, double v);
 double ctrl_str_value(const char *s, size_t n);
 
 /* ---- names, variables and arrays (ctrl_var.c) ------------------------ */
 
 struct ctrl_var {
-	uint64_t key;		/* packed name, 0 = free slot */
+	uint64_t key; /* packed name, 0 = free slot */
 	double v;
 };
 
 struct ctrl_array {
-	uint64_t key;		/* 0 = free */
-	int n;			/* elements */
+	uint64_t key; /* 0 = free */
+	int n;	      /* elements */
 	double *v;
 };
 
@@ -108,7 +107,7 @@ struct ctrl_vars {
 	struct ctrl_var slot[CTRL_VAR_SLOTS];
 	int count;
 	struct ctrl_array arr[CTRL_ARRAYS];
-	int arr_used;		/* elements allocated in total */
+	int arr_used; /* elements allocated in total */
 };
 
 size_t ctrl_ident_len(const char *s);
@@ -132,11 +131,11 @@ enum ctrl_flow {
 };
 
 struct ctrl_stmt {
-	int line;		/* 0-based program line */
-	uint8_t off, len;	/* text within the line */
-	int text;		/* the text, NUL-terminated, in pool[] */
-	uint8_t flow;		/* enum ctrl_flow */
-	int match;		/* IF -> its ELSE/ENDIF, ELSE -> ENDIF, or -1 */
+	int line;	  /* 0-based program line */
+	uint8_t off, len; /* text within the line */
+	int text;	  /* the text, NUL-terminated, in pool[] */
+	uint8_t flow;	  /* enum ctrl_flow */
+	int match;	  /* IF -> its ELSE/ENDIF, ELSE -> ENDIF, or -1 */
 };
 
 struct ctrl_label {
@@ -147,12 +146,12 @@ struct ctrl_label {
 struct ctrl_prog {
 	int nlines;
 	char (*line)[CTRL_LINE_MAX + 1];
-	int *first;		/* first statement of each line */
+	int *first; /* first statement of each line */
 	int nstmts;
 	struct ctrl_stmt *stmt;
 	int nlabels;
-	struct ctrl_label *label;	/* sorted by key */
-	char *pool;		/* statement texts */
+	struct ctrl_label *label; /* sorted by key */
+	char *pool;		  /* statement texts */
 	size_t pool_len, pool_cap;
 };
 
@@ -169,19 +168,19 @@ const char *ctrl_prog_stmt(const struct ctrl_prog *p, int i);
 
 enum ctrl_wait_kind {
 	CTRL_W_NONE,
-	CTRL_W_UNTIL,		/* WT / AT: TIME >= until */
-	CTRL_W_AM,		/* profilers of mask idle */
-	CTRL_W_MC,		/* AM plus encoder in position, TW timeout */
-	CTRL_W_MF,		/* _TP of axis >= pos */
-	CTRL_W_MR,		/* _TP of axis <= pos */
-	CTRL_W_AI,		/* input at level */
-	CTRL_W_RETRY,		/* statement retried (MG into a full FIFO) */
+	CTRL_W_UNTIL, /* WT / AT: TIME >= until */
+	CTRL_W_AM,    /* profilers of mask idle */
+	CTRL_W_MC,    /* AM plus encoder in position, TW timeout */
+	CTRL_W_MF,    /* _TP of axis >= pos */
+	CTRL_W_MR,    /* _TP of axis <= pos */
+	CTRL_W_AI,    /* input at level */
+	CTRL_W_RETRY, /* statement retried (MG into a full FIFO) */
 };
 
 struct ctrl_wait {
 	int kind;
-	int64_t until;		/* sample number (W_UNTIL; W_MC timeout) */
-	unsigned mask;		/* axes */
+	int64_t until; /* sample number (W_UNTIL; W_MC timeout) */
+	unsigned mask; /* axes */
 	int axis, input, level;
 	double pos;
 };
@@ -202,26 +201,26 @@ enum ctrl_frame_kind {
 };
 
 struct ctrl_frame {
-	int ret_pc;		/* statement to return to, -1 = end thread */
-	int kind;		/* enum ctrl_frame_kind */
-	int autosub;		/* enum ctrl_autosub for CTRL_FR_AUTO */
-	struct ctrl_wait saved;	/* interrupted trippoint (RE1/EN1) */
-	double par[CTRL_NPARAM];	/* ^a..^h of the called routine */
-	int16_t ref[CTRL_NPARAM];	/* variable slot when passed by &ref */
+	int ret_pc;		  /* statement to return to, -1 = end thread */
+	int kind;		  /* enum ctrl_frame_kind */
+	int autosub;		  /* enum ctrl_autosub for CTRL_FR_AUTO */
+	struct ctrl_wait saved;	  /* interrupted trippoint (RE1/EN1) */
+	double par[CTRL_NPARAM];  /* ^a..^h of the called routine */
+	int16_t ref[CTRL_NPARAM]; /* variable slot when passed by &ref */
 	int npar;
 };
 
 struct ctrl_thread {
 	int running;
-	int pc;			/* next statement */
+	int pc; /* next statement */
 	int depth;
 	struct ctrl_frame stack[CTRL_STACK_DEPTH];
 	struct ctrl_wait wait;
-	int64_t at_ref;		/* AT reference, sample number */
-	double js_ret;		/* _JS */
-	double par0[CTRL_NPARAM];	/* ^a..^h outside any subroutine */
-	int next_pc;		/* set while a statement runs */
-	int line;		/* _XQn: line of the current statement */
+	int64_t at_ref;		  /* AT reference, sample number */
+	double js_ret;		  /* _JS */
+	double par0[CTRL_NPARAM]; /* ^a..^h outside any subroutine */
+	int next_pc;		  /* set while a statement runs */
+	int line;		  /* _XQn: line of the current statement */
 };
 
 /* ---- axes ----------------------------------------------------------- */
@@ -235,12 +234,12 @@ enum ctrl_mode {
 
 /* Parameters BN burns (with the motor state). */
 struct ctrl_axis_par {
-	double sp, ac, dc, sd;	/* counts/s, counts/s^2 */
-	double kp, ki, kd, tl, il, of, ov;	/* gains; volts */
-	double er;		/* counts, -1 = off */
-	double fl, bl;		/* soft limits, counts */
+	double sp, ac, dc, sd;		   /* counts/s, counts/s^2 */
+	double kp, ki, kd, tl, il, of, ov; /* gains; volts */
+	double er;			   /* counts, -1 = off */
+	double fl, bl;			   /* soft limits, counts */
 	int oe, oa, ot, ld;
-	double tw;		/* MC timeout, ms (-1 = off) */
+	double tw; /* MC timeout, ms (-1 = off) */
 	int motor_off;
 };
 
@@ -248,21 +247,21 @@ struct ctrl_axis {
 	struct ctrl_axis_par p;
 	/* staged motion */
 	double jg, pr, pa;
-	int next_mode;		/* enum ctrl_mode for the next BG */
-	int pt;			/* position tracking on */
-	double za;		/* ZA user field */
-	double pa_last;		/* _PA: where motion last stopped */
+	int next_mode;	/* enum ctrl_mode for the next BG */
+	int pt;		/* position tracking on */
+	double za;	/* ZA user field */
+	double pa_last; /* _PA: where motion last stopped */
 	/* profiler */
 	int profiling, stopping, mode;
 	double ref, vel, target, stop_dec;
 	/* feedback */
-	double enc, offset;	/* controller counts = plant + offset */
-	int lim_f, lim_r;	/* switch active, after CN and LD */
+	double enc, offset; /* controller counts = plant + offset */
+	int lim_f, lim_r;   /* switch active, after CN and LD */
 	int stop_code;
 	/* servo and protection */
 	double err_prev, integ, torque;
-	int poserr;		/* |TE| > ER latched until back below */
-	int amp_fault;		/* amplifier fault seen while enabled */
+	int poserr;    /* |TE| > ER latched until back below */
+	int amp_fault; /* amplifier fault seen while enabled */
 	int oa_cnt;
 	double oa_enc0;
 	double tv_ring[CTRL_TV_SAMPLES];
@@ -279,16 +278,16 @@ enum ctrl_hmode {
 struct ctrl_handle {
 	int open;
 	int close_wanted;
-	int mode;		/* enum ctrl_hmode */
+	int mode; /* enum ctrl_hmode */
 	char line[CTRL_LINE_MAX + 1];
-	size_t len;		/* characters in line */
-	int overflow;		/* line longer than CTRL_LINE_MAX */
-	int semis;		/* ';' seen in an overflowing line */
-	struct ctrl_buf dl;	/* download text */
-	int dl_err;		/* TC of the first bad line, 0 */
+	size_t len;	    /* characters in line */
+	int overflow;	    /* line longer than CTRL_LINE_MAX */
+	int semis;	    /* ';' seen in an overflowing line */
+	struct ctrl_buf dl; /* download text */
+	int dl_err;	    /* TC of the first bad line, 0 */
 	int dl_lines;
 	size_t dl_linelen;
-	struct ctrl_buf out;	/* bytes for the host */
+	struct ctrl_buf out; /* bytes for the host */
 	int local_port, peer_port;
 	uint32_t peer_ip;
 };
@@ -311,36 +310,37 @@ struct ctrl_flash {
 struct ctrl {
 	struct ctrl_cfg cfg;
 	char model[64];
-	int sample_us;		/* TM */
-	int64_t time;		/* TIME, samples since power-up */
+	int sample_us; /* TM */
+	int64_t time;  /* TIME, samples since power-up */
 	int lines_per_sample;
 
 	struct ctrl_axis ax[CTRL_AXES];
 	struct ctrl_sense in;
-	int zero_pending;	/* define encoder zero at the next sample */
+	int zero_pending; /* define encoder zero at the next sample */
 	uint32_t outputs;
-	int amp_ok;		/* motor power present */
-	uint8_t ta0;		/* _TA0 amplifier status */
-	int cn0;		/* CN limit polarity: -1 active low */
+	int amp_ok;  /* motor power present */
+	uint8_t ta0; /* _TA0 amplifier status */
+	int cn0;     /* CN limit polarity: -1 active low */
+	int co;	     /* CO extended I/O configuration (stored only) */
 
 	struct ctrl_prog prog;
 	struct ctrl_vars vars;
 	struct ctrl_thread th[CTRL_THREADS];
 	int autosub_pend[CTRL_AS_N];
-	int auto_pending;	/* start #AUTO at the next sample */
+	int auto_pending; /* start #AUTO at the next sample */
 
 	int tc;			/* TC and _TC: last error; TC clears it */
-	int ed_line, ed_thread;	/* _ED, _ED1 */
+	int ed_line, ed_thread; /* _ED, _ED1 */
 
-	int cf;			/* unsolicited handle 0..7 or CTRL_SERIAL */
-	int cw_hibit, cw_drop;	/* CW 1 / CW ,1 */
+	int cf;		       /* unsolicited handle 0..7 or CTRL_SERIAL */
+	int cw_hibit, cw_drop; /* CW 1 / CW ,1 */
 	int vf_m, vf_n, pf_m, pf_n, lz;
-	int ia4;		/* _IA4: handle that lost communication */
-	double axdes[8];	/* ~a .. ~h: axis numbers */
-	int edepth;		/* expression nesting, bounded */
+	int ia4;	 /* _IA4: handle that lost communication */
+	double axdes[8]; /* ~a .. ~h: axis numbers */
+	int edepth;	 /* expression nesting, bounded */
 
 	struct ctrl_handle h[CTRL_NHANDLES];
-	struct ctrl_buf serial;	/* output routed to the serial port */
+	struct ctrl_buf serial; /* output routed to the serial port */
 	struct ctrl_buf tmp;	/* output of the running statement */
 	struct ctrl_flash flash;
 };
@@ -348,12 +348,12 @@ struct ctrl {
 /* Context of one statement: where it came from, where output goes. */
 struct ctrl_xc {
 	struct ctrl *c;
-	int thread;		/* 0..7, or -1 for a host command */
-	int handle;		/* host handle, -1 from a program */
-	int stmt;		/* statement index (program), else -1 */
-	int route;		/* MG {Ex}: handle, CTRL_SERIAL, or -2 default */
-	int binary;		/* output is binary (QR): no high bit */
-	int dl;			/* DL was accepted: enter download mode */
+	int thread; /* 0..7, or -1 for a host command */
+	int handle; /* host handle, -1 from a program */
+	int stmt;   /* statement index (program), else -1 */
+	int route;  /* MG {Ex}: handle, CTRL_SERIAL, or -2 default */
+	int binary; /* output is binary (QR): no high bit */
+	int dl;	    /* DL was accepted: enter download mode */
 };
 
 #define CTRL_ROUTE_DEFAULT (-2)
@@ -385,22 +385,19 @@ int ctrl_any_running(const struct ctrl *c);
 const char *ctrl_tc_text(int tc);
 
 /* command handlers shared through the table in ctrl_cmd.c */
-typedef int (*ctrl_cmd_fn)(struct ctrl_xc *x, const char *name,
-			   const char *a);
+typedef int (*ctrl_cmd_fn)(struct ctrl_xc *x, const char *name, const char *a);
 int ctrl_cmd_dispatch(struct ctrl_xc *x, const char *name, const char *a);
 int ctrl_cmd_assignable(const char *name);
 
 int ctrl_flow_cmd(struct ctrl_xc *x, const char *name, const char *a);
 int ctrl_axis_cmd(struct ctrl_xc *x, const char *name, const char *a);
-int ctrl_axis_param_get(const struct ctrl *c, const char *name, int axis,
-			double *v);
 int ctrl_axis_operand(struct ctrl *c, const char *name, int axis, double *v);
 int ctrl_mg(struct ctrl_xc *x, const char *a);
 
 /* arguments: "n,n,n" with '?' queries and "X=n" single axis forms */
 struct ctrl_args {
-	int n;			/* fields present (0..CTRL_AXES) */
-	int set[CTRL_AXES];	/* 1 value, 2 query, 0 empty */
+	int n;		    /* fields present (0..CTRL_AXES) */
+	int set[CTRL_AXES]; /* 1 value, 2 query, 0 empty */
 	double v[CTRL_AXES];
 };
 int ctrl_parse_axis_args(struct ctrl_xc *x, const char *a,
@@ -408,17 +405,17 @@ int ctrl_parse_axis_args(struct ctrl_xc *x, const char *a,
 int ctrl_parse_mask(struct ctrl_xc *x, const char *a, unsigned *mask);
 int ctrl_num_list(struct ctrl_xc *x, const char *a, double *v, int max,
 		  unsigned *present);
-#define CTRL_NUM_VF 0	/* variable format (VF, LZ) */
-#define CTRL_NUM_PF 1	/* position format (PF) */
-#define CTRL_NUM_INT 2	/* integer */
-#define CTRL_NUM_GAIN 3	/* 4 decimals */
+#define CTRL_NUM_VF   0 /* variable format (VF, LZ) */
+#define CTRL_NUM_PF   1 /* position format (PF) */
+#define CTRL_NUM_INT  2 /* integer */
+#define CTRL_NUM_GAIN 3 /* 4 decimals */
 int ctrl_put_num(struct ctrl_xc *x, double v, int how);
 
 /* ---- output (ctrl_proto.c) -------------------------------------------- */
 
 int ctrl_unsol_send(struct ctrl *c, int route, const uint8_t *p, size_t n);
 void ctrl_event(struct ctrl *c, const char *fmt, ...)
-	__attribute__((format(printf, 2, 3)));
+    __attribute__((format(printf, 2, 3)));
 void ctrl_proto_reset(struct ctrl *c);
 int ctrl_proto_host(struct ctrl *c, int h, const char *line);
 

@@ -63,7 +63,7 @@ static int other_fmt(struct ctrl_xc *x, const char *s, const char **p,
 		v = strtol(s + 1, &end, 10);
 		if (end != e || end == s + 1 || v < 0 || v > 255)
 			return 53;
-		ctrl_buf_put(&x->c->tmp, &(char){ (char)v }, 1);
+		ctrl_buf_put(&x->c->tmp, &(char){(char)v}, 1);
 	} else if (s[0] == 'E' && s + 2 == e && s[1] >= 'A' &&
 		   s[1] < 'A' + CTRL_HANDLES) {
 		x->route = s[1] - 'A';
@@ -125,7 +125,7 @@ static int mg_item(struct ctrl_xc *x, const char **p, struct ctrl_fmt *cur,
 int ctrl_mg(struct ctrl_xc *x, const char *a)
 {
 	struct ctrl *c = x->c;
-	struct ctrl_fmt cur = { c->lz ? 'Z' : 'F', c->vf_m, c->vf_n };
+	struct ctrl_fmt cur = {c->lz ? 'Z' : 'F', c->vf_m, c->vf_n};
 	int crlf = 1, rc;
 
 	a = ctrl_skip(a);

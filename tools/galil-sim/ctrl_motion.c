@@ -36,8 +36,8 @@ static char axis_name(int i)
 double ctrl_axis_tv(const struct ctrl_axis *a, double dt)
 {
 	double oldest = a->tv_ring[a->tv_i];
-	double newest = a->tv_ring[(a->tv_i + CTRL_TV_SAMPLES - 1) %
-				   CTRL_TV_SAMPLES];
+	double newest =
+	    a->tv_ring[(a->tv_i + CTRL_TV_SAMPLES - 1) % CTRL_TV_SAMPLES];
 
 	return (newest - oldest) / ((CTRL_TV_SAMPLES - 1) * dt);
 }
@@ -92,7 +92,8 @@ int ctrl_motion_begin(struct ctrl *c, int i, int dry_run)
 		target = a->ref + a->pr;
 	else if (a->next_mode == CTRL_MODE_PA)
 		target = a->pa;
-	dir = a->next_mode == CTRL_MODE_JG ? sign(a->jg) : sign(target - a->ref);
+	dir =
+	    a->next_mode == CTRL_MODE_JG ? sign(a->jg) : sign(target - a->ref);
 	if (ctrl_blocked_dir(a, dir))
 		return 22;
 	if (dry_run)
@@ -129,7 +130,7 @@ void ctrl_motion_stop(struct ctrl *c, int i, int code, double dec)
 	struct ctrl_axis *a = &c->ax[i];
 
 	if (code == 4)
-		a->pt = 0;	/* ST leaves position tracking */
+		a->pt = 0; /* ST leaves position tracking */
 	if (!a->profiling || a->stopping)
 		return;
 	a->stopping = 1;
@@ -163,7 +164,11 @@ void ctrl_motion_off(struct ctrl *c, int i, int code, const char *why)
 {
 	struct ctrl_axis *a = &c->ax[i];
 
-	if (a->profiling && code >= 0)
+	/* A protection that switches off a servoing axis records its cause
+	 * even when the axis was at rest (UNCONFIRMED on a real DMC-4030: the
+	 * fail-safe reading, so that the cause of a motor-off is never lost;
+	 * docs/galil-sim-controller.md). */
+	if (code >= 0 && (a->profiling || !a->p.motor_off))
 		a->stop_code = code;
 	a->p.motor_off = 1;
 	a->profiling = 0;
@@ -189,7 +194,7 @@ void ctrl_motion_sense(struct ctrl *c, const struct ctrl_sense *in)
 		struct ctrl_axis *a = &c->ax[i];
 
 		if (c->zero_pending) {
-			a->offset = -in->enc[i];	/* TP = 0 at power-up */
+			a->offset = -in->enc[i]; /* TP = 0 at power-up */
 			a->ref = a->target = a->pa_last = 0;
 			for (f = 0; f < CTRL_TV_SAMPLES; f++)
 				a->tv_ring[f] = 0;
@@ -197,7 +202,7 @@ void ctrl_motion_sense(struct ctrl *c, const struct ctrl_sense *in)
 		a->enc = in->enc[i] + a->offset;
 		f = in->fwd_limit[i] != 0;
 		r = in->rev_limit[i] != 0;
-		if (c->cn0 == 1) {	/* switches configured active high */
+		if (c->cn0 == 1) { /* switches configured active high */
 			f = !f;
 			r = !r;
 		}
@@ -220,9 +225,9 @@ static void amp_check(struct ctrl *c)
 		if (ok)
 			c->ta0 &= (uint8_t)~8;
 		else
-			c->ta0 |= 8;	/* under-voltage, axes A-D */
-		ctrl_event(c, ok ? "amplifier power restored" :
-				   "amplifier power lost (under-voltage)");
+			c->ta0 |= 8; /* under-voltage, axes A-D */
+		ctrl_event(c, ok ? "amplifier power restored"
+				 : "amplifier power lost (under-voltage)");
 	}
 	for (i = 0; i < CTRL_AXES; i++) {
 		struct ctrl_axis *a = &c->ax[i];
@@ -238,8 +243,10 @@ static void amp_check(struct ctrl *c)
 		if (a->p.oe)
 			ctrl_motion_off(c, i, 15, "amplifier fault");
 		else
-			ctrl_event(c, "axis %c amplifier fault, OE 0: motor "
-				      "stays on", axis_name(i));
+			ctrl_event(c,
+				   "axis %c amplifier fault, OE 0: motor "
+				   "stays on",
+				   axis_name(i));
 	}
 }
 
@@ -295,8 +302,8 @@ static void limit_hit(struct ctrl *c, int i, int code, int hw)
 
 	ctrl_autosub_raise(c, CTRL_AS_LIMSWI);
 	if (hw && (a->p.oe & 2)) {
-		ctrl_motion_off(c, i, code, hw ? "limit switch with OE 2" :
-						"soft limit");
+		ctrl_motion_off(c, i, code,
+				hw ? "limit switch with OE 2" : "soft limit");
 		return;
 	}
 	ctrl_motion_stop(c, i, code, a->p.sd);
@@ -329,9 +336,10 @@ static double approach(double v, double vd, double ac, double dec, double dt)
 	if (v == vd)
 		return v;
 	if (v != 0 && sign(v) != sign(vd))
-		vd = 0;		/* through zero first */
+		vd = 0; /* through zero first */
 	if (fabs(vd) > fabs(v))
-		return fabs(vd - v) <= ac * dt ? vd : v + sign(vd - v) * ac * dt;
+		return fabs(vd - v) <= ac * dt ? vd
+					       : v + sign(vd - v) * ac * dt;
 	return fabs(vd - v) <= dec * dt ? vd : v + sign(vd - v) * dec * dt;
 }
 
@@ -353,13 +361,13 @@ static int to_target(struct ctrl_axis *a, double dt)
 
 	if (dir == 0 && a->vel == 0)
 		return 1;
-	if (dir == 0 || a->vel * dir < 0) {	/* moving away: brake */
+	if (dir == 0 || a->vel * dir < 0) { /* moving away: brake */
 		a->vel = approach(a->vel, 0, a->p.ac, a->p.dc, dt);
 		a->ref += a->vel * dt;
 		return 0;
 	}
-	s_new = s > a->p.sp ? fmax(s - a->p.dc * dt, a->p.sp) :
-			      fmin(s + a->p.ac * dt, a->p.sp);
+	s_new = s > a->p.sp ? fmax(s - a->p.dc * dt, a->p.sp)
+			    : fmin(s + a->p.ac * dt, a->p.sp);
 	s_new = fmin(s_new, sqrt(2 * a->p.dc * fabs(d)));
 	if (s_new * dt >= fabs(d) || s_new <= 0) {
 		a->ref = a->target;
@@ -414,7 +422,8 @@ static void servo(struct ctrl_axis *a)
 		a->integ = ki_v / (a->p.ki / 2 * DAC_V_PER_COUNT);
 	}
 	t = (4 * a->p.kp * e + 4 * a->p.kd * (e - a->err_prev)) *
-		    DAC_V_PER_COUNT + ki_v + a->p.of;
+		DAC_V_PER_COUNT +
+	    ki_v + a->p.of;
 	a->torque = fmax(-a->p.tl, fmin(a->p.tl, t));
 	a->err_prev = e;
 }

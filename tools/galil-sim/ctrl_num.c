@@ -14,7 +14,7 @@
 #include "ctrl_int.h"
 
 #define FX_BITS 48
-#define FX_MOD 281474976710656.0	/* 2^48 */
+#define FX_MOD	281474976710656.0 /* 2^48 */
 
 int64_t ctrl_fx_raw(double v)
 {
@@ -24,9 +24,9 @@ int64_t ctrl_fx_raw(double v)
 	if (isnan(v))
 		return 0;
 	r = v * CTRL_FX_ONE;
-	if (!(fabs(r) < 9.0e18))	/* inf or far out of range */
-		r = isinf(r) ? (r > 0 ? FX_MOD / 2 - 1 : -FX_MOD / 2) :
-			       fmod(r, FX_MOD);
+	if (!(fabs(r) < 9.0e18)) /* inf or far out of range */
+		r = isinf(r) ? (r > 0 ? FX_MOD / 2 - 1 : -FX_MOD / 2)
+			     : fmod(r, FX_MOD);
 	raw = (int64_t)llround(r);
 	/* wrap into the signed 48-bit range */
 	raw &= (((int64_t)1 << FX_BITS) - 1);
@@ -62,8 +62,8 @@ double ctrl_str_value(const char *s, size_t n)
 }
 
 static const int64_t pow10_tab[] = {
-	1, 10, 100, 1000, 10000, 100000, 1000000, 10000000, 100000000,
-	1000000000, 10000000000LL,
+    1,	     10,       100,	  1000,	      10000,	     100000,
+    1000000, 10000000, 100000000, 1000000000, 10000000000LL,
 };
 
 /* Decimal F/Z format: sign (space or '-'), integer, '.', n decimals. */
@@ -79,7 +79,7 @@ static int fmt_dec(char *out, size_t cap, double v, const struct ctrl_fmt *f)
 	ip = mag >> 16;
 	fp = mag & 0xFFFF;
 	scaled = ip * pow10_tab[n] + (fp * pow10_tab[n] + 32768) / 65536;
-	maxv = pow10_tab[m] * pow10_tab[n] - 1;	/* "999.99" when too big */
+	maxv = pow10_tab[m] * pow10_tab[n] - 1; /* "999.99" when too big */
 	if (scaled > maxv)
 		scaled = maxv;
 	if (scaled == 0)
@@ -141,21 +141,9 @@ int ctrl_fmt_num(char *out, size_t cap, double v, const struct ctrl_fmt *f)
 {
 	switch (f->kind) {
 	case 'F':
-	case 'Z':
-		return fmt_dec(out, cap, v, f);
-	case '$':
-		return fmt_hex(out, cap, v, f);
-	case 'S':
-		return fmt_str(out, cap, v, f);
-	default:
-		return -1;
+	case 'Z': return fmt_dec(out, cap, v, f);
+	case '$': return fmt_hex(out, cap, v, f);
+	case 'S': return fmt_str(out, cap, v, f);
+	default: return -1;
 	}
-}
-
-/* ctrl_fmt_int() - an integer as interrogation commands print it (" 200"). */
-int ctrl_fmt_int(char *out, size_t cap, double v)
-{
-	struct ctrl_fmt f = { 'Z', 10, 0 };
-
-	return ctrl_fmt_num(out, cap, v, &f);
 }

@@ -36,7 +36,7 @@ static int digit_op(struct ctrl_xc *x, const char *code, int d, double *v)
 	else if (!strcmp(code, "TA") && d < 4)
 		*v = d == 0 ? c->ta0 : 0;
 	else if (!strcmp(code, "QZ") && d < 4)
-		*v = (int[]){ CTRL_AXES, 52, 26, 36 }[d];
+		*v = (int[]){CTRL_AXES, 52, 26, 36}[d];
 	else if (!strcmp(code, "ED") && (d == 0 || d == 1 || d == 4))
 		*v = d == 0 ? c->ed_line : d == 1 ? c->ed_thread : x->thread;
 	else if (!strcmp(code, "OP") && d == 0)
@@ -46,8 +46,8 @@ static int digit_op(struct ctrl_xc *x, const char *code, int d, double *v)
 	else if (!strcmp(code, "CW") && d == 4)
 		*v = c->cw_drop;
 	else if (!strcmp(code, "IA") && d <= 5)
-		*v = (double[]){ 2130706433.0, 250, CTRL_HANDLES,
-				 x->handle, c->ia4, 100 }[d];
+		*v = (double[]){2130706433.0, 250,    CTRL_HANDLES,
+				x->handle,    c->ia4, 100}[d];
 	else
 		return 1;
 	return 0;
@@ -71,6 +71,8 @@ static int plain_op(struct ctrl_xc *x, const char *code, double *v)
 		*v = CTRL_AXES;
 	else if (!strcmp(code, "TM"))
 		*v = c->sample_us;
+	else if (!strcmp(code, "CO"))
+		*v = c->co;
 	else if (!strcmp(code, "JS"))
 		*v = x->thread >= 0 ? c->th[x->thread].js_ret : 0;
 	else if (!strcmp(code, "CW"))
@@ -114,16 +116,10 @@ static int ih_op(struct ctrl *c, const char *rest, double *v)
 	case 0:
 		*v = c->h[h].open ? (double)(int32_t)c->h[h].peer_ip : 0;
 		return 0;
-	case 1:
-		*v = c->h[h].open ? c->h[h].peer_port : 0;
-		return 0;
-	case 2:
-		*v = c->h[h].open ? 2 : 0;
-		return 0;
+	case 1: *v = c->h[h].open ? c->h[h].peer_port : 0; return 0;
+	case 2: *v = c->h[h].open ? 2 : 0; return 0;
 	case 3:
-	case 4:
-		*v = 0;
-		return 0;
+	case 4: *v = 0; return 0;
 	}
 	return 1;
 }

@@ -75,8 +75,7 @@ static int stmt_flow(const char *s, size_t n)
 
 	while (i < n && s[i] == ' ')
 		i++;
-	for (k = 0; i + k < n && k < 7 && isalnum((unsigned char)s[i + k]);
-	     k++)
+	for (k = 0; i + k < n && k < 7 && isalnum((unsigned char)s[i + k]); k++)
 		w[k] = s[i + k];
 	w[k] = '\0';
 	if (!strcmp(w, "ELSE"))
@@ -88,7 +87,7 @@ static int stmt_flow(const char *s, size_t n)
 		while (i < n && s[i] == ' ')
 			i++;
 		if (i < n && (s[i] == '=' || s[i] == '['))
-			return CTRL_FLOW_NONE;	/* a variable IFxx= */
+			return CTRL_FLOW_NONE; /* a variable IFxx= */
 		return CTRL_FLOW_IF;
 	}
 	return CTRL_FLOW_NONE;
@@ -117,12 +116,12 @@ static void split_line(struct ctrl_prog *p, int ln)
 		if (i < n && (quote || s[i] != ';'))
 			continue;
 		if (i < n && is_rem(s + start, i - start))
-			continue;	/* REM runs to the end of the line */
+			continue; /* REM runs to the end of the line */
 		p->stmt[p->nstmts].line = ln;
 		p->stmt[p->nstmts].off = (uint8_t)start;
 		p->stmt[p->nstmts].len = (uint8_t)(i - start);
 		p->stmt[p->nstmts].flow =
-			(uint8_t)stmt_flow(s + start, i - start);
+		    (uint8_t)stmt_flow(s + start, i - start);
 		p->stmt[p->nstmts].match = -1;
 		p->stmt[p->nstmts].text = (int)p->pool_len;
 		memcpy(p->pool + p->pool_len, s + start, i - start);
@@ -303,7 +302,7 @@ int ctrl_prog_copy(struct ctrl_prog *dst, const struct ctrl_prog *src)
 /* ctrl_prog_label() - line of a label, or -1. */
 int ctrl_prog_label(const struct ctrl_prog *p, uint64_t key)
 {
-	struct ctrl_label k = { key, 0 }, *hit;
+	struct ctrl_label k = {key, 0}, *hit;
 
 	if (!p->nlabels)
 		return -1;
@@ -319,8 +318,7 @@ const char *ctrl_prog_stmt(const struct ctrl_prog *p, int i)
 }
 
 /* ctrl_prog_stmt_text() - statement @i as a string. Return 0 or -1. */
-int ctrl_prog_stmt_text(const struct ctrl_prog *p, int i, char *out,
-			size_t cap)
+int ctrl_prog_stmt_text(const struct ctrl_prog *p, int i, char *out, size_t cap)
 {
 	const struct ctrl_stmt *st;
 

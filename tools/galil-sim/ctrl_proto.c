@@ -123,13 +123,13 @@ int ctrl_unsol_send(struct ctrl *c, int route, const uint8_t *p, size_t n)
 		return 0;
 	}
 	if (!c->h[h].open)
-		return 0;	/* nobody there: dropped */
+		return 0; /* nobody there: dropped */
 	if (ctrl_buf_pending(&c->h[h].out) + n > CTRL_UNSOL_FIFO)
 		return c->cw_drop ? 0 : -1;
 	for (k = 0; k < n; k += i) {
 		for (i = 0; i < sizeof(tmp) && k + i < n; i++)
-			tmp[i] = c->cw_hibit ? (uint8_t)(p[k + i] | 0x80) :
-					       p[k + i];
+			tmp[i] =
+			    c->cw_hibit ? (uint8_t)(p[k + i] | 0x80) : p[k + i];
 		put_out(c, h, tmp, i);
 	}
 	return 0;
@@ -140,7 +140,7 @@ int ctrl_unsol_send(struct ctrl *c, int route, const uint8_t *p, size_t n)
 /* One command from a host. Return 1 when DL switched to download mode. */
 static int host_cmd(struct ctrl *c, int h, const char *s, int *errors)
 {
-	struct ctrl_xc x = { c, -1, h, -1, CTRL_ROUTE_DEFAULT, 0, 0 };
+	struct ctrl_xc x = {c, -1, h, -1, CTRL_ROUTE_DEFAULT, 0, 0};
 	int rc;
 
 	ctrl_buf_clear(&c->tmp);
@@ -235,11 +235,13 @@ static void dl_end_line(struct ctrl *c, int h)
 {
 	struct ctrl_handle *hd = &c->h[h];
 
-	hd->dl_lines++;
+	if (hd->dl_lines <= CTRL_PROG_LINES)
+		hd->dl_lines++;
 	if (hd->dl_linelen > CTRL_LINE_MAX || hd->dl_lines > CTRL_PROG_LINES)
 		dl_bad_line(c, h, 60);
 	hd->dl_linelen = 0;
-	ctrl_buf_put(&hd->dl, "\r", 1);
+	if (hd->dl_lines <= CTRL_PROG_LINES)
+		ctrl_buf_put(&hd->dl, "\r", 1);
 }
 
 static void dl_finish(struct ctrl *c, int h)
@@ -280,7 +282,9 @@ static void dl_byte(struct ctrl *c, int h, uint8_t b)
 		dl_end_line(c, h);
 	} else if (b != '\n') {
 		hd->dl_linelen++;
-		if (hd->dl_linelen <= CTRL_LINE_MAX + 1)
+		/* bounded: a refused download need not be kept whole */
+		if (hd->dl_linelen <= CTRL_LINE_MAX + 1 &&
+		    hd->dl_lines <= CTRL_PROG_LINES)
 			ctrl_buf_put(&hd->dl, &b, 1);
 	}
 }
@@ -298,7 +302,7 @@ static void cmd_byte(struct ctrl *c, int h, uint8_t b)
 	}
 	if (b == '\n')
 		return;
-	if (b == ';')
+	if (b == ';' && hd->semis < 100000)
 		hd->semis++;
 	if (hd->len >= CTRL_LINE_MAX || b == '\0')
 		hd->overflow = 1;

@@ -37,7 +37,7 @@ static uint16_t axis_status(const struct ctrl_axis *a)
 		if (a->stopping)
 			s |= GL_AXST_STOPPING;
 		else if (fabs(a->vel) >= a->p.sp && a->p.sp > 0)
-			s |= 1u << 5;	/* slewing */
+			s |= 1u << 5; /* slewing */
 	}
 	if (a->p.motor_off)
 		s |= GL_AXST_MOTOR_OFF;
@@ -48,7 +48,7 @@ static void axis_fill(const struct ctrl *c, int i, struct gl_rec_axis *r)
 {
 	const struct ctrl_axis *a = &c->ax[i];
 	uint8_t sw = GL_AXSW_HOME;
-	double an = c->in.an_v[i] * 3276.8;	/* AQ2: +-10 V = +-32768 */
+	double an = c->in.an_v[i] * 3276.8; /* AQ2: +-10 V = +-32768 */
 
 	if (!a->lim_f)
 		sw |= GL_AXSW_FLS;

@@ -1,6 +1,7 @@
 /*
  * sim.c - the simulator facade: controller + plant + relay stepped together
- * in simulated time, the event log, and the control-port requests.
+ * in simulated time, and the event log. The control-port requests are in
+ * sim_control.c.
  *
  * Time is counted in whole microseconds of simulated time (samples of
  * ctrl_sample_ms() each), so long runs do not drift.
@@ -203,7 +204,8 @@ void sim_step(struct sim *s)
 	ctrl_step(s->ctrl, &s->sense, &s->drive);
 	sim_plant_move(s->plant, &s->drive, power, dt_ms);
 	watch_changes(s);
-	s->time_us += (int64_t)llround(dt_ms * 1000);
+	/* at least 1 us per sample, so that time always advances */
+	s->time_us += dt_ms >= 0.001 ? (int64_t)llround(dt_ms * 1000) : 1;
 }
 
 void sim_advance_ms(struct sim *s, double ms)

@@ -495,13 +495,26 @@ static int build_poll(struct sim_net *n, struct pollfd *fds, int *slot)
 	return k;
 }
 
+/* A pty that fails (it should not: the slave is held open) is treated as
+ * an unplugged board: motor power off, never a busy loop. */
+static void relay_service(struct sim_net *n)
+{
+	struct sim_relay *r = sim_get_relay(n->sim);
+	char err[128];
+
+	if (sim_relay_service(r) >= 0)
+		return;
+	sim_event(n->sim, "relay pty failed: %s", strerror(errno));
+	sim_relay_set_fault(r, SIM_RELAY_UNPLUG, err, sizeof(err));
+}
+
 static void dispatch(struct sim_net *n, int slot)
 {
 	switch (slot) {
 	case -1: timer_read(n); break;
 	case -2: conn_accept(n); break;
 	case -3: client_accept(n); break;
-	case -4: sim_relay_service(sim_get_relay(n->sim)); break;
+	case -4: relay_service(n); break;
 	default:
 		if (slot >= 0 && slot < CTRL_HANDLES) {
 			if (n->conn[slot].fd >= 0)

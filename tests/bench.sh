@@ -1,0 +1,33 @@
+#!/bin/sh
+# bench.sh - make bench: performance figures of the whole system on
+# galil-sim, printed as a table and written as CSV to $BUILD/bench.csv.
+# Figures, not pass/fail (see tests/bench/bench_sys.c for what is measured).
+#
+# The Makefile's bench target has built the libraries, the binaries and the
+# tests; this script compiles the bench program with the project's flags
+# (the Makefile's object rule), links it, builds the LD_PRELOAD allocation
+# counter, and runs it. Knobs: ROBOELF_BENCH_S (seconds of joystick use per
+# period, default 20), ROBOELF_BENCH_REPEAT (runs of each fault, default 5).
+set -eu
+BUILD=${BUILD:-build}
+CC=${CC:-cc}
+TOP=$(cd "$(dirname "$0")/.." && pwd)
+cd "$TOP"
+ROBOELF_TOP=$TOP
+ROBOELF_BIN=$TOP/$BUILD/bin
+export BUILD ROBOELF_TOP ROBOELF_BIN
+
+make --no-print-directory BUILD="$BUILD" "$BUILD/obj/tests/bench/bench_sys.o"
+mkdir -p "$BUILD/bench"
+# shellcheck disable=SC2046
+$CC -o "$BUILD/bench/bench_sys" "$BUILD/obj/tests/bench/bench_sys.o" \
+	"$BUILD/lib/libharness.a" "$BUILD/lib/libre.a" "$BUILD/lib/libgl.a" \
+	$(pkg-config --libs libserialport yaml-0.1) -lpthread -lm
+$CC -O2 -Wall -Wextra -shared -fPIC -o "$BUILD/bench/alloc_count.so" \
+	tests/bench/alloc_count.c -ldl
+
+exec "$BUILD/bench/bench_sys" --csv "$BUILD/bench.csv" \
+	--seconds "${ROBOELF_BENCH_S:-20}" \
+	--repeat "${ROBOELF_BENCH_REPEAT:-5}" \
+	--alloc-lib "$TOP/$BUILD/bench/alloc_count.so" \
+	--faults-bin "$TOP/$BUILD/tests/system/test_sys_faults"

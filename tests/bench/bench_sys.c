@@ -1,0 +1,700 @@
+/*
+ * bench_sys.c - make bench: performance figures of the whole system on
+ * galil-sim, printed as a table and written as CSV. Figures, not pass/fail.
+ *
+ *   bench_sys --csv FILE [--seconds S] [--repeat N] [--alloc-lib SO]
+ *             [--faults-bin PATH]
+ *
+ *  1. full calibration time (roboelf --calibration full on the default
+ *     robot);
+ *  2. at supervisor periods 50, 10 and 2 ms, S seconds (default 20) of
+ *     joystick use: cycles (the program heartbeat hbpc the supervisor
+ *     writes every cycle, watched in the simulator), overruns and the worst
+ *     reply age (roboelf's last status line), wake-up lateness p50/p99/max
+ *     (roboelf's "stats:" log line at exit, when it writes one), TCP
+ *     segments and bytes per cycle on roboelf's controller connections
+ *     (ss -ti), CPU time per cycle (/proc/PID/schedstat), heap allocations
+ *     after start-up (LD_PRELOAD counter, SIGUSR2 marks);
+ *  3. galil-sim's virtual-time speed (galil-sim --bench 10: 8 busy
+ *     program threads, in-process sim_advance_ms());
+ *  4. fault reaction times: test_sys_faults run with ROBOELF_REPEAT=N,
+ *     median / p99 / max per fault in ms and in supervisor periods.
+ * Beside each figure: the original system's value where it has one
+ * (roboelf-software-description.txt: 50 ms loop, 75/125 ms watchdog,
+ * 0.5 s invalid input, one controller command per value read).
+ *
+ * Environment as for the system tests (ROBOELF_BIN, ROBOELF_TOP, BUILD).
+ */
+#include <errno.h>
+#include <math.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "sys_h.h"
+
+#define MAX_ROWS    512
+#define MAX_SAMPLES 256
+#define MAX_FAULTS  48
+
+struct row {
+	char section[24];
+	char item[64];
+	char stat[32];
+	char value[48];
+	char unit[16];
+	char original[96];
+};
+
+static struct row rows[MAX_ROWS];
+static int n_rows;
+
+static void add(const char *section, const char *item, const char *stat,
+		const char *unit, const char *original, const char *fmt, ...)
+    __attribute__((format(printf, 6, 7)));
+
+static void add(const char *section, const char *item, const char *stat,
+		const char *unit, const char *original, const char *fmt, ...)
+{
+	struct row *r;
+	va_list ap;
+
+	if (n_rows == MAX_ROWS)
+		return;
+	r = &rows[n_rows++];
+	snprintf(r->section, sizeof(r->section), "%s", section);
+	snprintf(r->item, sizeof(r->item), "%s", item);
+	snprintf(r->stat, sizeof(r->stat), "%s", stat);
+	snprintf(r->unit, sizeof(r->unit), "%s", unit);
+	snprintf(r->original, sizeof(r->original), "%s",
+		 original ? original : "");
+	va_start(ap, fmt);
+	vsnprintf(r->value, sizeof(r->value), fmt, ap);
+	va_end(ap);
+}
+
+/* ---- options ------------------------------------------------------------ */
+
+struct opts {
+	const char *csv;
+	const char *alloc_lib;
+	const char *faults_bin;
+	int seconds;
+	int repeat;
+};
+
+static int parse_opts(int argc, char **argv, struct opts *o)
+{
+	memset(o, 0, sizeof(*o));
+	o->seconds = 20;
+	o->repeat = 5;
+	for (int i = 1; i < argc; i++) {
+		const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+
+		if (!v)
+			goto usage;
+		if (!strcmp(a, "--csv"))
+			o->csv = v;
+		else if (!strcmp(a, "--alloc-lib"))
+			o->alloc_lib = v;
+		else if (!strcmp(a, "--faults-bin"))
+			o->faults_bin = v;
+		else if (!strcmp(a, "--seconds"))
+			o->seconds = atoi(v);
+		else if (!strcmp(a, "--repeat"))
+			o->repeat = atoi(v);
+		else
+			goto usage;
+		i++;
+	}
+	if (o->csv && o->seconds >= 1 && o->repeat >= 0)
+		return 0;
+usage:
+	fprintf(stderr, "usage: bench_sys --csv FILE [--seconds S] [--repeat "
+			"N] [--alloc-lib SO] [--faults-bin PATH]\n");
+	return -1;
+}
+
+/* ---- process figures ---------------------------------------------------- */
+
+/* CPU time of @pid in ns (schedstat; else utime + stime in ticks). */
+static double cpu_ns(pid_t pid)
+{
+	char path[64];
+	unsigned long long ns, ut, st;
+	FILE *f;
+	int ok;
+
+	snprintf(path, sizeof(path), "/proc/%d/schedstat", (int)pid);
+	f = fopen(path, "r");
+	if (f) {
+		ok = fscanf(f, "%llu", &ns) == 1;
+		fclose(f);
+		if (ok)
+			return (double)ns;
+	}
+	snprintf(path, sizeof(path), "/proc/%d/stat", (int)pid);
+	f = fopen(path, "r");
+	if (!f)
+		return -1;
+	ok = fscanf(f,
+		    "%*d %*s %*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u "
+		    "%llu %llu",
+		    &ut, &st) == 2;
+	fclose(f);
+	return ok ? (double)(ut + st) * 1e9 / (double)sysconf(_SC_CLK_TCK) : -1;
+}
+
+struct tcp_fig {
+	int ok;
+	double bytes_out, bytes_in, segs_out;
+};
+
+static double field(const char *line, const char *key)
+{
+	const char *p = strstr(line, key);
+
+	return p ? strtod(p + strlen(key), NULL) : 0;
+}
+
+/* Sum over roboelf's established connections to the controller port. */
+static struct tcp_fig tcp_now(int port)
+{
+	struct tcp_fig t = {0};
+	char cmd[128], line[2048];
+	FILE *f;
+
+	snprintf(cmd, sizeof(cmd),
+		 "ss -tinH state established dst "
+		 "127.0.0.1:%d 2>/dev/null",
+		 port);
+	f = popen(cmd, "r");
+	if (!f)
+		return t;
+	while (fgets(line, sizeof(line), f)) {
+		if (!strstr(line, "bytes_received:") &&
+		    !strstr(line, "segs_out:"))
+			continue;
+		t.ok = 1;
+		t.bytes_out += field(line, "bytes_acked:");
+		t.bytes_in += field(line, "bytes_received:");
+		t.segs_out += field(line, "data_segs_out:");
+	}
+	pclose(f);
+	return t;
+}
+
+/* ---- one supervised run at a period ------------------------------------- */
+
+struct loop_fig {
+	int period_ms;
+	char fault[512]; /* the FAULT line if it tripped */
+	double trip_s;	 /* when, from the start of the run; -1 */
+	double ready_s;
+	double seconds;
+	double cycles;
+	double cpu_us;	    /* per cycle */
+	struct tcp_fig tcp; /* per cycle */
+	long allocs;	    /* after start-up; -1 n/a */
+	long overruns;	    /* -1 n/a */
+	double wd_worst_ms; /* -1 n/a */
+	double late[3];	    /* p50, p99, max ms; -1 n/a */
+};
+
+static double hbpc(struct sys_case *c)
+{
+	char st[2048];
+
+	if (sys_state(c, st, sizeof(st)) < 0)
+		return NAN;
+	return sys_state_num(st, "var.hbpc");
+}
+
+/* Joystick use for @secs of simulated time: A and B back and forth.
+ * Return: 0, or the simulated time at which a FAULT line was seen (> 0),
+ * or -1 on error. */
+static double drive(struct sys_case *c, int secs)
+{
+	static const char *const moves[] = {"A fwd", "A rev", "B fwd", "B rev"};
+	double t = sys_sim_time(c), end = t + secs * 1000.0;
+
+	for (int k = 0; t >= 0 && t < end; k++) {
+		const char *m = moves[k % 4];
+
+		if (sys_ctl(c, "joy %s", m) < 0 ||
+		    sys_wait_sim(c, t + 1000, 10000) < 0 ||
+		    sys_ctl(c, "joy %c neutral", m[0]) < 0 ||
+		    sys_wait_sim(c, t + 1300, 10000) < 0)
+			return -1;
+		if (proc_find_line(&c->re, PROC_STDOUT, "FAULT ", NULL, 0) == 0)
+			return t;
+		t = sys_sim_time(c);
+	}
+	return t < 0 ? -1 : 0;
+}
+
+/* The last "status" line's overruns and worst reply age. */
+static void status_figures(struct sys_case *c, struct loop_fig *f)
+{
+	const char *out = proc_output(&c->re, PROC_STDOUT), *p, *last = NULL;
+	double wl, ww;
+
+	for (p = strstr(out, "status "); p; p = strstr(p + 1, "\nstatus "))
+		last = p;
+	if (!last)
+		return;
+	p = strstr(last, " overruns=");
+	if (p)
+		f->overruns = strtol(p + 10, NULL, 10);
+	p = strstr(last, " wd=");
+	if (p && sscanf(p + 4, "%lf/%lfms", &wl, &ww) == 2)
+		f->wd_worst_ms = ww;
+}
+
+/* roboelf's "stats:" log line, if it writes one (lateness p50/p99/max). */
+static void stats_line(struct sys_case *c, struct loop_fig *f)
+{
+	char line[4096];
+	const char *p;
+
+	if (sys_log_find(c, "stats:", NULL, line, sizeof(line)) < 0)
+		return;
+	p = strstr(line, "late");
+	if (!p)
+		return;
+	f->late[0] = strstr(p, "p50=") ? field(p, "p50=") : -1;
+	f->late[1] = strstr(p, "p99=") ? field(p, "p99=") : -1;
+	f->late[2] = strstr(p, "max=") ? field(p, "max=") : -1;
+	if (strstr(line, "overruns="))
+		f->overruns = (long)field(line, "overruns=");
+}
+
+static long alloc_figure(const char *path)
+{
+	long total, m0, m1;
+	FILE *f = fopen(path, "r");
+	int n;
+
+	if (!f)
+		return -1;
+	n = fscanf(f, "allocs total=%ld marks=%ld,%ld", &total, &m0, &m1);
+	fclose(f);
+	return n == 3 ? m1 - m0 : -1;
+}
+
+struct mark {
+	double hb, cpu, t;
+	struct tcp_fig tcp;
+};
+
+static int take_mark(struct sys_case *c, int use_alloc, struct mark *m)
+{
+	if (use_alloc)
+		proc_signal(&c->re, SIGUSR2);
+	m->t = sys_sim_time(c);
+	m->hb = hbpc(c);
+	m->cpu = cpu_ns(c->re.pid);
+	m->tcp = tcp_now(c->sim.port);
+	return m->t < 0 || isnan(m->hb) ? -1 : 0;
+}
+
+static void figures(struct loop_fig *f, const struct mark *a,
+		    const struct mark *b)
+{
+	f->seconds = (b->t - a->t) / 1000.0;
+	f->cycles = fmod(b->hb - a->hb + 1e6, 1e6);
+	if (f->cycles <= 0)
+		return;
+	f->cpu_us = a->cpu >= 0 && b->cpu >= 0
+			? (b->cpu - a->cpu) / f->cycles / 1000.0
+			: -1;
+	f->tcp.ok = a->tcp.ok && b->tcp.ok;
+	f->tcp.bytes_out = (b->tcp.bytes_out - a->tcp.bytes_out) / f->cycles;
+	f->tcp.bytes_in = (b->tcp.bytes_in - a->tcp.bytes_in) / f->cycles;
+	f->tcp.segs_out = (b->tcp.segs_out - a->tcp.segs_out) / f->cycles;
+}
+
+static int loop_run(struct sys_env *e, const struct opts *o, int period,
+		    struct loop_fig *f)
+{
+	char out_env[SYS_PATH_MAX + 32], pre_env[SYS_PATH_MAX + 16],
+	    alloc_out[SYS_PATH_MAX];
+	char *env[3] = {NULL, NULL, NULL};
+	struct sys_opts so = {.period_ms = period, .re_env = env};
+	struct sys_case c;
+	struct mark a, b;
+	int rc = -1;
+
+	memset(f, 0, sizeof(*f));
+	f->period_ms = period;
+	f->allocs = f->overruns = -1;
+	f->trip_s = -1;
+	f->wd_worst_ms = f->late[0] = f->late[1] = f->late[2] = -1;
+	snprintf(alloc_out, sizeof(alloc_out), "%s/alloc-%d.txt", e->dir,
+		 period);
+	if (o->alloc_lib) {
+		snprintf(pre_env, sizeof(pre_env), "LD_PRELOAD=%s",
+			 o->alloc_lib);
+		snprintf(out_env, sizeof(out_env), "ROBOELF_ALLOC_OUT=%s",
+			 alloc_out);
+		env[0] = pre_env;
+		env[1] = out_env;
+	}
+	if (sys_case_start(&c, e, &so) < 0) {
+		snprintf(f->fault, sizeof(f->fault), "did not start: %.400s",
+			 c.err);
+		return -1;
+	}
+	f->ready_s = c.ready_wall_s;
+	if (sys_ctl(&c, "watch hbpc") < 0 ||
+	    sys_wait_sim(&c, c.t_ready_ms + 1000, 5000) < 0 ||
+	    take_mark(&c, o->alloc_lib != NULL, &a) < 0)
+		goto out;
+	f->trip_s = drive(&c, o->seconds);
+	if (f->trip_s < 0 || take_mark(&c, o->alloc_lib != NULL, &b) < 0)
+		goto out;
+	if (f->trip_s > 0) {
+		int i = sys_events(&c) < 0
+			    ? -1
+			    : sys_event_find(&c, "relay off", c.t_ready_ms + 1);
+
+		f->trip_s = i < 0 ? -1 : (c.ev[i].t_ms - c.t_ready_ms) / 1e3;
+	} else {
+		f->trip_s = -1;
+	}
+	figures(f, &a, &b);
+	proc_find_line(&c.re, PROC_STDOUT, "FAULT ", f->fault,
+		       sizeof(f->fault));
+	proc_signal(&c.re, SIGTERM);
+	proc_wait_exit(&c.re, 5000, NULL);
+	status_figures(&c, f);
+	stats_line(&c, f);
+	if (o->alloc_lib)
+		f->allocs = alloc_figure(alloc_out);
+	rc = 0;
+out:
+	if (rc < 0)
+		snprintf(f->fault, sizeof(f->fault), "run failed: %.400s",
+			 c.err);
+	sys_case_stop(&c);
+	return rc;
+}
+
+/* @v with @decimals, or "n/a" when negative or NaN. */
+static void fmt_or_na(char *buf, size_t cap, double v, int decimals)
+{
+	if (v < 0 || isnan(v))
+		snprintf(buf, cap, "n/a");
+	else
+		snprintf(buf, cap, "%.*f", decimals, v);
+}
+
+static void add_loop_cycle(const struct loop_fig *f, const char *item, int is50)
+{
+	char v[48];
+
+	for (int k = 0; k < 3; k++) {
+		static const char *const st[] = {"lateness p50", "lateness p99",
+						 "lateness max"};
+
+		fmt_or_na(v, sizeof(v), f->late[k], 3);
+		add("loop", item, st[k], "ms", "", "%s%s", v,
+		    f->late[k] < 0 ? " (not reported by roboelf)" : "");
+	}
+	add("loop", item, "overruns", "", "", "%ld", f->overruns);
+	fmt_or_na(v, sizeof(v), f->wd_worst_ms, 1);
+	add("loop", item, "worst reply age", "ms",
+	    is50 ? "limits 75 / 125 ms" : "", "%s", v);
+	if (f->tcp.ok) {
+		add("loop", item, "requests per cycle", "",
+		    is50 ? "one command per value read" : "", "%.2f",
+		    f->tcp.segs_out);
+		add("loop", item, "bytes out / in per cycle", "B", "",
+		    "%.1f / %.1f", f->tcp.bytes_out, f->tcp.bytes_in);
+	} else {
+		add("loop", item, "requests per cycle", "", "",
+		    "n/a (ss not available)");
+	}
+	fmt_or_na(v, sizeof(v), f->cpu_us, 1);
+	add("loop", item, "supervisor CPU per cycle", "us", "", "%s", v);
+	fmt_or_na(v, sizeof(v), (double)f->allocs, 0);
+	add("loop", item, "heap allocations after start-up", "", "", "%s", v);
+}
+
+static void add_loop(const struct loop_fig *f)
+{
+	char item[32];
+	int is50 = f->period_ms == 50;
+
+	snprintf(item, sizeof(item), "period %d ms", f->period_ms);
+	add("loop", item, "start-up with --calibration file", "s", "", "%.2f",
+	    f->ready_s);
+	if (f->fault[0]) {
+		add("loop", item, "tripped", "", is50 ? "50 ms loop" : "",
+		    "%.1f s after Ready: %s", f->trip_s, f->fault);
+		add("loop", item, "overruns before the trip", "", "", "%ld",
+		    f->overruns);
+		add("loop", item, "worst reply age", "ms", "", "%.1f",
+		    f->wd_worst_ms);
+		return;
+	}
+	add("loop", item, "tripped", "", is50 ? "50 ms loop" : "", "no");
+	add("loop", item, "cycles measured", "", "", "%.0f in %.1f s",
+	    f->cycles, f->seconds);
+	add_loop_cycle(f, item, is50);
+}
+
+/* ---- galil-sim's virtual-time speed ------------------------------------- */
+
+static void sim_speed(const struct sys_env *e)
+{
+	char cmd[SYS_PATH_MAX + 32], line[512];
+	double x = -1;
+	FILE *f;
+
+	snprintf(cmd, sizeof(cmd), "'%s/galil-sim' --bench 10", e->bin);
+	f = popen(cmd, "r");
+	if (f) {
+		while (fgets(line, sizeof(line), f))
+			if (sscanf(line, "galil-sim virtual time: %lf", &x) ==
+			    1)
+				break;
+		pclose(f);
+	}
+	if (x < 0)
+		add("sim", "virtual time, 8 busy threads", "speed",
+		    "x real time", "", "n/a");
+	else
+		add("sim", "virtual time, 8 busy threads", "speed",
+		    "x real time", "", "%.1f", x);
+}
+
+/* ---- fault reaction times ----------------------------------------------- */
+
+struct fault_samples {
+	char name[64];
+	double relay[MAX_SAMPLES], motors[MAX_SAMPLES];
+	int nr, nm;
+	double d_relay, d_motors;
+	int period_ms;
+};
+
+static const char *original_for(const char *name)
+{
+	static const struct {
+		const char *key, *orig;
+	} t[] = {
+	    {"pot stuck", "<= 50 ms after the tolerance is passed"},
+	    {"encoder stuck", "<= 50 ms after the tolerance is passed"},
+	    {"pot", "<= 50 ms (every cycle, no persistence)"},
+	    {"encoder slip", "<= 50 ms (every cycle, no persistence)"},
+	    {"link stalled", "125 ms (critical watchdog 2.5 P)"},
+	    {"link latency", "125 ms (critical watchdog 2.5 P)"},
+	    {"link dropped", "<= 50 ms (next command fails)"},
+	    {"power cycle", "<= 50 ms (next command fails)"},
+	    {"joystick", "0.5 s + <= 50 ms (PC checks)"},
+	    {"invalid", "0.5 s + <= 50 ms (PC checks)"},
+	    {"two directions", "0.5 s + <= 50 ms (PC checks)"},
+	    {"relay unplugged", "<= 50 ms (EStop_CheckConnection)"},
+	    {"supervisor killed", "Galil watchdog (timeout undocumented)"},
+	};
+
+	for (size_t i = 0; i < sizeof(t) / sizeof(t[0]); i++)
+		if (strstr(name, t[i].key))
+			return t[i].orig;
+	return "";
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+
+	return x < y ? -1 : x > y;
+}
+
+/* Nearest-rank percentile of @n sorted values. */
+static double pct(const double *v, int n, double p)
+{
+	int k = (int)ceil(p / 100.0 * n) - 1;
+
+	return v[k < 0 ? 0 : k >= n ? n - 1 : k];
+}
+
+static int load_reactions(const char *csv, struct fault_samples *fs)
+{
+	char line[512];
+	int n = 0;
+	FILE *f = fopen(csv, "r");
+
+	while (f && fgets(line, sizeof(line), f)) {
+		char name[64];
+		double r, m, dr, dm;
+		int p, i;
+
+		if (sscanf(line, "%63[^,],%lf,%lf,%lf,%lf,%d", name, &r, &m,
+			   &dr, &dm, &p) != 6)
+			continue;
+		for (i = 0; i < n && strcmp(fs[i].name, name); i++)
+			;
+		if (i == n) {
+			if (n == MAX_FAULTS)
+				continue;
+			memset(&fs[n], 0, sizeof(fs[n]));
+			snprintf(fs[n].name, sizeof(fs[n].name), "%s", name);
+			n++;
+		}
+		fs[i].d_relay = dr;
+		fs[i].d_motors = dm;
+		fs[i].period_ms = p;
+		if (r >= 0 && fs[i].nr < MAX_SAMPLES)
+			fs[i].relay[fs[i].nr++] = r;
+		if (m >= 0 && fs[i].nm < MAX_SAMPLES)
+			fs[i].motors[fs[i].nm++] = m;
+	}
+	if (f)
+		fclose(f);
+	return n;
+}
+
+static void add_reaction(const struct fault_samples *s, const char *what,
+			 double *v, int n, double deadline)
+{
+	char item[96], dl[48] = "";
+	double p = s->period_ms > 0 ? s->period_ms : 50;
+
+	if (n == 0)
+		return;
+	qsort(v, (size_t)n, sizeof(v[0]), cmp_double);
+	snprintf(item, sizeof(item), "%s: %s (n=%d)", s->name, what, n);
+	if (deadline >= 0)
+		snprintf(dl, sizeof(dl), ", deadline %.0f", deadline);
+	add("reaction", item, "median / p99 / max", "ms", original_for(s->name),
+	    "%.0f / %.0f / %.0f%s", pct(v, n, 50), pct(v, n, 99),
+	    pct(v, n, 100), dl);
+	if (deadline >= 0)
+		snprintf(dl, sizeof(dl), ", deadline %.2f", deadline / p);
+	add("reaction", item, "median / p99 / max", "P", "",
+	    "%.2f / %.2f / %.2f%s", pct(v, n, 50) / p, pct(v, n, 99) / p,
+	    pct(v, n, 100) / p, dl);
+}
+
+static void reactions(const struct sys_env *e, const struct opts *o)
+{
+	static struct fault_samples fs[MAX_FAULTS];
+	char csv[SYS_PATH_MAX + 16], outp[SYS_PATH_MAX + 16], cmd[4096];
+	int n, rc;
+
+	if (o->repeat == 0 || !o->faults_bin)
+		return;
+	snprintf(csv, sizeof(csv), "%s/reactions.csv", e->dir);
+	snprintf(outp, sizeof(outp), "%s/faults.out", e->dir);
+	snprintf(cmd, sizeof(cmd),
+		 "ROBOELF_REPEAT=%d ROBOELF_REACTION_CSV='%s' "
+		 "ROBOELF_SYS_CAL='%s' ROBOELF_BIN='%s' ROBOELF_TOP='%s' '%s' "
+		 "> '%s' 2>&1",
+		 o->repeat, csv, e->cal, e->bin, e->top, o->faults_bin, outp);
+	printf("bench: fault matrix x %d (%s) ...\n", o->repeat, outp);
+	fflush(stdout);
+	rc = system(cmd);
+	add("reaction", "test_sys_faults run", "failed tests", "", "",
+	    "%d (output: %s)", WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, outp);
+	n = load_reactions(csv, fs);
+	for (int i = 0; i < n; i++) {
+		add_reaction(&fs[i], "relay off", fs[i].relay, fs[i].nr,
+			     fs[i].d_relay);
+		add_reaction(&fs[i], "motors off", fs[i].motors, fs[i].nm,
+			     fs[i].d_motors);
+	}
+}
+
+/* ---- output ------------------------------------------------------------- */
+
+static void csv_field(FILE *f, const char *s, int last)
+{
+	int quote = strpbrk(s, ",\"\n") != NULL;
+
+	if (quote) {
+		fputc('"', f);
+		for (; *s; s++) {
+			if (*s == '"')
+				fputc('"', f);
+			fputc(*s, f);
+		}
+		fputc('"', f);
+	} else {
+		fputs(s, f);
+	}
+	fputc(last ? '\n' : ',', f);
+}
+
+static int write_csv(const char *path)
+{
+	FILE *f = fopen(path, "w");
+
+	if (!f) {
+		fprintf(stderr, "bench: cannot write '%s': %s\n", path,
+			strerror(errno));
+		return -1;
+	}
+	fprintf(f, "section,item,statistic,value,unit,original\n");
+	for (int i = 0; i < n_rows; i++) {
+		csv_field(f, rows[i].section, 0);
+		csv_field(f, rows[i].item, 0);
+		csv_field(f, rows[i].stat, 0);
+		csv_field(f, rows[i].value, 0);
+		csv_field(f, rows[i].unit, 0);
+		csv_field(f, rows[i].original, 1);
+	}
+	return fclose(f);
+}
+
+static void print_table(void)
+{
+	printf("\n%-10s %-44s %-32s %-22s %-6s %s\n", "section", "item",
+	       "statistic", "value", "unit", "original design");
+	for (int i = 0; i < n_rows; i++)
+		printf("%-10s %-44.44s %-32.32s %-22s %-6s %s\n",
+		       rows[i].section, rows[i].item, rows[i].stat,
+		       rows[i].value, rows[i].unit, rows[i].original);
+}
+
+int main(int argc, char **argv)
+{
+	static const int periods[] = {50, 10, 2};
+	static struct sys_env env;
+	struct opts o;
+
+	if (parse_opts(argc, argv, &o) < 0)
+		return 2;
+	if (sys_env_init(&env) < 0 || sys_env_calibrate(&env, 150000) < 0) {
+		fprintf(stderr, "bench: %s\n", env.err);
+		env.keep = 1;
+		sys_env_cleanup(&env);
+		return 1;
+	}
+	if (getenv("ROBOELF_SYS_CAL") && *getenv("ROBOELF_SYS_CAL"))
+		add("calibration", "full calibration, default robot", "time",
+		    "s", "", "n/a (reused from ROBOELF_SYS_CAL)");
+	else
+		add("calibration", "full calibration, default robot", "time",
+		    "s", "", "%.1f", env.calib_s);
+	for (size_t i = 0; i < sizeof(periods) / sizeof(periods[0]); i++) {
+		struct loop_fig f;
+
+		printf("bench: %d s of joystick use at a %d ms period ...\n",
+		       o.seconds, periods[i]);
+		fflush(stdout);
+		loop_run(&env, &o, periods[i], &f);
+		add_loop(&f);
+	}
+	sim_speed(&env);
+	reactions(&env, &o);
+	print_table();
+	printf("\nbench: written to %s (work files in %s)\n", o.csv, env.dir);
+	env.keep = 1;
+	return write_csv(o.csv) < 0 ? 1 : 0;
+}
