@@ -160,18 +160,19 @@ MAN5 := $(wildcard docs/*.5)
 install: all
 	$(INSTALL) -d "$(DESTDIR)$(PREFIX)/bin" "$(DESTDIR)$(PREFIX)/share/man/man1" \
 		"$(DESTDIR)$(PREFIX)/share/man/man5" "$(DESTDIR)$(PREFIX)/share/roboelf/dmc" \
-		"$(DESTDIR)$(PREFIX)/share/roboelf/config"
+		"$(DESTDIR)$(PREFIX)/share/roboelf/config" "$(DESTDIR)$(PREFIX)/share/doc/roboelf"
 	$(INSTALL) -m 755 $(BINS:$(BUILD)/bin/galil-stub=) "$(DESTDIR)$(PREFIX)/bin/"
 	$(if $(MAN1),$(INSTALL) -m 644 $(MAN1) "$(DESTDIR)$(PREFIX)/share/man/man1/")
 	$(if $(MAN5),$(INSTALL) -m 644 $(MAN5) "$(DESTDIR)$(PREFIX)/share/man/man5/")
 	$(INSTALL) -m 644 $(wildcard dmc/*.dmc dmc/MANIFEST) "$(DESTDIR)$(PREFIX)/share/roboelf/dmc/"
 	$(INSTALL) -m 644 $(wildcard config/*.yaml) "$(DESTDIR)$(PREFIX)/share/roboelf/config/"
+	$(INSTALL) -m 644 README.md $(wildcard docs/*.md) "$(DESTDIR)$(PREFIX)/share/doc/roboelf/"
 
 uninstall:
 	rm -f $(addprefix "$(DESTDIR)$(PREFIX)/bin/",roboelf galil-load galil-sim)
 	rm -f $(addprefix "$(DESTDIR)$(PREFIX)/share/man/man1/",$(notdir $(MAN1)))
 	rm -f $(addprefix "$(DESTDIR)$(PREFIX)/share/man/man5/",$(notdir $(MAN5)))
-	rm -rf "$(DESTDIR)$(PREFIX)/share/roboelf"
+	rm -rf "$(DESTDIR)$(PREFIX)/share/roboelf" "$(DESTDIR)$(PREFIX)/share/doc/roboelf"
 
 clean:
 	rm -rf $(BUILD)

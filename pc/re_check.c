@@ -285,8 +285,10 @@ static void re_out_template(struct re_out *o, const char *t,
 	}
 }
 
-int re_fault_format(const struct re_fault *f, const char *const *axis_names,
-		    char *buf, size_t cap)
+/* The FAULT line (@full) or only its "what happened" part. */
+static int re_fault_text(const struct re_fault *f,
+			 const char *const *axis_names, char *buf, size_t cap,
+			 int full)
 {
 	const struct re_fault_msg *m;
 	struct re_out o = {buf, cap, 0, 0};
@@ -297,29 +299,29 @@ int re_fault_format(const struct re_fault *f, const char *const *axis_names,
 	m = re_fault_lookup(f->id);
 	if (!m)
 		return GL_ERR_ARG;
-	re_out_str(&o, "FAULT ");
-	re_out_str(&o, re_fault_class_name(m->cls));
-	re_out_str(&o, ": ");
+	if (full) {
+		re_out_str(&o, "FAULT ");
+		re_out_str(&o, re_fault_class_name(m->cls));
+		re_out_str(&o, ": ");
+	}
 	re_out_template(&o, m->what, f, axis_names);
-	re_out_str(&o, ". Recovery: ");
-	re_out_template(&o, m->recovery, f, axis_names);
+	if (full) {
+		re_out_str(&o, ". Recovery: ");
+		re_out_template(&o, m->recovery, f, axis_names);
+	}
 	return o.trunc ? GL_ERR_OVERFLOW : (int)o.len;
+}
+
+int re_fault_format(const struct re_fault *f, const char *const *axis_names,
+		    char *buf, size_t cap)
+{
+	return re_fault_text(f, axis_names, buf, cap, 1);
 }
 
 int re_fault_what(const struct re_fault *f, const char *const *axis_names,
 		  char *buf, size_t cap)
 {
-	const struct re_fault_msg *m;
-	struct re_out o = {buf, cap, 0, 0};
-
-	if (!f || !buf || cap == 0)
-		return GL_ERR_ARG;
-	buf[0] = '\0';
-	m = re_fault_lookup(f->id);
-	if (!m)
-		return GL_ERR_ARG;
-	re_out_template(&o, m->what, f, axis_names);
-	return o.trunc ? GL_ERR_OVERFLOW : (int)o.len;
+	return re_fault_text(f, axis_names, buf, cap, 0);
 }
 
 /* ---- encoder / potentiometer ---------------------------------------------*/

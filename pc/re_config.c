@@ -749,7 +749,7 @@ static const struct field calibration_fields[] = {
 static const struct field log_fields[] = {
 	S(struct re_config_log, path, 1),
 	L(struct re_config_log, max_bytes, 4096, 1073741824),
-	I(struct re_config_log, keep, 0, 99),
+	I(struct re_config_log, keep, 1, 9),
 	END,
 };
 

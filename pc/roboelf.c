@@ -268,8 +268,7 @@ static int open_log(struct app *a)
 	int rc;
 
 	lc.max_bytes = (size_t)a->cfg.log.max_bytes;
-	if (a->cfg.log.keep >= 1 && a->cfg.log.keep <= 9)
-		lc.keep = a->cfg.log.keep;
+	lc.keep = a->cfg.log.keep; /* 1..9, checked by the config loader */
 	rc = re_log_open(&a->log, a->cfg.log.path, &lc);
 	if (rc != GL_OK) {
 		fprintf(stderr, "roboelf: error: cannot open log '%s': %s\n",
@@ -430,6 +429,20 @@ static void stamp_calset(struct app *a)
 	re_calfile_date(time(NULL), a->cal->date, sizeof(a->cal->date));
 }
 
+/* calibration.backup false: the save kept the previous table as FILE.bak
+ * (re_calfile_save always does, atomically); remove it afterwards. */
+static void drop_backup(struct app *a)
+{
+	char bak[RE_PATH_MAX + 8];
+
+	if (a->cfg.calibration.backup)
+		return;
+	snprintf(bak, sizeof(bak), "%s.bak", a->cfg.calibration.file);
+	if (unlink(bak) != 0 && errno != ENOENT)
+		re_log_msg(&a->log, RE_LOG_WARN, "cannot remove '%s': %s", bak,
+			   strerror(errno));
+}
+
 static int calib_full(struct app *a, struct re_calib *c,
 		      const struct re_calib_cfg *cc)
 {
@@ -453,6 +466,7 @@ static int calib_full(struct app *a, struct re_calib *c,
 	} else {
 		progress(a, "calibration saved to '%s'",
 			 a->cfg.calibration.file);
+		drop_backup(a);
 	}
 	return 0;
 }

@@ -841,8 +841,11 @@ static void test_relay_writefail(void **state)
 						RE_F_CTRL_POWER, RE_F_NONE};
 
 	(void)state;
+	/* R + 2P: the next state query within P, its answer timeout R, the
+	 * cycle that sees it within P; plus one P of scheduling allowance, as
+	 * for every PC-side deadline (docs/safety.md section 3). */
 	relay_fault("relay write failing", "relayfault writefail", ids,
-		    env.readback_timeout_ms + 2 * P());
+		    env.readback_timeout_ms + 3 * P());
 }
 
 /* ---- controller --------------------------------------------------------- */

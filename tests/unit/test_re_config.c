@@ -81,7 +81,7 @@ static const struct bad_case bad_cases[] = {
     {"bad_invalid_timeout.yaml", 3, 23,
      "'invalid_timeout_ms' must be between 50 and 5000, got 20"},
     {"bad_key_not_scalar.yaml", 2, 3, "expected a key name, got a list"},
-    {"bad_log_keep.yaml", 3, 9, "'keep' must be between 0 and 99, got 100"},
+    {"bad_log_keep.yaml", 3, 9, "'keep' must be between 1 and 9, got 10"},
     {"bad_log_path_empty.yaml", 3, 9, "'path' must not be empty"},
     {"bad_map_for_number.yaml", 2, 12,
      "expected an integer for 'period_ms', got a mapping"},
