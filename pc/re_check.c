@@ -57,7 +57,7 @@ static const struct re_fault_msg re_fault_table[] = {
 	 "axis {a}: the controller switched the motor off: {s} (stop code {i0})",
 	 "keep the E-stop pressed, check that axis {a} moves freely and nothing blocks it, check its motor and encoder cables, then restart roboelf"},
 	{RE_F_CTRL_POSERR, RE_FC_MOTION,
-	 "axis {a}: position error of {i0} counts above the limit; the controller switched the motors off",
+	 "axis {a}: position error of at least {i0} counts, above the limit; the controller switched the motors off",
 	 "keep the E-stop pressed, check that axis {a} moves freely and nothing blocks it, then restart roboelf"},
 	{RE_F_CTRL_AMPERR, RE_FC_MOTION,
 	 "axis {a}: amplifier fault, motor power lost (stop code {i0})",

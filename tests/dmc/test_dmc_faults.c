@@ -46,6 +46,9 @@ static void test_jam(void **state)
 	assert_true(t >= 0 && t <= 260);
 	dmc_h_advance(h, 20);
 	assert_fault(h, 4, 2);
+	/* OE switched it off as the error passed ER: fdet = ER (500), or the
+	 * error itself if it was read above ER */
+	assert_true(fabs(dmc_h_var(h, "fdet")) >= 500);
 	assert_true(fabs(dmc_h_var(h, "fdet")) <= 1000);
 }
 

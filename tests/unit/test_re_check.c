@@ -513,8 +513,9 @@ static void test_ctrl_fault_texts(void **state)
 	re_fault_format(&f, NULL, line, sizeof(line));
 	assert_string_equal(
 	    line,
-	    "FAULT MOTION: axis B: position error of 5012 counts above the "
-	    "limit; the controller switched the motors off. Recovery: keep "
+	    "FAULT MOTION: axis B: position error of at least 5012 counts, "
+	    "above the limit; the controller switched the motors off. "
+	    "Recovery: keep "
 	    "the E-stop pressed, check that axis B moves freely and nothing "
 	    "blocks it, then restart roboelf");
 	z.fcode = 3;
