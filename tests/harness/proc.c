@@ -353,6 +353,10 @@ int proc_sim_start(struct proc_sim *s, const char *bin_dir,
 	if (relay_link) {
 		argv[n++] = (char *)"--relay-link";
 		argv[n++] = (char *)relay_link;
+	} else {
+		/* never the shared default /tmp/roboelf-relay: tests and a
+		 * running demo must not meet there */
+		argv[n++] = (char *)"--no-relay-link";
 	}
 	for (int i = 0; extra && extra[i] && n < 31; i++)
 		argv[n++] = extra[i];

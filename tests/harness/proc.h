@@ -107,7 +107,8 @@ struct proc_sim {
 
 /*
  * proc_sim_start() - start @bin_dir/galil-sim --port 0 --control-port 0
- * [--relay-link @relay_link] [@extra...] and wait (@timeout_ms) for its line
+ * [--relay-link @relay_link, or --no-relay-link when NULL] [@extra...] and
+ * wait (@timeout_ms) for its line
  * "galil-sim: listening on 127.0.0.1:<port> control <port> relay <path>".
  * @extra: optional NULL-terminated extra arguments, or NULL.
  * Return: 0, or -1 (the process is killed and reaped).
