@@ -853,15 +853,16 @@ static void test_format_names_and_overflow(void **state)
 
 	(void)state;
 	re_fault_set(&f, RE_F_ESTOP_LOST, -1);
-	snprintf(f.s, sizeof(f.s), "'/dev/ttyUSB0': Input/output error");
+	snprintf(f.s, sizeof(f.s),
+		 "'/dev/serial/by-id/usb-TEST_relay-if00': Input/output error");
 	re_fault_format(&f, NULL, line, sizeof(line));
 	assert_string_equal(
-	    line,
-	    "FAULT ESTOP: the E-stop relay stopped answering "
-	    "('/dev/ttyUSB0': Input/output error); the motors were switched "
-	    "off through the controller. Recovery: press the hardware "
-	    "E-stop now, check the relay's USB cable and power, then "
-	    "restart roboelf");
+	    line, "FAULT ESTOP: the E-stop relay stopped answering "
+		  "('/dev/serial/by-id/usb-TEST_relay-if00': Input/output "
+		  "error); the motors were switched "
+		  "off through the controller. Recovery: press the hardware "
+		  "E-stop now, check the relay's USB cable and power, then "
+		  "restart roboelf");
 	re_fault_set(&f, RE_F_CAL_ABORT, 2);
 	snprintf(f.s, sizeof(f.s), "forward limit switch never came");
 	re_fault_format(&f, names, line, sizeof(line));

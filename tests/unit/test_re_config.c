@@ -586,15 +586,18 @@ static void test_clinical_accepted(void **state)
 	char err[RE_CONFIG_ERR_MAX];
 
 	(void)state;
-	assert_int_equal(parse_text("mode: clinical\ncontroller:\n"
-				    "  address: 10.0.0.2\nrelay:\n"
-				    "  port_clinical: /dev/ttyUSB0\n"
-				    "  channel: 2\n",
-				    &c, err, sizeof(err)),
-			 GL_OK);
-	assert_string_equal(re_config_relay_port(&c), "/dev/ttyUSB0");
+	assert_int_equal(
+	    parse_text(
+		"mode: clinical\ncontroller:\n"
+		"  address: 10.0.0.2\nrelay:\n"
+		"  port_clinical: /dev/serial/by-id/usb-TEST_relay-if00\n"
+		"  channel: 2\n",
+		&c, err, sizeof(err)),
+	    GL_OK);
+	assert_string_equal(re_config_relay_port(&c),
+			    "/dev/serial/by-id/usb-TEST_relay-if00");
 	re_config_relay_cfg(&c, &r);
-	assert_string_equal(r.port, "/dev/ttyUSB0");
+	assert_string_equal(r.port, "/dev/serial/by-id/usb-TEST_relay-if00");
 	assert_true(r.clinical);
 	assert_int_equal(r.channel, 2);
 	assert_int_equal(r.proto, RE_RELAY_DEVANTECH);
@@ -635,7 +638,7 @@ static void test_validate_overrides(void **state)
 	c.relay.readback = false;
 	assert_int_equal(re_config_validate(&c, err, sizeof(err)), GL_OK);
 	c.mode = RE_MODE_CLINICAL;
-	strcpy(c.relay.port_clinical, "/dev/ttyACM0");
+	strcpy(c.relay.port_clinical, "/dev/serial/by-id/usb-TEST_relay-if00");
 	assert_int_equal(re_config_validate(&c, err, sizeof(err)),
 			 GL_ERR_CONFIG);
 	assert_string_equal(err,
