@@ -5,10 +5,13 @@
 #include "re_console.h"
 
 #include <ctype.h>
+#include <errno.h>
+#include <fcntl.h>
 #include <poll.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #define BAR_WIDTH   12
@@ -21,6 +24,22 @@ static const char *const cmd_names[7] = {
     "none", "A fwd", "A rev", "B fwd", "B rev", "C fwd", "C rev",
 };
 
+/* A second, non-blocking open file description of a terminal or pipe
+ * @fd (reopened through /proc, so the shell's own description is left
+ * blocking); -1 for anything else: a regular file does not block, and
+ * reopening it would write from its start. */
+static int open_nonblocking(int fd)
+{
+	char path[32];
+	struct stat st;
+
+	if (fd < 0 || fstat(fd, &st) < 0 ||
+	    !(S_ISCHR(st.st_mode) || S_ISFIFO(st.st_mode)))
+		return -1;
+	snprintf(path, sizeof(path), "/proc/self/fd/%d", fd);
+	return open(path, O_WRONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+}
+
 int re_console_open(struct re_console *c, FILE *out, int in_fd)
 {
 	const char *term = getenv("TERM");
@@ -29,6 +48,7 @@ int re_console_open(struct re_console *c, FILE *out, int in_fd)
 	memset(c, 0, sizeof(*c));
 	c->out = out;
 	c->out_fd = fileno(out);
+	c->nb_fd = open_nonblocking(c->out_fd);
 	c->in_fd = in_fd;
 	c->tty_out = isatty(c->out_fd);
 	c->tty_in = in_fd >= 0 && isatty(in_fd);
@@ -45,6 +65,7 @@ void re_console_raw(struct re_console *c)
 		return;
 	t = c->saved;
 	t.c_lflag &= ~(tcflag_t)(ICANON | ECHO);
+	t.c_iflag &= ~(tcflag_t)IXON; /* Ctrl-S must not freeze the board */
 	t.c_cc[VMIN] = 0;
 	t.c_cc[VTIME] = 0;
 	if (tcsetattr(c->in_fd, TCSANOW, &t) == 0)
@@ -63,6 +84,58 @@ void re_console_close(struct re_console *c)
 {
 	re_console_restore(c);
 	fflush(c->out);
+	if (c->nb_fd >= 0)
+		close(c->nb_fd);
+	c->nb_fd = -1;
+}
+
+/* ---- status frames: built in c->frame, written without blocking -------- */
+
+static void frame_add(struct re_console *c, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+
+static void frame_add(struct re_console *c, const char *fmt, ...)
+{
+	size_t cap = sizeof(c->frame) - c->frame_len;
+	va_list ap;
+	int n;
+
+	va_start(ap, fmt);
+	n = vsnprintf(c->frame + c->frame_len, cap, fmt, ap);
+	va_end(ap);
+	if (n > 0)
+		c->frame_len += (size_t)n < cap ? (size_t)n : cap - 1;
+}
+
+static int count_lines(const char *buf, size_t len)
+{
+	int n = 0;
+
+	for (size_t i = 0; i < len; i++)
+		n += buf[i] == '\n';
+	return n;
+}
+
+/* Write the frame; a short or refused write drops the rest of it. Return
+ * the number of complete lines that reached the output. */
+static int frame_send(struct re_console *c)
+{
+	size_t len = c->frame_len;
+	ssize_t n;
+
+	c->frame_len = 0;
+	fflush(c->out); /* earlier messages first */
+	if (c->nb_fd < 0) {
+		fwrite(c->frame, 1, len, c->out);
+		fflush(c->out);
+		return count_lines(c->frame, len);
+	}
+	do
+		n = write(c->nb_fd, c->frame, len);
+	while (n < 0 && errno == EINTR);
+	if (n < (ssize_t)len)
+		c->dropped++;
+	return n > 0 ? count_lines(c->frame, (size_t)n) : 0;
 }
 
 /* Take the board off the screen so that a message can scroll above it. */
@@ -226,44 +299,42 @@ static void board_axis(struct re_console *c, const struct re_status *st, int i)
 			 a->pot_expected_v,
 			 col(c, a->margin_v < 0 ? ANSI_RED : ""), a->margin_v,
 			 col(c, a->margin_v < 0 ? ANSI_OFF : ""));
-	fprintf(c->out, "%-2.2s %7d %s %3.0f%% %5.3f %s %6.0f %-7s %-3s %s\n",
-		st->axis_names[i], (int)a->enc_counts, b,
-		a->pos_pct < 0 ? 0.0 : a->pos_pct, a->pot_v, exp, a->vel_cps,
-		motion_text(a), limit_text(a), a->motor_off ? "off" : "on");
+	frame_add(c, "%-2.2s %7d %s %3.0f%% %5.3f %s %6.0f %-7s %-3s %s\n",
+		  st->axis_names[i], (int)a->enc_counts, b,
+		  a->pos_pct < 0 ? 0.0 : a->pos_pct, a->pot_v, exp, a->vel_cps,
+		  motion_text(a), limit_text(a), a->motor_off ? "off" : "on");
 }
 
 static void board_draw(struct re_console *c, const struct re_status *st)
 {
 	char ctl[48];
-	int n = 0;
 
-	board_erase(c);
+	if (c->board_lines > 0)
+		frame_add(c, "\033[%dA\r\033[J", c->board_lines);
 	ctrl_text(st, ctl, sizeof(ctl));
-	fprintf(c->out, "RoboELF  mode %s  up %.1f s  relay %s%s%s  link %s\n",
-		st->mode_name, st->uptime_s,
-		col(c, st->relay == RE_RELAY_ON ? ANSI_GREEN : ANSI_YELLOW),
-		relay_text(st->relay), col(c, ANSI_OFF),
-		st->link_ok ? "ok" : "DOWN");
-	fprintf(c->out, "ax encoder position         pot V expect margin"
-			"  vel/s state   lim mot\n");
-	n += 2;
-	for (int i = 0; i < st->n_axes; i++, n++)
+	frame_add(c, "RoboELF  mode %s  up %.1f s  relay %s%s%s  link %s\n",
+		  st->mode_name, st->uptime_s,
+		  col(c, st->relay == RE_RELAY_ON ? ANSI_GREEN : ANSI_YELLOW),
+		  relay_text(st->relay), col(c, ANSI_OFF),
+		  st->link_ok ? "ok" : "DOWN");
+	frame_add(c, "ax encoder position         pot V expect margin"
+		     "  vel/s state   lim mot\n");
+	for (int i = 0; i < st->n_axes; i++)
 		board_axis(c, st, i);
-	fprintf(c->out,
-		"watchdog %.1f ms (worst %.1f, warn %llu) period "
-		"%.0f ms late %.1f/%.1f ms overruns %llu\n",
-		st->wd_last_ms, st->wd_worst_ms,
-		(unsigned long long)st->wd_warnings, st->period_ms,
-		st->late_last_ms, st->late_worst_ms,
-		(unsigned long long)st->overruns);
-	fprintf(c->out, "controller %s  joystick %s  moving %s  %s\n", ctl,
-		st->have_za ? cmd_text(st->za.jcmd) : "-",
-		st->have_za ? cmd_text(st->za.mcmd) : "-",
-		st->latched ? "LATCHED: quit with q" : "q: quit");
-	n += 2;
-	c->board_lines = n;
+	frame_add(c,
+		  "watchdog %.1f ms (worst %.1f, warn %llu) period "
+		  "%.0f ms late %.1f/%.1f ms overruns %llu\n",
+		  st->wd_last_ms, st->wd_worst_ms,
+		  (unsigned long long)st->wd_warnings, st->period_ms,
+		  st->late_last_ms, st->late_worst_ms,
+		  (unsigned long long)st->overruns);
+	frame_add(c, "controller %s  joystick %s  moving %s  %s\n", ctl,
+		  st->have_za ? cmd_text(st->za.jcmd) : "-",
+		  st->have_za ? cmd_text(st->za.mcmd) : "-",
+		  st->latched ? "LATCHED: quit with q" : "q: quit");
+	/* the lines now on screen: the next frame moves up over them */
+	c->board_lines = frame_send(c);
 	c->drawn = 1;
-	fflush(c->out);
 }
 
 void re_console_status(struct re_console *c, const struct re_status *st,
@@ -280,8 +351,8 @@ void re_console_status(struct re_console *c, const struct re_status *st,
 		return;
 	}
 	re_console_format_line(st, line, sizeof(line));
-	fprintf(c->out, "%s\n", line);
-	fflush(c->out);
+	frame_add(c, "%s\n", line);
+	frame_send(c);
 }
 
 /* ---- questions ------------------------------------------------------------

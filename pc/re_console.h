@@ -15,6 +15,15 @@
  *
  * Not on a terminal: one "status ..." line per second, no escape codes.
  *
+ * The periodic status (board or line) runs in the supervisor's loop, so it
+ * must never block it: each frame is built in a fixed buffer and written
+ * through a second, non-blocking open file description of the output (a
+ * terminal or a pipe). A terminal or reader that stops draining (a frozen
+ * SSH session, a paused pager) makes frames drop (counted in @dropped), not
+ * the safety cycle stop. Messages and the FAULT line are written blocking:
+ * they happen at start-up, at quit, or after the safe state is reached.
+ * Raw mode also turns off XON/XOFF, so Ctrl-S cannot freeze the board.
+ *
  * This is the only supervisor module that prints.
  */
 #ifndef RE_CONSOLE_H
@@ -28,6 +37,7 @@
 
 #define RE_CONSOLE_BOARD_NS 100000000LL	 /* >= 100 ms between redraws */
 #define RE_CONSOLE_LINE_NS  1000000000LL /* 1 s between status lines */
+#define RE_CONSOLE_FRAME    4096	 /* one status frame, bytes */
 
 struct re_console {
 	FILE *out; /* stdout */
@@ -41,6 +51,10 @@ struct re_console {
 	int64_t last_draw_ns;
 	int drawn;
 	struct termios saved; /* the terminal before raw mode */
+	int nb_fd;	      /* non-blocking description of @out, or -1 */
+	uint64_t dropped;     /* status frames not (fully) written */
+	size_t frame_len;
+	char frame[RE_CONSOLE_FRAME];
 };
 
 enum re_calib_choice {

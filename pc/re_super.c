@@ -85,7 +85,7 @@ void re_super_start(struct re_super *s, const struct re_caltable *const *tables,
 int64_t re_super_wait(struct re_super *s)
 {
 	int64_t now = now_ns(s);
-	int64_t late;
+	int64_t late, bin;
 
 	if (now > s->deadline_ns) {
 		/* the last cycle ran into this one: no burst of late cycles */
@@ -101,9 +101,8 @@ int64_t re_super_wait(struct re_super *s)
 	s->late_last_ns = late;
 	if (late > s->late_worst_ns)
 		s->late_worst_ns = late;
-	s->late_hist[late / (RE_LATE_BIN_US * 1000) < RE_LATE_BINS - 1
-			 ? late / (RE_LATE_BIN_US * 1000)
-			 : RE_LATE_BINS - 1]++;
+	bin = late / (RE_LATE_BIN_US * 1000);
+	s->late_hist[bin < RE_LATE_BINS - 1 ? bin : RE_LATE_BINS - 1]++;
 	s->deadline_ns += s->cfg.period_ns;
 	return late;
 }

@@ -693,6 +693,7 @@ static int supervise(struct app *a)
 		fprintf(stderr, "roboelf: error: no terminal to ask full or "
 				"file calibration: use --calibration full or "
 				"--calibration file\n");
+		re_console_close(&a->con);
 		re_log_close(&a->log);
 		return EXIT_USAGE;
 	}

@@ -1,0 +1,163 @@
+/*
+ * test_re_console.c - the periodic status output never blocks the
+ * supervisor's loop: with its reader stalled (a full pipe) every status
+ * frame returns at once and is counted as dropped; once the reader drains,
+ * frames arrive whole again. Also the one-line format without a terminal.
+ */
+#include <errno.h>
+#include <fcntl.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "re_console.h"
+
+static int64_t mono_ns(void)
+{
+	struct timespec t;
+
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+}
+
+/* Fill the pipe until the kernel refuses more; return the bytes written. */
+static size_t fill_pipe(int wfd)
+{
+	static const char junk[4096];
+	int fl = fcntl(wfd, F_GETFL);
+	size_t total = 0;
+	ssize_t n;
+
+	fcntl(wfd, F_SETFL, fl | O_NONBLOCK);
+	while ((n = write(wfd, junk, sizeof(junk))) > 0)
+		total += (size_t)n;
+	assert_int_equal(errno, EAGAIN);
+	fcntl(wfd, F_SETFL, fl); /* the console's FILE stays blocking */
+	return total;
+}
+
+static void drain_pipe(int rfd, size_t n)
+{
+	static char buf[4096];
+
+	while (n > 0) {
+		ssize_t r = read(rfd, buf, n < sizeof(buf) ? n : sizeof(buf));
+
+		assert_true(r > 0);
+		n -= (size_t)r;
+	}
+}
+
+static void status_of(struct re_status *st)
+{
+	static const char *names[] = {"A", "B", "C"};
+
+	memset(st, 0, sizeof(*st));
+	st->n_axes = 3;
+	for (int i = 0; i < 3; i++) {
+		st->axis_names[i] = names[i];
+		st->axis[i].enc_counts = 1000 * (i + 1);
+	}
+	st->mode_name = "development";
+	st->relay = RE_RELAY_ON;
+	st->link_ok = 1;
+}
+
+static void test_stalled_reader_never_blocks(void **state)
+{
+	static struct re_console c;
+	struct re_status st;
+	int p[2];
+	FILE *out;
+	size_t filled;
+	int64_t t0, took_ns;
+	char buf[1024];
+	ssize_t n;
+
+	(void)state;
+	assert_int_equal(pipe(p), 0);
+	out = fdopen(p[1], "w");
+	assert_non_null(out);
+	assert_int_equal(re_console_open(&c, out, -1), 0);
+	assert_true(c.nb_fd >= 0);
+	assert_int_equal(c.tty_out, 0);
+	status_of(&st);
+	filled = fill_pipe(p[1]);
+
+	t0 = mono_ns();
+	for (int i = 0; i < 50; i++)
+		re_console_status(&c, &st, 0, 1);
+	took_ns = mono_ns() - t0;
+	/* a blocked write would never return: the 50 frames take
+	 * microseconds; 500 ms is a generous bound for a busy machine */
+	assert_true(took_ns < 500000000LL);
+	assert_int_equal(c.dropped, 50);
+
+	drain_pipe(p[0], filled);
+	re_console_status(&c, &st, 0, 1);
+	assert_int_equal(c.dropped, 50);
+	n = read(p[0], buf, sizeof(buf) - 1);
+	assert_true(n > 0);
+	buf[n] = '\0';
+	assert_non_null(strstr(buf, "status 0.0s mode=development relay=on "
+				    "link=ok"));
+	assert_non_null(strstr(buf, " B enc=2000 "));
+	assert_int_equal(buf[n - 1], '\n');
+
+	re_console_close(&c);
+	assert_int_equal(c.nb_fd, -1);
+	fclose(out);
+	close(p[0]);
+}
+
+/* A regular file is never reopened (that would write from its start): the
+ * frames go through the FILE and append after what is there. */
+static void test_regular_file_appends(void **state)
+{
+	static struct re_console c;
+	struct re_status st;
+	char path[] = "/tmp/roboelf-console.XXXXXX", buf[2048];
+	int fd = mkstemp(path);
+	FILE *out;
+	ssize_t n;
+
+	(void)state;
+	assert_true(fd >= 0);
+	out = fdopen(fd, "w");
+	assert_non_null(out);
+	fputs("before\n", out);
+	assert_int_equal(re_console_open(&c, out, -1), 0);
+	assert_int_equal(c.nb_fd, -1);
+	status_of(&st);
+	re_console_status(&c, &st, 0, 1);
+	re_console_close(&c);
+	fclose(out);
+	fd = open(path, O_RDONLY);
+	assert_true(fd >= 0);
+	n = read(fd, buf, sizeof(buf) - 1);
+	close(fd);
+	unlink(path);
+	assert_true(n > 0);
+	buf[n] = '\0';
+	assert_int_equal(
+	    strncmp(buf, "before\nstatus 0.0s mode=development", 35), 0);
+	assert_int_equal(c.dropped, 0);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	    cmocka_unit_test(test_stalled_reader_never_blocks),
+	    cmocka_unit_test(test_regular_file_appends),
+	};
+
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
