@@ -52,6 +52,45 @@ static void test_jam(void **state)
 	assert_true(fabs(dmc_h_var(h, "fdet")) <= 1000);
 }
 
+/* The jam at every phase of the 10 ms motion loop, with ER 500 and 800
+ * (the system tests' setting): OE switches the motor off while thread 1
+ * may be about to retarget it, and that retarget then fails with TC 20.
+ * The fault latched must always be the position error (4) on that axis,
+ * never a command error (6): #CMDERR passes a TC 20 on a protected axis
+ * on as the protection's fault. */
+static void test_jam_any_phase(void **state)
+{
+	static const double ers[] = {500, 800};
+
+	(void)state;
+	for (int e = 0; e < 2; e++) {
+		for (int phase = 0; phase < 10; phase++) {
+			static struct dmc_h h;
+			struct dmc_h_params p;
+
+			memset(&h, 0, sizeof(h));
+			dmc_h_params_default(&p);
+			for (int i = 0; i < DMC_H_AXES; i++)
+				p.er[i] = ers[e];
+			if (dmc_h_open(&h) < 0 || dmc_h_start(&h) < 0 ||
+			    dmc_h_configure(&h, &p) < 0 || dmc_h_arm(&h) < 0)
+				fail_msg("set-up: %s", h.err);
+			DMC_H_CHECK(&h, dmc_h_control(&h, "joy A fwd"));
+			dmc_h_advance(&h, 300 + phase);
+			DMC_H_CHECK(&h, dmc_h_control(&h, "block A 1"));
+			assert_true(dmc_h_wait_motor_off(&h, 1, 600) >= 0);
+			dmc_h_advance(&h, 30);
+			if (dmc_h_var(&h, "fcode") != 4)
+				fail_msg("ER %g, jam at +%d ms: fault %g "
+					 "(detail %g), want 4",
+					 ers[e], phase, dmc_h_var(&h, "fcode"),
+					 dmc_h_var(&h, "fdet"));
+			assert_fault(&h, 4, 1);
+			dmc_h_close(&h);
+		}
+	}
+}
+
 /*
  * Encoder failure (OA on) during motion: the motor runs on while the count
  * stays, so the servo torque rises with no counts; OA switches the motor
@@ -283,6 +322,7 @@ static void test_tcp_lost(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+	    cmocka_unit_test(test_jam_any_phase),
 	    cmocka_unit_test_setup_teardown(test_jam, dmc_h_fx_armed,
 					    dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_encoder_failure,

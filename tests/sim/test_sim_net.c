@@ -229,10 +229,11 @@ static void test_real_time(void **state)
 	} while (w1 - w0 < 500);
 	t1 = strtol(ctl(f, "time"), NULL, 10);
 	w1 = proc_now_ms() - w0;
-	/* the loop catches up when late: simulated time never runs ahead
-	 * and lags by well under the wall-clock span */
+	/* the loop catches up when late: simulated time never runs ahead,
+	 * and lags by at most its 100-sample catch-up (the reaction times of
+	 * docs/safety.md are measured in simulated ms) */
 	assert_true(t1 - t0 <= w1 + 20);
-	assert_true(t1 - t0 >= w1 / 2);
+	assert_true(t1 - t0 >= w1 - 100);
 }
 
 /* ---- command port and link faults -------------------------------------- */

@@ -192,6 +192,30 @@ static int motors_off(int timeout_ms)
 	return 0;
 }
 
+/* Wait until axis @axis's encoder ("<axis>.pos") is @counts away from
+ * where it was at the call. */
+static int axis_moved(char axis, long counts, int timeout_ms)
+{
+	long long deadline = proc_now_ms() + timeout_ms;
+	char st[2048], v[32], key[8];
+	long p0;
+
+	snprintf(key, sizeof(key), "%c.pos", axis);
+	ctl("state", st, sizeof(st));
+	if (proc_ctl_state_get(st, key, v, sizeof(v)))
+		return 0;
+	p0 = strtol(v, NULL, 10);
+	do {
+		poll(NULL, 0, 20);
+		ctl("state", st, sizeof(st));
+		if (!proc_ctl_state_get(st, key, v, sizeof(v)) &&
+		    labs(strtol(v, NULL, 10) - p0) >= counts)
+			return 1;
+	} while (proc_now_ms() < deadline);
+	fprintf(stderr, "state: %s\n", st);
+	return 0;
+}
+
 static void assert_relay_off(void)
 {
 	char resp[64];
@@ -404,7 +428,7 @@ static void test_sys_fault_motion(void **state)
 	(void)state;
 	assert_ready();
 	ctl_ok("joy A fwd");
-	poll(NULL, 0, 300);
+	assert_true(axis_moved('A', 300, 3000)); /* jam it while it moves */
 	ctl_ok("block A 1");
 	expect_fault("FAULT MOTION: axis A");
 }
