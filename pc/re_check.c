@@ -590,6 +590,16 @@ static enum re_fault_id re_ctrl_fault_id(int fcode)
 	}
 }
 
+int re_fault_is_ctrl(enum re_fault_id id)
+{
+	/* derived from the mapping, so that a new program fault code cannot
+	 * be missing here */
+	for (int code = 0; code < 100; code++)
+		if (re_ctrl_fault_id(code) == id)
+			return 1;
+	return id == RE_F_CTRL_POWER;
+}
+
 int re_ctrl_fault(const struct re_za *za, long long fdet,
 		  struct re_fault *fault)
 {

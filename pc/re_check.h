@@ -394,6 +394,13 @@ int re_za_decode(int32_t zaa, int32_t zab, int32_t zac, struct re_za *out);
 const char *re_stop_reason(int stop_code);
 
 /*
+ * re_fault_is_ctrl() - @id is a fault the controller program latched (one
+ * that re_ctrl_fault() produces).
+ * Return: 1 or 0.
+ */
+int re_fault_is_ctrl(enum re_fault_id id);
+
+/*
  * re_ctrl_fault() - turn a latched controller fault (state 2) into a fault.
  * @za: [in] decoded fields; fcode, faxis used.
  * @fdet: the detail (MG fdet), or RE_VAL_UNKNOWN when not read.

@@ -144,7 +144,6 @@ static void board_erase(struct re_console *c)
 	if (c->tty_out && c->board_lines > 0)
 		fprintf(c->out, "\033[%dA\r\033[J", c->board_lines);
 	c->board_lines = 0;
-	c->drawn = 0;
 }
 
 void re_console_msg(struct re_console *c, const char *fmt, ...)
@@ -334,7 +333,6 @@ static void board_draw(struct re_console *c, const struct re_status *st)
 		  st->latched ? "LATCHED: quit with q" : "q: quit");
 	/* the lines now on screen: the next frame moves up over them */
 	c->board_lines = frame_send(c);
-	c->drawn = 1;
 }
 
 void re_console_status(struct re_console *c, const struct re_status *st,

@@ -49,7 +49,6 @@ struct re_console {
 	int raw;	 /* termios changed; restore on close */
 	int board_lines; /* lines of the board now on screen */
 	int64_t last_draw_ns;
-	int drawn;
 	struct termios saved; /* the terminal before raw mode */
 	int nb_fd;	      /* non-blocking description of @out, or -1 */
 	uint64_t dropped;     /* status frames not (fully) written */

@@ -68,28 +68,10 @@ static int cmd(const struct re_io *io, const char *line, char *err,
 	return rc < 0 ? rc : GL_OK;
 }
 
-int re_ctl_read(const struct re_io *io, const char *expr, double *v,
-		int timeout_ms)
-{
-	char line[96], resp[128], *end;
-	int rc;
-
-	snprintf(line, sizeof(line), "MG %s", expr);
-	rc = io->ops->command(io->ud, line, resp, sizeof(resp), timeout_ms);
-	if (rc < 0)
-		return rc;
-	*v = strtod(resp, &end);
-	if (end == resp)
-		return GL_ERR_PROTO;
-	while (*end == ' ' || *end == '\r' || *end == '\n')
-		end++;
-	return *end ? GL_ERR_PROTO : GL_OK;
-}
-
 static int read_err(const struct re_io *io, const char *expr, double *v,
 		    char *err, size_t errlen)
 {
-	int rc = re_ctl_read(io, expr, v, 0);
+	int rc = re_io_read(io, expr, v, 0);
 
 	if (rc == GL_ERR_CTRL)
 		seterr(err, errlen, "cannot read '%s': %s", expr,
@@ -122,7 +104,7 @@ static void pause_ms(const struct re_io *io, int ms)
 int re_ctl_stop(const struct re_io *io, int timeout_ms)
 {
 	char resp[64];
-	int rc = io->ops->command(io->ud, "AB 1;MO ABC", resp, sizeof(resp),
+	int rc = io->ops->command(io->ud, RE_STOP_ALL, resp, sizeof(resp),
 				  timeout_ms);
 
 	return rc < 0 ? rc : GL_OK;
@@ -323,7 +305,7 @@ int re_ctl_configure(const struct re_io *io, const struct re_config *cfg,
 
 	rc = cmd(io, "HX", err, errlen);
 	if (rc == GL_OK)
-		rc = cmd(io, "AB 1;MO ABC", err, errlen);
+		rc = cmd(io, RE_STOP_ALL, err, errlen);
 	if (rc == GL_OK)
 		rc = write_co(io, cfg, err, errlen);
 	n = fill_settings(cfg, s);
@@ -456,9 +438,9 @@ static int wait_program(const struct re_io *io, struct re_ctl_info *info,
 
 	do {
 		pause_ms(io, POLL_MS);
-		rc = re_ctl_read(io, "state", &state, 0);
+		rc = re_io_read(io, "state", &state, 0);
 		if (rc == GL_OK)
-			rc = re_ctl_read(io, "hbdmc", &hb, 0);
+			rc = re_io_read(io, "hbdmc", &hb, 0);
 		if (rc == GL_OK && hb0 < 0)
 			hb0 = hb;
 		if (rc == GL_OK && state == 0 && hb != hb0)
@@ -487,7 +469,7 @@ static int wait_armed(const struct re_io *io, long *hbpc,
 
 	while (now_ns(io) < deadline) {
 		pause_ms(io, POLL_MS);
-		*hbpc = (*hbpc + 1) % 1000000;
+		*hbpc = (*hbpc + 1) % RE_HBPC_WRAP;
 		snprintf(prefix, sizeof(prefix), "hbpc=%ld", *hbpc);
 		rc = io->ops->record(io->ud, prefix, &rec, 0);
 		if (rc < 0) {
@@ -504,7 +486,7 @@ static int wait_armed(const struct re_io *io, long *hbpc,
 		if (za.state == RE_DMC_FAULT) {
 			double fdet = 0;
 
-			re_ctl_read(io, "fdet", &fdet, 0);
+			re_io_read(io, "fdet", &fdet, 0);
 			re_ctrl_fault(&za, (long long)fdet, fault);
 			return RE_FAULT;
 		}

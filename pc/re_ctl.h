@@ -23,7 +23,6 @@
 #include "re_config.h"
 #include "re_io.h"
 
-#define RE_CTL_ERR_MAX	  256
 #define RE_CTL_UPLOAD_MAX (4000 * 82 + 1024) /* 4000 lines of 80 + CR LF */
 #define RE_CTL_SOFT_OPEN  2147483647	     /* FL/BL "no soft limit", counts */
 
@@ -83,16 +82,9 @@ int re_ctl_arm(const struct re_io *io, const struct re_config *cfg,
 	       long *hbpc, struct re_fault *fault, char *err, size_t errlen);
 
 /*
- * re_ctl_stop() - stop every axis and switch the motors off (ST ABC;MO ABC),
- * best effort with @timeout_ms. Return: GL_OK or the link error.
+ * re_ctl_stop() - stop every axis and switch the motors off (RE_STOP_ALL: AB
+ * 1;MO ABC), best effort with @timeout_ms. Return: GL_OK or the link error.
  */
 int re_ctl_stop(const struct re_io *io, int timeout_ms);
-
-/*
- * re_ctl_read() - "MG <expr>" and parse the number.
- * Return: GL_OK, GL_ERR_PROTO (not a number), or a link error.
- */
-int re_ctl_read(const struct re_io *io, const char *expr, double *v,
-		int timeout_ms);
 
 #endif /* RE_CTL_H */

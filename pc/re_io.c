@@ -7,6 +7,7 @@
 #include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <time.h>
 
 #include "gl_err.h"
@@ -145,4 +146,22 @@ int re_io_logf(const struct re_io *io, enum re_log_level lvl, const char *fmt,
 	vsnprintf(text, sizeof(text), fmt, ap);
 	va_end(ap);
 	return io->ops->log(io->ud, lvl, text);
+}
+
+int re_io_read(const struct re_io *io, const char *expr, double *v,
+	       int timeout_ms)
+{
+	char line[96], resp[128], *end;
+	int rc;
+
+	snprintf(line, sizeof(line), "MG %s", expr);
+	rc = io->ops->command(io->ud, line, resp, sizeof(resp), timeout_ms);
+	if (rc < 0)
+		return rc;
+	*v = strtod(resp, &end);
+	if (end == resp)
+		return GL_ERR_PROTO;
+	while (*end == ' ' || *end == '\r' || *end == '\n')
+		end++;
+	return *end ? GL_ERR_PROTO : GL_OK;
 }

@@ -19,6 +19,16 @@
 #include "re_log.h"
 #include "re_relay.h"
 
+/*
+ * The one command that stops every axis and switches the motors off: AB 1
+ * aborts the motion only (a bare AB would abort the program too), and MO is
+ * refused while an axis still decelerates (so not "ST ABC;MO ABC").
+ */
+#define RE_STOP_ALL "AB 1;MO ABC"
+
+/* The PC heartbeat hbpc counts 0 .. RE_HBPC_WRAP - 1 (a short decimal). */
+#define RE_HBPC_WRAP 1000000
+
 struct re_io_ops {
 	/* gl_link_record(): one "[prefix;]QR" round trip. */
 	int (*record)(void *ud, const char *prefix, struct gl_record *rec,
@@ -73,5 +83,14 @@ int64_t re_io_now_ns(void);
  */
 int re_io_logf(const struct re_io *io, enum re_log_level lvl, const char *fmt,
 	       ...) __attribute__((format(printf, 3, 4)));
+
+/*
+ * re_io_read() - "MG <expr>" through @io and parse the one number.
+ * @timeout_ms: 0 = the link default.
+ * Return: GL_OK; an error of ops->command; GL_ERR_PROTO when the reply is
+ *         not exactly one number.
+ */
+int re_io_read(const struct re_io *io, const char *expr, double *v,
+	       int timeout_ms);
 
 #endif /* RE_IO_H */

@@ -12,13 +12,9 @@
 #include "gl_err.h"
 
 #define NS_PER_MS 1000000LL
-#define HBPC_WRAP 1000000 /* hbpc stays a short decimal number */
-/* Abort the motion only (AB 1: a bare AB would also abort the program) and
- * switch the motors off. Not "ST ABC;MO ABC": the controller refuses MO
- * (TC 7) while an axis is still decelerating from ST, which would leave the
- * motors on. The DMC's own #FAULT uses the same two commands. */
-#define STOP_ALL  "AB 1;MO ABC"
-#define FAULT_CMD STOP_ALL ";pcflt=1"
+/* The stop (re_io.h; the DMC's own #FAULT uses the same two commands), and
+ * the program told to latch in the same line. */
+#define FAULT_CMD RE_STOP_ALL ";pcflt=1"
 
 static int64_t now_ns(const struct re_super *s)
 {
@@ -109,49 +105,14 @@ int64_t re_super_wait(struct re_super *s)
 
 /* ---- fault reaction ------------------------------------------------------ */
 
-static int is_ctrl_fault(enum re_fault_id id)
-{
-	switch (id) {
-	case RE_F_CTRL_ENCODER:
-	case RE_F_CTRL_WATCHDOG:
-	case RE_F_CTRL_POSERR:
-	case RE_F_CTRL_AMPERR:
-	case RE_F_CTRL_POWER:
-	case RE_F_CTRL_MOTOROFF:
-	case RE_F_CTRL_INPUT:
-	case RE_F_CTRL_TCPERR:
-	case RE_F_CTRL_PARAM:
-	case RE_F_CTRL_LIMIT:
-	case RE_F_CTRL_CMDERR:
-	case RE_F_CTRL_THREAD:
-	case RE_F_CTRL_SUPERVISOR:
-	case RE_F_CTRL_UNKNOWN: return 1;
-	default: return 0;
-	}
-}
-
-/* "MG <name>" as a number. */
-static int read_num(struct re_super *s, const char *name, double *v)
-{
-	char cmd[32], *end;
-	int rc;
-
-	snprintf(cmd, sizeof(cmd), "MG %s", name);
-	rc = s->io.ops->command(s->io.ud, cmd, s->resp, sizeof(s->resp),
-				s->cfg.fault_cmd_timeout_ms);
-	if (rc < 0)
-		return rc;
-	*v = strtod(s->resp, &end);
-	return end == s->resp ? GL_ERR_PROTO : GL_OK;
-}
-
 /* Re-read the controller's fault detail (MG fdet) for a CTRL fault. */
 static void ctrl_fault_detail(struct re_super *s, struct re_fault *f)
 {
 	double fdet;
 
 	if (s->have_za && s->za.fcode != 0 &&
-	    read_num(s, "fdet", &fdet) == GL_OK)
+	    re_io_read(&s->io, "fdet", &fdet, s->cfg.fault_cmd_timeout_ms) ==
+		GL_OK)
 		re_ctrl_fault(&s->za, (long long)fdet, f);
 }
 
@@ -174,7 +135,8 @@ static void program_verdict(struct re_super *s, struct re_fault *f)
 	int rc;
 
 	do {
-		rc = read_num(s, "fcode", &code);
+		rc = re_io_read(&s->io, "fcode", &code,
+				s->cfg.fault_cmd_timeout_ms);
 		if (rc != GL_OK) {
 			snprintf(s->verdict, sizeof(s->verdict),
 				 "program fault code unreadable: %s",
@@ -185,8 +147,10 @@ static void program_verdict(struct re_super *s, struct re_fault *f)
 			snprintf(s->verdict, sizeof(s->verdict),
 				 "program fault %d after %.1f ms", (int)code,
 				 ns_to_ms(now_ns(s) - t0));
-			read_num(s, "faxis", &axis);
-			read_num(s, "fdet", &det);
+			re_io_read(&s->io, "faxis", &axis,
+				   s->cfg.fault_cmd_timeout_ms);
+			re_io_read(&s->io, "fdet", &det,
+				   s->cfg.fault_cmd_timeout_ms);
 			memset(&za, 0, sizeof(za));
 			za.state = RE_DMC_FAULT;
 			za.fcode = (int)code;
@@ -210,11 +174,11 @@ static int stop_controller(struct re_super *s, struct re_fault *f)
 		rc = s->io.ops->command(s->io.ud, FAULT_CMD, s->resp,
 					sizeof(s->resp),
 					s->cfg.fault_cmd_timeout_ms);
-		if (is_ctrl_fault(f->id))
+		if (re_fault_is_ctrl(f->id))
 			ctrl_fault_detail(s, f);
 		return rc;
 	}
-	rc = s->io.ops->command(s->io.ud, STOP_ALL, s->resp, sizeof(s->resp),
+	rc = s->io.ops->command(s->io.ud, RE_STOP_ALL, s->resp, sizeof(s->resp),
 				s->cfg.fault_cmd_timeout_ms);
 	program_verdict(s, f);
 	s->io.ops->command(s->io.ud, "pcflt=1", s->resp, sizeof(s->resp),
@@ -324,7 +288,7 @@ static int exchange(struct re_super *s, struct re_fault *f)
 	int64_t now, age = 0;
 	int rc, v;
 
-	s->hbpc = (s->hbpc + 1) % HBPC_WRAP;
+	s->hbpc = (s->hbpc + 1) % RE_HBPC_WRAP;
 	snprintf(s->prefix, sizeof(s->prefix), "hbpc=%ld", s->hbpc);
 	rc = s->io.ops->record(s->io.ud, s->prefix, &s->rec,
 			       reply_timeout_ms(s));
@@ -568,7 +532,7 @@ double re_super_late_ms(const struct re_super *s, double pct)
 int re_super_shutdown(struct re_super *s)
 {
 	int rc =
-	    s->io.ops->command(s->io.ud, STOP_ALL, s->resp, sizeof(s->resp),
+	    s->io.ops->command(s->io.ud, RE_STOP_ALL, s->resp, sizeof(s->resp),
 			       s->cfg.fault_cmd_timeout_ms);
 	int relay_rc = s->io.ops->relay_off(s->io.ud);
 

@@ -7,7 +7,7 @@
  * program's fields (latched controller fault, state, threads, motors), the
  * program heartbeat and the record sample number advancing, encoder against
  * potentiometer per axis, and the E-stop relay link. On the first fault, in
- * the same cycle: relay off (motor power cut) first, then "ST ABC;MO ABC;
+ * the same cycle: relay off (motor power cut) first, then "AB 1;MO ABC;
  * pcflt=1" through the controller (best effort, bounded time), latch, and
  * the log entry written and fsync'ed; only then does the caller print the
  * FAULT line (re_super_fault_line()). A latched supervisor never re-arms,
@@ -45,7 +45,7 @@ struct re_super_cfg {
 	struct re_encpot_cfg encpot[RE_SUPER_AXES];
 	const char *axis_names[RE_SUPER_AXES];
 	int pot_input[RE_SUPER_AXES]; /* analog input 1..8; 0: axis + 1 */
-	int fault_cmd_timeout_ms;     /* "ST ABC;MO ABC;pcflt=1" deadline */
+	int fault_cmd_timeout_ms;     /* "AB 1;MO ABC;pcflt=1" deadline */
 	/* A motor off, a stopped thread or a left state may be the first
 	 * sign of a fault the program is latching itself (its ZA fields
 	 * follow every mainms): after cutting power and stopping, wait up to
@@ -132,7 +132,6 @@ struct re_super {
 	int latched;
 	struct re_fault fault;
 	char fault_line[RE_SUPER_LINE];
-	int fault_printed;     /* set by the caller once shown */
 	int relay_lost_logged; /* relay failure while latched, logged once */
 	/* scratch, preallocated */
 	char prefix[32];
@@ -187,7 +186,7 @@ int re_super_cycle(struct re_super *s);
 
 /*
  * re_super_fault() - the fault reaction, also for faults found outside the
- * cycle (start-up, calibration): relay off, "ST ABC;MO ABC;pcflt=1", latch,
+ * cycle (start-up, calibration): relay off, "AB 1;MO ABC;pcflt=1", latch,
  * FAULT log entry fsync'ed, FAULT line composed. A second fault while
  * latched is only logged.
  * @f: [in] the fault.
@@ -206,7 +205,7 @@ void re_super_status(const struct re_super *s, struct re_status *st);
 
 /*
  * re_super_shutdown() - the operator quits: stop motion and switch the
- * motors off through the controller ("ST ABC;MO ABC"), then cut motor power
+ * motors off through the controller ("AB 1;MO ABC"), then cut motor power
  * (relay off). Both are attempted whatever fails.
  * Return: GL_OK, or the first error (the caller logs it).
  */

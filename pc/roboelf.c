@@ -643,12 +643,13 @@ static void run(struct app *a)
 	re_log_msg(
 	    &a->log, RE_LOG_INFO,
 	    "stats: cycles=%llu overruns=%llu period=%.1f ms "
-	    "late p50=%.3f p99=%.3f max=%.3f ms; reply age worst=%.1f ms",
+	    "late p50=%.3f p99=%.3f max=%.3f ms; reply age worst=%.1f ms; "
+	    "status frames dropped=%llu",
 	    (unsigned long long)a->sup->cycles,
 	    (unsigned long long)a->sup->overruns,
 	    ms_of_ns(a->sup->cfg.period_ns), re_super_late_ms(a->sup, 50),
 	    re_super_late_ms(a->sup, 99), re_super_late_ms(a->sup, 100),
-	    ms_of_ns(a->sup->age_worst_ns));
+	    ms_of_ns(a->sup->age_worst_ns), (unsigned long long)a->con.dropped);
 }
 
 /* Return: 1 when a fault was latched. */
