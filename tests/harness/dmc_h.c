@@ -10,6 +10,8 @@
 
 #include "dmc_h.h"
 #include "gl_err.h"
+#include "gload_diag.h"
+#include "gload_prep.h"
 
 #define UNSOL_HANDLE 0	/* handle A: CF A, the program's MG lines */
 #define QR_HANDLE    1	/* handle B: QR for the ZA fields */
@@ -18,64 +20,6 @@
 #define REC_ZA	     32 /* ZA inside an axis block (SL) */
 
 /* ---- preprocessing ------------------------------------------------------ */
-
-static int is_comment(const char *s, size_t n)
-{
-	return (n >= 1 && s[0] == '\'') ||
-	       (n >= 3 && !strncmp(s, "REM", 3) &&
-		(n == 3 || s[3] == ' ' || s[3] == '\t'));
-}
-
-int dmc_h_preprocess(const char *src, size_t len, char *out, size_t cap)
-{
-	size_t o = 0, i = 0;
-
-	while (i < len) {
-		size_t b = i, e;
-
-		while (i < len && src[i] != '\n')
-			i++;
-		e = i++;
-		while (b < e && (src[b] == ' ' || src[b] == '\t'))
-			b++;
-		while (e > b && (src[e - 1] == ' ' || src[e - 1] == '\t' ||
-				 src[e - 1] == '\r'))
-			e--;
-		if (e == b || is_comment(src + b, e - b))
-			continue;
-		if (o + (e - b) + 2 > cap)
-			return GL_ERR_OVERFLOW;
-		memcpy(out + o, src + b, e - b);
-		o += e - b;
-		out[o++] = '\n';
-	}
-	if (o < cap)
-		out[o] = '\0';
-	return (int)o;
-}
-
-static int read_file(const char *path, char **buf, size_t *len)
-{
-	FILE *f = fopen(path, "rb");
-	long n;
-
-	if (!f)
-		return GL_ERR_NOENT;
-	if (fseek(f, 0, SEEK_END) < 0 || (n = ftell(f)) < 0 ||
-	    fseek(f, 0, SEEK_SET) < 0) {
-		fclose(f);
-		return GL_ERR_SYS;
-	}
-	*buf = malloc((size_t)n + 1);
-	if (!*buf) {
-		fclose(f);
-		return GL_ERR_NOMEM;
-	}
-	*len = fread(*buf, 1, (size_t)n, f);
-	(*buf)[*len] = '\0';
-	fclose(f);
-	return 0;
-}
 
 static const char *top_dir(const char *top)
 {
@@ -86,59 +30,35 @@ static const char *top_dir(const char *top)
 	return env && *env ? env : ".";
 }
 
-static int load_one(const char *top, const char *name, char *out, size_t cap,
-		    char *err, size_t errlen)
-{
-	char path[512];
-	char *src;
-	size_t len;
-	int n;
-
-	snprintf(path, sizeof(path), "%s/dmc/%s", top, name);
-	if (read_file(path, &src, &len) < 0) {
-		snprintf(err, errlen, "%s: %s", path, strerror(errno));
-		return GL_ERR_NOENT;
-	}
-	n = dmc_h_preprocess(src, len, out, cap);
-	free(src);
-	if (n < 0)
-		snprintf(err, errlen, "%s: program too large", path);
-	return n;
-}
-
 int dmc_h_load_program(const char *top, char *out, size_t cap, char *err,
 		       size_t errlen)
 {
-	char path[512], *man, *line, *save = NULL;
-	size_t len, o = 0;
-	int n, files = 0;
+	struct gload_prog p;
+	struct gload_diags d;
+	char path[512];
+	int rc;
 
-	top = top_dir(top);
-	snprintf(path, sizeof(path), "%s/dmc/MANIFEST", top);
-	if (read_file(path, &man, &len) < 0) {
-		snprintf(err, errlen, "%s: cannot read", path);
-		return GL_ERR_NOENT;
+	memset(&p, 0, sizeof(p));
+	memset(&d, 0, sizeof(d));
+	snprintf(path, sizeof(path), "%s/dmc", top_dir(top));
+	/* galil-load's own preprocessor: the tests run, byte for byte, the
+	 * program galil-load downloads (without its identity line) */
+	rc = gload_prep_path(&p, path, &d);
+	if (rc == GL_OK)
+		rc = gload_prog_finish(&p);
+	if (rc != GL_OK) {
+		snprintf(err, errlen, "%s",
+			 d.n > 0 ? d.v[0].text : gl_strerror(rc));
+	} else if (p.body_len + 1 > cap) {
+		rc = GL_ERR_OVERFLOW;
+	} else {
+		memcpy(out, p.text, p.body_len);
+		out[p.body_len] = '\0';
+		rc = (int)p.body_len;
 	}
-	for (line = strtok_r(man, "\r\n", &save); line;
-	     line = strtok_r(NULL, "\r\n", &save)) {
-		while (*line == ' ' || *line == '\t')
-			line++;
-		if (!*line || *line == '#')
-			continue;
-		n = load_one(top, line, out + o, cap - o, err, errlen);
-		if (n < 0) {
-			free(man);
-			return n;
-		}
-		o += (size_t)n;
-		files++;
-	}
-	free(man);
-	if (!files) {
-		snprintf(err, errlen, "%s: no files listed", path);
-		return GL_ERR_FORMAT;
-	}
-	return (int)o;
+	gload_prog_free(&p);
+	gload_diags_free(&d);
+	return rc;
 }
 
 /* ---- simulator set-up -----------------------------------------------------

@@ -51,18 +51,9 @@ struct dmc_h {
 };
 
 /*
- * dmc_h_preprocess() - strip a DMC source like galil-load: CR LF -> LF,
- * leading and trailing blanks removed, lines that are empty or start with
- * "'" or "REM" dropped.
- * @src, @len: [in] the source text.
- * @out, @cap: [out] the result, one LF-terminated line per program line.
- * Return: its length, or GL_ERR_OVERFLOW when @cap is too small.
- */
-int dmc_h_preprocess(const char *src, size_t len, char *out, size_t cap);
-
-/*
  * dmc_h_load_program() - read dmc/MANIFEST under @top (the repository
- * root; NULL: $ROBOELF_TOP or ".") and preprocess its files in order.
+ * root; NULL: $ROBOELF_TOP or ".") and preprocess its files in order with
+ * galil-load's preprocessor (gload_prep), without the identity line.
  * @out, @cap: [out] the joined program.
  * @err: [out] "PATH: reason" on failure.
  * Return: the program length, GL_ERR_NOENT (a file missing),
