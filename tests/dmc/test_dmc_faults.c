@@ -277,8 +277,9 @@ static void test_power_lost(void **state)
 	assert_true(dmc_h_var(h, "fdet") == 15);
 }
 
-/* Unarmed, motor power lost is only counted: nothing can move, and the
- * supervisor may switch the relay during its start-up. */
+/* In the safe state (motors off) motor power lost and restored is only
+ * counted: nothing can move, and the supervisor switches the relay on
+ * during its start-up before it asks for the service state. */
 static void test_power_lost_unarmed(void **state)
 {
 	struct dmc_h *h = *state;
@@ -286,12 +287,36 @@ static void test_power_lost_unarmed(void **state)
 	dmc_h_close(h);
 	DMC_H_CHECK(h, dmc_h_open(h));
 	DMC_H_CHECK(h, dmc_h_start(h));
-	DMC_H_CHECK(h, dmc_h_cmd(h, "SH ABC", NULL, 0));
 	DMC_H_CHECK(h, dmc_h_control(h, "relay off"));
 	dmc_h_advance(h, 100);
+	DMC_H_CHECK(h, dmc_h_control(h, "relay on"));
+	dmc_h_advance(h, 100);
 	assert_true(dmc_h_var(h, "state") == 0);
-	assert_true(dmc_h_var(h, "namp") >= 1);
 	assert_int_equal(dmc_h_fault_lines(h, NULL, NULL, NULL), 0);
+	for (int i = 0; i < DMC_H_AXES; i++)
+		assert_int_equal(dmc_h_axis(h, i).motor_off, 1);
+}
+
+/* In the safe state nothing may switch a motor on: a host's SH is fault
+ * 13 (axis 0, detail 3) within one main loop, every motor off again. */
+static void test_servo_on_in_safe_state(void **state)
+{
+	struct dmc_h *h = *state;
+	double mainms, t;
+
+	dmc_h_close(h);
+	DMC_H_CHECK(h, dmc_h_open(h));
+	DMC_H_CHECK(h, dmc_h_start(h));
+	mainms = dmc_h_var(h, "mainms");
+	DMC_H_CHECK(h, dmc_h_cmd(h, "SH B", NULL, 0));
+	assert_int_equal(dmc_h_axis(h, 1).motor_off, 0);
+	t = dmc_h_wait_var(h, "state", 2, 100);
+	assert_true(t >= 0 && t <= mainms + 1);
+	dmc_h_advance(h, 5);
+	assert_fault(h, 13, 0);
+	assert_true(dmc_h_var(h, "fdet") == 3);
+	for (int i = 0; i < DMC_H_AXES; i++)
+		assert_int_equal(dmc_h_axis(h, i).motor_off, 1);
 }
 
 /* A TCP handle lost while armed: #TCPERR latches fault 7 with the handle
@@ -341,6 +366,8 @@ int main(void)
 					    dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_power_lost, dmc_h_fx_armed,
 					    dmc_h_fx_free),
+	    cmocka_unit_test_setup_teardown(test_servo_on_in_safe_state,
+					    dmc_h_fx_armed, dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_power_lost_unarmed,
 					    dmc_h_fx_armed, dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_tcp_lost, dmc_h_fx_armed,

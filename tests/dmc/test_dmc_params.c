@@ -22,35 +22,53 @@ struct pcase {
 	double value;
 	const char *cmd; /* controller commands before arming, or NULL */
 	int check, axis; /* expected fdet, faxis */
+	int moving;	 /* 1: arm from service while a move of B runs */
 };
 
 /* Each case breaks one thing of the defaults (dmc_h_params_default()). */
 static const struct pcase cases[] = {
-    {"vmax B = 0", "vmax[1]", 0, NULL, 1, 2},
-    {"vmax A > SP range", "vmax[0]", 15000001, NULL, 1, 1},
-    {"vmax C: AC below 1024", "vmax[2]", 100, NULL, 1, 3},
-    {"vmin A = 0", "vmin[0]", 0, NULL, 2, 1},
-    {"vmin C > vmax C", "vmin[2]", 8001, NULL, 2, 3},
-    {"wst B < 0", "wst[1]", -1, NULL, 3, 2},
-    {"wen A = wst A", "wen[0]", 500, NULL, 4, 1},
-    {"stp C = 0", "stp[2]", 0, NULL, 5, 3},
-    {"srev B = sfwd B", "srev[1]", 45000, NULL, 6, 2},
-    {"ER B = stp B", NULL, 0, "ER ,1000", 7, 2},
-    {"ER C off", NULL, 0, "ER ,,-1", 7, 3},
-    {"OE off", NULL, 0, "OE 0,0,0", 8, 1},
-    {"OE C off", NULL, 0, "OE ,,0", 8, 3},
-    {"jin[5] = 0", "jin[5]", 0, NULL, 10, 0},
-    {"jin[11] = 33", "jin[11]", 33, NULL, 10, 0},
-    {"jin[3] = 2.5", "jin[3]", 2.5, NULL, 10, 0},
-    {"jin[7] = jin[2]", "jin[7]", 3, NULL, 11, 0},
-    {"jval[4] = 3", "jval[4]", 3, NULL, 12, 0},
-    {"jpol = 2", "jpol", 2, NULL, 13, 0},
-    {"jto = 49", "jto", 49, NULL, 14, 0},
-    {"jto = 5001", "jto", 5001, NULL, 14, 0},
-    {"wdto = 19", "wdto", 19, NULL, 15, 0},
-    {"wdto = 5001", "wdto", 5001, NULL, 15, 0},
-    {"TM 500", NULL, 0, "TM 500", 16, 0},
-    {"axis B moving", NULL, 0, "SH B;JG ,2000;BG B", 17, 0},
+    {"vmax B = 0", "vmax[1]", 0, NULL, 1, 2, 0},
+    {"vmax A > SP range", "vmax[0]", 15000001, NULL, 1, 1, 0},
+    {"vmax C: AC below 1024", "vmax[2]", 100, NULL, 1, 3, 0},
+    {"vmin A = 0", "vmin[0]", 0, NULL, 2, 1, 0},
+    {"vmin C > vmax C", "vmin[2]", 8001, NULL, 2, 3, 0},
+    {"wst B < 0", "wst[1]", -1, NULL, 3, 2, 0},
+    {"wen A = wst A", "wen[0]", 500, NULL, 4, 1, 0},
+    {"stp C = 0", "stp[2]", 0, NULL, 5, 3, 0},
+    {"srev B = sfwd B", "srev[1]", 45000, NULL, 6, 2, 0},
+    {"ER B = stp B", NULL, 0, "ER ,1000", 7, 2, 0},
+    {"ER C off", NULL, 0, "ER ,,-1", 7, 3, 0},
+    {"OE off", NULL, 0, "OE 0,0,0", 8, 1, 0},
+    {"OE C off", NULL, 0, "OE ,,0", 8, 3, 0},
+    {"jin[5] = 0", "jin[5]", 0, NULL, 10, 0, 0},
+    {"jin[11] = 49", "jin[11]", 49, NULL, 10, 0, 0},
+    {"jin[11] = 9 (no input 9 on a DMC-4030)", "jin[11]", 9, NULL, 10, 0, 0},
+    {"jin[0] = 16 (no input 16 on a DMC-4030)", "jin[0]", 16, NULL, 10, 0, 0},
+    {"jin[3] = 2.5", "jin[3]", 2.5, NULL, 10, 0, 0},
+    {"jin[7] = jin[2]", "jin[7]", 3, NULL, 11, 0, 0},
+    {"jval[4] = 3", "jval[4]", 3, NULL, 12, 0, 0},
+    {"jpol = 2", "jpol", 2, NULL, 13, 0, 0},
+    {"jto = 49", "jto", 49, NULL, 14, 0, 0},
+    {"jto = 5001", "jto", 5001, NULL, 14, 0, 0},
+    {"wdto = 19", "wdto", 19, NULL, 15, 0, 0},
+    {"wdto = 5001", "wdto", 5001, NULL, 15, 0, 0},
+    {"TM 500", NULL, 0, "TM 500", 16, 0, 0},
+    {"axis B moving (a service move)", NULL, 0, NULL, 17, 0, 1},
+    {"pwrout = 9", "pwrout", 9, NULL, 18, 0, 0},
+    {"pwrout = 1.5", "pwrout", 1.5, NULL, 18, 0, 0},
+    {"potin B = 0", "potin[1]", 0, NULL, 19, 2, 0},
+    {"potin C = 9", "potin[2]", 9, NULL, 19, 3, 0},
+    {"potin A = 1.5", "potin[0]", 1.5, NULL, 19, 1, 0},
+    {"potlo A = pnlo A", "potlo[0]", 1.0, NULL, 20, 1, 0},
+    {"pnhi B = pnlo B", "pnhi[1]", 1.0, NULL, 20, 2, 0},
+    {"pnhi C = pothi C", "pnhi[2]", 4.75, NULL, 20, 3, 0},
+    {"svslow A = 0", "svslow[0]", 0, NULL, 21, 1, 0},
+    {"svslow B > svmax B", "svslow[1]", 10001, NULL, 21, 2, 0},
+    {"svdmax C = 0", "svdmax[2]", 0, NULL, 22, 3, 0},
+    {"hbmaxd = 0", "hbmaxd", 0, NULL, 23, 0, 0},
+    {"hbmaxd = 2.5", "hbmaxd", 2.5, NULL, 23, 0, 0},
+    {"svmax A > SP range", "svmax[0]", 15000001, NULL, 24, 1, 0},
+    {"svmax B: AC below 1024", "svmax[1]", 100, NULL, 21, 2, 0},
 };
 
 static void run_case(struct dmc_h *h, const struct pcase *c)
@@ -75,6 +93,9 @@ static void run_case(struct dmc_h *h, const struct pcase *c)
 				fail_msg("%s: %s", c->what, h->err);
 		dmc_h_advance(h, 20);
 	}
+	if (c->moving && (dmc_h_service(h) < 0 ||
+			  dmc_h_move(h, 1, 20000, 5000, 10000) < 0))
+		fail_msg("%s: service move: %s", c->what, h->err);
 	if (dmc_h_arm(h) != GL_ERR_CTRL)
 		fail_msg("%s: armed (or timed out): %s", c->what, h->err);
 	if (dmc_h_var(h, "fcode") != 1 || dmc_h_var(h, "fdet") != c->check ||
@@ -87,7 +108,8 @@ static void run_case(struct dmc_h *h, const struct pcase *c)
 	assert_int_equal(axis, c->axis);
 	assert_true(det == c->check);
 	assert_true(dmc_h_var(h, "state") == 2);
-	/* motors off, thread 1 never started, nothing moves */
+	/* motors off, thread 1 never started, nothing moves (a service move
+	 * is aborted by the latch) */
 	dmc_h_advance(h, 200);
 	for (int i = 0; i < DMC_H_AXES; i++)
 		if (!dmc_h_axis(h, i).motor_off)

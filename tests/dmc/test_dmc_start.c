@@ -238,10 +238,11 @@ static void test_restart_clears_latch(void **state)
 	assert_int_equal(dmc_h_axis(h, 0).motor_off, 0);
 }
 
-/* Unarmed, the supervisor may run an axis into its limit switch (as the
- * calibration does) without a latch; arming on the switch is refused
- * with fault 5 (axis A, forward). */
-static void test_limit_unarmed_then_arm(void **state)
+/* In service the supervisor may run an axis into its limit switch (as
+ * the calibration does: fast far from it, slowly where the potentiometer
+ * says it is near) without a latch; arming on the switch is refused with
+ * fault 5 (axis A, forward). */
+static void test_limit_service_then_arm(void **state)
 {
 	struct dmc_h *h = *state;
 	struct dmc_h_params p;
@@ -251,17 +252,20 @@ static void test_limit_unarmed_then_arm(void **state)
 	DMC_H_CHECK(h, dmc_h_open(h));
 	DMC_H_CHECK(h, dmc_h_start(h));
 	DMC_H_CHECK(h, dmc_h_configure(h, &p));
-	DMC_H_CHECK(h, dmc_h_cmd(h, "SH A", NULL, 0));
-	DMC_H_CHECK(h, dmc_h_cmd(h, "JG 20000", NULL, 0));
-	DMC_H_CHECK(h, dmc_h_cmd(h, "BG A", NULL, 0));
-	for (t = 0; t < 4000 && !dmc_h_axis(h, 0).fwd_limit; t += 10)
+	DMC_H_CHECK(h, dmc_h_service(h));
+	DMC_H_CHECK(h, dmc_h_move(h, 0, 30000, p.svmax[0], 10000));
+	for (t = 0; t < 5000 && dmc_h_var(h, "own[0]") != 0; t += 10)
+		dmc_h_advance(h, 10);
+	assert_true(fabs(dmc_h_axis(h, 0).enc - 30000) < 2);
+	DMC_H_CHECK(h, dmc_h_move(h, 0, 60000, p.svslow[0], 20000));
+	for (t = 0; t < 15000 && !dmc_h_axis(h, 0).fwd_limit; t += 10)
 		dmc_h_advance(h, 10);
 	assert_true(dmc_h_axis(h, 0).fwd_limit);
 	dmc_h_advance(h, 500);
 	assert_int_equal(dmc_h_axis(h, 0).moving, 0);
-	assert_true(dmc_h_var(h, "state") == 0);
+	assert_true(dmc_h_var(h, "own[0]") == 0);
+	assert_true(dmc_h_var(h, "state") == 3);
 	assert_int_equal(dmc_h_fault_lines(h, NULL, NULL, NULL), 0);
-	DMC_H_CHECK(h, dmc_h_cmd(h, "MO A", NULL, 0));
 	assert_int_equal(dmc_h_arm(h), GL_ERR_CTRL);
 	assert_true(dmc_h_var(h, "fcode") == 5);
 	assert_true(dmc_h_var(h, "faxis") == 1);
@@ -287,7 +291,7 @@ int main(void)
 					    dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_restart_clears_latch,
 					    dmc_h_fx_new, dmc_h_fx_free),
-	    cmocka_unit_test_setup_teardown(test_limit_unarmed_then_arm,
+	    cmocka_unit_test_setup_teardown(test_limit_service_then_arm,
 					    dmc_h_fx_new, dmc_h_fx_free),
 	};
 

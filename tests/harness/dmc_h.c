@@ -290,6 +290,18 @@ void dmc_h_params_default(struct dmc_h_params *p)
 	p->jto = 500;
 	p->wdto = 125;
 	p->oe = 1;
+	p->hbmaxd = 5;
+	p->pwrout = 0;
+	for (int i = 0; i < DMC_H_AXES; i++) {
+		p->potin[i] = i + 1;
+		p->potlo[i] = 0.25;
+		p->pothi[i] = 4.75;
+		p->pnlo[i] = 1.0;
+		p->pnhi[i] = 4.0;
+		p->svmax[i] = vmax[i];
+		p->svslow[i] = vmax[i] / 4;
+		p->svdmax[i] = 4 * lim[i];
+	}
 }
 
 static int set_checked(struct dmc_h *h, const char *name, double v)
@@ -342,12 +354,24 @@ int dmc_h_configure(struct dmc_h *h, const struct dmc_h_params *p)
 		return rc;
 	if ((rc = set_checked(h, "jpol", p->jpol)) < 0 ||
 	    (rc = set_checked(h, "jto", p->jto)) < 0 ||
-	    (rc = set_checked(h, "wdto", p->wdto)) < 0)
+	    (rc = set_checked(h, "wdto", p->wdto)) < 0 ||
+	    (rc = set_checked(h, "hbmaxd", p->hbmaxd)) < 0 ||
+	    (rc = set_checked(h, "pwrout", p->pwrout)) < 0)
+		return rc;
+	if ((rc = set_array(h, "potin", p->potin, DMC_H_AXES)) < 0 ||
+	    (rc = set_array(h, "potlo", p->potlo, DMC_H_AXES)) < 0 ||
+	    (rc = set_array(h, "pothi", p->pothi, DMC_H_AXES)) < 0 ||
+	    (rc = set_array(h, "pnlo", p->pnlo, DMC_H_AXES)) < 0 ||
+	    (rc = set_array(h, "pnhi", p->pnhi, DMC_H_AXES)) < 0 ||
+	    (rc = set_array(h, "svmax", p->svmax, DMC_H_AXES)) < 0 ||
+	    (rc = set_array(h, "svslow", p->svslow, DMC_H_AXES)) < 0 ||
+	    (rc = set_array(h, "svdmax", p->svdmax, DMC_H_AXES)) < 0)
 		return rc;
 	return 0;
 }
 
-int dmc_h_arm(struct dmc_h *h)
+/* Set @req to 1 with the heartbeat on, wait for @want (or a latch). */
+static int request_state(struct dmc_h *h, const char *req, double want)
 {
 	double t0 = dmc_h_now(h);
 	int rc;
@@ -355,28 +379,80 @@ int dmc_h_arm(struct dmc_h *h)
 	h->hb_on = 1;
 	h->hb_next_ms = t0;
 	dmc_h_advance(h, 1);
-	if ((rc = dmc_h_set(h, "armreq", 1)) < 0)
+	if ((rc = dmc_h_set(h, req, 1)) < 0)
 		return rc;
 	while (dmc_h_now(h) - t0 < 1000) {
 		double st = dmc_h_var(h, "state");
 
-		if (st == 1) {
-			/* let thread 1 run a few loops (and see neutral) */
-			dmc_h_advance(h, 30);
+		if (st == want)
 			return 0;
-		}
 		if (st == 2) {
 			dmc_h_advance(h, 10); /* the FAULT line */
 			snprintf(h->err, sizeof(h->err),
-				 "arm refused: fault %g axis %g detail %g",
+				 "%s refused: fault %g axis %g detail %g", req,
 				 dmc_h_var(h, "fcode"), dmc_h_var(h, "faxis"),
 				 dmc_h_var(h, "fdet"));
 			return GL_ERR_CTRL;
 		}
 		dmc_h_advance(h, 1);
 	}
-	snprintf(h->err, sizeof(h->err), "not armed after 1000 ms");
+	snprintf(h->err, sizeof(h->err), "%s: state %g after 1000 ms", req,
+		 dmc_h_var(h, "state"));
 	return GL_ERR_TIMEOUT;
+}
+
+int dmc_h_service(struct dmc_h *h)
+{
+	return request_state(h, "svcreq", 3);
+}
+
+int dmc_h_move(struct dmc_h *h, int axis, double target, double speed,
+	       double limit_ms)
+{
+	char name[16];
+	double t0;
+	int rc = 0;
+
+	for (int i = 0; i < DMC_H_AXES && rc == 0; i++) {
+		snprintf(name, sizeof(name), "mvax[%d]", i);
+		rc = dmc_h_set(h, name, i == axis);
+	}
+	snprintf(name, sizeof(name), "mvtg[%d]", axis);
+	if (rc == 0)
+		rc = dmc_h_set(h, name, target);
+	snprintf(name, sizeof(name), "mvsp[%d]", axis);
+	if (rc == 0)
+		rc = dmc_h_set(h, name, speed);
+	if (rc == 0)
+		rc = dmc_h_set(h, "mvto", limit_ms);
+	if (rc == 0)
+		rc = dmc_h_set(h, "mvreq", 1);
+	if (rc < 0)
+		return rc;
+	t0 = dmc_h_now(h);
+	while (dmc_h_var(h, "mvreq") != 0 && dmc_h_now(h) - t0 < 30)
+		dmc_h_advance(h, 1);
+	if (dmc_h_var(h, "state") == 2) {
+		snprintf(h->err, sizeof(h->err),
+			 "move refused: fault %g axis %g detail %g",
+			 dmc_h_var(h, "fcode"), dmc_h_var(h, "faxis"),
+			 dmc_h_var(h, "fdet"));
+		return GL_ERR_CTRL;
+	}
+	if (dmc_h_var(h, "mvreq") != 0) {
+		snprintf(h->err, sizeof(h->err), "move not taken in 30 ms");
+		return GL_ERR_TIMEOUT;
+	}
+	return 0;
+}
+
+int dmc_h_arm(struct dmc_h *h)
+{
+	int rc = request_state(h, "armreq", 1);
+
+	if (rc == 0)
+		dmc_h_advance(h, 30); /* thread 1 runs and sees neutral */
+	return rc;
 }
 
 int dmc_h_setup(struct dmc_h *h)

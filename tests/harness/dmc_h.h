@@ -36,6 +36,13 @@ struct dmc_h_params {
 	double jpol, jto, wdto;			   /* -, ms, ms */
 	double er[DMC_H_AXES];			   /* controller ER, counts */
 	int oe; /* controller OE for every axis */
+	/* version 2.00: service state, potentiometer range, power output */
+	double hbmaxd, pwrout;			   /* -, output no. */
+	double potin[DMC_H_AXES];		   /* analog input no. */
+	double potlo[DMC_H_AXES], pothi[DMC_H_AXES]; /* V */
+	double pnlo[DMC_H_AXES], pnhi[DMC_H_AXES];   /* V */
+	double svmax[DMC_H_AXES], svslow[DMC_H_AXES]; /* counts/s */
+	double svdmax[DMC_H_AXES];		      /* counts */
 };
 
 struct dmc_h {
@@ -90,7 +97,10 @@ int dmc_h_start(struct dmc_h *h);
 /* dmc_h_params_default() - the parameters every test starts from: the
  * default robot's joystick map, vmax 10000/10000/8000 counts/s, vmin a
  * quarter of it, window 500..2000 ms, step 1000 counts, soft limits 5000
- * counts inside the limit switches, jto 500 ms, wdto 125 ms, ER 500, OE 1. */
+ * counts inside the limit switches, jto 500 ms, wdto 125 ms, ER 500, OE 1;
+ * hbmaxd 5, no power output, potentiometers on inputs 1..3 with the
+ * absolute range 0.25..4.75 V and the near zones below 1.0 V / above
+ * 4.0 V; service speed vmax, slow speed vmax / 4, longest move 200000. */
 void dmc_h_params_default(struct dmc_h_params *p);
 
 /*
@@ -108,6 +118,23 @@ int dmc_h_configure(struct dmc_h *h, const struct dmc_h_params *p);
  * the program latched a fault instead (state 2), GL_ERR_TIMEOUT.
  */
 int dmc_h_arm(struct dmc_h *h);
+
+/*
+ * dmc_h_service() - heartbeat on, svcreq=1, wait (<= 1000 ms) until state
+ * leaves 0. Return: 0 in service (state 3), GL_ERR_CTRL when the program
+ * latched a fault instead, GL_ERR_TIMEOUT.
+ */
+int dmc_h_service(struct dmc_h *h);
+
+/*
+ * dmc_h_move() - one service move request: axis @axis (0..2) to the
+ * absolute @target (counts) at @speed (counts/s) within @limit_ms, then
+ * wait (<= 3 mainms) until the program took it (mvreq back to 0).
+ * Return: 0 when taken and no fault latched; GL_ERR_CTRL when a fault
+ * (h->err: code, axis, detail); GL_ERR_TIMEOUT.
+ */
+int dmc_h_move(struct dmc_h *h, int axis, double target, double speed,
+	       double limit_ms);
 
 /*
  * dmc_h_setup() - dmc_h_open, dmc_h_start, default parameters,
