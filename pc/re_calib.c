@@ -1,6 +1,7 @@
 /*
- * re_calib.c - full calibration (all axes at once, continuous sweep) and the
- * check of tables loaded from a file. See re_calib.h.
+ * re_calib.c - full calibration (all axes at once, continuous sweep, every
+ * move a supervised service move) and the check of tables loaded from a
+ * file. See re_calib.h.
  */
 #include "re_calib.h"
 
@@ -15,12 +16,17 @@
 
 #define NS_PER_MS 1000000LL
 #define AXES	  "ABC"
+#define ACFACT	  10	/* dmc/constants.dmc: DC = 10 x speed */
+#define GUARD_CNT 200	/* extra counts before a slow zone */
+#define POLL_MS	  2	/* move request taken? */
 
 enum phase {
 	PH_START,    /* nothing sent yet */
-	PH_TO_REV,   /* bounded move onto the reverse switch */
+	PH_FAST_REV, /* fast toward the reverse switch, short of its zone */
+	PH_TO_REV,   /* slowly onto the reverse switch */
 	PH_BACK_REV, /* backing off it: then table point 0 */
-	PH_SWEEP,    /* bounded move onto the forward switch, sampling */
+	PH_SWEEP,    /* sweeping forward at vmax, short of the fwd zone */
+	PH_SLOW_FWD, /* still sweeping, slowly onto the forward switch */
 	PH_BACK_FWD, /* backing off it: the forward soft limit */
 	PH_DONE,
 };
@@ -38,14 +44,24 @@ struct cal_axis {
 	int have_edge;
 	double start; /* table point 0 = reverse soft limit */
 	double soft_fwd;
+	double seek_len; /* length of the bounded slow move, counts */
 	struct acc acc[RE_CAL_MAX_POINTS];
+};
+
+/* The moves requested in one sample, sent together. */
+struct batch {
+	unsigned mask;
+	long tgt[RE_AXES];
+	int sp[RE_AXES];
 };
 
 struct re_calib {
 	struct cal_axis ax[RE_AXES];
-	struct gl_record rec;
+	const struct gl_record *rec;
 	struct re_encpot_state encpot[RE_AXES];
-	int64_t t0_ns, next_ns;
+	struct batch b;
+	int64_t t0_ns;
+	int filled;
 	char line[GL_LINE_MAX + 1];
 	char resp[128];
 };
@@ -61,39 +77,56 @@ void re_calib_free(struct re_calib *c)
 	free(c);
 }
 
-void re_calib_cfg_from(const struct re_config *cfg, const char *const *names,
-		       struct re_calib_cfg *out)
+static void axis_cfg_from(const struct re_config *cfg,
+			  const struct re_plan_axis *pa, int i,
+			  struct re_calib_axis_cfg *o)
+{
+	const struct re_config_axis *a = &cfg->axes[i];
+	int back = cfg->calibration.backoff_counts;
+	double lo = a->travel_counts * (1 - a->travel_tolerance) - 2.0 * back;
+	double hi = a->travel_counts * (1 + a->travel_tolerance);
+
+	o->vmax_cps = a->vmax_cps;
+	o->travel_cps = pa->travel_cps;
+	o->seek_cps = pa->seek_cps;
+	o->gain_v = pa->gain_v_per_count;
+	o->pnlo_v = pa->pnlo_v;
+	o->pnhi_v = pa->pnhi_v;
+	o->potlo_v = pa->potlo_v;
+	o->pothi_v = pa->pothi_v;
+	o->step_counts = a->step_counts;
+	o->travel_counts = a->travel_counts;
+	o->travel_tol = a->travel_tolerance;
+	o->backoff_counts = back;
+	o->pot_input = a->analog.input;
+	o->check.noise_margin_v = a->monotonic_margin_v;
+	o->check.expected_range_v = a->analog.expected_range_v;
+	o->check.range_tol = a->analog.range_tolerance;
+	o->check.min_points =
+	    lo / a->step_counts > 2 ? (int)(lo / a->step_counts) : 2;
+	o->check.max_points = (int)(hi / a->step_counts) + 1;
+	if (o->check.max_points > RE_CAL_MAX_POINTS)
+		o->check.max_points = RE_CAL_MAX_POINTS;
+	o->check.step_tol_counts = a->step_counts / 2.0;
+	/* the table ends are a back-off inside the switches */
+	o->check.abs_first_v = a->analog.reverse_v + back * pa->gain_v_per_count;
+	o->check.abs_last_v = a->analog.forward_v - back * pa->gain_v_per_count;
+	o->check.abs_tol_v = a->analog.absolute_tolerance_v;
+	o->encpot.allowed_error = a->allowed_error;
+	o->encpot.persistence_cycles = a->persistence_cycles;
+}
+
+void re_calib_cfg_from(const struct re_config *cfg, const struct re_plan *plan,
+		       const char *const *names, struct re_calib_cfg *out)
 {
 	memset(out, 0, sizeof(*out));
 	out->n_axes = RE_AXES;
 	out->names = names;
 	out->move_timeout_ms = cfg->calibration.move_timeout_ms;
 	out->cmd_timeout_ms = cfg->controller.timeout_ms;
-	for (int i = 0; i < RE_AXES; i++) {
-		const struct re_config_axis *a = &cfg->axes[i];
-		struct re_calib_axis_cfg *o = &out->axis[i];
-		double lo = a->travel_counts * (1 - a->travel_tolerance) -
-			    2.0 * cfg->calibration.backoff_counts;
-		double hi = a->travel_counts * (1 + a->travel_tolerance);
-
-		o->vmax_cps = a->vmax_cps;
-		o->step_counts = a->step_counts;
-		o->travel_counts = a->travel_counts;
-		o->travel_tol = a->travel_tolerance;
-		o->backoff_counts = cfg->calibration.backoff_counts;
-		o->pot_input = a->analog.input;
-		o->check.noise_margin_v = a->monotonic_margin_v;
-		o->check.expected_range_v = a->analog.expected_range_v;
-		o->check.range_tol = a->analog.range_tolerance;
-		o->check.min_points =
-		    lo / a->step_counts > 2 ? (int)(lo / a->step_counts) : 2;
-		o->check.max_points = (int)(hi / a->step_counts) + 1;
-		if (o->check.max_points > RE_CAL_MAX_POINTS)
-			o->check.max_points = RE_CAL_MAX_POINTS;
-		o->check.step_tol_counts = a->step_counts / 2.0;
-		o->encpot.allowed_error = a->allowed_error;
-		o->encpot.persistence_cycles = a->persistence_cycles;
-	}
+	out->accept_ms = 3 * (plan->mainms > 0 ? plan->mainms : 10) + 20;
+	for (int i = 0; i < RE_AXES; i++)
+		axis_cfg_from(cfg, &plan->axis[i], i, &out->axis[i]);
 }
 
 /* ---- faults ----------------------------------------------------------------
@@ -123,6 +156,11 @@ static int comm_fault(struct re_fault *f, const char *what, int rc)
 /* ---- I/O ------------------------------------------------------------------
  */
 
+static int64_t now_ns(const struct re_io *io)
+{
+	return io->ops->now_ns(io->ud);
+}
+
 static int send(struct re_calib *c, const struct re_io *io,
 		const struct re_calib_cfg *cfg, struct re_fault *f)
 {
@@ -138,93 +176,115 @@ static int send(struct re_calib *c, const struct re_io *io,
 	return rc < 0 ? comm_fault(f, "command failed", rc) : GL_OK;
 }
 
-static int sendf(struct re_calib *c, const struct re_io *io,
-		 const struct re_calib_cfg *cfg, struct re_fault *f,
-		 const char *fmt, ...) __attribute__((format(printf, 5, 6)));
-
-static int sendf(struct re_calib *c, const struct re_io *io,
-		 const struct re_calib_cfg *cfg, struct re_fault *f,
-		 const char *fmt, ...)
+/* The next supervised sample. A fault the sampler latched is passed on
+ * as RE_F_NONE (the supervisor reacted to it already). */
+static int sample(struct re_calib *c, const struct re_calib_cfg *cfg,
+		  struct re_fault *f)
 {
-	va_list ap;
-
-	va_start(ap, fmt);
-	vsnprintf(c->line, sizeof(c->line), fmt, ap);
-	va_end(ap);
-	return send(c, io, cfg, f);
-}
-
-static int64_t now_ns(const struct re_io *io)
-{
-	return io->ops->now_ns(io->ud);
-}
-
-/* Next sample: wait for its deadline, read the record, check the relay
- * and that every motor is still on. */
-static int sample_x(struct re_calib *c, const struct re_io *io,
-		    const struct re_calib_cfg *cfg, int motors_on,
-		    struct re_fault *f)
-{
-	char why[sizeof(f->s)];
 	int rc;
 
 	if (cfg->stop && *cfg->stop)
 		return GL_ERR_AGAIN;
-	c->next_ns += RE_CALIB_SAMPLE_MS * NS_PER_MS;
-	if (c->next_ns < now_ns(io))
-		c->next_ns = now_ns(io);
-	io->ops->sleep_until(io->ud, c->next_ns);
-	rc = io->ops->record(io->ud, NULL, &c->rec, cfg->cmd_timeout_ms);
-	if (rc < 0)
-		return comm_fault(f, "cannot read the data record", rc);
-	if (c->rec.n_axes < cfg->n_axes)
+	rc = cfg->sampler.sample(cfg->sampler.ud, &c->rec);
+	if (rc == RE_FAULT)
+		re_fault_set(f, RE_F_NONE, -1);
+	else if (rc == GL_OK && c->rec->n_axes < cfg->n_axes)
 		return comm_fault(f, "data record", GL_ERR_RECORD);
-	if (io->ops->relay_check(io->ud, why, sizeof(why)) != GL_OK) {
-		re_fault_set(f, RE_F_ESTOP_LOST, -1);
-		snprintf(f->s, sizeof(f->s), "%s", why);
-		return RE_FAULT;
-	}
-	if (re_check_motors(&c->rec, cfg->n_axes, motors_on, f) == RE_FAULT)
-		return abort_axis(f, f->axis,
-				  "the controller switched the "
-				  "motor off: %s (stop code %d)",
-				  re_stop_reason((int)f->i[0]), (int)f->i[0]);
-	return GL_OK;
-}
-
-static int sample(struct re_calib *c, const struct re_io *io,
-		  const struct re_calib_cfg *cfg, struct re_fault *f)
-{
-	return sample_x(c, io, cfg, 1, f);
+	return rc;
 }
 
 static double enc_of(const struct re_calib *c, int i)
 {
-	return c->rec.axis[i].motor_pos;
+	return c->rec->axis[i].motor_pos;
 }
 
 static double pot_of(const struct re_calib *c, const struct re_calib_cfg *cfg,
 		     int i)
 {
-	int in = cfg->axis[i].pot_input;
-	int k = in >= 1 && in <= c->rec.n_axes ? in - 1 : i;
-
-	return re_pot_volts(c->rec.axis[k].analog_in);
+	return re_pot_of(c->rec, i, cfg->axis[i].pot_input);
 }
 
 static int moving(const struct re_calib *c, int i)
 {
-	return !!(c->rec.axis[i].status & GL_AXST_MOVING);
+	return !!(c->rec->axis[i].status & GL_AXST_MOVING);
 }
 
 static int rev_switch(const struct re_calib *c, int i)
 {
-	return !(c->rec.axis[i].switches & GL_AXSW_RLS);
+	return !(c->rec->axis[i].switches & GL_AXSW_RLS);
 }
 
 static int fwd_switch(const struct re_calib *c, int i)
 {
-	return !(c->rec.axis[i].switches & GL_AXSW_FLS);
+	return !(c->rec->axis[i].switches & GL_AXSW_FLS);
+}
+
+/* ---- service moves -------------------------------------------------------
+ */
+
+/* Queue a move of axis i to @target at @speed (sent by flush()). */
+static void move_to(struct re_calib *c, int i, double target, int speed)
+{
+	c->b.mask |= 1u << i;
+	c->b.tgt[i] = lround(target);
+	c->b.sp[i] = speed;
+}
+
+static int append(char *line, size_t cap, const char *item)
+{
+	if (strlen(line) + strlen(item) + 1 > cap - 1)
+		return -1;
+	if (line[0])
+		strcat(line, ";");
+	strcat(line, item);
+	return 0;
+}
+
+/* The targets and speeds, then the request; wait until the program took
+ * it (mvreq back to 0). A refused request is a fault the program latched:
+ * the next sample reports it. */
+static int flush(struct re_calib *c, const struct re_io *io,
+		 const struct re_calib_cfg *cfg, struct re_fault *f)
+{
+	char item[48];
+	double req = 1;
+	int64_t end;
+	int rc = GL_OK;
+
+	if (!c->b.mask)
+		return GL_OK;
+	c->line[0] = '\0';
+	for (int i = 0; rc == GL_OK && i < RE_AXES; i++) {
+		if (!(c->b.mask >> i & 1))
+			continue;
+		snprintf(item, sizeof(item), "mvtg[%d]=%ld;mvsp[%d]=%d", i,
+			 c->b.tgt[i], i, c->b.sp[i]);
+		if (append(c->line, sizeof(c->line), item) < 0) {
+			rc = send(c, io, cfg, f);
+			snprintf(c->line, sizeof(c->line), "%s", item);
+		}
+	}
+	if (rc == GL_OK && c->line[0])
+		rc = send(c, io, cfg, f);
+	snprintf(c->line, sizeof(c->line), "mvax[0]=%u;mvax[1]=%u;mvax[2]=%u;"
+		 "mvreq=1", c->b.mask & 1, c->b.mask >> 1 & 1,
+		 c->b.mask >> 2 & 1);
+	if (rc == GL_OK)
+		rc = send(c, io, cfg, f);
+	c->b.mask = 0;
+	end = now_ns(io) + (int64_t)cfg->accept_ms * NS_PER_MS;
+	while (rc == GL_OK && req != 0 && now_ns(io) < end) {
+		io->ops->sleep_until(io->ud, now_ns(io) + POLL_MS * NS_PER_MS);
+		rc = re_io_read(io, "mvreq", &req, cfg->cmd_timeout_ms);
+		if (rc < 0)
+			return comm_fault(f, "move request", rc);
+	}
+	if (rc == GL_OK && req != 0)
+		return abort_axis(f, -1,
+				  "the controller program did not take a move "
+				  "request within %d ms",
+				  cfg->accept_ms);
+	return rc;
 }
 
 /* ---- the per-axis steps ----------------------------------------------------
@@ -250,33 +310,61 @@ static void note_edge(struct re_calib *c, int i, int active)
 	}
 }
 
-/* An absolute move of axis i at its maximum velocity. */
-static int move_abs(struct re_calib *c, const struct re_io *io,
-		    const struct re_calib_cfg *cfg, int i, double target,
-		    struct re_fault *f)
+/* How far the axis can run at @speed before its pot reaches @zone_v:
+ * from the pot's absolute reading, with the gain overestimated by the
+ * range tolerance (the move ends early, never late), less the braking
+ * distance, two samples and a guard. <= 0: already too close. */
+static double fast_len(const struct re_calib_axis_cfg *a, double pot,
+		       double zone_v, int speed)
 {
-	return sendf(c, io, cfg, f, "SP%c=%d;PA%c=%.0f;BG%c", AXES[i],
-		     cfg->axis[i].vmax_cps, AXES[i], target, AXES[i]);
+	double gain_hi = a->gain_v * (1 + a->check.range_tol);
+	double brake = speed / (2.0 * ACFACT) + speed * 0.02 + GUARD_CNT;
+
+	return fabs(pot - zone_v) / gain_hi - brake;
 }
 
-/* A bounded relative move of axis i at its maximum velocity. */
-static int move_rel(struct re_calib *c, const struct re_io *io,
-		    const struct re_calib_cfg *cfg, int i, double counts,
-		    struct re_fault *f)
+/* The bounded slow move onto a switch: to the far side of where it can
+ * be (the pot's lowest/highest possible reading), plus two back-offs. */
+static double seek_len(const struct re_calib_axis_cfg *a, double pot,
+		       double end_v)
 {
-	return sendf(c, io, cfg, f, "SP%c=%d;PR%c=%.0f;BG%c", AXES[i],
-		     cfg->axis[i].vmax_cps, AXES[i], counts, AXES[i]);
+	double gain_lo = a->gain_v * (1 - a->check.range_tol);
+
+	return fabs(pot - end_v) / gain_lo + 2.0 * a->backoff_counts;
 }
 
-static double sweep_counts(const struct re_calib_axis_cfg *a)
+static int start_seek_rev(struct re_calib *c, const struct re_io *io,
+			  const struct re_calib_cfg *cfg, int i)
 {
-	return a->travel_counts * (1 + a->travel_tol) + 2.0 * a->backoff_counts;
+	const struct re_calib_axis_cfg *a = &cfg->axis[i];
+	double pot = pot_of(c, cfg, i);
+
+	c->ax[i].seek_len = seek_len(a, pot, a->potlo_v);
+	move_to(c, i, enc_of(c, i) - c->ax[i].seek_len, a->seek_cps);
+	return enter(c, io, i, PH_TO_REV);
+}
+
+static int step_start(struct re_calib *c, const struct re_io *io,
+		      const struct re_calib_cfg *cfg, int i)
+{
+	const struct re_calib_axis_cfg *a = &cfg->axis[i];
+	double pot = pot_of(c, cfg, i), len;
+
+	if (rev_switch(c, i)) { /* already on it: just back off */
+		move_to(c, i, enc_of(c, i) + a->backoff_counts, a->seek_cps);
+		return enter(c, io, i, PH_BACK_REV);
+	}
+	len = pot > a->pnlo_v ? fast_len(a, pot, a->pnlo_v, a->travel_cps) : 0;
+	if (len <= 0)
+		return start_seek_rev(c, io, cfg, i);
+	move_to(c, i, enc_of(c, i) - len, a->travel_cps);
+	return enter(c, io, i, PH_FAST_REV);
 }
 
 static int stopped_badly(const struct re_calib *c, int i, const char *where,
 			 struct re_fault *f)
 {
-	int sc = c->rec.axis[i].stop_code;
+	int sc = c->rec->axis[i].stop_code;
 
 	return abort_axis(f, i,
 			  "stopped before the %s: %s (stop code %d, "
@@ -284,19 +372,18 @@ static int stopped_badly(const struct re_calib *c, int i, const char *where,
 			  where, re_stop_reason(sc), sc, enc_of(c, i));
 }
 
-static int step_start(struct re_calib *c, const struct re_io *io,
-		      const struct re_calib_cfg *cfg, int i, struct re_fault *f)
+static int step_fast_rev(struct re_calib *c, const struct re_io *io,
+			 const struct re_calib_cfg *cfg, int i,
+			 struct re_fault *f)
 {
-	const struct re_calib_axis_cfg *a = &cfg->axis[i];
-	int rc;
-
-	if (rev_switch(c, i)) { /* already on it: just back off */
-		rc = move_abs(c, io, cfg, i, enc_of(c, i) + a->backoff_counts,
-			      f);
-		return rc ? rc : enter(c, io, i, PH_BACK_REV);
-	}
-	rc = move_rel(c, io, cfg, i, -sweep_counts(a), f);
-	return rc ? rc : enter(c, io, i, PH_TO_REV);
+	if (moving(c, i))
+		return GL_OK;
+	if (rev_switch(c, i)) /* the switch came early: fine, it is there */
+		return enter(c, io, i, PH_TO_REV);
+	if (c->rec->axis[i].stop_code != 1)
+		return stopped_badly(c, i, "slow zone of the reverse switch",
+				     f);
+	return start_seek_rev(c, io, cfg, i);
 }
 
 static int step_to_rev(struct re_calib *c, const struct re_io *io,
@@ -304,30 +391,28 @@ static int step_to_rev(struct re_calib *c, const struct re_io *io,
 		       struct re_fault *f)
 {
 	const struct re_calib_axis_cfg *a = &cfg->axis[i];
-	double edge;
-	int rc;
 
 	note_edge(c, i, rev_switch(c, i));
 	if (moving(c, i))
 		return GL_OK;
-	if (c->rec.axis[i].stop_code == 1 && !rev_switch(c, i))
+	if (c->rec->axis[i].stop_code == 1 && !rev_switch(c, i))
 		return abort_axis(f, i,
 				  "the reverse limit switch never came "
-				  "within %.0f counts",
-				  sweep_counts(a));
+				  "within %.0f counts (potentiometer %.3f V)",
+				  c->ax[i].seek_len, pot_of(c, cfg, i));
 	if (!rev_switch(c, i))
 		return stopped_badly(c, i, "reverse limit switch", f);
-	edge = c->ax[i].edge;
-	rc = move_abs(c, io, cfg, i, edge + a->backoff_counts, f);
-	return rc ? rc : enter(c, io, i, PH_BACK_REV);
+	move_to(c, i, c->ax[i].edge + a->backoff_counts, a->seek_cps);
+	return enter(c, io, i, PH_BACK_REV);
 }
 
 static int step_back_rev(struct re_calib *c, const struct re_io *io,
 			 const struct re_calib_cfg *cfg, int i,
 			 struct re_fault *f)
 {
+	const struct re_calib_axis_cfg *a = &cfg->axis[i];
 	struct cal_axis *ax = &c->ax[i];
-	int rc;
+	double pot = pot_of(c, cfg, i), len;
 
 	if (moving(c, i))
 		return GL_OK;
@@ -335,13 +420,19 @@ static int step_back_rev(struct re_calib *c, const struct re_io *io,
 		return abort_axis(f, i,
 				  "still on the reverse limit switch "
 				  "after backing off %d counts",
-				  cfg->axis[i].backoff_counts);
-	if (c->rec.axis[i].stop_code != 1)
+				  a->backoff_counts);
+	if (c->rec->axis[i].stop_code != 1)
 		return stopped_badly(c, i, "end of the back-off", f);
 	ax->start = enc_of(c, i);
 	memset(ax->acc, 0, sizeof(ax->acc));
-	rc = move_rel(c, io, cfg, i, sweep_counts(&cfg->axis[i]), f);
-	return rc ? rc : enter(c, io, i, PH_SWEEP);
+	len = fast_len(a, pot, a->pnhi_v, a->vmax_cps);
+	if (len <= 0) {
+		ax->seek_len = seek_len(a, pot, a->pothi_v);
+		move_to(c, i, ax->start + ax->seek_len, a->seek_cps);
+		return enter(c, io, i, PH_SLOW_FWD);
+	}
+	move_to(c, i, ax->start + len, a->vmax_cps);
+	return enter(c, io, i, PH_SWEEP);
 }
 
 /* Add this sample to the table point nearest to the encoder. */
@@ -370,23 +461,40 @@ static int step_sweep(struct re_calib *c, const struct re_io *io,
 		      const struct re_calib_cfg *cfg, int i, struct re_fault *f)
 {
 	const struct re_calib_axis_cfg *a = &cfg->axis[i];
-	double edge;
-	int rc;
+	struct cal_axis *ax = &c->ax[i];
+
+	accumulate(c, cfg, i);
+	if (moving(c, i))
+		return GL_OK;
+	if (fwd_switch(c, i))
+		return enter(c, io, i, PH_SLOW_FWD);
+	if (c->rec->axis[i].stop_code != 1)
+		return stopped_badly(c, i, "slow zone of the forward switch",
+				     f);
+	ax->seek_len = seek_len(a, pot_of(c, cfg, i), a->pothi_v);
+	move_to(c, i, enc_of(c, i) + ax->seek_len, a->seek_cps);
+	return enter(c, io, i, PH_SLOW_FWD);
+}
+
+static int step_slow_fwd(struct re_calib *c, const struct re_io *io,
+			 const struct re_calib_cfg *cfg, int i,
+			 struct re_fault *f)
+{
+	const struct re_calib_axis_cfg *a = &cfg->axis[i];
 
 	accumulate(c, cfg, i);
 	note_edge(c, i, fwd_switch(c, i));
 	if (moving(c, i))
 		return GL_OK;
-	if (c->rec.axis[i].stop_code == 1 && !fwd_switch(c, i))
+	if (c->rec->axis[i].stop_code == 1 && !fwd_switch(c, i))
 		return abort_axis(f, i,
 				  "the forward limit switch never came "
-				  "within %.0f counts",
-				  sweep_counts(a));
+				  "within %.0f counts (potentiometer %.3f V)",
+				  c->ax[i].seek_len, pot_of(c, cfg, i));
 	if (!fwd_switch(c, i))
 		return stopped_badly(c, i, "forward limit switch", f);
-	edge = c->ax[i].edge;
-	rc = move_abs(c, io, cfg, i, edge - a->backoff_counts, f);
-	return rc ? rc : enter(c, io, i, PH_BACK_FWD);
+	move_to(c, i, c->ax[i].edge - a->backoff_counts, a->seek_cps);
+	return enter(c, io, i, PH_BACK_FWD);
 }
 
 static int step_back_fwd(struct re_calib *c, const struct re_io *io,
@@ -400,7 +508,7 @@ static int step_back_fwd(struct re_calib *c, const struct re_io *io,
 				  "still on the forward limit switch "
 				  "after backing off %d counts",
 				  cfg->axis[i].backoff_counts);
-	if (c->rec.axis[i].stop_code != 1)
+	if (c->rec->axis[i].stop_code != 1)
 		return stopped_badly(c, i, "end of the back-off", f);
 	c->ax[i].soft_fwd = enc_of(c, i);
 	return enter(c, io, i, PH_DONE);
@@ -418,10 +526,12 @@ static int axis_step(struct re_calib *c, const struct re_io *io,
 				  "within %d ms (encoder %.0f)",
 				  cfg->move_timeout_ms, enc_of(c, i));
 	switch (c->ax[i].ph) {
-	case PH_START: return step_start(c, io, cfg, i, f);
+	case PH_START: return step_start(c, io, cfg, i);
+	case PH_FAST_REV: return step_fast_rev(c, io, cfg, i, f);
 	case PH_TO_REV: return step_to_rev(c, io, cfg, i, f);
 	case PH_BACK_REV: return step_back_rev(c, io, cfg, i, f);
 	case PH_SWEEP: return step_sweep(c, io, cfg, i, f);
+	case PH_SLOW_FWD: return step_slow_fwd(c, io, cfg, i, f);
 	case PH_BACK_FWD: return step_back_fwd(c, io, cfg, i, f);
 	default: return GL_OK;
 	}
@@ -443,6 +553,29 @@ static double point_value(const struct acc *a, double step, double *enc_off)
 	return my - (a->sxy / a->n - mx * my) / var * mx;
 }
 
+/* @a's sums with every dx shifted by @d. */
+static void acc_add_shifted(struct acc *out, const struct acc *a, double d)
+{
+	out->n += a->n;
+	out->sx += a->sx + a->n * d;
+	out->sy += a->sy;
+	out->sxx += a->sxx + 2 * d * a->sx + a->n * d * d;
+	out->sxy += a->sxy + d * a->sy;
+}
+
+/* A point without samples (the PC stalled up to one step): the line
+ * through both neighbours' samples, when both have some. */
+static int fill_point(const struct cal_axis *ax, int j, int n, double step,
+		      struct acc *out)
+{
+	memset(out, 0, sizeof(*out));
+	if (j < 1 || j + 1 >= n || !ax->acc[j - 1].n || !ax->acc[j + 1].n)
+		return -1;
+	acc_add_shifted(out, &ax->acc[j - 1], -step);
+	acc_add_shifted(out, &ax->acc[j + 1], step);
+	return 0;
+}
+
 static int build_table(struct re_calib *c, const struct re_calib_cfg *cfg,
 		       int i, struct re_caltable *t, struct re_fault *f)
 {
@@ -450,6 +583,7 @@ static int build_table(struct re_calib *c, const struct re_calib_cfg *cfg,
 	struct cal_axis *ax = &c->ax[i];
 	double prev_enc = 0, enc_off;
 	long n = lround(floor((ax->soft_fwd - ax->start) / a->step_counts)) + 1;
+	struct acc filled;
 
 	memset(t, 0, sizeof(*t));
 	t->n = n > RE_CAL_MAX_POINTS ? RE_CAL_MAX_POINTS : (int)n;
@@ -458,15 +592,19 @@ static int build_table(struct re_calib *c, const struct re_calib_cfg *cfg,
 	t->soft_rev = ax->start;
 	t->soft_fwd = ax->soft_fwd;
 	for (int j = 0; j < t->n; j++) {
+		const struct acc *s = &ax->acc[j];
 		double x = ax->start + (double)j * a->step_counts;
 
-		if (ax->acc[j].n == 0)
-			return abort_axis(f, i,
-					  "no potentiometer sample near "
-					  "point %d (encoder %.0f)",
-					  j, x);
-		t->pot_v[j] =
-		    point_value(&ax->acc[j], a->step_counts, &enc_off);
+		if (s->n == 0) {
+			if (fill_point(ax, j, t->n, a->step_counts, &filled))
+				return abort_axis(f, i,
+						  "no potentiometer sample "
+						  "near point %d (encoder %.0f)",
+						  j, x);
+			s = &filled;
+			c->filled++;
+		}
+		t->pot_v[j] = point_value(s, a->step_counts, &enc_off);
 		if (j > 0 &&
 		    re_cal_check_point(&a->check, i, j, a->step_counts,
 				       prev_enc, x + enc_off, t->pot_v[j - 1],
@@ -481,24 +619,6 @@ static int build_table(struct re_calib *c, const struct re_calib_cfg *cfg,
 /* ---- to the centre, checking the pot against the tables --------------------
  */
 
-static int check_encpot(struct re_calib *c, const struct re_calib_cfg *cfg,
-			const struct re_calset *set, struct re_fault *f)
-{
-	for (int i = 0; i < cfg->n_axes; i++) {
-		struct re_encpot_result r;
-		double enc = enc_of(c, i), pot = pot_of(c, cfg, i);
-
-		if (re_check_encpot(&set->axis[i], &cfg->axis[i].encpot, i, enc,
-				    pot, &c->encpot[i], &r, f) != RE_FAULT)
-			continue;
-		return abort_axis(f, i,
-				  "potentiometer %.3f V at encoder %.0f,"
-				  " table expects %.3f V +- %.3f V",
-				  pot, enc, r.exp.pot_v, r.tol_v);
-	}
-	return GL_OK;
-}
-
 static int all_stopped(const struct re_calib *c, int n)
 {
 	for (int i = 0; i < n; i++)
@@ -507,26 +627,22 @@ static int all_stopped(const struct re_calib *c, int n)
 	return 1;
 }
 
+/* Every axis to the centre of its soft limits at the travel speed; the
+ * supervisor checks the encoders against @set on every sample. */
 static int to_centre(struct re_calib *c, const struct re_io *io,
 		     const struct re_calib_cfg *cfg,
 		     const struct re_calset *set, struct re_fault *f)
 {
 	int64_t deadline = now_ns(io) + cfg->move_timeout_ms * NS_PER_MS;
-	long tgt[RE_AXES];
 	int rc;
 
 	for (int i = 0; i < RE_AXES; i++)
-		tgt[i] =
-		    lround((set->axis[i].soft_rev + set->axis[i].soft_fwd) / 2);
-	memset(c->encpot, 0, sizeof(c->encpot));
-	rc = sendf(c, io, cfg, f, "SP %d,%d,%d;PA %ld,%ld,%ld;BG ABC",
-		   cfg->axis[0].vmax_cps, cfg->axis[1].vmax_cps,
-		   cfg->axis[2].vmax_cps, tgt[0], tgt[1], tgt[2]);
+		move_to(c, i, (set->axis[i].soft_rev + set->axis[i].soft_fwd) / 2,
+			cfg->axis[i].travel_cps);
+	rc = flush(c, io, cfg, f);
 	do {
 		if (rc == GL_OK)
-			rc = sample(c, io, cfg, f);
-		if (rc == GL_OK)
-			rc = check_encpot(c, cfg, set, f);
+			rc = sample(c, cfg, f);
 		if (rc == GL_OK && all_stopped(c, cfg->n_axes))
 			return GL_OK;
 	} while (rc == GL_OK && now_ns(io) < deadline);
@@ -547,41 +663,63 @@ static int sweep_all(struct re_calib *c, const struct re_io *io,
 	int rc, done;
 
 	do {
-		rc = sample(c, io, cfg, f);
+		rc = sample(c, cfg, f);
 		done = 1;
 		for (int i = 0; rc == GL_OK && i < cfg->n_axes; i++) {
 			rc = axis_step(c, io, cfg, i, f);
 			done &= c->ax[i].ph == PH_DONE;
 		}
+		if (rc == GL_OK)
+			rc = flush(c, io, cfg, f);
 	} while (rc == GL_OK && !done);
 	return rc;
 }
 
+static void own(const struct re_calib_cfg *cfg, unsigned mask)
+{
+	if (cfg->sampler.own)
+		cfg->sampler.own(cfg->sampler.ud, mask);
+}
+
+static void use_tables(const struct re_calib_cfg *cfg,
+		       const struct re_calset *set)
+{
+	if (cfg->sampler.tables)
+		cfg->sampler.tables(cfg->sampler.ud, set);
+}
+
 int re_calib_full(struct re_calib *c, const struct re_io *io,
 		  const struct re_calib_cfg *cfg, struct re_calset *set,
-		  struct re_fault *fault, double *seconds)
+		  struct re_fault *fault, double *seconds, int *filled)
 {
 	int rc;
 
-	if (!c || !io || !cfg || !set || cfg->n_axes != RE_AXES)
+	if (!c || !io || !cfg || !set || cfg->n_axes != RE_AXES ||
+	    !cfg->sampler.sample)
 		return GL_ERR_ARG;
 	memset(set, 0, sizeof(*set));
+	memset(&c->b, 0, sizeof(c->b));
+	c->filled = 0;
 	for (int i = 0; i < RE_AXES; i++)
 		enter(c, io, i, PH_START);
-	c->t0_ns = c->next_ns = now_ns(io);
-	rc = sendf(c, io, cfg, fault, "SH ABC");
-	if (rc == GL_OK)
-		rc = sweep_all(c, io, cfg, fault);
+	c->t0_ns = now_ns(io);
+	own(cfg, 7);
+	rc = sweep_all(c, io, cfg, fault);
 	for (int i = 0; rc == GL_OK && i < RE_AXES; i++)
 		rc = build_table(c, cfg, i, &set->axis[i], fault);
 	set->n_axes = RE_AXES;
 	for (int i = 0; i < RE_AXES; i++)
 		snprintf(set->name[i], sizeof(set->name[i]), "%s",
 			 cfg->names[i]);
-	if (rc == GL_OK)
+	if (rc == GL_OK) {
+		use_tables(cfg, set);
 		rc = to_centre(c, io, cfg, set, fault);
+	}
+	own(cfg, 0);
 	if (seconds)
 		*seconds = (double)(now_ns(io) - c->t0_ns) / 1e9;
+	if (filled)
+		*filled = c->filled;
 	if (rc != GL_OK)
 		memset(set, 0, sizeof(*set));
 	return rc;
@@ -598,11 +736,15 @@ static int check_position(struct re_calib *c, const struct re_calib_cfg *cfg,
 		const struct re_caltable *t = &set->axis[i];
 		double enc = enc_of(c, i), pot = pot_of(c, cfg, i);
 		struct re_encpot_cfg once = cfg->axis[i].encpot;
+		int v;
 
 		once.persistence_cycles = 0;
-		if (re_check_encpot(t, &once, i, enc, pot, &st, &r, f) !=
-		    RE_FAULT)
+		v = re_check_encpot(t, &once, i, enc, pot, &st, &r, f);
+		if (v == RE_OK)
 			continue;
+		if (v < 0)
+			return abort_axis(f, i, "the table cannot be used "
+						"(%s)", gl_strerror(v));
 		if (r.exp.where == RE_TPOS_OUTSIDE)
 			return abort_axis(f, i,
 					  "encoder %.0f is outside the "
@@ -623,15 +765,19 @@ int re_calib_check_robot(struct re_calib *c, const struct re_io *io,
 {
 	int rc;
 
-	if (!c || !io || !cfg || !set || set->n_axes != cfg->n_axes)
+	if (!c || !io || !cfg || !set || set->n_axes != cfg->n_axes ||
+	    !cfg->sampler.sample)
 		return GL_ERR_ARG;
-	c->t0_ns = c->next_ns = now_ns(io);
-	rc = sample_x(c, io, cfg, 0, fault);
+	memset(&c->b, 0, sizeof(c->b));
+	c->t0_ns = now_ns(io);
+	rc = sample(c, cfg, fault);
 	if (rc == GL_OK)
 		rc = check_position(c, cfg, set, fault);
+	own(cfg, 7);
 	if (rc == GL_OK)
-		rc = sendf(c, io, cfg, fault, "SH ABC");
+		use_tables(cfg, set);
 	if (rc == GL_OK)
 		rc = to_centre(c, io, cfg, set, fault);
+	own(cfg, 0);
 	return rc;
 }

@@ -36,7 +36,7 @@ static const struct re_fault_msg re_fault_table[] = {
 	 "axis {a}: encoder position {i0} counts is outside the calibrated travel {i1} to {i2} counts",
 	 "keep the E-stop pressed, check the encoder cable of axis {a} and that the axis did not slip, restart roboelf and recalibrate"},
 	{RE_F_CTRL_ENCODER, RE_FC_ENCODER,
-	 "axis {a}: the controller detected an encoder failure and switched the motors off (stop code {i0})",
+	 "axis {a}: the controller detected an encoder failure (stop code {i0})",
 	 "keep the E-stop pressed, check the encoder cable and the motor of axis {a}, restart roboelf and recalibrate"},
 	{RE_F_WDOG_REPLY, RE_FC_WATCHDOG,
 	 "no reply from the controller for {i0} ms (limit {i1} ms)",
@@ -51,19 +51,19 @@ static const struct re_fault_msg re_fault_table[] = {
 	 "the controller stopped the robot: no heartbeat from this PC for {i0} ms",
 	 "keep the E-stop pressed, check the controller's Ethernet cable and that this PC is not overloaded, then restart roboelf"},
 	{RE_F_ESTOP_LOST, RE_FC_ESTOP,
-	 "the E-stop relay stopped answering ({s}); the motors were switched off through the controller",
+	 "the E-stop relay stopped answering ({s})",
 	 "press the hardware E-stop now, check the relay's USB cable and power, then restart roboelf"},
 	{RE_F_MOTOR_OFF, RE_FC_MOTION,
 	 "axis {a}: the controller switched the motor off: {s} (stop code {i0})",
 	 "keep the E-stop pressed, check that axis {a} moves freely and nothing blocks it, check its motor and encoder cables, then restart roboelf"},
 	{RE_F_CTRL_POSERR, RE_FC_MOTION,
-	 "axis {a}: position error of at least {i0} counts, above the limit; the controller switched the motors off",
+	 "axis {a}: position error of at least {i0} counts, above its limit (blocked or jammed?)",
 	 "keep the E-stop pressed, check that axis {a} moves freely and nothing blocks it, then restart roboelf"},
 	{RE_F_CTRL_AMPERR, RE_FC_MOTION,
 	 "axis {a}: amplifier fault, motor power lost (stop code {i0})",
 	 "keep the E-stop pressed, check the amplifier and motor cable of axis {a} and the motor power supply, then restart roboelf"},
 	{RE_F_CTRL_POWER, RE_FC_ESTOP,
-	 "motor power lost on every axis (E-stop button, relay or power supply); the controller switched the motors off",
+	 "motor power lost on every axis (E-stop button, relay or power supply)",
 	 "keep the E-stop pressed; if nobody pressed it, check the relay, its USB cable and the motor power supply, then restart roboelf"},
 	{RE_F_CTRL_MOTOROFF, RE_FC_MOTION,
 	 "axis {a}: the controller found the motor off while armed: {s} (stop code {i0})",
@@ -128,6 +128,39 @@ static const struct re_fault_msg re_fault_table[] = {
 	{RE_F_PROGRAM_ID, RE_FC_PROGRAM,
 	 "the controller does not run the program stamped by galil-load: {s}",
 	 "load the program with galil-load, then restart roboelf"},
+	{RE_F_CTRL_UNCMD, RE_FC_MOTION,
+	 "axis {a}: the controller stopped motion its program did not command: {s}",
+	 "keep the E-stop pressed, find which other program or person sent commands to the controller (another roboelf, galil-load, a terminal) and stop it, then restart roboelf"},
+	{RE_F_CTRL_SAFE_ON, RE_FC_FOREIGN,
+	 "a motor was switched on while the controller program held the robot in its safe state: another program sent commands to the controller",
+	 "keep the E-stop pressed, find which other program or person sent commands to the controller (another roboelf, galil-load, a terminal) and stop it, then restart roboelf"},
+	{RE_F_CTRL_FOREIGN_HB, RE_FC_FOREIGN,
+	 "the controller received a heartbeat that is not this supervisor's (out of sequence): another program writes to the controller",
+	 "keep the E-stop pressed, close every other program connected to the controller (another roboelf, a terminal), then restart roboelf"},
+	{RE_F_CTRL_FOREIGN_CONN, RE_FC_FOREIGN,
+	 "another program connected to the controller (handle {s}) while the motors were on",
+	 "keep the E-stop pressed, close every other program connected to the controller (another roboelf, galil-load, a terminal), then restart roboelf"},
+	{RE_F_CTRL_SVCMOVE, RE_FC_MOTION,
+	 "axis {a}: the controller stopped an automatic move: {s}",
+	 "keep the E-stop pressed, check axis {a}, its limit switches and its potentiometer, then restart roboelf; report the log if it happens again"},
+	{RE_F_CTRL_POTRANGE, RE_FC_ENCODER,
+	 "axis {a}: the potentiometer reads {f0} V, outside the range it can read on this robot",
+	 "keep the E-stop pressed, check the potentiometer of axis {a} and its cable (broken wire?) and that the axis is not beyond its limit switch, then restart roboelf and recalibrate"},
+	{RE_F_UNCMD, RE_FC_MOTION,
+	 "axis {a}: moving although nothing commanded it ({s})",
+	 "keep the E-stop pressed, find which other program or person sent commands to the controller (another roboelf, galil-load, a terminal) and stop it, then restart roboelf"},
+	{RE_F_STALL, RE_FC_WATCHDOG,
+	 "this supervisor did not run for {i0} ms (limit {i1} ms): the PC stalled (suspended, overloaded or stopped in a debugger), not the link",
+	 "keep the E-stop pressed, find what stopped roboelf (Ctrl-Z, a debugger, CPU or disk load), then restart it"},
+	{RE_F_RELAY_POWER, RE_FC_ESTOP,
+	 "motor power lost on every axis and the E-stop relay board does not confirm its state ({s})",
+	 "press the hardware E-stop now, check the relay board, its USB cable and its power, then restart roboelf"},
+	{RE_F_CAL_ABSOLUTE, RE_FC_CALIBRATION,
+	 "axis {a}: potentiometer reads {f0} V at the {s} end of the travel, {f1} V +- {f2} V expected there",
+	 "keep the E-stop pressed, check the potentiometer of axis {a} (offset, wrong part, wiring) and the configured reverse_v / forward_v, then restart roboelf and calibrate again"},
+	{RE_F_CTRL_STATE, RE_FC_PROGRAM,
+	 "the controller program is in state {i0}, not {s} as expected (reset, or another program took over)",
+	 "keep the E-stop pressed, find out whether the controller was reset or another program took over, then restart roboelf"},
 };
 /* clang-format on */
 
@@ -144,6 +177,7 @@ static const char *const re_fclass_names[RE_FC_COUNT] = {
     [RE_FC_PARAM] = "PARAM",
     [RE_FC_LIMIT] = "LIMIT",
     [RE_FC_PROGRAM] = "PROGRAM",
+    [RE_FC_FOREIGN] = "FOREIGN",
 };
 
 static const char *const re_axis_letters[] = {"A", "B", "C", "D",
@@ -537,7 +571,7 @@ int re_za_decode(int32_t zaa, int32_t zab, int32_t zac, struct re_za *out)
 	z.jraw = zac % 4096;
 	z.jcmd = (zac / 4096) % 8 - 1;
 	z.mcmd = zac / 32768;
-	if (z.state > RE_DMC_FAULT || z.fcode > RE_DMC_F_SUPERVISOR ||
+	if (z.state > RE_DMC_SERVICE || z.fcode > RE_DMC_F_MAX ||
 	    z.faxis > 3 || z.mcmd > 6 || z.jcmd > 6)
 		return GL_ERR_RANGE;
 	*out = z;
@@ -586,6 +620,10 @@ static enum re_fault_id re_ctrl_fault_id(int fcode)
 	case RE_DMC_F_MOTOROFF: return RE_F_CTRL_MOTOROFF;
 	case RE_DMC_F_THREAD: return RE_F_CTRL_THREAD;
 	case RE_DMC_F_SUPERVISOR: return RE_F_CTRL_SUPERVISOR;
+	case RE_DMC_F_UNCMD: return RE_F_CTRL_UNCMD;
+	case RE_DMC_F_FOREIGN: return RE_F_CTRL_FOREIGN_CONN;
+	case RE_DMC_F_SVCMOVE: return RE_F_CTRL_SVCMOVE;
+	case RE_DMC_F_POTRANGE: return RE_F_CTRL_POTRANGE;
 	default: return RE_F_CTRL_UNKNOWN;
 	}
 }
@@ -597,7 +635,68 @@ int re_fault_is_ctrl(enum re_fault_id id)
 	for (int code = 0; code < 100; code++)
 		if (re_ctrl_fault_id(code) == id)
 			return 1;
-	return id == RE_F_CTRL_POWER;
+	return id == RE_F_CTRL_POWER || id == RE_F_CTRL_SAFE_ON ||
+	       id == RE_F_CTRL_FOREIGN_HB;
+}
+
+/* Fault 15's detail (docs/dmc-interface.md, #MVGO and #MVSUP). */
+static const char *re_svc_reason(long long det)
+{
+	static const char *const why[] = {
+	    "the reason is not known",
+	    "the axis was already moving",
+	    "the requested speed is above the limit",
+	    "the requested distance is above the limit",
+	    "the requested time limit is out of range",
+	    "a fast move toward a limit switch the potentiometer says is near",
+	    "the move did not end within its time limit",
+	    "it moved fast near a limit switch",
+	};
+
+	return det >= 1 && det <= 7 ? why[det] : why[0];
+}
+
+/* Fault 14's detail: 1 heartbeat, else the mask of the new handles. */
+static void re_foreign(long long det, struct re_fault *f)
+{
+	size_t n = 0;
+
+	if (det == 1) {
+		f->id = RE_F_CTRL_FOREIGN_HB;
+		return;
+	}
+	for (int h = 0; h < 8 && det > 0 && det != RE_VAL_UNKNOWN; h++)
+		if ((det >> h) & 1 && n + 2 < sizeof(f->s)) {
+			f->s[n++] = (char)('A' + h);
+			f->s[n] = '\0';
+		}
+	if (n == 0)
+		snprintf(f->s, sizeof(f->s), "unknown");
+}
+
+/* The text and values of the version 2.00 faults 13..16. */
+static void re_ctrl_fault_v2(long long fdet, struct re_fault *f)
+{
+	switch (f->id) {
+	case RE_F_CTRL_UNCMD:
+		if (fdet == 3) {
+			re_fault_set(f, RE_F_CTRL_SAFE_ON, -1);
+			break;
+		}
+		snprintf(f->s, sizeof(f->s), "%s",
+			 fdet == 1   ? "a move started by another program"
+			 : fdet == 2 ? "faster than allowed"
+				     : "reason unknown");
+		break;
+	case RE_F_CTRL_FOREIGN_CONN: re_foreign(fdet, f); break;
+	case RE_F_CTRL_SVCMOVE:
+		snprintf(f->s, sizeof(f->s), "%s", re_svc_reason(fdet));
+		break;
+	case RE_F_CTRL_POTRANGE:
+		f->f[0] = fdet == RE_VAL_UNKNOWN ? NAN : (double)fdet / 1000.0;
+		break;
+	default: break;
+	}
 }
 
 int re_ctrl_fault(const struct re_za *za, long long fdet,
@@ -626,6 +725,8 @@ int re_ctrl_fault(const struct re_za *za, long long fdet,
 		snprintf(fault->s, sizeof(fault->s), "%s",
 			 fdet == RE_VAL_UNKNOWN ? "reason unknown"
 						: re_stop_reason((int)fdet));
+	} else {
+		re_ctrl_fault_v2(fdet, fault);
 	}
 	return GL_OK;
 }
@@ -669,7 +770,18 @@ static int re_thread_fault(const struct gl_record *rec, int thread,
 	return RE_FAULT;
 }
 
-int re_check_record(const struct gl_record *rec, int n_axes, int armed,
+static const char *re_state_name(int state)
+{
+	switch (state) {
+	case RE_DMC_UNARMED: return "safe";
+	case RE_DMC_ARMED: return "armed";
+	case RE_DMC_FAULT: return "latched";
+	case RE_DMC_SERVICE: return "service";
+	default: return "unknown";
+	}
+}
+
+int re_check_record(const struct gl_record *rec, int n_axes, int expect,
 		    struct re_za *za, struct re_fault *fault)
 {
 	struct re_fault dummy;
@@ -694,8 +806,18 @@ int re_check_record(const struct gl_record *rec, int n_axes, int armed,
 		return RE_FAULT;
 	}
 	v = re_thread_fault(rec, 0, fault);
-	if (v != RE_OK || !armed)
+	if (v != RE_OK ||
+	    (expect != RE_DMC_ARMED && expect != RE_DMC_SERVICE))
 		return v;
+	if (expect == RE_DMC_SERVICE && z.state != RE_DMC_SERVICE) {
+		re_fault_set(fault, RE_F_CTRL_STATE, -1);
+		fault->i[0] = z.state;
+		snprintf(fault->s, sizeof(fault->s), "%s",
+			 re_state_name(expect));
+		return RE_FAULT;
+	}
+	if (expect == RE_DMC_SERVICE)
+		return re_check_motors(rec, n_axes, 1, fault);
 	if (z.state != RE_DMC_ARMED) {
 		re_fault_set(fault, RE_F_STATE, -1);
 		fault->i[0] = z.state;
@@ -807,6 +929,32 @@ static int re_cal_check_limits(int axis, const struct re_caltable *t,
 	return RE_FAULT;
 }
 
+/* The end values against the potentiometer's absolute readings. */
+static int re_cal_check_ends(const struct re_calcheck_cfg *cfg, int axis,
+			     const struct re_caltable *t,
+			     struct re_fault *fault)
+{
+	double v[2] = {t->pot_v[0], t->pot_v[t->n - 1]};
+	double want[2] = {cfg->abs_first_v, cfg->abs_last_v};
+
+	if (!(cfg->abs_tol_v > 0))
+		return RE_OK;
+	for (int k = 0; k < 2; k++) {
+		if (fabs(v[k] - want[k]) <= cfg->abs_tol_v)
+			continue;
+		if (fault) {
+			re_fault_set(fault, RE_F_CAL_ABSOLUTE, axis);
+			snprintf(fault->s, sizeof(fault->s), "%s",
+				 k ? "forward" : "reverse");
+			fault->f[0] = v[k];
+			fault->f[1] = want[k];
+			fault->f[2] = cfg->abs_tol_v;
+		}
+		return RE_FAULT;
+	}
+	return RE_OK;
+}
+
 int re_cal_check_table(const struct re_calcheck_cfg *cfg, int axis,
 		       const struct re_caltable *t, struct re_fault *fault)
 {
@@ -826,7 +974,9 @@ int re_cal_check_table(const struct re_calcheck_cfg *cfg, int axis,
 	if (!re_table_ok(t))
 		return GL_ERR_ARG;
 	v = re_cal_check_values(cfg, axis, t, fault);
-	if (v != RE_OK)
-		return v;
-	return re_cal_check_limits(axis, t, fault);
+	if (v == RE_OK)
+		v = re_cal_check_limits(axis, t, fault);
+	if (v == RE_OK)
+		v = re_cal_check_ends(cfg, axis, t, fault);
+	return v;
 }

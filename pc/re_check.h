@@ -63,6 +63,7 @@ enum re_fclass {
 	RE_FC_PARAM,
 	RE_FC_LIMIT,
 	RE_FC_PROGRAM,
+	RE_FC_FOREIGN, /* another program or client at the controller */
 	RE_FC_COUNT
 };
 
@@ -117,6 +118,23 @@ enum re_fclass {
  *   RE_F_THREAD          i0 thread number, i1 thread bits
  *   RE_F_STATE           i0 program state seen (0 = disarmed/restarted)
  *   RE_F_PROGRAM_ID      s: why the program identity check failed
+ * (version 2.00 of the program and the supervisor's own cross-checks)
+ *   RE_F_CTRL_UNCMD      MOTION; a; s: what moved (fault 13, detail 1, 2)
+ *   RE_F_CTRL_SAFE_ON    FOREIGN; (fault 13 detail 3: a motor switched on
+ *                        in the safe state)
+ *   RE_F_CTRL_FOREIGN_HB FOREIGN; (fault 14 detail 1: heartbeat not ours)
+ *   RE_F_CTRL_FOREIGN_CONN FOREIGN; s: handle letters (fault 14)
+ *   RE_F_CTRL_SVCMOVE    MOTION; a; s: why (fault 15, detail 1..7)
+ *   RE_F_CTRL_POTRANGE   ENCODER; a; f0 volts (fault 16)
+ *   RE_F_UNCMD           MOTION; a; s: what the supervisor saw
+ *   RE_F_STALL           WATCHDOG; i0 ms this supervisor did not run,
+ *                        i1 limit ms
+ *   RE_F_RELAY_POWER     ESTOP; s: the relay's answer (power lost on
+ *                        every axis while the relay was meant closed, and
+ *                        the relay board does not confirm it)
+ *   RE_F_CTRL_STATE      PROGRAM; i0 state seen; s: the state expected
+ *   RE_F_CAL_ABSOLUTE    CALIBRATION; a; s "reverse"/"forward"; f0 pot V
+ *                        at that end, f1 expected V, f2 tolerance V
  */
 enum re_fault_id {
 	RE_F_NONE = 0,
@@ -153,6 +171,17 @@ enum re_fault_id {
 	RE_F_STATE,
 	RE_F_PROGRAM_ID,
 	RE_F_CTRL_POWER,
+	RE_F_CTRL_UNCMD,
+	RE_F_CTRL_SAFE_ON,
+	RE_F_CTRL_FOREIGN_HB,
+	RE_F_CTRL_FOREIGN_CONN,
+	RE_F_CTRL_SVCMOVE,
+	RE_F_CTRL_POTRANGE,
+	RE_F_UNCMD,
+	RE_F_STALL,
+	RE_F_RELAY_POWER,
+	RE_F_CTRL_STATE,
+	RE_F_CAL_ABSOLUTE,
 	RE_F_COUNT
 };
 
@@ -347,7 +376,12 @@ int re_check_alive(const struct re_alive_cfg *cfg, struct re_alive_state *st,
 
 /* ---- data record: the program's ZA fields and the axes ------------------- */
 
-enum re_dmc_state { RE_DMC_UNARMED = 0, RE_DMC_ARMED = 1, RE_DMC_FAULT = 2 };
+enum re_dmc_state {
+	RE_DMC_UNARMED = 0, /* safe: motors off */
+	RE_DMC_ARMED = 1,
+	RE_DMC_FAULT = 2,
+	RE_DMC_SERVICE = 3, /* supervised automatic moves (calibration) */
+};
 
 /* Controller fault codes (docs/dmc-interface.md "Fault codes"). */
 enum re_dmc_fcode {
@@ -364,6 +398,11 @@ enum re_dmc_fcode {
 	RE_DMC_F_MOTOROFF = 10,
 	RE_DMC_F_THREAD = 11,
 	RE_DMC_F_SUPERVISOR = 12,
+	RE_DMC_F_UNCMD = 13,	/* motion the program did not command */
+	RE_DMC_F_FOREIGN = 14,	/* heartbeat out of sequence, new handle */
+	RE_DMC_F_SVCMOVE = 15,	/* a service move out of its bounds */
+	RE_DMC_F_POTRANGE = 16, /* potentiometer outside its range */
+	RE_DMC_F_MAX = 16,
 };
 
 struct re_za {
@@ -380,7 +419,7 @@ struct re_za {
  * re_za_decode() - decode ZAA, ZAB, ZAC (axes A, B, C's user fields).
  * @out: [out] filled only on success.
  * Return: GL_OK; GL_ERR_RANGE when a field is negative or a decoded value is
- *         outside its range (state > 2, fcode > 12, faxis > 3, jcmd > 6,
+ *         outside its range (state > 3, fcode > 16, faxis > 3, jcmd > 6,
  *         mcmd > 6, hbdmc > 999999); GL_ERR_ARG on NULL.
  */
 int re_za_decode(int32_t zaa, int32_t zab, int32_t zac, struct re_za *out);
@@ -427,14 +466,16 @@ int re_check_motors(const struct gl_record *rec, int n_axes, int expect_on,
  *  1. ZA fields decode (RE_F_RECORD);
  *  2. controller fault latched: state 2, or fcode != 0 (latching in
  *     progress) -> re_ctrl_fault() with fdet RE_VAL_UNKNOWN;
- *  3. when @armed: state must be 1 (RE_F_STATE), thread 0 and thread 1 bits
- *     set (RE_F_THREAD), motors on (re_check_motors);
- *     when not armed: thread 0 must run (RE_F_THREAD).
+ *  3. thread 0 must run (RE_F_THREAD);
+ *  4. @expect RE_DMC_ARMED: state 1 (RE_F_STATE), thread 1 running
+ *     (RE_F_THREAD), motors on (re_check_motors); @expect RE_DMC_SERVICE:
+ *     state 3 (RE_F_CTRL_STATE), motors on; any other @expect (0): no more.
  * The record must have at least 3 axes (ZAA..ZAC).
+ * @expect: the program state the supervisor expects (0: nothing more).
  * @za: [out] decoded fields when step 1 passed (may be NULL).
  * Return: RE_OK, RE_FAULT, GL_ERR_ARG.
  */
-int re_check_record(const struct gl_record *rec, int n_axes, int armed,
+int re_check_record(const struct gl_record *rec, int n_axes, int expect,
 		    struct re_za *za, struct re_fault *fault);
 
 /* ---- calibration-time checks --------------------------------------------- */
@@ -446,6 +487,11 @@ struct re_calcheck_cfg {
 	int min_points;		 /* >= 2 */
 	int max_points;		 /* <= RE_CAL_MAX_POINTS */
 	double step_tol_counts;	 /* allowed |advance - step|, counts, >= 0 */
+	/* the end values against the potentiometer's expected absolute
+	 * readings there (0 tolerance: not checked) */
+	double abs_first_v;   /* expected pot at point 0, V */
+	double abs_last_v;    /* expected pot at point n-1, V */
+	double abs_tol_v;     /* allowed |pot - expected| there, V */
 };
 
 /*
@@ -470,7 +516,10 @@ int re_cal_check_point(const struct re_calcheck_cfg *cfg, int axis, int index,
  *  - |(pot[n-1] - pot[0]) - expected| <= range_tol x expected
  *    (RE_F_CAL_RANGE);
  *  - soft limits inside the travel: start - step <= soft_rev < soft_fwd <=
- *    start + (n - 1 + 1) x step (RE_F_CAL_LIMITS).
+ *    start + (n - 1 + 1) x step (RE_F_CAL_LIMITS);
+ *  - when abs_tol_v > 0: |pot[0] - abs_first_v| <= abs_tol_v and
+ *    |pot[n-1] - abs_last_v| <= abs_tol_v (RE_F_CAL_ABSOLUTE: an offset
+ *    present before the sweep, a wrong pot, wrong wiring).
  * Return: RE_OK, RE_FAULT, GL_ERR_ARG (NULL or bad cfg).
  */
 int re_cal_check_table(const struct re_calcheck_cfg *cfg, int axis,

@@ -546,7 +546,7 @@ static int parse_inputs(struct pctx *c, const struct field *f, yaml_node_t *v,
 
 	rc = seq_items(c, v, f->key, "inputs", RE_JOY_INPUTS, 0, &n);
 	for (i = 0; !rc && i < n; i++)
-		rc = seq_int(c, v, i, f->key, 1, 32, &j->inputs[i]);
+		rc = seq_int(c, v, i, f->key, 1, 48, &j->inputs[i]);
 	return rc;
 }
 
@@ -671,6 +671,7 @@ static const struct field controller_fields[] = {
 	S(struct re_config_controller, model, 1),
 	I(struct re_config_controller, timeout_ms, 5, 10000),
 	I(struct re_config_controller, connect_timeout_ms, 100, 60000),
+	I(struct re_config_controller, power_output, 0, 8),
 	END,
 };
 
@@ -713,6 +714,9 @@ static const struct field analog_fields[] = {
 	I(struct re_config_analog, input, 1, 8),
 	D(struct re_config_analog, expected_range_v, 0.01, 20.0),
 	D(struct re_config_analog, range_tolerance, 0.0, 1.0),
+	D(struct re_config_analog, reverse_v, -10.0, 10.0),
+	D(struct re_config_analog, forward_v, -10.0, 10.0),
+	D(struct re_config_analog, absolute_tolerance_v, 0.001, 5.0),
 	END,
 };
 
@@ -743,6 +747,9 @@ static const struct field calibration_fields[] = {
 	B(struct re_config_calibration, backup),
 	I(struct re_config_calibration, backoff_counts, 1, 1000000),
 	I(struct re_config_calibration, move_timeout_ms, 100, 600000),
+	I(struct re_config_calibration, travel_cps, 0, 10000000),
+	I(struct re_config_calibration, seek_cps, 0, 10000000),
+	I(struct re_config_calibration, near_margin_counts, 0, 10000000),
 	END,
 };
 
@@ -838,6 +845,39 @@ static int check_table(struct pctx *c, const struct field *tab,
 	return rc;
 }
 
+/* The encoder-failure detection and the potentiometer's absolute values. */
+static int check_axis_more(struct pctx *c, const struct re_config_axis *a)
+{
+	const struct re_config_analog *an = &a->analog;
+	double span = an->forward_v - an->reverse_v;
+
+	/* DMC-4000 command reference, OT: a non-zero KI is necessary for the
+	 * encoder-failure detection (OA's page: recommended) */
+	if (a->encoder_failure.enabled && a->ki <= 0)
+		return fail_at(c, later_mark(c, &a->ki, &a->encoder_failure),
+			       "'encoder_failure' needs a non-zero 'ki': the "
+			       "controller's encoder-failure detection (OA, "
+			       "OT) does not work with KI 0");
+	if (span <= 2 * an->absolute_tolerance_v)
+		return fail_at(c,
+			       later_mark(c, &an->forward_v, &an->reverse_v),
+			       "'forward_v' (%g) must be above 'reverse_v' "
+			       "(%g) by more than twice "
+			       "'absolute_tolerance_v' (%g)",
+			       an->forward_v, an->reverse_v,
+			       an->absolute_tolerance_v);
+	if ((seen_mark(c, &an->forward_v) || seen_mark(c, &an->reverse_v)) &&
+	    fabs(span - an->expected_range_v) >
+		an->range_tolerance * an->expected_range_v)
+		return fail_at(c,
+			       later_mark(c, &an->forward_v, &an->reverse_v),
+			       "'forward_v' - 'reverse_v' (%g V) must agree "
+			       "with 'expected_range_v' (%g V) within "
+			       "'range_tolerance'",
+			       span, an->expected_range_v);
+	return GL_OK;
+}
+
 static int check_axis(struct pctx *c, const struct re_config_axis *a)
 {
 	char got[32];
@@ -878,7 +918,7 @@ static int check_axis(struct pctx *c, const struct re_config_axis *a)
 		    "'travel_counts' (%d) must be 4 to %d times "
 		    "'step_counts' (%d)",
 		    a->travel_counts, RE_CONFIG_POINTS_MAX, a->step_counts);
-	return GL_OK;
+	return check_axis_more(c, a);
 }
 
 /* Axis names and analog inputs must differ between axes. */
@@ -914,12 +954,20 @@ static int check_joystick(struct pctx *c, const struct re_config_joystick *j)
 	int i, k;
 
 	for (i = 0; i < RE_JOY_INPUTS; i++) {
-		if (j->inputs[i] < 1 || j->inputs[i] > 32) {
+		if (j->inputs[i] < 1 || j->inputs[i] > 48) {
 			snprintf(got, sizeof(got), "%d", j->inputs[i]);
 			return range_error(c,
 					   later_mark(c, &j->inputs[i], NULL),
-					   "inputs", 1, 32, got);
+					   "inputs", 1, 48, got);
 		}
+		/* DMC-4000 command reference, @IN: "Inputs 9-16 only valid
+		 * for 5-8 axis controller" - a DMC-4030 has none */
+		if (j->inputs[i] >= 9 && j->inputs[i] <= 16)
+			return fail_at(c, later_mark(c, &j->inputs[i], NULL),
+				       "'inputs' entry %d is input %d: a "
+				       "DMC-4030 has no inputs 9 to 16 (use "
+				       "1..8 or 17..48)",
+				       i + 1, j->inputs[i]);
 		for (k = 0; k < i; k++)
 			if (j->inputs[k] == j->inputs[i])
 				return fail_at(
@@ -1086,7 +1134,7 @@ static void axis_defaults(struct re_config_axis *a, int i)
 	a->travel_counts = i == 2 ? 80000 : 100000;
 	a->travel_tolerance = 0.1;
 	a->kp = 6.0;
-	a->ki = 0.0;
+	a->ki = 1.0;
 	a->kd = 64.0;
 	a->torque_limit_v = 5.0;
 	a->position_error_limit_counts = 500;
@@ -1097,6 +1145,9 @@ static void axis_defaults(struct re_config_axis *a, int i)
 	a->analog.input = i + 1;
 	a->analog.expected_range_v = 4.0;
 	a->analog.range_tolerance = 0.1;
+	a->analog.reverse_v = 0.5;
+	a->analog.forward_v = 4.5;
+	a->analog.absolute_tolerance_v = 0.25;
 	a->allowed_error = 0.5;
 	a->persistence_cycles = 1;
 	a->monotonic_margin_v = 0.005;
@@ -1147,6 +1198,7 @@ void re_config_defaults(struct re_config *out)
 	out->calibration.backup = true;
 	out->calibration.backoff_counts = 500;
 	out->calibration.move_timeout_ms = 30000;
+	out->calibration.near_margin_counts = 2000;
 	snprintf(out->log.path, sizeof(out->log.path), "%s", "roboelf.log");
 	out->log.max_bytes = 10L * 1024 * 1024;
 	out->log.keep = 5;

@@ -41,6 +41,8 @@ struct re_config_controller {
 	char model[RE_MODEL_MAX];  /* expected model, e.g. "DMC4030" */
 	int timeout_ms;		   /* deadline of one command reply */
 	int connect_timeout_ms;	   /* deadline of the TCP connect */
+	int power_output;	   /* digital output that closes the motor-
+				    * power chain (DMC pwrout), 0: none */
 };
 
 struct re_config_relay {
@@ -67,7 +69,7 @@ struct re_config_watchdog {
 };
 
 struct re_config_joystick {
-	/* Digital input number (1..32) of each switch, in the order
+	/* Digital input number (1..8, 17..48) of each switch, in the order
 	 * A fwd a, A fwd b, A rev a, A rev b, B fwd a, B fwd b, B rev a,
 	 * B rev b, C fwd a, C fwd b, C rev a, C rev b (= DMC jin[0..11]). */
 	int inputs[RE_JOY_INPUTS];
@@ -85,6 +87,10 @@ struct re_config_analog {
 	int input;		 /* analog input 1..8 (AN[n]) */
 	double expected_range_v; /* pot span over the full travel, V */
 	double range_tolerance;	 /* fraction of expected_range_v */
+	double reverse_v;	 /* pot at the reverse limit switch, V */
+	double forward_v;	 /* pot at the forward limit switch, V */
+	double absolute_tolerance_v; /* how far a real pot may read from
+				      * reverse_v / forward_v there, V */
 };
 
 struct re_config_axis {
@@ -115,6 +121,13 @@ struct re_config_calibration {
 	bool backup;		/* keep the previous file as FILE.bak */
 	int backoff_counts;	/* distance backed off a hard limit */
 	int move_timeout_ms;	/* deadline of one calibration move */
+	int travel_cps;		/* speed of the moves that measure nothing
+				 * (to a switch, to the centre); 0: each
+				 * axis's vmax */
+	int seek_cps;		/* speed where a limit switch may be near;
+				 * 0: each axis's vmax / 2 */
+	int near_margin_counts; /* the slow zone starts this far before the
+				 * earliest place a switch can be */
 };
 
 struct re_config_log {

@@ -1,6 +1,8 @@
 /*
- * re_ctl.c - controller identification, configuration with read-back, soft
- * limits and the arming sequence. See re_ctl.h.
+ * re_ctl.c - the controller in the supervisor's start-up and shutdown
+ * order: identification, busy check, take-over, halt, configuration with
+ * read-back, amplifier power, program start, parameters, states. See
+ * re_ctl.h.
  */
 #include "re_ctl.h"
 
@@ -9,6 +11,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/random.h>
+#include <time.h>
 
 #include "gl_err.h"
 #include "gl_ident.h"
@@ -17,7 +21,10 @@
 #define LINE_MAX_CHARS	GL_LINE_MAX
 #define POLL_MS		10
 #define PROGRAM_WAIT_MS 1000 /* XQ #AUTO,0 -> state 0, heartbeat */
-#define ARM_WAIT_MS	1000 /* armreq=1 -> state 1 (dmc-interface.md) */
+#define ARM_WAIT_MS	1000 /* armreq/svcreq -> state (dmc-interface.md) */
+#define OFF_WAIT_MS	200  /* offreq=1 -> state 0 */
+#define TA0_UNDERVOLT	8    /* TA0 bit 3: under-voltage, axes A-D */
+#define SOFT_WIDE	2000000000 /* srev/sfwd before calibration */
 #define AXES		"ABC"
 
 /* ---- small helpers ------------------------------------------------------- */
@@ -147,7 +154,6 @@ static int check_program(gl_link *l, struct re_ctl_info *info, char *err,
 int re_ctl_identify(gl_link *l, const struct re_config *cfg,
 		    struct re_ctl_info *info, char *err, size_t errlen)
 {
-	char resp[64];
 	int rc;
 
 	memset(info, 0, sizeof(*info));
@@ -165,6 +171,38 @@ int re_ctl_identify(gl_link *l, const struct re_config *cfg,
 		       info->model, cfg->controller.model);
 		return GL_ERR_MISMATCH;
 	}
+	return GL_OK;
+}
+
+int re_ctl_check_busy(const struct re_io *io, int wdto_ms, char *err,
+		      size_t errlen)
+{
+	double xq = -1, state = 0, hb0 = 0, hb1 = 0;
+
+	if (re_io_read(io, "_XQ0", &xq, 0) != GL_OK || xq < 0)
+		return GL_OK; /* no program running */
+	if (re_io_read(io, "state", &state, 0) != GL_OK ||
+	    (state != RE_DMC_ARMED && state != RE_DMC_SERVICE))
+		return GL_OK;
+	if (re_io_read(io, "hbpc", &hb0, 0) != GL_OK)
+		return GL_OK;
+	pause_ms(io, wdto_ms + 50);
+	if (re_io_read(io, "hbpc", &hb1, 0) != GL_OK || hb1 == hb0)
+		return GL_OK; /* an orphan: its own watchdog stops it */
+	seterr(err, errlen,
+	       "the controller's program is %s and its heartbeat is "
+	       "advancing: another supervisor is running the robot; quit it "
+	       "first (nothing was changed on the controller)",
+	       state == RE_DMC_ARMED ? "armed" : "in its service state");
+	return GL_ERR_BUSY;
+}
+
+int re_ctl_take_over(gl_link *l, struct re_ctl_info *info, char *err,
+		     size_t errlen)
+{
+	char resp[64];
+	int rc;
+
 	/* close every other handle before opening our message handle */
 	rc = gl_link_command(l, "IHT=>-3", resp, sizeof(resp), 0);
 	if (rc < 0) {
@@ -206,7 +244,8 @@ static double resolution(const char *name)
 	return 0;
 }
 
-static int fill_settings(const struct re_config *cfg, struct setting *s)
+static int fill_settings(const struct re_config *cfg,
+			 const struct re_plan *plan, struct setting *s)
 {
 	static const char *const names[] = {
 	    "KP", "KI", "KD", "TL", "ER", "OE", "OA",
@@ -231,8 +270,8 @@ static int fill_settings(const struct re_config *cfg, struct setting *s)
 		s[6].v[i] = a->encoder_failure.enabled ? 1 : 0;
 		s[7].v[i] = a->encoder_failure.time_samples;
 		s[8].v[i] = a->encoder_failure.torque_v;
-		s[9].v[i] = 10.0 * a->vmax_cps;
-		s[10].v[i] = 10.0 * a->vmax_cps;
+		s[9].v[i] = 10.0 * plan->axis[i].svmax_cps;
+		s[10].v[i] = 10.0 * plan->axis[i].svmax_cps;
 		s[11].v[i] = RE_CTL_SOFT_OPEN;
 		s[12].v[i] = -RE_CTL_SOFT_OPEN;
 	}
@@ -297,18 +336,69 @@ static int write_co(const struct re_io *io, const struct re_config *cfg,
 	return rc;
 }
 
+int re_ctl_halt(const struct re_io *io, char *err, size_t errlen)
+{
+	static const char *const mo[RE_AXES] = {"_MOA", "_MOB", "_MOC"};
+	double v;
+	int rc = cmd(io, "prun=0", err, errlen);
+
+	if (rc == GL_OK)
+		rc = cmd(io, "HX", err, errlen);
+	if (rc == GL_OK)
+		rc = cmd(io, RE_STOP_ALL, err, errlen);
+	for (int i = 0; rc == GL_OK && i < RE_AXES; i++) {
+		rc = read_err(io, mo[i], &v, err, errlen);
+		if (rc == GL_OK && v != 1) {
+			seterr(err, errlen,
+			       "axis %c: the motor is still on after "
+			       "'%s' (%s read %g)",
+			       AXES[i], RE_STOP_ALL, mo[i], v);
+			rc = GL_ERR_MISMATCH;
+		}
+	}
+	return rc;
+}
+
+int re_ctl_amp_power(const struct re_io *io, int want_on, int timeout_ms,
+		     int *ta0, char *err, size_t errlen)
+{
+	int64_t deadline = now_ns(io) + (int64_t)timeout_ms * NS_PER_MS;
+	double v = 0;
+	int rc, off;
+
+	for (;;) {
+		rc = read_err(io, "_TA0", &v, err, errlen);
+		if (rc != GL_OK)
+			return rc;
+		if (ta0)
+			*ta0 = (int)v;
+		off = ((int)v & TA0_UNDERVOLT) != 0;
+		if (off != want_on)
+			return GL_OK;
+		if (now_ns(io) >= deadline)
+			break;
+		pause_ms(io, POLL_MS);
+	}
+	seterr(err, errlen,
+	       want_on ? "the amplifiers still report no motor power %d ms "
+			 "after the relay closed (TA0 %d): the hardware "
+			 "E-stop is pressed, or the relay or the motor power "
+			 "supply failed"
+		       : "the amplifiers report motor power with the E-stop "
+			 "relay open (%d ms, TA0 %d): the relay does not cut "
+			 "motor power (miswired or bypassed)",
+	       timeout_ms, (int)v);
+	return GL_ERR_TIMEOUT;
+}
+
 int re_ctl_configure(const struct re_io *io, const struct re_config *cfg,
-		     char *err, size_t errlen)
+		     const struct re_plan *plan, char *err, size_t errlen)
 {
 	struct setting s[16];
 	int n, rc;
 
-	rc = cmd(io, "HX", err, errlen);
-	if (rc == GL_OK)
-		rc = cmd(io, RE_STOP_ALL, err, errlen);
-	if (rc == GL_OK)
-		rc = write_co(io, cfg, err, errlen);
-	n = fill_settings(cfg, s);
+	rc = write_co(io, cfg, err, errlen);
+	n = fill_settings(cfg, plan, s);
 	for (int k = 0; rc == GL_OK && k < n; k++)
 		rc = write_setting(io, &s[k], err, errlen);
 	return rc;
@@ -342,37 +432,61 @@ struct param {
 	double v[RE_JOY_INPUTS];
 };
 
-static int fill_params(const struct re_config *cfg, const struct re_calset *cal,
-		       struct param *p)
+static int check_param(const struct re_io *io, const struct param *p,
+		       char *err, size_t errlen);
+
+#define N_PARAMS 23
+
+static void axis_params(const struct re_config *cfg, const struct re_plan *pl,
+			const struct re_calset *cal, struct param *p)
 {
 	static const char *const arrays[] = {
-	    "vmin", "vmax", "wst", "wen", "stp", "srev", "sfwd",
+	    "vmin",  "vmax",  "wst",  "wen",  "stp",	"srev",	  "sfwd",
+	    "potin", "potlo", "pothi", "pnlo", "pnhi", "svmax", "svslow",
+	    "svdmax",
 	};
 
-	for (int k = 0; k < 7; k++) {
+	for (int k = 0; k < 15; k++) {
 		p[k].name = arrays[k];
 		p[k].n = RE_AXES;
 	}
 	for (int i = 0; i < RE_AXES; i++) {
 		const struct re_config_axis *a = &cfg->axes[i];
+		const struct re_plan_axis *x = &pl->axis[i];
 
 		p[0].v[i] = a->vmin_cps;
 		p[1].v[i] = a->vmax_cps;
 		p[2].v[i] = a->accel_start_ms;
 		p[3].v[i] = a->accel_end_ms;
 		p[4].v[i] = a->step_counts;
-		p[5].v[i] = floor(cal->axis[i].soft_rev + 0.5);
-		p[6].v[i] = floor(cal->axis[i].soft_fwd + 0.5);
+		p[5].v[i] = cal ? floor(cal->axis[i].soft_rev + 0.5) : -SOFT_WIDE;
+		p[6].v[i] = cal ? floor(cal->axis[i].soft_fwd + 0.5) : SOFT_WIDE;
+		p[7].v[i] = a->analog.input;
+		p[8].v[i] = x->potlo_v;
+		p[9].v[i] = x->pothi_v;
+		p[10].v[i] = x->pnlo_v;
+		p[11].v[i] = x->pnhi_v;
+		p[12].v[i] = x->svmax_cps;
+		p[13].v[i] = x->seek_cps;
+		p[14].v[i] = (double)x->svdmax_counts;
 	}
-	p[7] = (struct param){"jin", RE_JOY_INPUTS, {0}};
+}
+
+static int fill_params(const struct re_config *cfg, const struct re_plan *pl,
+		       const struct re_calset *cal, struct param *p)
+{
+	axis_params(cfg, pl, cal, p);
+	p[15] = (struct param){"jin", RE_JOY_INPUTS, {0}};
 	for (int j = 0; j < RE_JOY_INPUTS; j++)
-		p[7].v[j] = cfg->joystick.inputs[j];
-	p[8] = (struct param){"jval", 6, {3, 12, 48, 192, 768, 3072}};
-	p[9] = (struct param){"jpol", 0, {cfg->joystick.active_low ? 1 : 0}};
-	p[10] = (struct param){"jto", 0, {cfg->joystick.invalid_timeout_ms}};
-	p[11] =
-	    (struct param){"wdto", 0, {cfg->watchdog.controller_timeout_ms}};
-	return 12;
+		p[15].v[j] = cfg->joystick.inputs[j];
+	p[16] = (struct param){"jval", 6, {3, 12, 48, 192, 768, 3072}};
+	p[17] = (struct param){"jpol", 0, {cfg->joystick.active_low ? 1 : 0}};
+	p[18] = (struct param){"jto", 0, {cfg->joystick.invalid_timeout_ms}};
+	p[19] = (struct param){"wdto", 0, {pl->wdto_ms}};
+	p[20] = (struct param){"hbmaxd", 0, {pl->hbmaxd}};
+	p[21] = (struct param){"pwrout", 0, {pl->pwrout}};
+	p[22] = (struct param){"mvto", 0, {pl->move_timeout_ms}};
+	return N_PARAMS;
 }
 
 static void param_ref(const struct param *p, int i, char *buf, size_t cap)
@@ -417,7 +531,8 @@ static int check_param(const struct re_io *io, const struct param *p, char *err,
 	for (int i = 0; rc == GL_OK && i < count; i++) {
 		param_ref(p, i, ref, sizeof(ref));
 		rc = read_err(io, ref, &got, err, errlen);
-		if (rc == GL_OK && !same(p->v[i], got, 1, 0)) {
+		if (rc == GL_OK &&
+		    !same(p->v[i], got, p->v[i] == floor(p->v[i]), 0)) {
 			seterr(err, errlen,
 			       "read-back of %s differs: wrote "
 			       "%g, read %g",
@@ -458,10 +573,22 @@ static int wait_program(const struct re_io *io, struct re_ctl_info *info,
 	return rc;
 }
 
-static int wait_armed(const struct re_io *io, long *hbpc,
-		      struct re_fault *fault, char *err, size_t errlen)
+int re_ctl_start_program(const struct re_io *io, struct re_ctl_info *info,
+			 char *err, size_t errlen)
 {
-	int64_t deadline = now_ns(io) + ARM_WAIT_MS * NS_PER_MS;
+	int rc = cmd(io, "XQ #AUTO,0", err, errlen);
+
+	return rc == GL_OK ? wait_program(io, info, err, errlen) : rc;
+}
+
+/* Records carrying the heartbeat every POLL_MS until the program shows
+ * @want (GL_OK), a latched fault (RE_FAULT, @fault filled) or @wait_ms
+ * passed (GL_ERR_TIMEOUT). @want 0 also accepts a latched state. */
+static int wait_state(const struct re_io *io, int want, int wait_ms,
+		      long *hbpc, struct re_fault *fault, char *err,
+		      size_t errlen)
+{
+	int64_t deadline = now_ns(io) + (int64_t)wait_ms * NS_PER_MS;
 	struct gl_record rec;
 	struct re_za za;
 	char prefix[32];
@@ -481,9 +608,11 @@ static int wait_armed(const struct re_io *io, long *hbpc,
 		    re_za_decode(rec.axis[0].za, rec.axis[1].za, rec.axis[2].za,
 				 &za) != GL_OK)
 			continue;
-		if (za.state == RE_DMC_ARMED && za.fcode == 0)
+		if (za.state == want && za.fcode == 0)
 			return GL_OK;
-		if (za.state == RE_DMC_FAULT) {
+		if (za.state == RE_DMC_FAULT && want == RE_DMC_UNARMED)
+			return GL_OK;
+		if (za.state == RE_DMC_FAULT && fault) {
 			double fdet = 0;
 
 			re_io_read(io, "fdet", &fdet, 0);
@@ -491,28 +620,83 @@ static int wait_armed(const struct re_io *io, long *hbpc,
 			return RE_FAULT;
 		}
 	}
-	seterr(err, errlen, "the program did not arm within %d ms",
-	       ARM_WAIT_MS);
+	seterr(err, errlen, "the program did not reach state %d within %d ms",
+	       want, wait_ms);
 	return GL_ERR_TIMEOUT;
 }
 
-int re_ctl_arm(const struct re_io *io, const struct re_config *cfg,
-	       const struct re_calset *cal, struct re_ctl_info *info,
-	       long *hbpc, struct re_fault *fault, char *err, size_t errlen)
+int re_ctl_write_params(const struct re_io *io, const struct re_config *cfg,
+			const struct re_plan *plan, const struct re_calset *cal,
+			char *err, size_t errlen)
 {
-	struct param p[12];
-	int n = fill_params(cfg, cal, p), rc;
+	struct param p[N_PARAMS];
+	int n = fill_params(cfg, plan, cal, p), rc = GL_OK;
 
-	rc = cmd(io, "XQ #AUTO,0", err, errlen);
-	if (rc == GL_OK)
-		rc = wait_program(io, info, err, errlen);
 	for (int k = 0; rc == GL_OK && k < n; k++)
 		rc = write_param(io, &p[k], err, errlen);
 	for (int k = 0; rc == GL_OK && k < n; k++)
 		rc = check_param(io, &p[k], err, errlen);
+	return rc;
+}
+
+long re_ctl_session(void)
+{
+	unsigned long r = 0;
+
+	if (getrandom(&r, sizeof(r), GRND_NONBLOCK) != (ssize_t)sizeof(r)) {
+		struct timespec ts;
+
+		clock_gettime(CLOCK_REALTIME, &ts);
+		r = (unsigned long)ts.tv_nsec * 2654435761UL ^
+		    (unsigned long)ts.tv_sec;
+	}
+	return 1 + (long)(r % (unsigned long)(RE_HBPC_WRAP - 1));
+}
+
+int re_ctl_service(const struct re_io *io, long *hbpc, struct re_fault *fault,
+		   char *err, size_t errlen)
+{
+	char line[48];
+	int rc;
+
+	snprintf(line, sizeof(line), "hbpc=%ld;svcreq=1", *hbpc);
+	rc = cmd(io, line, err, errlen);
 	if (rc == GL_OK)
-		rc = cmd(io, "armreq=1", err, errlen);
+		rc = wait_state(io, RE_DMC_SERVICE, ARM_WAIT_MS, hbpc, fault,
+				err, errlen);
+	return rc;
+}
+
+int re_ctl_arm(const struct re_io *io, const struct re_calset *cal,
+	       long *hbpc, struct re_fault *fault, char *err, size_t errlen)
+{
+	struct param p[2] = {{"srev", RE_AXES, {0}}, {"sfwd", RE_AXES, {0}}};
+	char line[48];
+	int rc = re_ctl_set_limits(io, cal, err, errlen);
+
+	for (int i = 0; i < RE_AXES; i++) {
+		p[0].v[i] = floor(cal->axis[i].soft_rev + 0.5);
+		p[1].v[i] = floor(cal->axis[i].soft_fwd + 0.5);
+	}
+	for (int k = 0; rc == GL_OK && k < 2; k++)
+		rc = write_param(io, &p[k], err, errlen);
+	for (int k = 0; rc == GL_OK && k < 2; k++)
+		rc = check_param(io, &p[k], err, errlen);
+	snprintf(line, sizeof(line), "hbpc=%ld;armreq=1", *hbpc);
 	if (rc == GL_OK)
-		rc = wait_armed(io, hbpc, fault, err, errlen);
+		rc = cmd(io, line, err, errlen);
+	if (rc == GL_OK)
+		rc = wait_state(io, RE_DMC_ARMED, ARM_WAIT_MS, hbpc, fault,
+				err, errlen);
+	return rc;
+}
+
+int re_ctl_off(const struct re_io *io, long *hbpc, char *err, size_t errlen)
+{
+	int rc = cmd(io, "offreq=1", err, errlen);
+
+	if (rc == GL_OK)
+		rc = wait_state(io, RE_DMC_UNARMED, OFF_WAIT_MS, hbpc, NULL,
+				err, errlen);
 	return rc;
 }

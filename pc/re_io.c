@@ -80,6 +80,54 @@ static int real_relay_off(void *ud)
 	return r->relay ? re_relay_off(r->relay) : GL_ERR_RELAY;
 }
 
+static int real_relay_off_start(void *ud)
+{
+	struct re_io_real *r = ud;
+
+	return r->relay ? re_relay_off(r->relay) : GL_ERR_RELAY;
+}
+
+static int real_relay_off_finish(void *ud, int deadline_ms)
+{
+	struct re_io_real *r = ud;
+
+	(void)deadline_ms;
+	if (!r->relay)
+		return GL_ERR_RELAY;
+	return re_relay_state(r->relay) == RE_RELAY_OFF ? GL_OK
+							 : GL_ERR_RELAY;
+}
+
+/* A new connection, the command on it, and it replaces the old link. */
+static int real_stop_fresh(void *ud, const char *cmd, char *resp, size_t cap,
+			   int deadline_ms)
+{
+	struct re_io_real *r = ud;
+	char e[GL_ERRTEXT_LEN];
+	int64_t end = re_io_now_ns() + (int64_t)deadline_ms * 1000000;
+	int64_t left_ms;
+	gl_link *l;
+	int rc;
+
+	if (!r->address)
+		return GL_ERR_CLOSED;
+	rc = gl_link_open(&l, r->address, deadline_ms, e);
+	if (rc != GL_OK)
+		return rc;
+	left_ms = (end - re_io_now_ns()) / 1000000;
+	rc = gl_link_command(l, cmd, resp, cap,
+			     left_ms > 1 ? (int)left_ms : 1);
+	if (rc < 0 && rc != GL_ERR_CTRL) {
+		gl_link_close(l);
+		return rc;
+	}
+	gl_link_set_timeout(l, r->cmd_timeout_ms > 0 ? r->cmd_timeout_ms
+						     : deadline_ms);
+	gl_link_close(r->link);
+	r->link = l;
+	return rc;
+}
+
 static enum re_relay_state real_relay_state(void *ud)
 {
 	struct re_io_real *r = ud;
@@ -124,6 +172,9 @@ static const struct re_io_ops real_ops = {
     .message = real_message,
     .relay_check = real_relay_check,
     .relay_off = real_relay_off,
+    .relay_off_start = real_relay_off_start,
+    .relay_off_finish = real_relay_off_finish,
+    .stop_fresh = real_stop_fresh,
     .relay_state = real_relay_state,
     .log = real_log,
     .now_ns = real_now_ns,

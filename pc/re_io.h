@@ -26,8 +26,10 @@
  */
 #define RE_STOP_ALL "AB 1;MO ABC"
 
-/* The PC heartbeat hbpc counts 0 .. RE_HBPC_WRAP - 1 (a short decimal). */
-#define RE_HBPC_WRAP 1000000
+/* The PC heartbeat hbpc counts 0 .. RE_HBPC_WRAP - 1 (the DMC's hbpcwr):
+ * a session starts at a random value and adds 1 per write, so a value
+ * from another writer is out of sequence (dmc-interface.md, #HBCHK). */
+#define RE_HBPC_WRAP 1000000000L
 
 struct re_io_ops {
 	/* gl_link_record(): one "[prefix;]QR" round trip. */
@@ -43,8 +45,22 @@ struct re_io_ops {
 	int (*message)(void *ud, char *line, size_t cap);
 	/* re_relay_check(): GL_OK or GL_ERR_RELAY with @why filled. */
 	int (*relay_check)(void *ud, char *why, size_t cap);
-	/* re_relay_off(): GL_OK or GL_ERR_RELAY. */
+	/* re_relay_off(): GL_OK or GL_ERR_RELAY / GL_ERR_TIMEOUT; bounded by
+	 * the relay's own deadline. */
 	int (*relay_off)(void *ud);
+	/* Optional (NULL: relay_off is used). re_relay_off_start(): begin
+	 * switching motor power off without waiting for anything. */
+	int (*relay_off_start)(void *ud);
+	/* Optional, with relay_off_start. re_relay_off_finish(): wait at most
+	 * @deadline_ms for the off state to be written and, where the board
+	 * answers, confirmed. Return: GL_OK or an error. */
+	int (*relay_off_finish)(void *ud, int deadline_ms);
+	/* Optional (NULL: not attempted). Deliver one command line over a new
+	 * connection to the controller (the old one is out of step or gone),
+	 * connect and reply within @deadline_ms in all; on success the new
+	 * connection replaces the command link. Return: as command(). */
+	int (*stop_fresh)(void *ud, const char *cmd, char *resp, size_t cap,
+			  int deadline_ms);
 	/* re_relay_state(): what was last confirmed written. */
 	enum re_relay_state (*relay_state)(void *ud);
 	/* re_log: one event; RE_LOG_FAULT is on disk (fsync) on return. */
@@ -65,6 +81,8 @@ struct re_io_real {
 	gl_link *link;
 	re_relay *relay;
 	struct re_log *log;
+	const char *address; /* the controller, for stop_fresh; NULL: none */
+	int cmd_timeout_ms;  /* the command link's default reply deadline */
 };
 
 /*

@@ -1,6 +1,7 @@
 /*
- * re_super.c - the supervisor's periodic cycle and fault reaction.
- * See re_super.h; the checks themselves are in re_check.c.
+ * re_super.c - the supervisor's periodic cycle: schedule, round trip,
+ * checks, status. See re_super.h; the checks themselves are in re_check.c,
+ * the fault reaction in re_react.c.
  */
 #include "re_super.h"
 
@@ -12,9 +13,6 @@
 #include "gl_err.h"
 
 #define NS_PER_MS 1000000LL
-/* The stop (re_io.h; the DMC's own #FAULT uses the same two commands), and
- * the program told to latch in the same line. */
-#define FAULT_CMD RE_STOP_ALL ";pcflt=1"
 
 static int64_t now_ns(const struct re_super *s)
 {
@@ -31,18 +29,22 @@ double re_pot_volts(int32_t analog_in)
 	return (double)analog_in / RE_AN_COUNTS_PER_V;
 }
 
-/* The potentiometer of axis i: analog input n is in axis block n - 1. */
+/* Analog input n is in axis block n - 1 of the DMC-4030 record. */
+double re_pot_of(const struct gl_record *rec, int axis, int input)
+{
+	int k = input >= 1 && input <= rec->n_axes ? input - 1 : axis;
+
+	return re_pot_volts(rec->axis[k].analog_in);
+}
+
 static double pot_of(const struct re_super *s, int i)
 {
-	int in = s->cfg.pot_input[i];
-	int k = in >= 1 && in <= s->rec.n_axes ? in - 1 : i;
-
-	return re_pot_volts(s->rec.axis[k].analog_in);
+	return re_pot_of(&s->rec, i, s->cfg.pot_input[i]);
 }
 
 int re_super_init(struct re_super *s, const struct re_io *io,
 		  const struct re_super_cfg *cfg,
-		  const struct re_caltable *const *tables, int armed)
+		  const struct re_caltable *const *tables, int expect)
 {
 	memset(s, 0, sizeof(*s));
 	if (!io || !io->ops || !cfg || cfg->n_axes < 1 ||
@@ -54,7 +56,9 @@ int re_super_init(struct re_super *s, const struct re_io *io,
 		return GL_ERR_ARG;
 	for (int i = 0; tables && i < cfg->n_axes; i++)
 		s->table[i] = tables[i];
-	s->armed = armed;
+	s->expect = expect;
+	s->armed = expect == RE_DMC_ARMED;
+	s->period_ns = cfg->period_ns;
 	s->t0_ns = now_ns(s);
 	s->deadline_ns = s->t0_ns + cfg->period_ns; /* no previous cycle */
 	s->last_good_ns = s->t0_ns;
@@ -63,19 +67,48 @@ int re_super_init(struct re_super *s, const struct re_io *io,
 }
 
 void re_super_start(struct re_super *s, const struct re_caltable *const *tables,
-		    long hbpc)
+		    long hbpc, int expect)
 {
 	if (s->latched)
 		return;
 	for (int i = 0; i < s->cfg.n_axes; i++) {
 		s->table[i] = tables ? tables[i] : NULL;
 		s->encpot[i].violations = 0;
+		s->moving_ns[i] = 0;
 	}
-	s->armed = 1;
+	s->expect = expect;
+	s->armed = expect == RE_DMC_ARMED;
+	s->own_mask = 0;
 	s->hbpc = hbpc;
 	s->last_good_ns = now_ns(s);
-	s->deadline_ns = s->last_good_ns + s->cfg.period_ns;
+	s->last_end_ns = 0;
+	s->deadline_ns = s->last_good_ns + s->period_ns;
 	re_alive_reset(&s->alive);
+}
+
+void re_super_tables(struct re_super *s,
+		     const struct re_caltable *const *tables)
+{
+	for (int i = 0; i < s->cfg.n_axes; i++) {
+		s->table[i] = tables ? tables[i] : NULL;
+		s->encpot[i].violations = 0;
+	}
+}
+
+void re_super_set_period(struct re_super *s, int64_t period_ns)
+{
+	s->period_ns = period_ns > 0 ? period_ns : s->cfg.period_ns;
+	s->deadline_ns = now_ns(s) + s->period_ns;
+}
+
+void re_super_own(struct re_super *s, unsigned mask)
+{
+	int64_t now = now_ns(s);
+
+	for (int i = 0; i < s->cfg.n_axes; i++)
+		if ((s->own_mask | mask) >> i & 1)
+			s->cmd_ns[i] = now;
+	s->own_mask = mask;
 }
 
 int64_t re_super_wait(struct re_super *s)
@@ -99,168 +132,8 @@ int64_t re_super_wait(struct re_super *s)
 		s->late_worst_ns = late;
 	bin = late / (RE_LATE_BIN_US * 1000);
 	s->late_hist[bin < RE_LATE_BINS - 1 ? bin : RE_LATE_BINS - 1]++;
-	s->deadline_ns += s->cfg.period_ns;
+	s->deadline_ns += s->period_ns;
 	return late;
-}
-
-/* ---- fault reaction ------------------------------------------------------ */
-
-/* Re-read the controller's fault detail (MG fdet) for a CTRL fault. */
-static void ctrl_fault_detail(struct re_super *s, struct re_fault *f)
-{
-	double fdet;
-
-	if (s->have_za && s->za.fcode != 0 &&
-	    re_io_read(&s->io, "fdet", &fdet, s->cfg.fault_cmd_timeout_ms) ==
-		GL_OK)
-		re_ctrl_fault(&s->za, (long long)fdet, f);
-}
-
-/* Faults that may be the program's own fault seen half-way (motors off by
- * #JINV before #MAIN latched INPUT, thread 1 halted by #FAULT ...). */
-static int may_settle(const struct re_super *s, enum re_fault_id id)
-{
-	return s->cfg.settle_ms > 0 &&
-	       (id == RE_F_MOTOR_OFF || id == RE_F_THREAD || id == RE_F_STATE);
-}
-
-/* Poll the program's fault code for up to settle_ms; when it latched
- * one, that is the fault to report (with its axis and detail). */
-static void program_verdict(struct re_super *s, struct re_fault *f)
-{
-	int64_t t0 = now_ns(s);
-	int64_t end = t0 + (int64_t)s->cfg.settle_ms * NS_PER_MS;
-	double code = 0, axis = 0, det = 0;
-	struct re_za za;
-	int rc;
-
-	do {
-		rc = re_io_read(&s->io, "fcode", &code,
-				s->cfg.fault_cmd_timeout_ms);
-		if (rc != GL_OK) {
-			snprintf(s->verdict, sizeof(s->verdict),
-				 "program fault code unreadable: %s",
-				 gl_strerror(rc));
-			return;
-		}
-		if (code > 0 && code < 100) {
-			snprintf(s->verdict, sizeof(s->verdict),
-				 "program fault %d after %.1f ms", (int)code,
-				 ns_to_ms(now_ns(s) - t0));
-			re_io_read(&s->io, "faxis", &axis,
-				   s->cfg.fault_cmd_timeout_ms);
-			re_io_read(&s->io, "fdet", &det,
-				   s->cfg.fault_cmd_timeout_ms);
-			memset(&za, 0, sizeof(za));
-			za.state = RE_DMC_FAULT;
-			za.fcode = (int)code;
-			za.faxis = axis >= 0 && axis <= 3 ? (int)axis : 0;
-			re_ctrl_fault(&za, (long long)det, f);
-			return;
-		}
-		s->io.ops->sleep_until(s->io.ud, now_ns(s) + 2 * NS_PER_MS);
-	} while (now_ns(s) < end);
-	snprintf(s->verdict, sizeof(s->verdict),
-		 "no program fault within %d ms", s->cfg.settle_ms);
-}
-
-/* Stop and switch off through the controller and tell the program
- * (pcflt) - after its own verdict when it may be latching one. */
-static int stop_controller(struct re_super *s, struct re_fault *f)
-{
-	int rc;
-
-	if (!may_settle(s, f->id)) {
-		rc = s->io.ops->command(s->io.ud, FAULT_CMD, s->resp,
-					sizeof(s->resp),
-					s->cfg.fault_cmd_timeout_ms);
-		if (re_fault_is_ctrl(f->id))
-			ctrl_fault_detail(s, f);
-		return rc;
-	}
-	rc = s->io.ops->command(s->io.ud, RE_STOP_ALL, s->resp, sizeof(s->resp),
-				s->cfg.fault_cmd_timeout_ms);
-	program_verdict(s, f);
-	s->io.ops->command(s->io.ud, "pcflt=1", s->resp, sizeof(s->resp),
-			   s->cfg.fault_cmd_timeout_ms);
-	return rc;
-}
-
-/* Append the axes of the last record to the log text. */
-static size_t snapshot(const struct re_super *s, char *buf, size_t cap)
-{
-	size_t n = 0;
-
-	for (int i = 0; s->have_record && i < s->cfg.n_axes && n < cap; i++) {
-		const struct gl_rec_axis *a = &s->rec.axis[i];
-
-		n += (size_t)snprintf(buf + n, cap - n,
-				      "; %s enc=%d ref=%d err=%d sc=%d mo=%d"
-				      " an=%.4fV",
-				      s->cfg.axis_names[i], (int)a->motor_pos,
-				      (int)a->ref_pos, (int)a->pos_err,
-				      a->stop_code,
-				      a->status & GL_AXST_MOTOR_OFF ? 1 : 0,
-				      re_pot_volts(a->analog_in));
-	}
-	if (n < cap && s->have_za)
-		n += (size_t)snprintf(buf + n, cap - n,
-				      "; dmc state=%d fcode=%d faxis=%d "
-				      "hbdmc=%d jraw=%d",
-				      s->za.state, s->za.fcode, s->za.faxis,
-				      (int)s->za.hbdmc, s->za.jraw);
-	return n < cap ? n : cap;
-}
-
-static void log_fault(struct re_super *s, int relay_rc, int cmd_rc)
-{
-	char *t = s->text;
-	size_t cap = sizeof(s->text), n;
-
-	n = (size_t)snprintf(
-	    t, cap,
-	    "%s | relay off: %s | controller stop: %s%s%s | "
-	    "cycle %llu, reply age %.1f ms",
-	    s->fault_line, relay_rc == GL_OK ? "confirmed" : "NOT confirmed",
-	    cmd_rc >= 0 ? "ok" : gl_strerror(cmd_rc), s->verdict[0] ? "; " : "",
-	    s->verdict, (unsigned long long)s->cycles,
-	    ns_to_ms(s->age_last_ns));
-	if (n < cap)
-		snapshot(s, t + n, cap - n);
-	s->io.ops->log(s->io.ud, RE_LOG_FAULT, t);
-}
-
-int re_super_fault(struct re_super *s, const struct re_fault *f)
-{
-	struct re_fault fault = *f;
-	int relay_rc, cmd_rc;
-
-	if (s->latched) {
-		re_fault_format(f, s->cfg.axis_names, s->msg, sizeof(s->msg));
-		re_io_logf(&s->io, RE_LOG_WARN, "while latched: %s", s->msg);
-		return RE_OK;
-	}
-	s->verdict[0] = '\0';
-	/* 1. cut motor power; 2. stop and switch off through the controller */
-	relay_rc = s->io.ops->relay_off(s->io.ud);
-	cmd_rc = stop_controller(s, &fault);
-	s->latched = 1;
-	s->armed = 0;
-	s->fault = fault;
-	if (re_fault_format(&fault, s->cfg.axis_names, s->fault_line,
-			    sizeof(s->fault_line)) == GL_ERR_ARG)
-		snprintf(s->fault_line, sizeof(s->fault_line),
-			 "FAULT PROGRAM: unknown fault %d. Recovery: quit, "
-			 "note the log and call service",
-			 (int)fault.id);
-	/* 3. the log entry on disk before anyone reports the relay open */
-	log_fault(s, relay_rc, cmd_rc);
-	return RE_FAULT;
-}
-
-const char *re_super_fault_line(const struct re_super *s)
-{
-	return s->latched ? s->fault_line : "";
 }
 
 /* ---- the cycle ----------------------------------------------------------- */
@@ -282,6 +155,25 @@ static int comm_fault(int rc, struct re_fault *f)
 	return RE_FAULT;
 }
 
+/* The supervisor itself did not run for longer than the critical limit
+ * (SIGSTOP, a debugger, an overloaded PC): that, measured on its own
+ * monotonic clock, is the cause - not the link, and not the controller's
+ * watchdog that tripped meanwhile. */
+static int check_stall(struct re_super *s, struct re_fault *f)
+{
+	int64_t gap;
+
+	if (!s->last_end_ns)
+		return RE_OK;
+	gap = now_ns(s) - s->last_end_ns;
+	if (gap <= s->crit_ns)
+		return RE_OK;
+	re_fault_set(f, RE_F_STALL, -1);
+	f->i[0] = gap / NS_PER_MS;
+	f->i[1] = s->crit_ns / NS_PER_MS;
+	return RE_FAULT;
+}
+
 /* The round trip and the PC-side watchdog verdict on it. */
 static int exchange(struct re_super *s, struct re_fault *f)
 {
@@ -297,6 +189,12 @@ static int exchange(struct re_super *s, struct re_fault *f)
 	if (rc != GL_OK && rc != GL_ERR_TIMEOUT)
 		return comm_fault(rc, f);
 	v = re_check_reply_age(&s->cfg.wdog, s->last_good_ns, now, &age, f);
+	if (v < 0) {
+		re_fault_set(f, RE_F_WDOG_REPLY, -1);
+		f->i[0] = RE_VAL_UNKNOWN;
+		f->i[1] = s->crit_ns / NS_PER_MS;
+		v = RE_FAULT;
+	}
 	if (rc == GL_ERR_TIMEOUT && v != RE_FAULT) {
 		/* the deadline was the critical limit: rounding aside, late */
 		re_fault_set(f, RE_F_WDOG_REPLY, -1);
@@ -311,7 +209,7 @@ static int exchange(struct re_super *s, struct re_fault *f)
 		if (age > s->age_worst_ns)
 			s->age_worst_ns = age;
 	}
-	return v < 0 ? RE_OK : v;
+	return v;
 }
 
 static void warn_watchdog(struct re_super *s)
@@ -367,6 +265,47 @@ static int check_encpot(struct re_super *s, struct re_fault *f)
 	return RE_OK;
 }
 
+/* The axis the program's joystick command (k + 1) moves, or -1. */
+static int cmd_axis(int cmd)
+{
+	return cmd >= 1 && cmd <= 6 ? (cmd - 1) / 2 : -1;
+}
+
+/* Motion only where commanded: an axis whose profiler runs must be the one
+ * the program's command moves (armed: mcmd or jcmd), or one the supervisor
+ * moves itself (service), or have been one of those within the grace (the
+ * program publishes its command up to mainms late; a stopped axis still
+ * decelerates). */
+static int check_uncmd(struct re_super *s, struct re_fault *f)
+{
+	int64_t now = now_ns(s);
+
+	if (!s->cfg.uncmd_grace_ns || !s->have_za)
+		return RE_OK;
+	for (int i = 0; i < s->cfg.n_axes; i++) {
+		int moving = !!(s->rec.axis[i].status & GL_AXST_MOVING);
+
+		if ((s->own_mask >> i & 1) || cmd_axis(s->za.mcmd) == i ||
+		    cmd_axis(s->za.jcmd) == i)
+			s->cmd_ns[i] = now;
+		if (!moving) {
+			s->moving_ns[i] = 0;
+			continue;
+		}
+		if (!s->moving_ns[i])
+			s->moving_ns[i] = now;
+		if (now - s->cmd_ns[i] <= s->cfg.uncmd_grace_ns ||
+		    now - s->moving_ns[i] <= s->cfg.uncmd_grace_ns)
+			continue;
+		re_fault_set(f, RE_F_UNCMD, i);
+		snprintf(f->s, sizeof(f->s),
+			 "its profiler runs, seen by the supervisor for %.0f ms",
+			 ns_to_ms(now - s->moving_ns[i]));
+		return RE_FAULT;
+	}
+	return RE_OK;
+}
+
 static void drain_messages(struct re_super *s)
 {
 	for (int i = 0; i < RE_SUPER_MSGS; i++) {
@@ -383,7 +322,7 @@ static int check_record(struct re_super *s, struct re_fault *f)
 {
 	int v;
 
-	v = re_check_record(&s->rec, s->cfg.n_axes, s->armed, &s->za, f);
+	v = re_check_record(&s->rec, s->cfg.n_axes, s->expect, &s->za, f);
 	s->have_za = v == RE_OK || f->id != RE_F_RECORD;
 	if (v < 0)
 		return check_error(f, RE_F_COMM, -1, "the record check", v);
@@ -391,15 +330,21 @@ static int check_record(struct re_super *s, struct re_fault *f)
 		return v;
 	v = re_check_alive(&s->cfg.alive, &s->alive, now_ns(s), s->za.hbdmc,
 			   s->rec.sample, f);
+	if (v < 0)
+		return check_error(f, RE_F_WDOG_HEARTBEAT, -1,
+				   "the liveness check", v);
 	if (v == RE_FAULT)
 		return v;
-	return check_encpot(s, f);
+	v = check_encpot(s, f);
+	if (v == RE_FAULT || !s->expect)
+		return v;
+	return check_uncmd(s, f);
 }
 
 static int latched_cycle(struct re_super *s)
 {
 	int rc = s->io.ops->record(s->io.ud, NULL, &s->rec,
-				   (int)(s->cfg.period_ns / NS_PER_MS) + 1);
+				   (int)(s->period_ns / NS_PER_MS) + 1);
 	struct re_fault scratch;
 
 	memset(&scratch, 0, sizeof(scratch));
@@ -421,21 +366,20 @@ static int latched_cycle(struct re_super *s)
 		s->relay_lost_logged = 1;
 		re_fault_format(&scratch, s->cfg.axis_names, s->text,
 				sizeof(s->text));
-		re_io_logf(&s->io, RE_LOG_FAULT, "while latched: %s", s->text);
+		re_io_logf(&s->io, RE_LOG_WARN, "while latched: %s", s->text);
 	}
 	drain_messages(s);
 	return RE_OK;
 }
 
-int re_super_cycle(struct re_super *s)
+static int cycle_checks(struct re_super *s)
 {
 	struct re_fault f, rf;
 	int v, rv, warn;
 
-	s->cycles++;
-	if (s->latched)
-		return latched_cycle(s);
 	memset(&f, 0, sizeof(f));
+	if (check_stall(s, &f) == RE_FAULT)
+		return re_super_fault(s, &f);
 	v = exchange(s, &f);
 	warn = s->link_ok && s->age_last_ns > s->noncrit_ns;
 	rv = check_relay(s, &rf);
@@ -452,7 +396,19 @@ int re_super_cycle(struct re_super *s)
 	return warn ? RE_WARN : RE_OK;
 }
 
-/* ---- status and shutdown ------------------------------------------------- */
+int re_super_cycle(struct re_super *s)
+{
+	int v;
+
+	s->cycles++;
+	if (s->latched)
+		return latched_cycle(s);
+	v = cycle_checks(s);
+	s->last_end_ns = s->latched ? 0 : now_ns(s);
+	return v;
+}
+
+/* ---- status ------------------------------------------------------------- */
 
 static void axis_status(const struct re_super *s, int i,
 			struct re_axis_status *out)
@@ -493,13 +449,15 @@ void re_super_status(const struct re_super *s, struct re_status *st)
 	st->relay = s->io.ops->relay_state(s->io.ud);
 	st->wd_last_ms = ns_to_ms(s->age_last_ns);
 	st->wd_worst_ms = ns_to_ms(s->age_worst_ns);
-	st->period_ms = ns_to_ms(s->cfg.period_ns);
+	st->period_ms = ns_to_ms(s->period_ns);
 	st->late_last_ms = ns_to_ms(s->late_last_ns);
 	st->late_worst_ms = ns_to_ms(s->late_worst_ns);
 	st->cycles = s->cycles;
 	st->overruns = s->overruns;
 	st->wd_warnings = s->wd_warnings;
 	st->armed = s->armed;
+	st->expect = s->expect;
+	st->log_failing = s->log_failing;
 	st->link_ok = s->link_ok;
 	st->za = s->za;
 	st->have_za = s->have_za;
@@ -529,15 +487,3 @@ double re_super_late_ms(const struct re_super *s, double pct)
 	return ns_to_ms(s->late_worst_ns);
 }
 
-int re_super_shutdown(struct re_super *s)
-{
-	int rc =
-	    s->io.ops->command(s->io.ud, RE_STOP_ALL, s->resp, sizeof(s->resp),
-			       s->cfg.fault_cmd_timeout_ms);
-	int relay_rc = s->io.ops->relay_off(s->io.ud);
-
-	s->armed = 0;
-	if (rc < 0)
-		return rc;
-	return relay_rc;
-}

@@ -1,18 +1,26 @@
 /*
  * re_super.h - the supervisor's periodic cycle (robotTask::Run) and its
- * fault reaction.
+ * fault reaction, in every phase in which a motor can be powered.
  *
- * Every period: one round trip with the controller ("hbpc=<n>;QR"), then the
- * checks of re_check.h on the record: the reply age (PC-side watchdog), the
- * program's fields (latched controller fault, state, threads, motors), the
+ * Every period: the supervisor's own stall checked on its monotonic clock,
+ * then one round trip with the controller ("hbpc=<n>;QR"), then the checks
+ * of re_check.h on the record: the reply age (PC-side watchdog), the
+ * program's fields (latched controller fault, the expected state - service
+ * while calibrating and centring, armed afterwards - threads, motors), the
  * program heartbeat and the record sample number advancing, encoder against
- * potentiometer per axis, and the E-stop relay link. On the first fault, in
- * the same cycle: relay off (motor power cut) first, then "AB 1;MO ABC;
- * pcflt=1" through the controller (best effort, bounded time), latch, and
- * the log entry written and fsync'ed; only then does the caller print the
- * FAULT line (re_super_fault_line()). A latched supervisor never re-arms,
- * never switches motor power on, and keeps polling the record for the status
- * board until the operator quits.
+ * potentiometer per axis (once tables exist), motion only where something
+ * commanded it, and the E-stop relay link.
+ *
+ * On the first fault, in the same cycle: the relay is told to open (never
+ * waiting), "AB 1;MO ABC;pcflt=1" goes to the controller at once - over a
+ * new connection within a deadline when the old one is out of step or gone
+ * - then the relay's off is confirmed within its deadline, the motors' off
+ * is read back, the fault is latched and the log entry written and fsync'ed
+ * (a failed write is kept and retried, and shown); only then does the caller
+ * print the FAULT line (re_super_fault_line()), which names the first cause
+ * and says exactly what was confirmed. A latched supervisor never re-arms,
+ * never switches motor power on, and keeps polling the record for the
+ * status board until the operator quits.
  *
  * Deadlines are absolute (re_super_wait()); a cycle that ends after the next
  * deadline is an overrun: counted, and the schedule restarts from now rather
@@ -31,7 +39,7 @@
 #include "re_io.h"
 
 #define RE_SUPER_AXES 3
-#define RE_SUPER_LINE 512 /* FAULT line, bytes incl. NUL */
+#define RE_SUPER_LINE 768 /* FAULT line, bytes incl. NUL */
 #define RE_SUPER_MSGS 8	  /* unsolicited lines drained per cycle */
 
 /* AQ2 (default): analog inputs read +-10 V as +-32768 counts. */
@@ -46,12 +54,19 @@ struct re_super_cfg {
 	const char *axis_names[RE_SUPER_AXES];
 	int pot_input[RE_SUPER_AXES]; /* analog input 1..8; 0: axis + 1 */
 	int fault_cmd_timeout_ms;     /* "AB 1;MO ABC;pcflt=1" deadline */
+	int fresh_stop_ms; /* the stop over a new connection: connect and
+			    * reply within this, ms; 0: never tried */
+	int relay_off_ms;  /* relay off confirmed within this, ms */
 	/* A motor off, a stopped thread or a left state may be the first
 	 * sign of a fault the program is latching itself (its ZA fields
 	 * follow every mainms): after cutting power and stopping, wait up to
 	 * this long for the program's own fault code, the more specific
 	 * cause. 0: report at once. */
 	int settle_ms;
+	/* An axis moving although nothing commanded it is a fault once that
+	 * has lasted this long (the program publishes its command up to
+	 * mainms late), ns; 0: the check is off. */
+	int64_t uncmd_grace_ns;
 	const char *mode_name; /* "clinical" / "development" */
 };
 
@@ -71,6 +86,15 @@ struct re_axis_status {
 	int stop_code;
 };
 
+/* What the fault reaction could confirm (for the FAULT line and the log). */
+struct re_confirm {
+	int relay_rc;	/* relay off: GL_OK when confirmed */
+	int stop_rc;	/* the stop command: >= 0 delivered */
+	int stop_fresh; /* 1: delivered over a new connection */
+	int motors_rc;	/* GL_OK: every motor read back off */
+	double stop_ms; /* time to deliver the stop, ms */
+};
+
 /* Everything the console shows; a snapshot made by re_super_status(). */
 struct re_status {
 	int n_axes;
@@ -87,12 +111,14 @@ struct re_status {
 	uint64_t overruns;
 	uint64_t wd_warnings; /* non-critical watchdog events */
 	int armed;
-	int link_ok;	 /* last round trip succeeded */
+	int expect; /* program state expected: RE_DMC_ARMED, _SERVICE, 0 */
+	int link_ok; /* last round trip succeeded */
 	struct re_za za; /* program fields (valid when have_za) */
 	int have_za;
 	const char *mode_name;
 	int latched;
 	const char *fault_line; /* "" when none */
+	int log_failing;	/* a log entry could not be written */
 	double uptime_s;
 };
 
@@ -103,15 +129,19 @@ struct re_super {
 	struct re_io io;
 	struct re_super_cfg cfg;
 	const struct re_caltable *table[RE_SUPER_AXES]; /* NULL: no check */
-	int armed; /* the program is armed: motors on */
+	int expect; /* RE_DMC_ARMED, RE_DMC_SERVICE, or 0 (nothing on) */
+	int armed;  /* expect == RE_DMC_ARMED (kept for the status) */
 	/* schedule */
 	int64_t t0_ns;
 	int64_t deadline_ns; /* start of the next cycle */
+	int64_t period_ns;   /* the schedule's period (cfg or override) */
 	int64_t late_last_ns, late_worst_ns;
 	uint64_t cycles, overruns;
 	/* wake-up lateness histogram: RE_LATE_BIN_US bins, the last one
 	 * counts everything later (for the exit statistics; no allocation) */
 	uint32_t late_hist[RE_LATE_BINS];
+	/* the supervisor's own liveness: end of the last cycle (0: none) */
+	int64_t last_end_ns;
 	/* watchdog */
 	int64_t noncrit_ns, crit_ns;
 	int64_t last_good_ns;
@@ -128,17 +158,28 @@ struct re_super {
 	struct re_encpot_state encpot[RE_SUPER_AXES];
 	struct re_encpot_result encres[RE_SUPER_AXES];
 	int have_encres[RE_SUPER_AXES];
+	/* motion cross-check: what the supervisor itself commands (service
+	 * moves), when each axis was last commanded, since when it moves */
+	unsigned own_mask;
+	int64_t cmd_ns[RE_SUPER_AXES];
+	int64_t moving_ns[RE_SUPER_AXES]; /* 0: at rest */
 	/* fault latch */
 	int latched;
 	struct re_fault fault;
+	struct re_confirm confirm;
 	char fault_line[RE_SUPER_LINE];
 	int relay_lost_logged; /* relay failure while latched, logged once */
+	/* a log entry that could not be written, kept for re_super_retry() */
+	int log_failing;
+	enum re_log_level pending_lvl;
+	char pending[2048];
 	/* scratch, preallocated */
 	char prefix[32];
 	char resp[128];
-	char verdict[64]; /* what the settle wait found, for the log */
+	char verdict[96]; /* what the settle wait found, for the log */
+	char then[160];	  /* consequences seen after the first cause */
 	char msg[RE_SUPER_LINE];
-	char text[1536];
+	char text[2048];
 };
 
 /*
@@ -148,24 +189,48 @@ struct re_super {
  * @cfg: [in] copied; axis_names and mode_name must outlive @s.
  * @tables: [in] per-axis calibration tables (must outlive @s), or NULL
  *          entries / NULL for no encoder/pot check on those axes.
- * @armed: 1 when the program is armed (motors expected on).
+ * @expect: the program state expected from the first cycle: RE_DMC_ARMED,
+ *          RE_DMC_SERVICE (motors on in both), or 0 (nothing expected).
  * The first deadline is one period from now; the last good reply is taken
  * as "now".
  * Return: GL_OK or GL_ERR_ARG (bad period, axes or watchdog factors).
  */
 int re_super_init(struct re_super *s, const struct re_io *io,
 		  const struct re_super_cfg *cfg,
-		  const struct re_caltable *const *tables, int armed);
+		  const struct re_caltable *const *tables, int expect);
 
 /*
- * re_super_start() - the program is armed: from now on the cycle expects
- * the motors on and checks the encoders against @tables (NULL entries: no
- * check on that axis). The schedule, the reply-age watchdog and the
- * liveness history restart from now; the heartbeat continues from @hbpc.
- * No-op when latched.
+ * re_super_start() - the program entered @expect (RE_DMC_SERVICE after the
+ * service request, RE_DMC_ARMED after arming): from now on the cycle checks
+ * that state, the motors on, and the encoders against @tables (NULL entries
+ * or NULL: no check on those axes). The schedule, the reply-age watchdog,
+ * the stall reference and the liveness history restart from now; the
+ * heartbeat continues from @hbpc. No-op when latched.
  */
 void re_super_start(struct re_super *s, const struct re_caltable *const *tables,
-		    long hbpc);
+		    long hbpc, int expect);
+
+/*
+ * re_super_tables() - check the encoders against @tables from now (NULL
+ * entries or NULL: no check on those axes); the persistence counts restart.
+ */
+void re_super_tables(struct re_super *s,
+		     const struct re_caltable *const *tables);
+
+/*
+ * re_super_set_period() - the schedule's period from now (calibration
+ * samples every RE_CALIB_SAMPLE_MS); 0 restores the configured period. The
+ * watchdog limits stay those of the configured period.
+ */
+void re_super_set_period(struct re_super *s, int64_t period_ns);
+
+/*
+ * re_super_own() - the supervisor itself moves the axes in @mask (bit i =
+ * axis i) from now (a service move it requested), or no longer (0): an
+ * axis moving outside @mask and outside the program's own command is
+ * "moving although nothing commanded it".
+ */
+void re_super_own(struct re_super *s, unsigned mask);
 
 /*
  * re_super_wait() - sleep until the next absolute deadline and advance it
@@ -186,9 +251,11 @@ int re_super_cycle(struct re_super *s);
 
 /*
  * re_super_fault() - the fault reaction, also for faults found outside the
- * cycle (start-up, calibration): relay off, "AB 1;MO ABC;pcflt=1", latch,
- * FAULT log entry fsync'ed, FAULT line composed. A second fault while
- * latched is only logged.
+ * cycle (start-up, calibration): relay off started, the stop sent (a new
+ * connection when needed), relay off confirmed, motors read back, latch,
+ * FAULT log entry fsync'ed (kept for a retry when that fails), FAULT line
+ * composed with what was confirmed. A second fault while latched is only
+ * logged.
  * @f: [in] the fault.
  * Return: RE_FAULT when this fault was latched, RE_OK if already latched.
  */
@@ -198,21 +265,38 @@ int re_super_fault(struct re_super *s, const struct re_fault *f);
 const char *re_super_fault_line(const struct re_super *s);
 
 /*
+ * re_super_retry() - write a log entry that failed before (the FAULT entry
+ * on a full disk, ...). Call it outside the cycle, e.g. once a second.
+ * Return: GL_OK when nothing is pending (any more), else the log error.
+ */
+int re_super_retry(struct re_super *s);
+
+/*
  * re_super_status() - fill @st from the supervisor's last cycle.
  * @st: [out]; its pointers point into @s (valid while @s is).
  */
 void re_super_status(const struct re_super *s, struct re_status *st);
 
 /*
- * re_super_shutdown() - the operator quits: stop motion and switch the
- * motors off through the controller ("AB 1;MO ABC"), then cut motor power
- * (relay off). Both are attempted whatever fails.
- * Return: GL_OK, or the first error (the caller logs it).
+ * re_super_shutdown() - the operator quits: ask the program back to its
+ * safe state ("offreq=1"), stop motion and switch the motors off through
+ * the controller ("AB 1;MO ABC"), read back that every motor is off, then
+ * cut motor power (relay off, confirmed within its deadline). Every step
+ * is attempted whatever fails before it.
+ * @what: [out] optional, a line saying what was confirmed, for the log.
+ * Return: GL_OK when everything was confirmed, else the first error.
  */
-int re_super_shutdown(struct re_super *s);
+int re_super_shutdown(struct re_super *s, char *what, size_t cap);
 
 /* re_pot_volts() - analog input counts (AQ2) to volts. */
 double re_pot_volts(int32_t analog_in);
+
+/*
+ * re_pot_of() - the potentiometer of axis @axis in @rec, volts: analog
+ * input @input (1..n_axes: its axis block), or the axis's own block when
+ * @input is out of that range.
+ */
+double re_pot_of(const struct gl_record *rec, int axis, int input);
 
 /*
  * re_super_late_ms() - wake-up lateness percentile over every cycle so far.

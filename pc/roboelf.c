@@ -12,11 +12,17 @@
  * calibration); 3 no relay, no controller, or the controller refused the
  * start-up (wrong program, read-back differs); 4 a fault was latched.
  *
- * Start-up order (issue 6): relay open and on (no relay, no start); connect,
- * identify, program identity, close foreign handles; configure and read
- * back; calibration (full or from file); soft limits; arm; "RoboELF Ready
- * for Use". Any fault on the way, or in the cycle, goes through
- * re_super_fault(): relay off, motors off, latch, log fsync'ed, FAULT line.
+ * Power-on order (docs/supervisor.md): the relay opened and kept off; the
+ * controller identified, refused when another supervisor runs it, other
+ * connections closed, program identity checked; what will move chosen by
+ * the operator (or --calibration); the program halted and every motor read
+ * back off; configured and read back; the amplifiers seen without motor
+ * power; the program started; only then the relay closes (and the
+ * amplifiers see power); parameters; the service state, in which the
+ * calibration (or the check of the file) and the move to the centre run as
+ * supervised cycles; back to the safe state; the file saved; armed; "RoboELF
+ * Ready for Use". Any fault on the way, or in the cycle, goes through
+ * re_super_fault(). Power-off is the reverse (re_super_shutdown()).
  */
 #include <errno.h>
 #include <getopt.h>
@@ -39,6 +45,7 @@
 #include "re_ctl.h"
 #include "re_io.h"
 #include "re_log.h"
+#include "re_plan.h"
 #include "re_relay.h"
 #include "re_super.h"
 
@@ -63,14 +70,16 @@ struct app {
 	struct re_log log;
 	struct re_console con;
 	re_relay *relay;
-	gl_link *link;
-	struct re_io_real real;
+	struct re_io_real real; /* real.link: the command link */
 	struct re_io io;
 	struct re_ctl_info info;
+	struct re_plan plan;
 	struct re_calset *cal;
 	struct re_super *sup;
 	const char *names[RE_AXES];
 	long hbpc;
+	int calib;   /* the operator's choice: RE_CALIB_FULL / _FILE */
+	int powered; /* the relay was switched on at some point */
 	char err[RE_CONFIG_ERR_MAX];
 };
 
@@ -81,18 +90,24 @@ static void on_signal(int sig)
 	quit_signal = sig;
 }
 
+/* Every signal a terminal or a person can send ends in the orderly
+ * shutdown (the safe state), never in a kill or a freeze with power on:
+ * Ctrl-C, Ctrl-\, SIGTERM and a lost terminal (SIGHUP) quit; Ctrl-Z and
+ * background terminal I/O are ignored; a closed pipe is an error return. */
 static void install_signals(void)
 {
+	static const int quit[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
+	static const int ignore[] = {SIGPIPE, SIGTSTP, SIGTTIN, SIGTTOU};
 	struct sigaction sa;
 
 	memset(&sa, 0, sizeof(sa));
 	sa.sa_handler = on_signal;
 	sigemptyset(&sa.sa_mask);
-	sigaction(SIGINT, &sa, NULL);
-	sigaction(SIGTERM, &sa, NULL);
-	sigaction(SIGHUP, &sa, NULL);
+	for (size_t i = 0; i < sizeof(quit) / sizeof(quit[0]); i++)
+		sigaction(quit[i], &sa, NULL);
 	sa.sa_handler = SIG_IGN;
-	sigaction(SIGPIPE, &sa, NULL);
+	for (size_t i = 0; i < sizeof(ignore) / sizeof(ignore[0]); i++)
+		sigaction(ignore[i], &sa, NULL);
 }
 
 /* ---- options ----------------------------------------------------------- */
@@ -307,103 +322,151 @@ static int fail(struct app *a, const char *what)
 	return EXIT_CONNECT;
 }
 
+/* The relay opened (which switches it off) and kept off. */
 static int start_relay(struct app *a)
 {
 	struct re_relay_cfg rc;
 
 	re_config_relay_cfg(&a->cfg, &rc);
-	progress(a, "opening the E-stop relay '%s'", rc.port);
+	progress(a, "opening the E-stop relay '%s' (motor power stays off)",
+		 rc.port);
 	if (re_relay_open(&a->relay, &rc, a->err, sizeof(a->err)) != GL_OK)
 		return fail(a, a->err);
 	a->real.relay = a->relay;
-	if (re_relay_on(a->relay) != GL_OK) {
-		snprintf(a->err, sizeof(a->err),
-			 "cannot switch motor power "
-			 "on: %s",
-			 re_relay_errmsg(a->relay));
-		return fail(a, a->err);
-	}
-	progress(a, "motor power on (relay closed)");
 	return 0;
 }
 
+/* Connect, identify, refuse a controller another supervisor runs, close
+ * the other connections, check the program's identity. */
 static int start_link(struct app *a)
 {
 	char e[GL_ERRTEXT_LEN];
 	char id[256];
+	gl_link *l;
 
 	progress(a, "connecting to the controller at %s",
 		 a->cfg.controller.address);
-	if (gl_link_open(&a->link, a->cfg.controller.address,
+	if (gl_link_open(&l, a->cfg.controller.address,
 			 a->cfg.controller.connect_timeout_ms, e) != GL_OK)
 		return fail(a, e);
-	gl_link_set_timeout(a->link, a->cfg.controller.timeout_ms);
-	a->real.link = a->link;
-	if (re_ctl_identify(a->link, &a->cfg, &a->info, a->err,
-			    sizeof(a->err)) != GL_OK)
+	gl_link_set_timeout(l, a->cfg.controller.timeout_ms);
+	a->real.link = l;
+	a->real.address = a->cfg.controller.address;
+	a->real.cmd_timeout_ms = a->cfg.controller.timeout_ms;
+	if (re_ctl_identify(l, &a->cfg, &a->info, a->err, sizeof(a->err)) ||
+	    re_ctl_check_busy(&a->io, a->cfg.watchdog.controller_timeout_ms,
+			      a->err, sizeof(a->err)) ||
+	    re_ctl_take_over(l, &a->info, a->err, sizeof(a->err)))
 		return fail(a, a->err);
 	snprintf(id, sizeof(id), "%s, serial %ld, program id %016llX",
 		 a->info.model, a->info.serial,
 		 (unsigned long long)a->info.program_id);
 	progress(a, "controller %s", id);
-	progress(a, "configuring the controller");
-	if (re_ctl_configure(&a->io, &a->cfg, a->err, sizeof(a->err)) != GL_OK)
+	return 0;
+}
+
+/* In development mode (the simulator, a bench) an amplifier check that
+ * fails is logged; in clinical mode it refuses the start. */
+static int amp_check(struct app *a, int want_on, int timeout_ms)
+{
+	int ta0 = 0;
+
+	if (re_ctl_amp_power(&a->io, want_on, timeout_ms, &ta0, a->err,
+			     sizeof(a->err)) == GL_OK)
+		return 0;
+	if (a->cfg.mode == RE_MODE_CLINICAL)
+		return fail(a, a->err);
+	re_console_msg(&a->con, "roboelf: warning: %s (development mode: "
+				"continuing)", a->err);
+	re_log_msg(&a->log, RE_LOG_WARN, "%s (development mode)", a->err);
+	return 0;
+}
+
+/* Halted and read back off, configured, no motor power seen, program
+ * started: the controller is known safe before the relay closes. */
+static int prepare_controller(struct app *a)
+{
+	re_plan_make(&a->cfg, 0, &a->plan);
+	progress(a, "halting the controller program; every motor off");
+	if (re_ctl_halt(&a->io, a->err, sizeof(a->err)) ||
+	    re_ctl_configure(&a->io, &a->cfg, &a->plan, a->err,
+			     sizeof(a->err)))
 		return fail(a, a->err);
 	progress(a, "controller configured and read back");
+	if (amp_check(a, 0, 200))
+		return EXIT_CONNECT;
+	if (re_ctl_start_program(&a->io, &a->info, a->err, sizeof(a->err)))
+		return fail(a, a->err);
+	re_plan_make(&a->cfg, a->info.mainms, &a->plan);
 	return 0;
+}
+
+static int power_on(struct app *a)
+{
+	if (re_relay_on(a->relay) != GL_OK) {
+		snprintf(a->err, sizeof(a->err),
+			 "cannot switch motor power on: %s",
+			 re_relay_errmsg(a->relay));
+		return fail(a, a->err);
+	}
+	a->powered = 1;
+	progress(a, "motor power on (relay closed); the motors are off");
+	return amp_check(a, 1, 500);
 }
 
 static int init_super(struct app *a)
 {
 	struct re_super_cfg sc;
 
-	memset(&sc, 0, sizeof(sc));
-	sc.n_axes = RE_AXES;
-	sc.period_ns = (int64_t)a->cfg.period_ms * 1000000;
-	sc.wdog.period_ns = sc.period_ns;
-	sc.wdog.noncrit_factor = a->cfg.watchdog.noncritical_factor;
-	sc.wdog.crit_factor = a->cfg.watchdog.critical_factor;
-	sc.alive.sample_limit_ns =
-	    (int64_t)(sc.wdog.crit_factor * (double)sc.period_ns);
-	sc.alive.hb_limit_ns = sc.alive.sample_limit_ns;
-	for (int i = 0; i < RE_AXES; i++) {
-		sc.encpot[i].allowed_error = a->cfg.axes[i].allowed_error;
-		sc.encpot[i].persistence_cycles =
-		    a->cfg.axes[i].persistence_cycles;
-		sc.axis_names[i] = a->names[i];
-		sc.pot_input[i] = a->cfg.axes[i].analog.input;
-	}
-	sc.fault_cmd_timeout_ms = a->cfg.controller.timeout_ms;
-	sc.mode_name = re_mode_name(a->cfg.mode);
+	re_plan_super_cfg(&a->plan, &a->cfg, a->names, &sc);
 	a->sup = calloc(1, sizeof(*a->sup));
 	if (!a->sup || re_super_init(a->sup, &a->io, &sc, NULL, 0) != GL_OK)
 		return fail(a, "cannot set up the supervisor");
 	return 0;
 }
 
-/* The heartbeat limit and the settle time need the program's period. */
-static void set_hb_limit(struct app *a)
-{
-	int64_t mainms_ns = (int64_t)a->info.mainms * 1000000;
-	int64_t p = a->sup->cfg.period_ns;
-
-	a->sup->cfg.alive.hb_limit_ns =
-	    (int64_t)(a->cfg.watchdog.critical_factor *
-		      (double)(mainms_ns > p ? mainms_ns : p));
-	/* the program publishes a fault within one mainms of latching it */
-	a->sup->cfg.settle_ms = 2 * a->info.mainms + 5;
-}
-
 static int latch(struct app *a, const struct re_fault *f)
 {
-	if (re_super_fault(a->sup, f) == RE_FAULT)
+	if (f->id != RE_F_NONE && re_super_fault(a->sup, f) == RE_FAULT)
 		re_console_fault(&a->con, re_super_fault_line(a->sup));
 	return EXIT_FAULT;
 }
 
+/* A start-up step that failed with a message: a CONFIG fault. */
+static int latch_err(struct app *a)
+{
+	struct re_fault f;
+
+	re_fault_set(&f, RE_F_CONFIG, -1);
+	snprintf(f.s, sizeof(f.s), "%.*s", (int)sizeof(f.s) - 1, a->err);
+	return latch(a, &f);
+}
+
+/* Parameters, then the service state: from here every move is supervised
+ * by the program and by the cycle. */
+static int enter_service(struct app *a)
+{
+	struct re_fault f;
+	int rc;
+
+	if (re_ctl_write_params(&a->io, &a->cfg, &a->plan, NULL, a->err,
+				sizeof(a->err)))
+		return latch_err(a);
+	a->hbpc = re_ctl_session();
+	rc = re_ctl_service(&a->io, &a->hbpc, &f, a->err, sizeof(a->err));
+	if (rc == RE_FAULT)
+		return latch(a, &f);
+	if (rc != GL_OK)
+		return latch_err(a);
+	re_super_start(a->sup, NULL, a->hbpc, RE_DMC_SERVICE);
+	re_super_set_period(a->sup, a->plan.sample_ns);
+	return 0;
+}
+
 /* ---- calibration --------------------------------------------------------- */
 
-static void log_calibration(struct app *a, const char *how, double secs)
+static void log_calibration(struct app *a, const char *how, double secs,
+			    int filled)
 {
 	for (int i = 0; i < a->cal->n_axes; i++) {
 		const struct re_caltable *t = &a->cal->axis[i];
@@ -416,6 +479,12 @@ static void log_calibration(struct app *a, const char *how, double secs)
 			   t->step_counts, t->soft_rev, t->soft_fwd,
 			   t->pot_v[0], t->pot_v[t->n - 1]);
 	}
+	if (filled)
+		re_log_msg(&a->log, RE_LOG_WARN,
+			   "calibration: %d table point(s) had no sample of "
+			   "their own (the PC was late) and were fitted from "
+			   "their neighbours",
+			   filled);
 	re_log_msg(&a->log, RE_LOG_INFO, "calibration (%s) done in %.1f s", how,
 		   secs);
 	re_console_msg(&a->con, "roboelf: calibration (%s) done in %.1f s", how,
@@ -443,32 +512,42 @@ static void drop_backup(struct app *a)
 			   strerror(errno));
 }
 
-static int calib_full(struct app *a, struct re_calib *c,
-		      const struct re_calib_cfg *cc)
+/* The calibration's sampler: one supervised cycle per sample. */
+static int sample_cb(void *ud, const struct gl_record **rec)
 {
-	struct re_fault f;
-	double secs = 0;
-	int rc;
+	struct app *a = ud;
+	struct re_status st;
+	int v;
 
-	progress(a, "full calibration: every axis end to end");
-	rc = re_calib_full(c, &a->io, cc, a->cal, &f, &secs);
-	if (rc == RE_FAULT)
-		return latch(a, &f);
-	if (rc != GL_OK)
-		return rc == GL_ERR_AGAIN ? 0 : fail(a, "calibration failed");
-	stamp_calset(a);
-	log_calibration(a, "full", secs);
-	if (re_calfile_save(a->cfg.calibration.file, a->cal, a->err,
-			    sizeof(a->err)) != GL_OK) {
-		re_console_msg(&a->con, "roboelf: warning: %s", a->err);
-		re_log_msg(&a->log, RE_LOG_WARN, "calibration not saved: %s",
-			   a->err);
-	} else {
-		progress(a, "calibration saved to '%s'",
-			 a->cfg.calibration.file);
-		drop_backup(a);
+	if (quit_signal)
+		return GL_ERR_AGAIN;
+	re_super_wait(a->sup);
+	v = re_super_cycle(a->sup);
+	re_super_status(a->sup, &st);
+	re_console_status(&a->con, &st, re_io_now_ns(), 0);
+	if (v == RE_FAULT) {
+		re_console_fault(&a->con, re_super_fault_line(a->sup));
+		return RE_FAULT;
 	}
-	return 0;
+	*rec = &a->sup->rec;
+	return GL_OK;
+}
+
+static void own_cb(void *ud, unsigned mask)
+{
+	struct app *a = ud;
+
+	re_super_own(a->sup, mask);
+}
+
+static void tables_cb(void *ud, const struct re_calset *set)
+{
+	const struct re_caltable *t[RE_AXES];
+	struct app *a = ud;
+
+	for (int i = 0; i < RE_AXES; i++)
+		t[i] = &set->axis[i];
+	re_super_tables(a->sup, t);
 }
 
 static void fill_expect(struct app *a, const struct re_calib_cfg *cc,
@@ -486,99 +565,153 @@ static void fill_expect(struct app *a, const struct re_calib_cfg *cc,
 	}
 }
 
-/* Load the tables; on failure offer a full calibration (terminal only).
- * Return: 0 loaded, 1 run a full calibration instead, EXIT_USAGE. */
-static int calib_load(struct app *a, const struct re_calib_cfg *cc)
+/* Load the tables (before anything is powered); on failure offer a full
+ * calibration (terminal only). Return: 0 loaded, 1 full calibration
+ * instead, EXIT_USAGE. */
+static int calib_load(struct app *a)
 {
 	struct re_calfile_expect e;
+	struct re_calib_cfg cc;
 	char serial[32];
 
+	re_calib_cfg_from(&a->cfg, &a->plan, a->names, &cc);
 	progress(a, "loading calibration '%s'", a->cfg.calibration.file);
-	fill_expect(a, cc, &e, serial);
+	fill_expect(a, &cc, &e, serial);
 	if (re_calfile_load(a->cfg.calibration.file, &e, a->cal, a->err,
 			    sizeof(a->err)) == GL_OK)
 		return 0;
 	re_console_msg(&a->con, "roboelf: error: %s", a->err);
 	re_log_msg(&a->log, RE_LOG_WARN, "calibration file refused: %s",
 		   a->err);
-	if (re_console_ask_yes(&a->con, "Run a full calibration instead?"))
+	if (re_console_ask_yes(&a->con, "Run a full calibration instead? "
+					"Every axis will move to both of its "
+					"limit switches, then to the centre."))
 		return 1;
 	re_console_msg(&a->con, "roboelf: run again with --calibration full");
 	return EXIT_USAGE;
 }
 
-static int calib_file(struct app *a, struct re_calib *c,
-		      const struct re_calib_cfg *cc)
+/* What will move and where, said before anything moves; the choice is the
+ * operator's (the prompt) or the command line's. Return: 0, EXIT_USAGE. */
+static int choose_calibration(struct app *a)
 {
-	struct re_fault f;
-	int rc = calib_load(a, cc);
+	int how = a->o.calib, rc;
 
-	if (rc == 1)
-		return calib_full(a, c, cc);
-	if (rc)
-		return rc;
-	progress(a, "checking the robot against the file, moving to the "
-		    "centre");
-	rc = re_calib_check_robot(c, &a->io, cc, a->cal, &f);
-	if (rc == RE_FAULT)
-		return latch(a, &f);
-	if (rc != GL_OK)
-		return rc == GL_ERR_AGAIN ? 0 : fail(a, "calibration failed");
-	log_calibration(a, "file", 0);
+	if (how == RE_CALIB_ASK)
+		how = re_console_ask_calibration(&a->con);
+	if (how != RE_CALIB_FULL && how != RE_CALIB_FILE)
+		return quit_signal ? 0 : EXIT_USAGE;
+	a->cal = calloc(1, sizeof(*a->cal));
+	if (!a->cal)
+		return fail(a, "out of memory");
+	if (how == RE_CALIB_FILE) {
+		rc = calib_load(a);
+		if (rc > 1)
+			return rc;
+		how = rc == 1 ? RE_CALIB_FULL : how;
+	}
+	a->calib = how;
+	if (how == RE_CALIB_FULL)
+		progress(a, "full calibration chosen: every axis will move to "
+			    "its reverse and forward limit switches, then to "
+			    "the centre of its travel");
+	else
+		progress(a, "calibration from the file: every axis will move "
+			    "to the centre of its calibrated travel (A %.0f, "
+			    "B %.0f, C %.0f counts)",
+			 (a->cal->axis[0].soft_rev + a->cal->axis[0].soft_fwd) / 2,
+			 (a->cal->axis[1].soft_rev + a->cal->axis[1].soft_fwd) / 2,
+			 (a->cal->axis[2].soft_rev + a->cal->axis[2].soft_fwd) / 2);
 	return 0;
 }
 
-static int choose_calibration(struct app *a)
+static void save_calibration(struct app *a)
 {
-	if (a->o.calib != RE_CALIB_ASK)
-		return a->o.calib;
-	return re_console_ask_calibration(&a->con);
+	stamp_calset(a);
+	if (re_calfile_save(a->cfg.calibration.file, a->cal, a->err,
+			    sizeof(a->err)) != GL_OK) {
+		re_console_msg(&a->con, "roboelf: warning: %s", a->err);
+		re_log_msg(&a->log, RE_LOG_WARN, "calibration not saved: %s",
+			   a->err);
+		return;
+	}
+	progress(a, "calibration saved to '%s'", a->cfg.calibration.file);
+	drop_backup(a);
+}
+
+/* The chosen procedure in the service state. Return: 0, EXIT_FAULT, or
+ * 0 with quit_signal set (interrupted). */
+static int run_calibration(struct app *a, struct re_calib *c,
+			   struct re_calib_cfg *cc)
+{
+	struct re_fault f;
+	double secs = 0;
+	int rc, filled = 0;
+
+	if (a->calib == RE_CALIB_FULL) {
+		progress(a, "full calibration: every axis end to end");
+		rc = re_calib_full(c, &a->io, cc, a->cal, &f, &secs, &filled);
+	} else {
+		progress(a, "checking the robot against the file, moving to "
+			    "the centre");
+		rc = re_calib_check_robot(c, &a->io, cc, a->cal, &f);
+	}
+	if (rc == RE_FAULT)
+		return latch(a, &f);
+	if (rc == GL_ERR_AGAIN) {
+		progress(a, "calibration interrupted: '%s' was not changed",
+			 a->cfg.calibration.file);
+		return 0;
+	}
+	if (rc != GL_OK) {
+		snprintf(a->err, sizeof(a->err), "calibration failed: %s",
+			 gl_strerror(rc));
+		return latch_err(a);
+	}
+	log_calibration(a, a->calib == RE_CALIB_FULL ? "full" : "file", secs,
+			filled);
+	return 0;
 }
 
 static int calibrate(struct app *a)
 {
 	struct re_calib_cfg cc;
 	struct re_calib *c;
-	int how = choose_calibration(a), rc;
+	int rc;
 
-	if (how != RE_CALIB_FULL && how != RE_CALIB_FILE)
-		return quit_signal ? 0 : EXIT_USAGE;
-	a->cal = calloc(1, sizeof(*a->cal));
-	if (!a->cal || re_calib_new(&c) != GL_OK)
+	if (re_calib_new(&c) != GL_OK)
 		return fail(a, "out of memory");
-	re_calib_cfg_from(&a->cfg, a->names, &cc);
+	re_calib_cfg_from(&a->cfg, &a->plan, a->names, &cc);
 	cc.stop = &quit_signal;
-	rc = how == RE_CALIB_FULL ? calib_full(a, c, &cc)
-				  : calib_file(a, c, &cc);
+	cc.sampler = (struct re_calib_sampler){sample_cb, own_cb, tables_cb, a};
+	rc = run_calibration(a, c, &cc);
 	re_calib_free(c);
 	return rc;
 }
 
+/* Back to the safe state (motors off) for the slow file I/O, then armed. */
 static int arm(struct app *a)
 {
 	const struct re_caltable *t[RE_AXES];
 	struct re_fault f;
 	int rc;
 
-	if (re_ctl_set_limits(&a->io, a->cal, a->err, sizeof(a->err)) != GL_OK)
-		goto out_config;
-	progress(a, "soft limits set and read back; arming");
-	rc = re_ctl_arm(&a->io, &a->cfg, a->cal, &a->info, &a->hbpc, &f, a->err,
-			sizeof(a->err));
+	if (re_ctl_off(&a->io, &a->hbpc, a->err, sizeof(a->err)) != GL_OK)
+		return latch_err(a);
+	re_super_start(a->sup, NULL, a->hbpc, 0);
+	if (a->calib == RE_CALIB_FULL)
+		save_calibration(a);
+	progress(a, "soft limits from the calibration; arming");
+	rc = re_ctl_arm(&a->io, a->cal, &a->hbpc, &f, a->err, sizeof(a->err));
 	if (rc == RE_FAULT)
 		return latch(a, &f);
 	if (rc != GL_OK)
-		goto out_config;
-	set_hb_limit(a);
+		return latch_err(a);
 	for (int i = 0; i < RE_AXES; i++)
 		t[i] = &a->cal->axis[i];
-	re_super_start(a->sup, t, a->hbpc);
+	re_super_set_period(a->sup, 0);
+	re_super_start(a->sup, t, a->hbpc, RE_DMC_ARMED);
 	return 0;
-
-out_config:
-	re_fault_set(&f, RE_F_CONFIG, -1);
-	snprintf(f.s, sizeof(f.s), "%.*s", (int)sizeof(f.s) - 1, a->err);
-	return latch(a, &f);
 }
 
 static int startup(struct app *a)
@@ -587,8 +720,16 @@ static int startup(struct app *a)
 
 	if (!rc)
 		rc = start_link(a);
-	if (!rc)
+	if (!rc && !quit_signal)
+		rc = choose_calibration(a);
+	if (!rc && !quit_signal)
+		rc = prepare_controller(a);
+	if (!rc && !quit_signal)
 		rc = init_super(a);
+	if (!rc && !quit_signal)
+		rc = power_on(a);
+	if (!rc && !quit_signal)
+		rc = enter_service(a);
 	if (!rc && !quit_signal)
 		rc = calibrate(a);
 	if (!rc && !quit_signal)
@@ -610,7 +751,8 @@ static const char *quit_reason(int key)
 	switch (quit_signal) {
 	case SIGINT: return "Ctrl-C (SIGINT)";
 	case SIGTERM: return "SIGTERM";
-	case SIGHUP: return "SIGHUP";
+	case SIGHUP: return "SIGHUP (terminal lost)";
+	case SIGQUIT: return "Ctrl-\\ (SIGQUIT)";
 	default: return "signal";
 	}
 }
@@ -620,11 +762,31 @@ static double ms_of_ns(int64_t ns)
 	return (double)ns / 1e6;
 }
 
+/* A log entry the disk refused: retried once a second, and shown. */
+static void retry_log(struct app *a, int64_t *next_ns)
+{
+	int64_t now = re_io_now_ns();
+
+	if (!a->sup->log_failing || now < *next_ns)
+		return;
+	*next_ns = now + 1000000000LL;
+	if (re_super_retry(a->sup) == GL_OK)
+		re_console_msg(&a->con, "roboelf: the log '%s' is written "
+					"again",
+			       a->cfg.log.path);
+	else
+		re_console_msg(&a->con,
+			       "roboelf: WARNING: cannot write the log '%s' "
+			       "(%s): the last entry is not on disk; retrying",
+			       a->cfg.log.path, strerror(errno));
+}
+
 /* Every period until the operator quits; a latched fault keeps the status
- * board running. */
+ * board running. A terminal that went away (end of input) quits. */
 static void run(struct app *a)
 {
 	struct re_status st;
+	int64_t next_retry = 0;
 	int key = 0;
 
 	re_console_raw(&a->con);
@@ -634,12 +796,14 @@ static void run(struct app *a)
 			re_console_fault(&a->con, re_super_fault_line(a->sup));
 		re_super_status(a->sup, &st);
 		re_console_status(&a->con, &st, re_io_now_ns(), 0);
+		retry_log(a, &next_retry);
 		key = re_console_key(&a->con);
-		if (key == 'q' || key == 'Q')
+		if (key == 'q' || key == 'Q' || key < 0)
 			break;
 		key = 0;
 	}
-	re_log_msg(&a->log, RE_LOG_INFO, "stop: %s", quit_reason(key));
+	re_log_msg(&a->log, RE_LOG_INFO, "stop: %s",
+		   key < 0 ? "the terminal went away" : quit_reason(key));
 	re_log_msg(
 	    &a->log, RE_LOG_INFO,
 	    "stats: cycles=%llu overruns=%llu period=%.1f ms "
@@ -647,35 +811,53 @@ static void run(struct app *a)
 	    "status frames dropped=%llu",
 	    (unsigned long long)a->sup->cycles,
 	    (unsigned long long)a->sup->overruns,
-	    ms_of_ns(a->sup->cfg.period_ns), re_super_late_ms(a->sup, 50),
+	    ms_of_ns(a->sup->period_ns), re_super_late_ms(a->sup, 50),
 	    re_super_late_ms(a->sup, 99), re_super_late_ms(a->sup, 100),
 	    ms_of_ns(a->sup->age_worst_ns), (unsigned long long)a->con.dropped);
+}
+
+/* Power-off, the reverse of power-on: the program back to its safe
+ * state, every motor off and read back, then the relay off and closed.
+ * What was confirmed is said, on the screen and in the log. */
+static void power_off(struct app *a, int latched)
+{
+	char what[192] = "";
+	int rc = GL_OK;
+
+	if (a->sup)
+		rc = re_super_shutdown(a->sup, what, sizeof(what));
+	else if (a->real.link)
+		rc = re_ctl_stop(&a->io, a->cfg.controller.timeout_ms);
+	if (a->relay && re_relay_close(a->relay) != GL_OK)
+		rc = rc ? rc : GL_ERR_RELAY;
+	a->relay = a->real.relay = NULL;
+	gl_link_close(a->real.link);
+	a->real.link = NULL;
+	if (!a->powered) {
+		re_console_msg(&a->con, "roboelf: motor power was never "
+					"switched on; %s",
+			       latched ? "a fault was latched" : "bye");
+		re_log_msg(&a->log, RE_LOG_INFO, "stop: motor power never on");
+		return;
+	}
+	if (!what[0])
+		snprintf(what, sizeof(what), "motors off: %s",
+			 rc == GL_OK ? "confirmed" : gl_strerror(rc));
+	re_console_msg(&a->con, "roboelf: %s%s; %s", what,
+		       rc == GL_OK ? ""
+				   : " - NOT ALL CONFIRMED: press the hardware "
+				     "E-stop",
+		       latched ? "a fault was latched" : "bye");
+	re_log_msg(&a->log, rc == GL_OK ? RE_LOG_INFO : RE_LOG_WARN,
+		   "stop: %s%s", what, latched ? " (fault latched)" : "");
 }
 
 /* Return: 1 when a fault was latched. */
 static int cleanup(struct app *a)
 {
 	int latched = a->sup && a->sup->latched;
-	int rc = GL_OK;
 
-	if (a->sup)
-		rc = re_super_shutdown(a->sup);
-	else if (a->link)
-		rc = re_ctl_stop(&a->io, a->cfg.controller.timeout_ms);
-	if (rc != GL_OK)
-		re_log_msg(&a->log, RE_LOG_WARN, "shutdown: %s",
-			   gl_strerror(rc));
-	if (a->relay && re_relay_close(a->relay) != GL_OK)
-		re_log_msg(&a->log, RE_LOG_WARN,
-			   "relay off not confirmed at "
-			   "close");
-	a->relay = a->real.relay = NULL;
-	gl_link_close(a->link);
-	a->link = a->real.link = NULL;
-	re_console_msg(&a->con, "roboelf: motors off, motor power off; %s",
-		       latched ? "a fault was latched" : "bye");
-	re_log_msg(&a->log, RE_LOG_INFO, "stop: motors off, relay off%s",
-		   latched ? " (fault latched)" : "");
+	power_off(a, latched);
 	re_console_close(&a->con);
 	re_log_close(&a->log);
 	free(a->sup);

@@ -11,8 +11,9 @@
  *
  * Servo model (docs/galil-sim-controller.md): with e = RP - TP in counts,
  * torque = (4*KP*e + 4*KD*(e - e_prev) + KI/2 * sum(e)) * 10/32768 + OF
- * volts, limited to +-TL (the integrator's part to +-IL). Motor off: the
- * reference follows the encoder and the torque is 0.
+ * volts, limited to +-TL (the integrator's part to +-IL; the sum leaks
+ * with a 100-sample time constant: the robot model has no load). Motor
+ * off: the reference follows the encoder and the torque is 0.
  */
 #include <math.h>
 #include <stdio.h>
@@ -21,6 +22,7 @@
 #include "ctrl_int.h"
 
 #define DAC_V_PER_COUNT (10.0 / 32768.0)
+#define CTRL_KI_LEAK	100.0 /* integrator leak time constant, samples */
 
 double ctrl_dt(const struct ctrl *c)
 {
@@ -209,8 +211,12 @@ void ctrl_motion_sense(struct ctrl *c, const struct ctrl_sense *in)
 		a->lim_f = f && !(a->p.ld & 1);
 		a->lim_r = r && !(a->p.ld & 2);
 	}
-	if (c->zero_pending)
+	if (c->zero_pending) {
+		/* the amplifiers' status at power-up: under-voltage while
+		 * motor power is absent, as after a loss */
 		c->amp_ok = in->amp_power != 0;
+		c->ta0 = c->amp_ok ? (uint8_t)(c->ta0 & ~8) : (uint8_t)(c->ta0 | 8);
+	}
 	c->zero_pending = 0;
 }
 
@@ -414,7 +420,12 @@ static void servo(struct ctrl_axis *a)
 		return;
 	}
 	e = a->ref - a->enc;
-	a->integ += e;
+	/* The plant has no load: a real loop's integrator settles at the
+	 * torque that holds the axis (about 0) once it follows. The velocity
+	 * model does not feed the torque back, so the integrator leaks with
+	 * a time constant of CTRL_KI_LEAK samples instead of winding up for
+	 * ever; a growing error (a jam, a stuck encoder) still integrates. */
+	a->integ += e - a->integ / CTRL_KI_LEAK;
 	ki_v = a->p.ki / 2 * a->integ * DAC_V_PER_COUNT;
 	ilim = fabs(a->p.il);
 	if (a->p.ki > 0 && fabs(ki_v) > ilim) {

@@ -1,0 +1,112 @@
+/*
+ * re_plan.c - the limits derived from the configuration. See re_plan.h and
+ * docs/supervisor.md ("Limits and where they come from").
+ */
+#include "re_plan.h"
+
+#include <math.h>
+#include <string.h>
+
+#define NS_PER_MS     1000000LL
+#define MAINMS_DEFAULT 10  /* dmc/constants.dmc */
+#define ACFACT	       10  /* dmc/constants.dmc: AC = DC = 10 x speed */
+#define DECEL_MS       (1000 / ACFACT) /* full speed to rest, ms */
+
+static int max3(int a, int b, int c)
+{
+	int m = a > b ? a : b;
+
+	return m > c ? m : c;
+}
+
+static void plan_axis(const struct re_config *cfg, int i,
+		      struct re_plan_axis *o)
+{
+	const struct re_config_axis *a = &cfg->axes[i];
+	const struct re_config_analog *an = &a->analog;
+	const struct re_config_calibration *c = &cfg->calibration;
+	double tol = an->absolute_tolerance_v;
+
+	o->gain_v_per_count = (an->forward_v - an->reverse_v) /
+			      (double)a->travel_counts;
+	o->margin_v = c->near_margin_counts * o->gain_v_per_count;
+	/* past a switch the axis can go as far as its end stop: the margin
+	 * covers that (and the pot's own tolerance covers the switch) */
+	o->potlo_v = an->reverse_v - tol - o->margin_v;
+	o->pothi_v = an->forward_v + tol + o->margin_v;
+	o->pnlo_v = an->reverse_v + tol + o->margin_v;
+	o->pnhi_v = an->forward_v - tol - o->margin_v;
+	o->vmax_cps = a->vmax_cps;
+	o->travel_cps = c->travel_cps ? c->travel_cps : a->vmax_cps;
+	o->seek_cps = c->seek_cps ? c->seek_cps : a->vmax_cps / 2;
+	if (o->seek_cps < 1)
+		o->seek_cps = 1;
+	o->svmax_cps = max3(o->travel_cps, o->seek_cps, a->vmax_cps);
+	if (o->seek_cps > o->svmax_cps)
+		o->seek_cps = o->svmax_cps;
+	o->svdmax_counts =
+	    lround(a->travel_counts * (1 + a->travel_tolerance)) +
+	    2L * c->backoff_counts + 2L * c->near_margin_counts;
+}
+
+void re_plan_make(const struct re_config *cfg, int mainms,
+		  struct re_plan *out)
+{
+	int64_t p_ns = (int64_t)cfg->period_ms * NS_PER_MS;
+	int ms = mainms > 0 ? mainms : MAINMS_DEFAULT;
+	int fastest = cfg->period_ms < RE_PLAN_SAMPLE_MS ? cfg->period_ms
+							  : RE_PLAN_SAMPLE_MS;
+	double crit = cfg->watchdog.critical_factor;
+
+	memset(out, 0, sizeof(*out));
+	for (int i = 0; i < RE_AXES; i++)
+		plan_axis(cfg, i, &out->axis[i]);
+	out->mainms = mainms;
+	out->wdto_ms = cfg->watchdog.controller_timeout_ms;
+	/* every write adds 1; the program sees at most this many writes
+	 * between two passes before its own watchdog would trip anyway */
+	out->hbmaxd = (out->wdto_ms + fastest - 1) / fastest + 2;
+	out->pwrout = cfg->controller.power_output;
+	out->move_timeout_ms = cfg->calibration.move_timeout_ms;
+	out->period_ns = p_ns;
+	out->sample_ns = (int64_t)RE_PLAN_SAMPLE_MS * NS_PER_MS;
+	out->sample_limit_ns = (int64_t)(crit * (double)p_ns);
+	out->hb_limit_ns =
+	    (int64_t)(crit * (double)(ms * NS_PER_MS > p_ns ? ms * NS_PER_MS
+							    : p_ns));
+	/* the program publishes a fault within one mainms of latching it */
+	out->settle_ms = 2 * ms + 5;
+	/* the program publishes its command up to mainms late, the record
+	 * is up to a period old, and a stopped axis still decelerates */
+	out->uncmd_grace_ns =
+	    (int64_t)(2 * ms + DECEL_MS + 50) * NS_PER_MS + 2 * p_ns;
+	out->fresh_stop_ms = 2 * cfg->controller.timeout_ms;
+	out->relay_off_ms = cfg->relay.write_timeout_ms;
+}
+
+void re_plan_super_cfg(const struct re_plan *p, const struct re_config *cfg,
+		       const char *const *names, struct re_super_cfg *out)
+{
+	memset(out, 0, sizeof(*out));
+	out->n_axes = RE_AXES;
+	out->period_ns = p->period_ns;
+	out->wdog.period_ns = p->period_ns;
+	out->wdog.noncrit_factor = cfg->watchdog.noncritical_factor;
+	out->wdog.crit_factor = cfg->watchdog.critical_factor;
+	out->alive.sample_limit_ns = p->sample_limit_ns;
+	out->alive.hb_limit_ns = p->hb_limit_ns;
+	for (int i = 0; i < RE_AXES; i++) {
+		out->encpot[i].allowed_error = cfg->axes[i].allowed_error;
+		out->encpot[i].persistence_cycles =
+		    cfg->axes[i].persistence_cycles;
+		out->axis_names[i] = names[i];
+		out->pot_input[i] = cfg->axes[i].analog.input;
+	}
+	out->fault_cmd_timeout_ms = cfg->controller.timeout_ms;
+	out->fresh_stop_ms = p->fresh_stop_ms;
+	out->relay_off_ms = p->relay_off_ms;
+	out->settle_ms = p->settle_ms;
+	out->uncmd_grace_ns = p->uncmd_grace_ns;
+	out->mode_name = cfg->mode == RE_MODE_CLINICAL ? "clinical"
+						       : "development";
+}

@@ -1,0 +1,68 @@
+/*
+ * re_plan.h - every limit the supervisor and the controller program work
+ * with, derived in one place from the configuration (and, once known, the
+ * program's own period mainms). Pure: no I/O, no allocation, no printing.
+ *
+ * Units: counts, counts/s, ms, volts. The potentiometer zones assume a pot
+ * that rises with the encoder (reverse_v < forward_v; the configuration
+ * loader enforces it): below pnlo the reverse switch may be near, above
+ * pnhi the forward one; outside potlo..pothi the pot reads something it
+ * cannot read on this robot (docs/dmc-interface.md, #GUARD and #MVGO).
+ */
+#ifndef RE_PLAN_H
+#define RE_PLAN_H
+
+#include <stdint.h>
+
+#include "re_config.h"
+#include "re_super.h"
+
+struct re_plan_axis {
+	double gain_v_per_count; /* nominal pot gain, V/count, > 0 */
+	double margin_v;	 /* near_margin_counts in volts */
+	double potlo_v, pothi_v; /* the pot's absolute range (DMC potlo/hi) */
+	double pnlo_v, pnhi_v;	 /* slow zones (DMC pnlo, pnhi) */
+	int vmax_cps;		 /* joystick and sweep speed */
+	int travel_cps;		 /* moves that measure nothing */
+	int seek_cps;		 /* in the slow zones (DMC svslow) */
+	int svmax_cps;		 /* any service move (DMC svmax) */
+	long svdmax_counts;	 /* longest service move (DMC svdmax) */
+};
+
+struct re_plan {
+	struct re_plan_axis axis[RE_AXES];
+	int mainms;	   /* the program's period, ms (0: not known yet) */
+	int wdto_ms;	   /* controller watchdog (DMC wdto) */
+	int hbmaxd;	   /* largest heartbeat step (DMC hbmaxd) */
+	int pwrout;	   /* motor-power output (DMC pwrout), 0: none */
+	int move_timeout_ms;	  /* one service move (DMC mvto) */
+	int64_t period_ns;	  /* supervisor cycle */
+	int64_t sample_ns;	  /* cycle while calibrating */
+	int64_t hb_limit_ns;	  /* program heartbeat frozen: fault */
+	int64_t sample_limit_ns;  /* record sample number frozen: fault */
+	int64_t uncmd_grace_ns;	  /* motion not commanded: fault after */
+	int settle_ms;		  /* wait for the program's own verdict */
+	int fresh_stop_ms;	  /* the stop over a new connection */
+	int relay_off_ms;	  /* relay off confirmed within */
+};
+
+#define RE_PLAN_SAMPLE_MS 10 /* the cycle while calibrating, ms */
+
+/*
+ * re_plan_make() - derive the plan from @cfg (validated) and @mainms (the
+ * program's period read at start-up; 0 when not known yet: the limits that
+ * depend on it use the constants' default 10 ms).
+ * @out: [out] the plan.
+ */
+void re_plan_make(const struct re_config *cfg, int mainms,
+		  struct re_plan *out);
+
+/*
+ * re_plan_super_cfg() - the supervisor's settings from the plan.
+ * @names: [in] the axis names (must outlive @out).
+ * @out: [out] filled completely.
+ */
+void re_plan_super_cfg(const struct re_plan *p, const struct re_config *cfg,
+		       const char *const *names, struct re_super_cfg *out);
+
+#endif /* RE_PLAN_H */

@@ -1,0 +1,409 @@
+/*
+ * re_react.c - the supervisor's fault reaction and orderly shutdown (the
+ * half of re_super.h that acts): relay off without waiting, the stop at
+ * once (over a new connection when the old one is gone), the relay's off
+ * confirmed within its deadline, the motors read back, the latch, the log
+ * entry (kept and retried when the disk refuses it) and the FAULT line that
+ * names the first cause and what was confirmed.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl_err.h"
+#include "re_super.h"
+
+#define NS_PER_MS 1000000LL
+/* The stop (re_io.h; the DMC's own #FAULT uses the same two commands), and
+ * the program told to latch in the same line. */
+#define FAULT_CMD RE_STOP_ALL ";pcflt=1"
+
+static int64_t now_ns(const struct re_super *s)
+{
+	return s->io.ops->now_ns(s->io.ud);
+}
+
+static double ns_to_ms(int64_t ns)
+{
+	return (double)ns / 1e6;
+}
+
+/* ---- the log, never silently lost --------------------------------------- */
+
+/* Write one entry; when that fails, keep it (the newest failed entry wins
+ * over an older INFO one, never over a FAULT) for re_super_retry(). */
+static void log_keep(struct re_super *s, enum re_log_level lvl,
+		     const char *text)
+{
+	if (s->io.ops->log(s->io.ud, lvl, text) == GL_OK)
+		return;
+	if (s->log_failing && s->pending_lvl == RE_LOG_FAULT &&
+	    lvl != RE_LOG_FAULT)
+		return;
+	s->log_failing = 1;
+	s->pending_lvl = lvl;
+	snprintf(s->pending, sizeof(s->pending), "%s", text);
+}
+
+int re_super_retry(struct re_super *s)
+{
+	int rc;
+
+	if (!s->log_failing)
+		return GL_OK;
+	rc = s->io.ops->log(s->io.ud, s->pending_lvl, s->pending);
+	if (rc == GL_OK)
+		s->log_failing = 0;
+	return rc;
+}
+
+/* ---- the stop ------------------------------------------------------------ */
+
+/* The command on the link; when the link is out of step, closed or silent,
+ * the same command over a new connection within cfg.fresh_stop_ms. */
+static int send_stop(struct re_super *s, const char *cmd)
+{
+	int64_t t0 = now_ns(s);
+	int rc = s->io.ops->command(s->io.ud, cmd, s->resp, sizeof(s->resp),
+				    s->cfg.fault_cmd_timeout_ms);
+
+	s->confirm.stop_fresh = 0;
+	if ((rc == GL_ERR_BROKEN || rc == GL_ERR_CLOSED ||
+	     rc == GL_ERR_TIMEOUT || rc == GL_ERR_SYS || rc == GL_ERR_PROTO) &&
+	    s->io.ops->stop_fresh && s->cfg.fresh_stop_ms > 0) {
+		rc = s->io.ops->stop_fresh(s->io.ud, cmd, s->resp,
+					   sizeof(s->resp),
+					   s->cfg.fresh_stop_ms);
+		s->confirm.stop_fresh = 1;
+	}
+	s->confirm.stop_ms = ns_to_ms(now_ns(s) - t0);
+	return rc;
+}
+
+/* Re-read the controller's fault detail (MG fdet) for a CTRL fault. */
+static void ctrl_fault_detail(struct re_super *s, struct re_fault *f)
+{
+	double fdet;
+
+	if (s->have_za && s->za.fcode != 0 &&
+	    re_io_read(&s->io, "fdet", &fdet, s->cfg.fault_cmd_timeout_ms) ==
+		GL_OK)
+		re_ctrl_fault(&s->za, (long long)fdet, f);
+}
+
+/* Faults that may be the program's own fault seen half-way (motors off by
+ * #JINV before #MAIN latched INPUT, thread 1 halted by #FAULT ...). */
+static int may_settle(const struct re_super *s, enum re_fault_id id)
+{
+	return s->cfg.settle_ms > 0 &&
+	       (id == RE_F_MOTOR_OFF || id == RE_F_THREAD ||
+		id == RE_F_STATE || id == RE_F_CTRL_STATE ||
+		id == RE_F_UNCMD);
+}
+
+/* The program's latched fault (code 0: none), read over the link. */
+static int program_fault(struct re_super *s, struct re_za *za, double *det)
+{
+	double code = 0, axis = 0;
+	int rc = re_io_read(&s->io, "fcode", &code,
+			    s->cfg.fault_cmd_timeout_ms);
+
+	memset(za, 0, sizeof(*za));
+	*det = RE_VAL_UNKNOWN;
+	if (rc != GL_OK)
+		return rc;
+	if (code > 0 && code < 100) {
+		re_io_read(&s->io, "faxis", &axis, s->cfg.fault_cmd_timeout_ms);
+		re_io_read(&s->io, "fdet", det, s->cfg.fault_cmd_timeout_ms);
+		za->state = RE_DMC_FAULT;
+		za->fcode = (int)code;
+		za->faxis = axis >= 0 && axis <= 3 ? (int)axis : 0;
+	}
+	return GL_OK;
+}
+
+/* Poll the program's fault code for up to settle_ms; when it latched
+ * one, that is the fault to report (with its axis and detail). */
+static void program_verdict(struct re_super *s, struct re_fault *f)
+{
+	int64_t t0 = now_ns(s);
+	int64_t end = t0 + (int64_t)s->cfg.settle_ms * NS_PER_MS;
+	struct re_za za;
+	double det;
+	int rc;
+
+	do {
+		rc = program_fault(s, &za, &det);
+		if (rc != GL_OK) {
+			snprintf(s->verdict, sizeof(s->verdict),
+				 "program fault code unreadable: %s",
+				 gl_strerror(rc));
+			return;
+		}
+		if (za.fcode) {
+			snprintf(s->verdict, sizeof(s->verdict),
+				 "program fault %d after %.1f ms", za.fcode,
+				 ns_to_ms(now_ns(s) - t0));
+			re_ctrl_fault(&za, (long long)det, f);
+			return;
+		}
+		s->io.ops->sleep_until(s->io.ud, now_ns(s) + 2 * NS_PER_MS);
+	} while (now_ns(s) < end);
+	snprintf(s->verdict, sizeof(s->verdict),
+		 "no program fault within %d ms", s->cfg.settle_ms);
+}
+
+/* Stop and switch off through the controller and tell the program
+ * (pcflt) - after its own verdict when it may be latching one. */
+static int stop_controller(struct re_super *s, struct re_fault *f)
+{
+	int rc;
+
+	if (!may_settle(s, f->id)) {
+		rc = send_stop(s, FAULT_CMD);
+		if (rc >= 0 && re_fault_is_ctrl(f->id))
+			ctrl_fault_detail(s, f);
+		return rc;
+	}
+	rc = send_stop(s, RE_STOP_ALL);
+	if (rc >= 0) {
+		program_verdict(s, f);
+		s->io.ops->command(s->io.ud, "pcflt=1", s->resp,
+				   sizeof(s->resp), s->cfg.fault_cmd_timeout_ms);
+	}
+	return rc;
+}
+
+/* Every motor read back off ("MG _MOA,_MOB,_MOC" all 1). */
+static int motors_off(struct re_super *s)
+{
+	static const char *const mo[RE_SUPER_AXES] = {"_MOA", "_MOB", "_MOC"};
+	double v;
+	int rc;
+
+	for (int i = 0; i < s->cfg.n_axes; i++) {
+		rc = re_io_read(&s->io, mo[i], &v, s->cfg.fault_cmd_timeout_ms);
+		if (rc != GL_OK)
+			return rc;
+		if (v != 1)
+			return GL_ERR_MISMATCH;
+	}
+	return GL_OK;
+}
+
+/* ---- root cause ---------------------------------------------------------- */
+
+/* Motor power lost on every axis while the relay was meant closed: when
+ * the relay board does not confirm its state, the relay is the cause. */
+static void relay_or_power(struct re_super *s, struct re_fault *f)
+{
+	char why[sizeof(f->s)];
+
+	if (f->id != RE_F_CTRL_POWER)
+		return;
+	if (s->io.ops->relay_check(s->io.ud, why, sizeof(why)) == GL_OK)
+		return;
+	re_fault_set(f, RE_F_RELAY_POWER, -1);
+	snprintf(f->s, sizeof(f->s), "%s", why);
+}
+
+/* What the controller did on its own (its latched fault) when that is not
+ * the cause reported: a consequence, said after it. */
+static void consequences(struct re_super *s, const struct re_fault *f)
+{
+	struct re_fault c;
+	struct re_za za;
+	double det;
+
+	s->then[0] = '\0';
+	if (s->confirm.stop_rc < 0 || re_fault_is_ctrl(f->id) ||
+	    program_fault(s, &za, &det) != GL_OK || !za.fcode)
+		return;
+	re_ctrl_fault(&za, (long long)det, &c);
+	if (re_fault_what(&c, s->cfg.axis_names, s->then, sizeof(s->then)) ==
+	    GL_ERR_ARG)
+		s->then[0] = '\0';
+}
+
+/* ---- the FAULT line ------------------------------------------------------- */
+
+/* " Safe state confirmed: ..." or " NOT CONFIRMED: ... PRESS THE HARDWARE
+ * E-STOP NOW." - inserted before the recovery text. */
+static size_t confirm_text(const struct re_super *s, char *buf, size_t cap)
+{
+	const struct re_confirm *c = &s->confirm;
+
+	if (c->relay_rc == GL_OK && c->motors_rc == GL_OK)
+		return (size_t)snprintf(
+		    buf, cap,
+		    " Safe state confirmed: motor power off (relay open), "
+		    "motors off.");
+	return (size_t)snprintf(
+	    buf, cap,
+	    " NOT CONFIRMED:%s%s%s PRESS THE HARDWARE E-STOP NOW.",
+	    c->relay_rc == GL_OK ? " motor power off (relay open) confirmed;"
+				 : " relay open not confirmed;",
+	    c->stop_rc < 0	   ? " stop command not delivered;"
+	    : c->motors_rc == GL_OK ? " motors off confirmed;"
+				    : " motors off not confirmed;",
+	    c->stop_rc < 0 ? " the controller did not answer." : "");
+}
+
+/* "FAULT CLASS: what[. Then: consequence]. <confirm>. Recovery: ..." */
+static void compose_line(struct re_super *s)
+{
+	char *line = s->fault_line, *rec;
+	size_t cap = sizeof(s->fault_line), n;
+	char tail[RE_SUPER_LINE];
+
+	if (re_fault_format(&s->fault, s->cfg.axis_names, line, cap) ==
+	    GL_ERR_ARG)
+		snprintf(line, cap,
+			 "FAULT PROGRAM: unknown fault %d. Recovery: quit, "
+			 "note the log and call service",
+			 (int)s->fault.id);
+	rec = strstr(line, ". Recovery: ");
+	if (!rec)
+		return;
+	snprintf(tail, sizeof(tail), "%s", rec + 2);
+	n = (size_t)(rec - line) + 1;
+	if (s->then[0] && n < cap)
+		n += (size_t)snprintf(line + n, cap - n, " Then: %s.",
+				      s->then);
+	if (n < cap)
+		n += confirm_text(s, line + n, cap - n);
+	if (n < cap)
+		snprintf(line + n, cap - n, " %.*s", (int)(cap - n - 2), tail);
+}
+
+/* Append the axes of the last record to the log text. */
+static size_t snapshot(const struct re_super *s, char *buf, size_t cap)
+{
+	size_t n = 0;
+
+	for (int i = 0; s->have_record && i < s->cfg.n_axes && n < cap; i++) {
+		const struct gl_rec_axis *a = &s->rec.axis[i];
+
+		n += (size_t)snprintf(buf + n, cap - n,
+				      "; %s enc=%d ref=%d err=%d sc=%d mo=%d"
+				      " an=%.4fV",
+				      s->cfg.axis_names[i], (int)a->motor_pos,
+				      (int)a->ref_pos, (int)a->pos_err,
+				      a->stop_code,
+				      a->status & GL_AXST_MOTOR_OFF ? 1 : 0,
+				      re_pot_volts(a->analog_in));
+	}
+	if (n < cap && s->have_za)
+		n += (size_t)snprintf(buf + n, cap - n,
+				      "; dmc state=%d fcode=%d faxis=%d "
+				      "hbdmc=%d jraw=%d",
+				      s->za.state, s->za.fcode, s->za.faxis,
+				      (int)s->za.hbdmc, s->za.jraw);
+	return n < cap ? n : cap;
+}
+
+static const char *rc_text(int rc, const char *ok)
+{
+	return rc >= 0 ? ok : gl_strerror(rc);
+}
+
+static void log_fault(struct re_super *s)
+{
+	const struct re_confirm *c = &s->confirm;
+	char *t = s->text;
+	size_t cap = sizeof(s->text), n;
+
+	n = (size_t)snprintf(
+	    t, cap,
+	    "%s | relay off: %s | controller stop: %s%s (%.1f ms) | motors "
+	    "off: %s%s%s | cycle %llu, reply age %.1f ms",
+	    s->fault_line, c->relay_rc == GL_OK ? "confirmed" : "NOT confirmed",
+	    rc_text(c->stop_rc, "delivered"),
+	    c->stop_fresh ? " over a new connection" : "", c->stop_ms,
+	    c->motors_rc == GL_OK ? "confirmed" : "NOT confirmed",
+	    s->verdict[0] ? " | " : "", s->verdict,
+	    (unsigned long long)s->cycles, ns_to_ms(s->age_last_ns));
+	if (n < cap)
+		snapshot(s, t + n, cap - n);
+	log_keep(s, RE_LOG_FAULT, t);
+}
+
+/* ---- the reaction -------------------------------------------------------- */
+
+static int relay_start(struct re_super *s)
+{
+	if (s->io.ops->relay_off_start)
+		return s->io.ops->relay_off_start(s->io.ud);
+	return s->io.ops->relay_off(s->io.ud);
+}
+
+static int relay_finish(struct re_super *s, int start_rc)
+{
+	if (!s->io.ops->relay_off_start || !s->io.ops->relay_off_finish)
+		return start_rc;
+	return s->io.ops->relay_off_finish(s->io.ud, s->cfg.relay_off_ms);
+}
+
+int re_super_fault(struct re_super *s, const struct re_fault *f)
+{
+	struct re_fault fault = *f;
+	int relay_rc;
+
+	if (s->latched) {
+		re_fault_format(f, s->cfg.axis_names, s->msg, sizeof(s->msg));
+		re_io_logf(&s->io, RE_LOG_WARN, "while latched: %s", s->msg);
+		return RE_OK;
+	}
+	s->verdict[0] = '\0';
+	memset(&s->confirm, 0, sizeof(s->confirm));
+	/* 1. motor power: told to open, never waiting; 2. the stop at once */
+	relay_rc = relay_start(s);
+	s->confirm.stop_rc = stop_controller(s, &fault);
+	/* 3. the relay's off confirmed; 4. the motors read back */
+	s->confirm.relay_rc = relay_finish(s, relay_rc);
+	s->confirm.motors_rc =
+	    s->confirm.stop_rc >= 0 ? motors_off(s) : s->confirm.stop_rc;
+	relay_or_power(s, &fault);
+	consequences(s, &fault);
+	s->latched = 1;
+	s->armed = 0;
+	s->fault = fault;
+	compose_line(s);
+	/* 5. the log entry on disk before anyone reports the relay open */
+	log_fault(s);
+	return RE_FAULT;
+}
+
+const char *re_super_fault_line(const struct re_super *s)
+{
+	return s->latched ? s->fault_line : "";
+}
+
+/* ---- shutdown ------------------------------------------------------------ */
+
+int re_super_shutdown(struct re_super *s, char *what, size_t cap)
+{
+	int off_rc, stop_rc, mo_rc, relay_rc;
+
+	/* the program back to its safe state, so that the motors off is not
+	 * a fault to it; then the stop itself, whatever the program did */
+	off_rc = s->io.ops->command(s->io.ud, "offreq=1", s->resp,
+				   sizeof(s->resp),
+				   s->cfg.fault_cmd_timeout_ms);
+	if (off_rc >= 0)
+		s->io.ops->sleep_until(s->io.ud, now_ns(s) + 25 * NS_PER_MS);
+	stop_rc = send_stop(s, RE_STOP_ALL);
+	mo_rc = stop_rc >= 0 ? motors_off(s) : stop_rc;
+	relay_rc = relay_finish(s, relay_start(s));
+	s->armed = 0;
+	s->expect = 0;
+	if (what)
+		snprintf(what, cap, "motors off: %s; motor power off (relay): %s",
+			 mo_rc == GL_OK ? "confirmed" : rc_text(mo_rc, "NOT confirmed"),
+			 relay_rc == GL_OK ? "confirmed"
+					   : rc_text(relay_rc, "NOT confirmed"));
+	if (mo_rc != GL_OK)
+		return mo_rc < 0 ? mo_rc : GL_ERR_MISMATCH;
+	return relay_rc;
+}
