@@ -107,7 +107,10 @@ static void axis_cfg_from(const struct re_config *cfg,
 	o->check.max_points = (int)(hi / a->step_counts) + 1;
 	if (o->check.max_points > RE_CAL_MAX_POINTS)
 		o->check.max_points = RE_CAL_MAX_POINTS;
-	o->check.step_tol_counts = a->step_counts / 2.0;
+	/* the mean sample positions of two neighbouring points: each within
+	 * half a step of its point, so 0 < advance < 2 steps; a PC stall
+	 * leaves points with samples at one edge only */
+	o->check.step_tol_counts = a->step_counts - 1.0;
 	/* the table ends are a back-off inside the switches */
 	o->check.abs_first_v = a->analog.reverse_v + back * pa->gain_v_per_count;
 	o->check.abs_last_v = a->analog.forward_v - back * pa->gain_v_per_count;
@@ -386,6 +389,29 @@ static int step_fast_rev(struct re_calib *c, const struct re_io *io,
 	return start_seek_rev(c, io, cfg, i);
 }
 
+/* At a switch the potentiometer must read what it reads there on this
+ * robot (reverse_v / forward_v +- absolute_tolerance_v): an offset, a
+ * wrong pot or its wiring, named at once rather than by the table. */
+static int check_at_switch(const struct re_calib *c,
+			   const struct re_calib_cfg *cfg, int i, int fwd,
+			   struct re_fault *f)
+{
+	const struct re_calib_axis_cfg *a = &cfg->axis[i];
+	double shift = a->backoff_counts * a->gain_v;
+	double want = fwd ? a->check.abs_last_v + shift
+			  : a->check.abs_first_v - shift;
+	double pot = pot_of(c, cfg, i);
+
+	if (!(a->check.abs_tol_v > 0) || fabs(pot - want) <= a->check.abs_tol_v)
+		return GL_OK;
+	re_fault_set(f, RE_F_CAL_ABSOLUTE, i);
+	snprintf(f->s, sizeof(f->s), "%s", fwd ? "forward" : "reverse");
+	f->f[0] = pot;
+	f->f[1] = want;
+	f->f[2] = a->check.abs_tol_v;
+	return RE_FAULT;
+}
+
 static int step_to_rev(struct re_calib *c, const struct re_io *io,
 		       const struct re_calib_cfg *cfg, int i,
 		       struct re_fault *f)
@@ -402,6 +428,8 @@ static int step_to_rev(struct re_calib *c, const struct re_io *io,
 				  c->ax[i].seek_len, pot_of(c, cfg, i));
 	if (!rev_switch(c, i))
 		return stopped_badly(c, i, "reverse limit switch", f);
+	if (check_at_switch(c, cfg, i, 0, f) == RE_FAULT)
+		return RE_FAULT;
 	move_to(c, i, c->ax[i].edge + a->backoff_counts, a->seek_cps);
 	return enter(c, io, i, PH_BACK_REV);
 }
@@ -493,6 +521,8 @@ static int step_slow_fwd(struct re_calib *c, const struct re_io *io,
 				  c->ax[i].seek_len, pot_of(c, cfg, i));
 	if (!fwd_switch(c, i))
 		return stopped_badly(c, i, "forward limit switch", f);
+	if (check_at_switch(c, cfg, i, 1, f) == RE_FAULT)
+		return RE_FAULT;
 	move_to(c, i, c->ax[i].edge - a->backoff_counts, a->seek_cps);
 	return enter(c, io, i, PH_BACK_FWD);
 }
@@ -563,8 +593,22 @@ static void acc_add_shifted(struct acc *out, const struct acc *a, double d)
 	out->sxy += a->sxy + d * a->sy;
 }
 
-/* A point without samples (the PC stalled up to one step): the line
- * through both neighbours' samples, when both have some. */
+/* Samples that do not spread over a point's window (fewer than 3, or all
+ * near one edge: the PC stalled) cannot give its value at the point. */
+static int sparse(const struct acc *a, double step)
+{
+	double mx, var;
+
+	if (a->n < 3)
+		return 1;
+	mx = a->sx / a->n;
+	var = a->sxx / a->n - mx * mx;
+	return var < (step / 8) * (step / 8);
+}
+
+/* A point whose samples are sparse or missing (the PC stalled up to one
+ * step): the line through its own and both neighbours' samples, when
+ * both neighbours have some. */
 static int fill_point(const struct cal_axis *ax, int j, int n, double step,
 		      struct acc *out)
 {
@@ -572,6 +616,7 @@ static int fill_point(const struct cal_axis *ax, int j, int n, double step,
 	if (j < 1 || j + 1 >= n || !ax->acc[j - 1].n || !ax->acc[j + 1].n)
 		return -1;
 	acc_add_shifted(out, &ax->acc[j - 1], -step);
+	acc_add_shifted(out, &ax->acc[j], 0);
 	acc_add_shifted(out, &ax->acc[j + 1], step);
 	return 0;
 }
@@ -595,16 +640,19 @@ static int build_table(struct re_calib *c, const struct re_calib_cfg *cfg,
 		const struct acc *s = &ax->acc[j];
 		double x = ax->start + (double)j * a->step_counts;
 
-		if (s->n == 0) {
-			if (fill_point(ax, j, t->n, a->step_counts, &filled))
-				return abort_axis(f, i,
-						  "no potentiometer sample "
-						  "near point %d (encoder %.0f)",
-						  j, x);
+		if (sparse(s, a->step_counts) &&
+		    fill_point(ax, j, t->n, a->step_counts, &filled) == 0) {
 			s = &filled;
 			c->filled++;
+		} else if (s->n == 0) {
+			return abort_axis(f, i,
+					  "no potentiometer sample near point "
+					  "%d (encoder %.0f)",
+					  j, x);
 		}
 		t->pot_v[j] = point_value(s, a->step_counts, &enc_off);
+		if (s == &filled)
+			enc_off = 0; /* the line is read at the point itself */
 		if (j > 0 &&
 		    re_cal_check_point(&a->check, i, j, a->step_counts,
 				       prev_enc, x + enc_off, t->pot_v[j - 1],

@@ -2,12 +2,16 @@
  * test_re_calib.c - the calibration procedure (re_calib) against a small
  * fake controller and robot behind struct re_io, in fake time: three axes
  * between limit switches at +-50000 counts, potentiometers 0.5..4.5 V with
- * a sine bow, PR/PA/SP/BG/ST/SH/MO. Covers a clean calibration (table
- * values, soft limits, centre, time), a limit switch that never comes, a
- * non-monotonic potentiometer, a wrong range, a motor switched off
- * mid-calibration, a lost relay, the stop flag, and the check of loaded
- * tables against the robot. The same procedure runs on galil-sim in the
- * system tests.
+ * a sine bow, and the program's service moves (mvtg, mvsp, mvax, mvreq),
+ * with the program's rule that a fast move toward a switch whose slow zone
+ * the potentiometer is in is refused. The sampler stands in for the
+ * supervisor's cycle. Covers a clean calibration (table values, soft
+ * limits, centre, time, never fast in a slow zone), a limit switch that
+ * never comes, a non-monotonic potentiometer, a wrong range, an offset
+ * present before the sweep, a PC stall during the sweep, a fault the
+ * supervisor latched, the stop flag, and the check of loaded tables
+ * against the robot. The same procedure runs on galil-sim in the system
+ * tests.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -41,10 +45,20 @@ static struct {
 	double dip_at, dip_v; /* non-monotonic stretch on axis C */
 	int trip_axis;	      /* motor off (stop code 8) at trip_pos */
 	double trip_pos;
-	int relay_bad;
+	double pot_offset[3]; /* added to every reading */
 	int n_records;
 	char last_cmd[96];
+	/* the program's service move request */
+	double mvtg[3], mvsp[3];
+	int mvax[3];
+	int fast_in_zone; /* a fast move toward a near switch was seen */
+	int64_t stall_at, stall_ns; /* the sampler stalls once */
+	int sampler_fault_at;	    /* the sampler reports RE_FAULT */
 } fk;
+
+#define PNLO 0.83 /* the plan's slow zones for this robot (V) */
+#define PNHI 4.17
+#define SEEK 4000 /* counts/s */
 
 static double pot_volts(int i, double pos)
 {
@@ -53,7 +67,19 @@ static double pot_volts(int i, double pos)
 
 	if (i == 2 && fk.dip_v != 0 && fabs(pos - fk.dip_at) < 1500)
 		v -= fk.dip_v;
-	return v;
+	return v + fk.pot_offset[i];
+}
+
+/* The program's rule (#MVSUP): never fast toward a near switch. */
+static void zone_rule(int i)
+{
+	const struct fax *a = &fk.ax[i];
+	double pot = pot_volts(i, a->pos);
+	int toward_rev = a->target < a->pos, toward_fwd = a->target > a->pos;
+
+	if (a->moving && a->v > SEEK &&
+	    ((toward_rev && pot < PNLO) || (toward_fwd && pot > PNHI)))
+		fk.fast_in_zone = 1;
 }
 
 static int fwd_active(const struct fax *a)
@@ -75,6 +101,7 @@ static void move_axis(int i, double dt)
 
 	if (!a->moving)
 		return;
+	zone_rule(i);
 	if (!a->motor_on) {
 		stop(a, a->stop_code);
 		return;
@@ -104,11 +131,6 @@ static void plant_run(void)
 	}
 }
 
-static int axis_of(char c)
-{
-	return c >= 'A' && c <= 'C' ? c - 'A' : -1;
-}
-
 static void begin(int i)
 {
 	if (fk.ax[i].motor_on && fk.ax[i].target != fk.ax[i].pos) {
@@ -118,42 +140,41 @@ static void begin(int i)
 	}
 }
 
-static void three(const char *args, double v[3])
+/* "name[i]=value" of the service move request. */
+static int assign(const char *c)
 {
-	sscanf(args, "%lf,%lf,%lf", &v[0], &v[1], &v[2]);
+	int i;
+	double v;
+	char name[8];
+
+	if (sscanf(c, "%7[a-z][%d]=%lf", name, &i, &v) != 3 || i < 0 || i > 2)
+		return GL_ERR_CTRL;
+	if (!strcmp(name, "mvtg"))
+		fk.mvtg[i] = v;
+	else if (!strcmp(name, "mvsp"))
+		fk.mvsp[i] = v;
+	else if (!strcmp(name, "mvax"))
+		fk.mvax[i] = v != 0;
+	else
+		return GL_ERR_CTRL;
+	return GL_OK;
 }
 
 static int one_cmd(const char *c)
 {
-	double v[3];
-	int i = axis_of(c[2]);
-
-	if (!strcmp(c, "SH ABC")) {
-		for (i = 0; i < 3; i++)
-			fk.ax[i].motor_on = 1;
-	} else if (!strncmp(c, "SP", 2) && c[3] == '=' && i >= 0) {
-		fk.ax[i].sp = atof(c + 4);
-	} else if (!strncmp(c, "PR", 2) && c[3] == '=' && i >= 0) {
-		fk.ax[i].target = fk.ax[i].pos + atof(c + 4);
-	} else if (!strncmp(c, "PA", 2) && c[3] == '=' && i >= 0) {
-		fk.ax[i].target = atof(c + 4) - fk.ax[i].enc_offset;
-	} else if (!strncmp(c, "BG", 2) && i >= 0 && c[3] == '\0') {
-		begin(i);
-	} else if (!strncmp(c, "SP ", 3)) {
-		three(c + 3, v);
-		for (i = 0; i < 3; i++)
-			fk.ax[i].sp = v[i];
-	} else if (!strncmp(c, "PA ", 3)) {
-		three(c + 3, v);
-		for (i = 0; i < 3; i++)
-			fk.ax[i].target = v[i] - fk.ax[i].enc_offset;
-	} else if (!strcmp(c, "BG ABC")) {
-		for (i = 0; i < 3; i++)
+	if (!strcmp(c, "mvreq=1")) {
+		for (int i = 0; i < 3; i++) {
+			if (!fk.mvax[i])
+				continue;
+			fk.ax[i].target = fk.mvtg[i] - fk.ax[i].enc_offset;
+			fk.ax[i].sp = fk.mvsp[i];
 			begin(i);
-	} else {
-		return GL_ERR_CTRL;
+		}
+		return GL_OK;
 	}
-	return GL_OK;
+	if (!strcmp(c, "MG mvreq"))
+		return GL_OK;
+	return assign(c);
 }
 
 static int f_command(void *ud, const char *cmd, char *resp, size_t cap,
@@ -171,7 +192,7 @@ static int f_command(void *ud, const char *cmd, char *resp, size_t cap,
 		if (one_cmd(c) != GL_OK)
 			return GL_ERR_CTRL;
 	if (cap)
-		resp[0] = '\0';
+		snprintf(resp, cap, "%s", strcmp(cmd, "MG mvreq") ? "" : " 0.0000");
 	return 0;
 }
 
@@ -221,10 +242,9 @@ static int f_message(void *ud, char *line, size_t cap)
 static int f_relay_check(void *ud, char *why, size_t cap)
 {
 	(void)ud;
-	if (!fk.relay_bad)
-		return GL_OK;
-	snprintf(why, cap, "relay gone");
-	return GL_ERR_RELAY;
+	(void)why;
+	(void)cap;
+	return GL_OK;
 }
 
 static int f_relay_off(void *ud)
@@ -261,11 +281,38 @@ static void f_sleep_until(void *ud, int64_t t)
 }
 
 static const struct re_io_ops ops = {
-    f_record,	 f_command,	f_ctrl_error, f_message, f_relay_check,
-    f_relay_off, f_relay_state, f_log,	      f_now,	 f_sleep_until,
+    .record = f_record,
+    .command = f_command,
+    .ctrl_error = f_ctrl_error,
+    .message = f_message,
+    .relay_check = f_relay_check,
+    .relay_off = f_relay_off,
+    .relay_state = f_relay_state,
+    .log = f_log,
+    .now_ns = f_now,
+    .sleep_until = f_sleep_until,
 };
 
 static const struct re_io io = {&ops, NULL};
+static struct gl_record rec;
+
+/* The supervisor's cycle, in short: every 10 ms a record (once, a stall
+ * of fk.stall_ns at fk.stall_at); RE_FAULT once fk.n_records passes
+ * fk.sampler_fault_at. */
+static int f_sample(void *ud, const struct gl_record **out)
+{
+	(void)ud;
+	f_sleep_until(NULL, fk.now + 10 * MS);
+	if (fk.stall_ns && fk.now >= fk.stall_at) {
+		f_sleep_until(NULL, fk.now + fk.stall_ns);
+		fk.stall_ns = 0;
+	}
+	f_record(NULL, NULL, &rec, 0);
+	if (fk.sampler_fault_at && fk.n_records > fk.sampler_fault_at)
+		return RE_FAULT;
+	*out = &rec;
+	return GL_OK;
+}
 static const char *const names[3] = {"A", "B", "C"};
 static struct re_calib_cfg cfg;
 static struct re_calib *cal;
@@ -280,6 +327,7 @@ static int setup(void **state)
 	for (int i = 0; i < 3; i++) {
 		fk.gain[i] = 4.0;
 		fk.ax[i].pos = i * 10000.0 - 10000; /* anywhere */
+		fk.ax[i].motor_on = 1; /* the service state */
 	}
 	memset(&cfg, 0, sizeof(cfg));
 	cfg.n_axes = 3;
@@ -290,6 +338,13 @@ static int setup(void **state)
 		struct re_calib_axis_cfg *a = &cfg.axis[i];
 
 		a->vmax_cps = 8000;
+		a->travel_cps = 8000;
+		a->seek_cps = SEEK;
+		a->gain_v = 4.0 / 100000;
+		a->pnlo_v = PNLO;
+		a->pnhi_v = PNHI;
+		a->potlo_v = 0.17;
+		a->pothi_v = 4.83;
 		a->step_counts = 1000;
 		a->travel_counts = 100000;
 		a->travel_tol = 0.1;
@@ -300,10 +355,15 @@ static int setup(void **state)
 		a->check.range_tol = 0.1;
 		a->check.min_points = 89;
 		a->check.max_points = 111;
-		a->check.step_tol_counts = 500;
+		a->check.step_tol_counts = 999;
+		a->check.abs_first_v = 0.5 + 500 * a->gain_v;
+		a->check.abs_last_v = 4.5 - 500 * a->gain_v;
+		a->check.abs_tol_v = 0.25;
 		a->encpot.allowed_error = 0.5;
 		a->encpot.persistence_cycles = 1;
 	}
+	cfg.accept_ms = 50;
+	cfg.sampler = (struct re_calib_sampler){f_sample, NULL, NULL, NULL};
 	stop_flag = 0;
 	cfg.stop = &stop_flag;
 	return re_calib_new(&cal);
@@ -322,9 +382,16 @@ static void test_calib_clean(void **state)
 {
 	struct re_fault f;
 	double secs = 0;
+	int filled = -1;
 
 	(void)state;
-	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, &secs), GL_OK);
+
+	int rc = re_calib_full(cal, &io, &cfg, &set, &f, &secs, &filled);
+
+	if (rc != GL_OK)
+		fail_msg("rc %d fault %d axis %d: %s", rc, f.id, f.axis, f.s);
+	assert_int_equal(filled, 0);
+	assert_int_equal(fk.fast_in_zone, 0);
 	assert_int_equal(set.n_axes, 3);
 	for (int i = 0; i < 3; i++) {
 		const struct re_caltable *t = &set.axis[i];
@@ -342,7 +409,62 @@ static void test_calib_clean(void **state)
 		assert_string_equal(set.name[i], names[i]);
 	}
 	print_message("calibration took %.2f s (fake time)\n", secs);
-	assert_true(secs > 20 && secs < 30);
+	assert_true(secs > 20 && secs < 35);
+}
+
+/* The PC stalls for 150 ms during the sweep (shorter than the controller
+ * watchdog), at 8 instants 20 ms apart: at 8000 counts/s the gap of 1280
+ * counts leaves the points beside it with samples at one edge only, or
+ * none; such a point is fitted from its and both neighbours' samples, and
+ * every table still matches the curve. */
+static void test_calib_pc_stall(void **state)
+{
+	struct re_fault f;
+	int total = 0;
+
+	(void)state;
+	for (int k = 0; k < 8; k++) {
+		int filled = -1;
+
+		teardown(NULL);
+		setup(NULL);
+		fk.stall_at = fk.now + (12000 + 20 * k) * MS; /* sweeping */
+		fk.stall_ns = 150 * MS;
+		if (re_calib_full(cal, &io, &cfg, &set, &f, NULL, &filled))
+			fail_msg("stall %d: fault %d axis %d: %s", k, f.id,
+				 f.axis, f.s);
+		/* all three axes sweep at once: per axis at most the points
+		 * on both sides of the gap */
+		assert_true(filled >= 0 && filled <= 6);
+		total += filled;
+		for (int i = 0; i < 3; i++)
+			for (int j = 0; j < set.axis[i].n; j++)
+				assert_true(
+				    fabs(set.axis[i].pot_v[j] -
+					 pot_volts(i, set.axis[i].start_counts +
+							  j * 1000.0)) < 0.002);
+	}
+	assert_true(total >= 1);
+}
+
+/* A 0.5 V offset on B's potentiometer from the start: it reads 1.0 V at
+ * the reverse switch where 0.5 +- 0.25 V is expected - named there, before
+ * the sweep. */
+static void test_calib_offset_before(void **state)
+{
+	struct re_fault f;
+
+	(void)state;
+	fk.pot_offset[1] = 0.5;
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL, NULL),
+			 RE_FAULT);
+	assert_int_equal(f.id, RE_F_CAL_ABSOLUTE);
+	assert_int_equal(f.axis, 1);
+	assert_string_equal(f.s, "reverse");
+	assert_true(fabs(f.f[0] - 1.0) < 0.01);
+	assert_true(fabs(f.f[1] - 0.5) < 1e-9);
+	assert_true(fabs(f.f[2] - 0.25) < 1e-9);
+	assert_int_equal(set.n_axes, 0);
 }
 
 /* The forward switch of B never closes: the bounded sweep ends without it. */
@@ -352,11 +474,12 @@ static void test_calib_switch_never_comes(void **state)
 
 	(void)state;
 	fk.ax[1].no_fwd_switch = 1;
-	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL),
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL, NULL),
 			 RE_FAULT);
 	assert_int_equal(f.id, RE_F_CAL_ABORT);
 	assert_int_equal(f.axis, 1);
-	assert_non_null(strstr(f.s, "forward limit switch never came"));
+	assert_non_null(strstr(f.s, "the forward limit switch never came "
+				    "within "));
 	assert_int_equal(set.n_axes, 0);
 }
 
@@ -368,52 +491,52 @@ static void test_calib_nonmonotonic(void **state)
 	(void)state;
 	fk.dip_at = 10000;
 	fk.dip_v = 0.1;
-	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL),
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL, NULL),
 			 RE_FAULT);
 	assert_int_equal(f.id, RE_F_CAL_NONMONO);
 	assert_int_equal(f.axis, 2);
 	assert_int_equal(f.i[0], 58); /* point at +8500 counts */
 }
 
-/* A's potentiometer spans 3 V instead of 4 V +- 10 %. */
+/* A's potentiometer spans 3 V instead of 4 V +- 10 %: with the absolute
+ * check off, the range check names it; with it on, the forward switch
+ * reading (3.5 V for 4.5 +- 0.25 V) does, earlier. */
 static void test_calib_wrong_range(void **state)
 {
 	struct re_fault f;
 
 	(void)state;
 	fk.gain[0] = 3.0;
-	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL),
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL, NULL),
+			 RE_FAULT);
+	assert_int_equal(f.id, RE_F_CAL_ABSOLUTE);
+	assert_int_equal(f.axis, 0);
+	assert_string_equal(f.s, "forward");
+	teardown(NULL);
+	setup(NULL);
+	fk.gain[0] = 3.0;
+	for (int i = 0; i < 3; i++)
+		cfg.axis[i].check.abs_tol_v = 0;
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL, NULL),
 			 RE_FAULT);
 	assert_int_equal(f.id, RE_F_CAL_RANGE);
 	assert_int_equal(f.axis, 0);
 }
 
-/* Position error mid-sweep: the controller switched B off; abort. */
-static void test_calib_motor_off(void **state)
+/* The supervisor's cycle latched a fault (a motor off, the relay, ...):
+ * the procedure ends at once with RE_FAULT and a fault id RE_F_NONE (the
+ * supervisor reacted already), nothing kept. */
+static void test_calib_supervisor_fault(void **state)
 {
 	struct re_fault f;
 
 	(void)state;
-	fk.trip_axis = 2;
-	fk.trip_pos = 0;
-	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL),
+	fk.sampler_fault_at = 300;
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL, NULL),
 			 RE_FAULT);
-	assert_int_equal(f.id, RE_F_CAL_ABORT);
-	assert_int_equal(f.axis, 1);
-	assert_non_null(strstr(f.s, "switched the motor off"));
-	assert_non_null(strstr(f.s, "stop code 8"));
-}
-
-/* The relay goes during calibration: ESTOP. */
-static void test_calib_relay_lost(void **state)
-{
-	struct re_fault f;
-
-	(void)state;
-	fk.relay_bad = 1;
-	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL),
-			 RE_FAULT);
-	assert_int_equal(f.id, RE_F_ESTOP_LOST);
+	assert_int_equal(f.id, RE_F_NONE);
+	assert_int_equal(fk.n_records, 301);
+	assert_int_equal(set.n_axes, 0);
 }
 
 /* SIGTERM during calibration: stop at the next sample. */
@@ -423,7 +546,7 @@ static void test_calib_stop_flag(void **state)
 
 	(void)state;
 	stop_flag = 1;
-	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL),
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, NULL, NULL),
 			 GL_ERR_AGAIN);
 	assert_int_equal(set.n_axes, 0);
 }
@@ -436,10 +559,9 @@ static void test_calib_check_robot(void **state)
 	struct re_fault f;
 
 	(void)state;
-	assert_int_equal(re_calib_full(cal, &io, &cfg, &saved, &f, NULL),
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &saved, &f, NULL, NULL),
 			 GL_OK);
 	fk.ax[0].pos = 20000;
-	fk.ax[0].motor_on = 0;
 	assert_int_equal(re_calib_check_robot(cal, &io, &cfg, &saved, &f),
 			 GL_OK);
 	assert_true(fabs(fk.ax[0].pos) <= 1);
@@ -461,9 +583,11 @@ int main(void)
 					    teardown),
 	    cmocka_unit_test_setup_teardown(test_calib_wrong_range, setup,
 					    teardown),
-	    cmocka_unit_test_setup_teardown(test_calib_motor_off, setup,
+	    cmocka_unit_test_setup_teardown(test_calib_supervisor_fault, setup,
 					    teardown),
-	    cmocka_unit_test_setup_teardown(test_calib_relay_lost, setup,
+	    cmocka_unit_test_setup_teardown(test_calib_pc_stall, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_calib_offset_before, setup,
 					    teardown),
 	    cmocka_unit_test_setup_teardown(test_calib_stop_flag, setup,
 					    teardown),

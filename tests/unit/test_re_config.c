@@ -77,7 +77,21 @@ static const struct bad_case bad_cases[] = {
     {"bad_inputs_duplicate.yaml", 3, 48,
      "'inputs' lists input 3 twice (entries 3 and 12)"},
     {"bad_inputs_range.yaml", 3, 48,
-     "'inputs' must be between 1 and 32, got 33"},
+     "'inputs' must be between 1 and 48, got 49"},
+    {"bad_inputs_9_16.yaml", 3, 36,
+     "'inputs' entry 9 is input 12: a DMC-4030 has no inputs 9 to 16 "
+     "(use 1..8 or 17..48)"},
+    {"bad_oa_ki0.yaml", 6, 9,
+     "'encoder_failure' needs a non-zero 'ki': the controller's "
+     "encoder-failure detection (OA, OT) does not work with KI 0"},
+    {"bad_pot_absolute.yaml", 7, 18,
+     "'forward_v' (1) must be above 'reverse_v' (0.9) by more than twice "
+     "'absolute_tolerance_v' (0.25)"},
+    {"bad_pot_span.yaml", 7, 18,
+     "'forward_v' - 'reverse_v' (3 V) must agree with 'expected_range_v' "
+     "(4 V) within 'range_tolerance'"},
+    {"bad_power_output.yaml", 3, 17,
+     "'power_output' must be between 0 and 8, got 9"},
     {"bad_invalid_timeout.yaml", 3, 23,
      "'invalid_timeout_ms' must be between 50 and 5000, got 20"},
     {"bad_key_not_scalar.yaml", 2, 3, "expected a key name, got a list"},
@@ -225,7 +239,10 @@ static void test_defaults_documented(void **state)
 		assert_int_equal(a->step_counts, 1000);
 		assert_int_equal(a->travel_counts, i == 2 ? 80000 : 100000);
 		assert_true(a->travel_tolerance == 0.1);
-		assert_true(a->kp == 6.0 && a->ki == 0.0 && a->kd == 64.0);
+		assert_true(a->kp == 6.0 && a->ki == 1.0 && a->kd == 64.0);
+		assert_true(a->analog.reverse_v == 0.5);
+		assert_true(a->analog.forward_v == 4.5);
+		assert_true(a->analog.absolute_tolerance_v == 0.25);
 		assert_true(a->torque_limit_v == 5.0);
 		assert_int_equal(a->position_error_limit_counts, 500);
 		assert_true(a->off_on_error);

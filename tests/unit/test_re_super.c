@@ -71,6 +71,7 @@ struct fake {
 	int fcode_after;  /* "MG fcode" answers 0 this many times, */
 	int fcode_val;	  /* then this */
 	int n_fcode;
+	int motors_on_after_stop; /* "MG _MOx" answers 0 (motor still on) */
 	char logs[16][1024];
 	int log_level[16];
 	int n_logs;
@@ -128,6 +129,8 @@ static int f_command(void *ud, const char *cmd, char *resp, size_t cap,
 			 fk.n_fcode++ < fk.fcode_after ? 0 : fk.fcode_val);
 	else if (!strcmp(cmd, "MG faxis"))
 		snprintf(resp, cap, " 0.0000");
+	else if (!strncmp(cmd, "MG _MO", 6))
+		snprintf(resp, cap, " %d.0000", fk.motors_on_after_stop ? 0 : 1);
 	else
 		snprintf(resp, cap, "%s",
 			 strcmp(cmd, "MG fdet") ? "" : fk.mg_fdet);
@@ -198,8 +201,16 @@ static void f_sleep_until(void *ud, int64_t t)
 }
 
 static const struct re_io_ops fake_ops = {
-    f_record,	 f_command,	f_ctrl_error, f_message, f_relay_check,
-    f_relay_off, f_relay_state, f_log,	      f_now,	 f_sleep_until,
+    .record = f_record,
+    .command = f_command,
+    .ctrl_error = f_ctrl_error,
+    .message = f_message,
+    .relay_check = f_relay_check,
+    .relay_off = f_relay_off,
+    .relay_state = f_relay_state,
+    .log = f_log,
+    .now_ns = f_now,
+    .sleep_until = f_sleep_until,
 };
 
 /* ---- fixtures ------------------------------------------------------------ */
@@ -331,8 +342,14 @@ static void test_super_encpot_fault_order(void **state)
 	assert_int_equal(step(), RE_OK); /* persistence 1: tolerated */
 	assert_int_equal(fk.n_relay_off, 0);
 	assert_int_equal(step(), RE_FAULT);
+	/* relay, stop, motors read back, the program's own verdict asked
+	 * (a consequence to name), then the log */
 	assert_string_equal(fk.seq, "relay_off,cmd:AB 1;MO ABC;pcflt=1,"
-				    "log:FAULT");
+				    "cmd:MG _MOA,cmd:MG _MOB,cmd:MG _MOC,"
+				    "cmd:MG fcode,log:FAULT");
+	assert_non_null(strstr(re_super_fault_line(&sup),
+			       ". Safe state confirmed: motor power off "
+			       "(relay open), motors off. Recovery: "));
 	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT ENCODER: ", 15));
 	assert_non_null(strstr(re_super_fault_line(&sup), "Recovery: "));
 	assert_non_null(strstr(fault_log(), re_super_fault_line(&sup)));
@@ -456,11 +473,12 @@ static void test_super_settle_program_verdict(void **state)
 	assert_string_equal(fk.seq, "relay_off,cmd:AB 1;MO ABC,cmd:MG fcode,"
 				    "cmd:MG fcode,cmd:MG fcode,cmd:MG fcode,"
 				    "cmd:MG faxis,cmd:MG fdet,cmd:pcflt=1,"
+				    "cmd:MG _MOA,cmd:MG _MOB,cmd:MG _MOC,"
 				    "log:FAULT");
 	assert_int_equal(sup.fault.id, RE_F_CTRL_INPUT);
 	assert_int_equal(sup.fault.i[0], 1);
 	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT INPUT: ", 13));
-	assert_non_null(strstr(fault_log(), "; program fault 3 after "));
+	assert_non_null(strstr(fault_log(), " | program fault 3 after "));
 }
 
 /* Nothing from the program within settle_ms: our own finding stands. */
@@ -478,7 +496,8 @@ static void test_super_settle_timeout(void **state)
 	assert_int_equal(step(), RE_FAULT);
 	assert_int_equal(sup.fault.id, RE_F_MOTOR_OFF);
 	assert_true(fk.now - t >= 25 * MS && fk.now - t < 80 * MS);
-	assert_string_equal(fk.commands[fk.n_commands - 1], "pcflt=1");
+	assert_string_equal(fk.commands[fk.n_commands - 5], "pcflt=1");
+	assert_string_equal(fk.commands[fk.n_commands - 4], "MG _MOA");
 	assert_non_null(strstr(re_super_fault_line(&sup), "position error"));
 	assert_non_null(strstr(fault_log(), "no program fault within 25 ms"));
 }
@@ -523,15 +542,18 @@ static void test_super_latch(void **state)
 {
 	struct re_fault f;
 	struct re_status st;
+	int n;
 
 	(void)state;
 	fk.record_rc = GL_ERR_CLOSED;
 	assert_int_equal(step(), RE_FAULT);
+	n = fk.n_commands;
+	assert_string_equal(fk.commands[0], "AB 1;MO ABC;pcflt=1");
 	fk.record_rc = GL_OK;
 	fk.relay_check_rc = GL_ERR_RELAY;
 	assert_int_equal(run(20), RE_OK);
 	assert_int_equal(fk.n_relay_off, 1);
-	assert_int_equal(fk.n_commands, 1);
+	assert_int_equal(fk.n_commands, n);
 	assert_string_equal(fk.last_prefix, "(none)");
 	re_fault_set(&f, RE_F_ESTOP_LOST, -1);
 	assert_int_equal(re_super_fault(&sup, &f), RE_OK);
@@ -566,8 +588,14 @@ static void test_super_shutdown(void **state)
 {
 	(void)state;
 	assert_int_equal(run(2), RE_OK);
-	assert_int_equal(re_super_shutdown(&sup), GL_OK);
-	assert_string_equal(fk.seq, "cmd:AB 1;MO ABC,relay_off");
+	char what[128];
+
+	assert_int_equal(re_super_shutdown(&sup, what, sizeof(what)), GL_OK);
+	assert_string_equal(fk.seq,
+			    "cmd:offreq=1,cmd:AB 1;MO ABC,cmd:MG _MOA,"
+			    "cmd:MG _MOB,cmd:MG _MOC,relay_off");
+	assert_string_equal(what, "motors off: confirmed; motor power off "
+				  "(relay): confirmed");
 }
 
 /* Status snapshot: position %, pot against expected, limits, margin. */
