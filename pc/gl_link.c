@@ -577,6 +577,17 @@ int gl_link_query_layout(gl_link *l)
 	return gl_record_layout_from_qz(qz, (size_t)rc, &l->layout, &l->n_axes);
 }
 
+int gl_link_axes(gl_link *l)
+{
+	int rc;
+
+	if (!l)
+		return GL_ERR_ARG;
+	if (l->layout == GL_LAYOUT_NONE && (rc = gl_link_query_layout(l)) < 0)
+		return rc;
+	return l->n_axes;
+}
+
 int gl_link_record(gl_link *l, const char *prefix, struct gl_record *rec,
 		   int timeout_ms)
 {

@@ -89,6 +89,12 @@ int gl_link_record(gl_link *l, const char *prefix, struct gl_record *rec,
 int gl_link_query_layout(gl_link *l);
 
 /*
+ * gl_link_axes() - the controller's number of axes (QZ), asked once and
+ * remembered. Return: 1..8, or a link error.
+ */
+int gl_link_axes(gl_link *l);
+
+/*
  * gl_link_ctrl_error() - the controller's last error after GL_ERR_CTRL.
  * @code: [out] optional TC code (e.g. 1).
  * Return: the TC1 text (e.g. "Unrecognized command"), "" if none; valid

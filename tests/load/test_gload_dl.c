@@ -12,10 +12,13 @@
  * faults; test_gload_stub.c uses it for what it offers.
  *
  * How the fake differs from a DMC-4030: one connection at a time; it knows
- * only ^R^V, MG _BN, MG _XQn, HXn, ST, MO, DL, UL, BP, XQ #L,0, TC1 and
- * "x=n"/"MG x" for one variable; a rejected DL line gets '?' at once, the
- * download then ends with one ':' (two terminators), and the lines before
- * the bad one stay stored (the worst case: a partial program).
+ * only ^R^V, MG _BN, QZ, MG _XQn, MG _BGx, MG _MOx, HXn, ST, MO (refused
+ * with TC 7 while an axis moves), DL, UL, BP, XQ #L,0, TC1, "x=n"/"MG x"
+ * for one variable, any other "name=n" (accepted, forgotten), and MG state
+ * / MG hbpc when a supervisor is simulated (hbpc advancing); a rejected DL
+ * line gets '?' at once, the download then ends with one ':' (two
+ * terminators), and the lines before the bad one stay stored (the worst
+ * case: a partial program).
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -54,6 +57,9 @@ struct fake {
 	int stuck_thread;   /* this thread ignores HX (-1: none) */
 	int reject_bp;
 	int xq_no_run; /* XQ answers ':' but the thread stays off */
+	int supervised; /* the RoboELF program runs armed, hbpc advancing */
+	int moving_polls; /* after ST, MG _BGA answers 1 this many times */
+	int jogging;	  /* axis A moves until ST */
 	/* state */
 	char prog[PROG_CAP]; /* lines, each ending in '\n' */
 	size_t prog_len;
@@ -62,6 +68,7 @@ struct fake {
 	int tc;
 	const char *tc_text;
 	double var_x;
+	int motors_on, hbpc;
 	int connections;
 	int downloads;
 	char log[LOG_CAP]; /* one command per line; DL lines as "> ..." */
@@ -161,6 +168,7 @@ static void fk_halt(int fd, int n)
 /* One command line (no DL in progress). */
 static void fk_command(int fd, const char *cmd)
 {
+	char c;
 	int n;
 
 	fk_log("", cmd[0] == 0x12 ? "^R^V" : cmd);
@@ -172,8 +180,22 @@ static void fk_command(int fd, const char *cmd)
 		fk_number(fd, fk.running[n] ? 5 : -1);
 	else if (sscanf(cmd, "HX%d", &n) == 1)
 		fk_halt(fd, n);
-	else if (!strcmp(cmd, "ST") || !strcmp(cmd, "MO"))
-		fk_send(fd, ":");
+	else if (!strcmp(cmd, "QZ"))
+		fk_send(fd, " 3, 52, 26, 36\r\n:");
+	else if (!strcmp(cmd, "ST"))
+		fk.jogging = 0, fk_send(fd, ":");
+	else if (sscanf(cmd, "MG _BG%c", &c) == 1 && c >= 'A' && c <= 'C')
+		fk_number(fd, c == 'A' && (fk.jogging || fk.moving_polls-- > 0));
+	else if (!strcmp(cmd, "MO") && (fk.jogging || fk.moving_polls > 0))
+		fk_reject(fd, 7, "Command not valid while running");
+	else if (!strcmp(cmd, "MO"))
+		fk.motors_on = 0, fk_send(fd, ":");
+	else if (sscanf(cmd, "MG _MO%c", &c) == 1 && c >= 'A' && c <= 'C')
+		fk_number(fd, !fk.motors_on);
+	else if (!strcmp(cmd, "MG state") && fk.supervised)
+		fk_number(fd, 1);
+	else if (!strcmp(cmd, "MG hbpc") && fk.supervised)
+		fk_number(fd, fk.hbpc += 3);
 	else if (!strcmp(cmd, "UL"))
 		fk_upload(fd);
 	else if (!strcmp(cmd, "DL"))
@@ -193,6 +215,8 @@ static void fk_command(int fd, const char *cmd)
 		fk.var_x = n, fk_send(fd, ":");
 	else if (!strcmp(cmd, "MG x"))
 		fk_number(fd, fk.var_x);
+	else if (strchr(cmd, '=') && cmd[0] >= 'a' && cmd[0] <= 'z')
+		fk_send(fd, ":"); /* a variable: made, and forgotten */
 	else
 		fk_reject(fd, 1, "Unrecognized command");
 }
@@ -387,12 +411,16 @@ static void dl_lines(char *out, size_t cap, const char *prog)
 	snprintf(out + o, cap - o, "> \\\n");
 }
 
+/* The halt: prun=0, every thread, ST, every axis stopped, MO, every motor
+ * read back off, no thread running (the axes from QZ). */
 #define HALT_CMDS                                                              \
-	"HX0\nHX1\nHX2\nHX3\nHX4\nHX5\nHX6\nHX7\nST\nMO\n"                     \
+	"QZ\nprun=0\nHX0\nHX1\nHX2\nHX3\nHX4\nHX5\nHX6\nHX7\nST\n"            \
+	"MG _BGA\nMG _BGB\nMG _BGC\nMO\nMG _MOA\nMG _MOB\nMG _MOC\n"           \
 	"MG _XQ0\nMG _XQ1\nMG _XQ2\nMG _XQ3\nMG _XQ4\nMG _XQ5\nMG _XQ6\n"      \
 	"MG _XQ7\n"
 
-static const char halt_log[] = "^R^V\nMG _BN\n" HALT_CMDS;
+/* Identify, the busy check (no program running: one question). */
+static const char halt_log[] = "^R^V\nMG _BN\nMG _XQ0\n" HALT_CMDS;
 
 static void assert_log(const char *want)
 {
@@ -648,6 +676,68 @@ static void test_commands(void **state)
 	proc_kill(&p);
 }
 
+/* roboelf drives the robot (the program armed, its heartbeat advancing):
+ * refused with exit 5 and why, nothing halted or sent after the busy
+ * check; with --force it is halted and loaded, with a warning. */
+static void test_busy_refused(void **state)
+{
+	static const char *const args[] = {GOOD "clean.dmc", NULL};
+	static const char *const force[] = {"--force", GOOD "clean.dmc", NULL};
+	struct proc p;
+
+	(void)state;
+	fk.running[0] = fk.running[1] = 1;
+	fk.supervised = 1;
+	fk.motors_on = 1;
+	assert_int_equal(run(&p, args), 5);
+	assert_log("^R^V\nMG _BN\nMG _XQ0\nMG state\nMG hbpc\nMG hbpc\n");
+	assert_true(has(&p, PROC_STDERR,
+			"galil-load: the controller's program is armed and "
+			"its supervisor's heartbeat is advancing: roboelf is "
+			"driving the robot. Loading halts the program: every "
+			"axis stops, every motor is switched off and roboelf "
+			"latches a fault. Quit roboelf first, or give --force "
+			"to do exactly that\n"));
+	assert_int_equal(fk.running[0], 1);
+	assert_int_equal(fk.motors_on, 1);
+	assert_int_equal(fk.downloads, 0);
+	proc_kill(&p);
+	assert_int_equal(run(&p, force), 0);
+	assert_true(has(&p, PROC_STDOUT, "warning: --force: halting a program "
+					 "that roboelf drives (armed)"));
+	assert_int_equal(fk.running[0], 0);
+	assert_int_equal(fk.motors_on, 0);
+	assert_int_equal(fk.downloads, 1);
+	proc_kill(&p);
+}
+
+/* An axis jogs when galil-load comes: ST, then it waits for the profiler
+ * to end before MO (which the controller refuses while an axis moves). */
+static void test_load_while_jogging(void **state)
+{
+	static const char *const args[] = {GOOD "clean.dmc", NULL};
+	struct proc p;
+
+	(void)state;
+	fk.jogging = 1;
+	fk.moving_polls = 3; /* still decelerating for three polls */
+	fk.motors_on = 1;
+	assert_int_equal(run(&p, args), 0);
+	pthread_mutex_lock(&fk.mu);
+	/* three rounds still moving, the fourth stopped, then MO */
+	assert_non_null(strstr(fk.log, "ST\n"
+				       "MG _BGA\nMG _BGB\nMG _BGC\n"
+				       "MG _BGA\nMG _BGB\nMG _BGC\n"
+				       "MG _BGA\nMG _BGB\nMG _BGC\n"
+				       "MG _BGA\nMG _BGB\nMG _BGC\nMO\n"
+				       "MG _MOA\n"));
+	assert_null(strstr(fk.log, "TC1"));
+	pthread_mutex_unlock(&fk.mu);
+	assert_int_equal(fk.motors_on, 0);
+	assert_int_equal(fk.downloads, 1);
+	proc_kill(&p);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -666,6 +756,10 @@ int main(void)
 	    cmocka_unit_test_setup_teardown(test_start_and_burn_fail, fk_start,
 					    fk_stop),
 	    cmocka_unit_test_setup_teardown(test_commands, fk_start, fk_stop),
+	    cmocka_unit_test_setup_teardown(test_busy_refused, fk_start,
+					    fk_stop),
+	    cmocka_unit_test_setup_teardown(test_load_while_jogging, fk_start,
+					    fk_stop),
 	};
 
 	return cmocka_run_group_tests(tests, setup_group, NULL);

@@ -11,7 +11,8 @@
  *
  * How it differs from a real DMC-4030:
  *   - It runs no program: only a small state table. Commands known:
- *     name=number, MG name|number|"text"|_BN|_CW|_TC, ^R^V, QZ, QR, TC, TC0,
+ *     name=number, MG name|number|"text"|_BN|_CW|_TC|_XQn|_BGx|_MOx, ^R^V,
+ *     QZ, QR, TC, TC0,
  *     TC1, WH, CF x, CW n, DL, UL, STUB ..., and HX ST MO SH BP BN BV XQ
  *     (accepted, no effect). Anything else is '?' with TC 1.
  *   - Values print as "% .4f" (e.g. " 5.0000"); TC1 prints "<code> <text>".
@@ -435,6 +436,10 @@ static void answer_mg(struct reply *r, const char *arg)
 		put_number(r, st.tc_code);
 	} else if (strncmp(arg, "_XQ", 3) == 0) {
 		put_number(r, -1); /* the stub runs no program threads */
+	} else if (strncmp(arg, "_BG", 3) == 0 && arg[3] && !arg[4]) {
+		put_number(r, 0); /* and moves no axis */
+	} else if (strncmp(arg, "_MO", 3) == 0 && arg[3] && !arg[4]) {
+		put_number(r, 1); /* its motors are off */
 	} else if (parse_num(arg, &d)) {
 		put_number(r, d);
 	} else if ((v = var_find(arg, false)) != NULL) {

@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "gl_err.h"
 #include "gl_ident.h"
@@ -45,25 +46,113 @@ static int send_simple(gl_link *l, const char *cmd, int timeout_ms)
 	return rc < 0 ? rc : GL_OK;
 }
 
-int gload_dl_halt(gl_link *l, int threads, int *running,
-		  char failed[GLOAD_CMD_LEN], int timeout_ms)
+/* ms on the monotonic clock. */
+static long long mono_ms(void)
+{
+	struct timespec ts;
+
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (long long)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+}
+
+static void sleep_ms(int ms)
+{
+	struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
+
+	while (nanosleep(&ts, &ts) == -1 && errno == EINTR)
+		;
+}
+
+int gload_dl_busy(gl_link *l, int watch_ms, int *state, int timeout_ms)
+{
+	double xq = -1, st = -1, hb0 = 0, hb1 = 0;
+
+	*state = -1;
+	if (gload_query_number(l, "MG _XQ0", &xq, timeout_ms) != GL_OK ||
+	    xq < 0)
+		return 0;
+	if (gload_query_number(l, "MG state", &st, timeout_ms) != GL_OK ||
+	    (st != 1 && st != 3))
+		return 0;
+	if (gload_query_number(l, "MG hbpc", &hb0, timeout_ms) != GL_OK)
+		return 0;
+	sleep_ms(watch_ms);
+	if (gload_query_number(l, "MG hbpc", &hb1, timeout_ms) != GL_OK ||
+	    hb1 == hb0)
+		return 0;
+	*state = (int)st;
+	return 1;
+}
+
+/* Every profiler stopped (_BGx = 0), waited for at most @stop_ms. */
+static int wait_stopped(gl_link *l, int axes, int stop_ms,
+			char failed[GLOAD_CMD_LEN], int timeout_ms)
+{
+	long long end = mono_ms() + stop_ms;
+	double bg;
+	int i, rc, moving;
+
+	do {
+		moving = 0;
+		for (i = 0; i < axes; i++) {
+			snprintf(failed, GLOAD_CMD_LEN, "MG _BG%c", 'A' + i);
+			rc = gload_query_number(l, failed, &bg, timeout_ms);
+			if (rc)
+				return rc;
+			moving |= bg != 0;
+		}
+		if (moving)
+			sleep_ms(10);
+	} while (moving && mono_ms() < end);
+	return moving ? GL_ERR_TIMEOUT : GL_OK;
+}
+
+/* Motors off (MO: never while a profiler runs) and read back off. */
+static int motors_off(gl_link *l, int axes, int *running,
+		      char failed[GLOAD_CMD_LEN], int timeout_ms)
+{
+	double mo;
+	int i, rc;
+
+	snprintf(failed, GLOAD_CMD_LEN, "MO");
+	rc = send_simple(l, failed, timeout_ms);
+	for (i = 0; !rc && i < axes; i++) {
+		snprintf(failed, GLOAD_CMD_LEN, "MG _MO%c", 'A' + i);
+		rc = gload_query_number(l, failed, &mo, timeout_ms);
+		if (!rc && mo != 1) {
+			*running = -1;
+			rc = GL_ERR_MISMATCH;
+		}
+	}
+	return rc;
+}
+
+int gload_dl_halt(gl_link *l, int threads, int axes, int stop_ms,
+		  int *running, char failed[GLOAD_CMD_LEN], int timeout_ms)
 {
 	double xq;
-	int i, rc = GL_OK;
+	int i, rc;
 
+	/* a controller without the RoboELF program makes prun a variable */
+	snprintf(failed, GLOAD_CMD_LEN, "prun=0");
+	rc = send_simple(l, failed, timeout_ms);
 	for (i = 0; !rc && i < threads; i++) {
 		snprintf(failed, GLOAD_CMD_LEN, "HX%d", i);
 		rc = send_simple(l, failed, timeout_ms);
 	}
-	/* bare ST and MO: every axis (and ST halts the threads once more) */
+	/* bare ST: every axis, decelerating (and the threads once more) */
 	if (!rc) {
 		snprintf(failed, GLOAD_CMD_LEN, "ST");
 		rc = send_simple(l, failed, timeout_ms);
 	}
-	if (!rc) {
-		snprintf(failed, GLOAD_CMD_LEN, "MO");
+	if (!rc)
+		rc = wait_stopped(l, axes, stop_ms, failed, timeout_ms);
+	if (rc == GL_ERR_TIMEOUT) {
+		snprintf(failed, GLOAD_CMD_LEN, "AB 1");
 		rc = send_simple(l, failed, timeout_ms);
 	}
+	if (!rc)
+		rc = motors_off(l, axes, running, failed, timeout_ms);
 	for (i = 0; !rc && i < threads; i++) {
 		snprintf(failed, GLOAD_CMD_LEN, "MG _XQ%d", i);
 		rc = gload_query_number(l, failed, &xq, timeout_ms);

@@ -24,6 +24,7 @@ enum gload_exit {
 			       * answering */
 	GLOAD_EXIT_CTRL = 4,  /* the controller rejected something, or the
 			       * read-back / start confirmation failed */
+	GLOAD_EXIT_BUSY = 5,  /* a supervisor drives the robot (no --force) */
 };
 
 #define GLOAD_SLOW_TIMEOUT_MS 10000	    /* DL, UL, BP [galil-notes 1.6] */
@@ -45,18 +46,36 @@ int gload_exit_for(int err);
 int gload_query_number(gl_link *l, const char *cmd, double *v, int timeout_ms);
 
 /*
- * gload_dl_halt() - stop every program thread (HX0..HXn-1), stop the axes
- * (ST) and switch the motors off (MO), then confirm with MG _XQn that no
- * thread runs.
+ * gload_dl_busy() - is a supervisor driving the robot? The RoboELF program
+ * runs (_XQ0 >= 0) in its armed (1) or service (3) state and its heartbeat
+ * hbpc changes within @watch_ms. A controller without that program, or one
+ * whose heartbeat stands still (its supervisor died: the program's own
+ * watchdog stops the robot), is not busy.
+ * @state: [out] the program's state when busy (1 or 3), else -1.
+ * Return: 1 busy, 0 not, or a link error.
+ */
+int gload_dl_busy(gl_link *l, int watch_ms, int *state, int timeout_ms);
+
+/*
+ * gload_dl_halt() - make the controller safe to load: prun=0 (the RoboELF
+ * program's automatic routines then only make safe: docs/dmc-interface.md),
+ * stop every program thread (HX0..HXn-1), stop the axes (ST, decelerating),
+ * wait until no profiler runs (_BGx = 0 on every axis, at most
+ * @stop_ms; past that AB 1 ends the motion at once), switch the motors off
+ * (MO: the controller refuses it while an axis moves, "7 Command not
+ * valid while running") and read every motor back off (_MOx = 1); then
+ * confirm with MG _XQn that no thread runs.
  * @threads: number of threads of the model (8 on a DMC-40x0).
- * @running: [out] on GL_ERR_MISMATCH, the thread still running.
+ * @axes: number of axes to stop and read back (3 on a DMC-4030).
+ * @running: [out] on GL_ERR_MISMATCH, the thread still running, or -1
+ *           when a motor is still on.
  * @failed: [out] the command that failed (or found the thread running),
  *          e.g. "MG _XQ3"; GLOAD_CMD_LEN bytes.
  * Return: GL_OK, GL_ERR_MISMATCH, or a link error (GL_ERR_CTRL: see
  *         gl_link_ctrl_error()).
  */
-int gload_dl_halt(gl_link *l, int threads, int *running,
-		  char failed[GLOAD_CMD_LEN], int timeout_ms);
+int gload_dl_halt(gl_link *l, int threads, int axes, int stop_ms,
+		  int *running, char failed[GLOAD_CMD_LEN], int timeout_ms);
 
 /*
  * gload_dl_compare() - compare the program meant (@want) with the one read

@@ -24,6 +24,8 @@
 #include "gload_prep.h"
 
 #define DEFAULT_TIMEOUT_MS 5000 /* gclib's default [galil-notes 1.6] */
+#define STOP_MS		   3000 /* every axis stopped after ST within */
+#define BUSY_WATCH_MS	   250	/* a supervisor's heartbeat changes within */
 #define MAX_COMMANDS	   64
 
 struct opts {
@@ -50,7 +52,9 @@ static const char usage_text[] =
     "  -m, --model MODEL          limits of 40x0 (default), 41x3, 21x3, 30010\n"
     "  -o, --output FILE          also write the stamped program to FILE\n"
     "  -f, --force                download even if the controller already\n"
-    "                             holds the same program\n"
+    "                             holds the same program, and even while\n"
+    "                             roboelf drives the robot (halts it: axes\n"
+    "                             stop, motors off, roboelf latches a fault)\n"
     "      --burn                 burn the program to flash (BP) after the\n"
     "                             read-back; #AUTO then runs at power-up\n"
     "      --start[=LABEL]        start LABEL (default AUTO) in thread 0 and\n"
@@ -366,6 +370,18 @@ static int open_link(const struct opts *o, gl_link **l)
 	return 0;
 }
 
+/* gload_dl_halt() with the controller's own number of axes. */
+static int halt(gl_link *l, const struct opts *o, int *running,
+		char failed[GLOAD_CMD_LEN])
+{
+	int axes = gl_link_axes(l);
+
+	if (axes < 0)
+		axes = 8; /* no QZ answer: every axis letter the family has */
+	return gload_dl_halt(l, o->model->threads, axes, STOP_MS, running,
+			     failed, o->timeout_ms);
+}
+
 /* Leave the controller halted and empty after a failed download. */
 static void erase_after_failure(gl_link **l, const struct opts *o)
 {
@@ -377,8 +393,7 @@ static void erase_after_failure(gl_link **l, const struct opts *o)
 		gl_link_close(*l);
 		*l = NULL;
 		if (open_link(o, l) == 0) {
-			rc = gload_dl_halt(*l, o->model->threads, &running,
-					   failed, o->timeout_ms);
+			rc = halt(*l, o, &running, failed);
 			if (rc == GL_OK)
 				rc = gload_dl_erase(*l, o->timeout_ms);
 		}
@@ -469,6 +484,33 @@ static int same_program(gl_link *l, const struct opts *o,
 	       GL_OK;
 }
 
+/* A supervisor driving the robot is not interrupted without --force. */
+static int busy(gl_link *l, const struct opts *o)
+{
+	int state, rc = gload_dl_busy(l, BUSY_WATCH_MS, &state, o->timeout_ms);
+
+	if (rc < 0)
+		return link_failed(l, "the busy check", rc, o->timeout_ms);
+	if (rc == 0)
+		return 0;
+	if (!o->force) {
+		fprintf(stderr,
+			"galil-load: the controller's program is %s and its "
+			"supervisor's heartbeat is advancing: roboelf is "
+			"driving the robot. Loading halts the program: every "
+			"axis stops, every motor is switched off and roboelf "
+			"latches a fault. Quit roboelf first, or give --force "
+			"to do exactly that\n",
+			state == 1 ? "armed" : "in its service state");
+		return GLOAD_EXIT_BUSY;
+	}
+	printf("warning: --force: halting a program that roboelf drives "
+	       "(%s): the axes stop, the motors go off, roboelf latches a "
+	       "fault\n",
+	       state == 1 ? "armed" : "service state");
+	return 0;
+}
+
 static int identify_and_halt(gl_link *l, const struct opts *o)
 {
 	char model[128] = "", failed[GLOAD_CMD_LEN], what[GLOAD_CMD_LEN + 16];
@@ -481,8 +523,16 @@ static int identify_and_halt(gl_link *l, const struct opts *o)
 	else if (rc != GL_ERR_CTRL)
 		return link_failed(l, "identification (^R^V, MG _BN)", rc,
 				   o->timeout_ms);
-	rc = gload_dl_halt(l, o->model->threads, &running, failed,
-			   o->timeout_ms);
+	rc = busy(l, o);
+	if (rc)
+		return rc;
+	rc = halt(l, o, &running, failed);
+	if (rc == GL_ERR_MISMATCH && running < 0) {
+		fprintf(stderr, "galil-load: a motor is still on after 'MO' "
+				"('%s')\n",
+			failed);
+		return GLOAD_EXIT_CTRL;
+	}
 	if (rc == GL_ERR_MISMATCH) {
 		fprintf(stderr,
 			"galil-load: thread %d still runs after "
