@@ -84,6 +84,9 @@ int ctrl_input(struct ctrl *c, int h, const uint8_t *buf, size_t len);
  */
 size_t ctrl_output(struct ctrl *c, int h, uint8_t *buf, size_t cap);
 
+/* ctrl_output_pending() - bytes ctrl_output() would give for handle h. */
+size_t ctrl_output_pending(const struct ctrl *c, int h);
+
 /*
  * ctrl_step() - one servo sample: read @in, update profilers, servo and
  * protection (limits, OE, OA, amplifier), run the program threads for one
@@ -132,9 +135,19 @@ void ctrl_power_cycle(struct ctrl *c);
 /*
  * ctrl_handle_close_wanted() - 1 when the controller wants the connection
  * on handle @h closed (IHS=>-3, IHT=>-3, IHB=>-2 ..., or a power cycle):
- * the network layer closes the socket and calls ctrl_handle_close().
+ * the network layer closes the socket and calls ctrl_handle_close(), which
+ * records the event "handle A closed by IHT from handle B".
  */
 int ctrl_handle_close_wanted(const struct ctrl *c, int h);
+
+/*
+ * ctrl_handle_close_by() - for a handle whose close is wanted: the handle
+ * (0..7, or 8 for ctrl_command()'s private port) whose IH command asked
+ * for it. The close is due once that handle's reply has been sent (IHS:
+ * the handle's own reply). Return: the handle, or -1 when there is no
+ * reply to wait for (a program's IH, a power cycle, no close wanted).
+ */
+int ctrl_handle_close_by(const struct ctrl *c, int h);
 
 /*
  * ctrl_handle_lost() - the TCP connection of handle @h failed (peer gone

@@ -421,11 +421,26 @@ static int cmd_cw(struct ctrl_xc *x, const char *a)
 	return 0;
 }
 
-/* IHh=>p closes handles: h = A..H, S (the sender), T (all but the sender) */
+/* Does "IH@h" sent on handle @sender name handle @i? */
+static int ih_names(char h, int i, int sender)
+{
+	if (h == 'T')
+		return i != sender;
+	if (h == 'S')
+		return i == sender;
+	return h == 'A' + i;
+}
+
+/*
+ * IHh=>r closes handles: h = A..H, S (the sender), T (every other one);
+ * r = -2 / -3 TCP (-1 UDP: the simulator has none, nothing to close). The
+ * network layer closes them once the sender's reply has gone
+ * (ctrl_handle_close_by()); the event names the command and its sender.
+ */
 static int cmd_ih(struct ctrl_xc *x, const char *a)
 {
 	struct ctrl *c = x->c;
-	char h;
+	char h, who[CTRL_WHO_LEN];
 	int i;
 
 	a = ctrl_skip(a);
@@ -436,17 +451,21 @@ static int cmd_ih(struct ctrl_xc *x, const char *a)
 	a = ctrl_skip(a + 2);
 	if (strcmp(a, "-1") && strcmp(a, "-2") && strcmp(a, "-3"))
 		return 6;
-	if (!strcmp(a, "-1"))
-		return 0; /* UDP handles: the simulator has none */
-	for (i = 0; i < CTRL_HANDLES; i++) {
-		if (!c->h[i].open)
-			continue;
-		if ((h == 'T' && i != x->handle) ||
-		    (h == 'S' && i == x->handle) || h == 'A' + i)
-			c->h[i].close_wanted = 1;
-	}
 	if (h != 'S' && h != 'T' && (h < 'A' || h >= 'A' + CTRL_HANDLES))
 		return 6;
+	if (!strcmp(a, "-1"))
+		return 0;
+	ctrl_xc_who(x, who, sizeof(who));
+	for (i = 0; i < CTRL_HANDLES; i++) {
+		struct ctrl_handle *hd = &c->h[i];
+
+		if (!hd->open || hd->close_wanted || !ih_names(h, i, x->handle))
+			continue;
+		hd->close_wanted = 1;
+		hd->close_by = x->handle;
+		snprintf(hd->close_why, sizeof(hd->close_why), "IH%c from %s",
+			 h, who);
+	}
 	return 0;
 }
 
