@@ -522,6 +522,48 @@ static void test_relay_over_pty(void **state)
 	assert_non_null(strstr(f->resp, " relay plugged in at /dev/pts/"));
 }
 
+/* ---- motor power options ------------------------------------------------ */
+
+/* --no-amp-undervoltage --power-output 2: the state line shows the output,
+ * SB 2 / CB 2 over the command port switch motor power (events), and the
+ * controller sees no under-voltage when power goes. */
+static void test_power_options(void **state)
+{
+	static char *const extra[] = {(char *)"--no-amp-undervoltage",
+				      (char *)"--power-output", (char *)"2",
+				      NULL};
+	struct fx *f = *state;
+	int fd;
+
+	proc_kill(&f->sim.p);
+	close(f->ctl);
+	f->ctl = -1;
+	assert_int_equal(
+	    proc_sim_start(&f->sim, bin_dir(), NULL, extra, START_MS), 0);
+	f->ctl = proc_ctl_connect(f->sim.ctl_port, REPLY_MS);
+	assert_true(f->ctl >= 0);
+	fd = cmd_connect(f);
+	assert_string_equal(ctl(f, "relay on"), "ok");
+	assert_int_equal(state_long(f, "pout"), 0);
+	assert_int_equal(state_long(f, "power"), 0);
+	expect_reply(fd, "SB 2", ":");
+	wait_event(f, "power output 2 set");
+	assert_int_equal(state_long(f, "pout"), 1);
+	assert_int_equal(state_long(f, "power"), 1);
+	expect_reply(fd, "CB 2", ":");
+	wait_event(f, "power output 2 cleared (motor power cut by the "
+		      "controller)");
+	assert_int_equal(state_long(f, "power"), 0);
+	events(f); /* drop what came so far */
+	expect_reply(fd, "SB 2", ":");
+	wait_event(f, "power output 2 set");
+	assert_string_equal(ctl(f, "relay off"), "ok");
+	wait_event(f, "motor power lost (amplifiers report nothing: "
+		      "under-voltage model off)");
+	expect_reply(fd, "MG _TA0", " 0.0000\r\n:");
+	close(fd);
+}
+
 /* ---- ending ------------------------------------------------------------- */
 
 static void test_quit(void **state)
@@ -623,6 +665,9 @@ static void test_usage_errors(void **state)
 		   "galil-sim: bad port '70000'\ntry 'galil-sim --help'\n");
 	run_expect((char *const[]){(char *)"extra", NULL}, 2,
 		   "galil-sim: unexpected argument 'extra'\n");
+	run_expect(
+	    (char *const[]){(char *)"--power-output", (char *)"9", NULL}, 2,
+	    "galil-sim: bad power output '9' (0..8)\ntry 'galil-sim --help'\n");
 }
 
 /* A relay link path holding a regular file is refused: exit 1, the file
@@ -698,6 +743,7 @@ int main(void)
 	    T(test_ihs_and_iha),
 	    T(test_ih_close_after_reply),
 	    T(test_relay_over_pty),
+	    T(test_power_options),
 	    T(test_quit),
 	    T(test_sigterm),
 	    cmocka_unit_test(test_bad_plant_file),

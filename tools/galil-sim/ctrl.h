@@ -122,6 +122,10 @@ int ctrl_set_var(struct ctrl *c, const char *name, double v);
 /* ctrl_axis_info() - state of axis 0..2. Return 0 or GL_ERR_ARG. */
 int ctrl_axis_info(const struct ctrl *c, int axis, struct ctrl_axis_info *out);
 
+/* ctrl_outputs() - the digital outputs now, bit n-1 = output n (SB, CB,
+ * OB, OP, also between samples). */
+uint32_t ctrl_outputs(const struct ctrl *c);
+
 /* ctrl_threads() - bit n = thread n running. */
 unsigned ctrl_threads(const struct ctrl *c);
 

@@ -368,6 +368,16 @@ static void put_axis(struct sim *s, int i, struct out *o)
 	    a, ps.pos);
 }
 
+/* "1" / "0": the plant's power output set / cleared; "-": none. */
+static const char *power_output_state(struct sim *s)
+{
+	int n = sim_plant_get_cfg(s->plant)->power_output;
+
+	if (n == 0)
+		return "-";
+	return (ctrl_outputs(s->ctrl) >> (n - 1)) & 1 ? "1" : "0";
+}
+
 static int req_state(struct sim *s, char **arg, int n, struct out *o)
 {
 	static const char *const links[] = {"ok", "drop", "stall", "delay"};
@@ -379,9 +389,9 @@ static int req_state(struct sim *s, char **arg, int n, struct out *o)
 	(void)arg;
 	(void)n;
 	sim_fmt_ms(t, sizeof(t), s->time_us);
-	put(o, "time=%s relay=%s power=%d link=%s threads=", t,
+	put(o, "time=%s relay=%s power=%d pout=%s link=%s threads=", t,
 	    sim_relay_power(s->relay) ? "on" : "off", sim_power(s),
-	    links[s->link]);
+	    power_output_state(s), links[s->link]);
 	for (int i = 0; i < CTRL_THREADS; i++) {
 		if (th & (1u << i)) {
 			put(o, "%s%d", any ? "," : "", i);
