@@ -147,7 +147,7 @@ static void test_errors(void **state)
 	ctl_err(f, "relay toggle", "error: usage: relay [on|off]");
 	ctl_err(f, "relayfault melt",
 		"error: usage: relayfault <ok|unplug|"
-		"writefail>");
+		"writefail|wedge>");
 	ctl_err(f, "watch bad;name", "error: bad variable name 'bad;name'");
 	ctl_err(f, "unwatch x", "error: 'x' is not watched");
 	ctl_err(f, "a b c d e f g h i", "error: too many words");

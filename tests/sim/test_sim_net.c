@@ -522,6 +522,57 @@ static void test_relay_over_pty(void **state)
 	assert_non_null(strstr(f->resp, " relay plugged in at /dev/pts/"));
 }
 
+#define WEDGE_HOLD_MS 200 /* a wedge is judged over this */
+
+/*
+ * relayfault wedge: the board stops reading its pty. A host (raw termios,
+ * O_NONBLOCK) writes "relay off": for WEDGE_HOLD_MS the relay still
+ * answers on and the state says power=1; "relay off" from the control port
+ * is refused; the host's writes end up refused (EAGAIN). relayfault ok:
+ * the queue is discarded unread, the relay is off, the board obeys again.
+ */
+static void test_relay_wedge(void **state)
+{
+	struct fx *f = *state;
+	int fd = open_relay(f->link);
+	long long end;
+	uint8_t chunk[256];
+	long total = 1;
+	ssize_t w;
+
+	assert_true(fd >= 0);
+	assert_int_equal(fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK),
+			 0);
+	assert_int_equal(write(fd, "\x65", 1), 1);
+	wait_answer(f, "relay", "on");
+	assert_string_equal(ctl(f, "relayfault wedge"), "ok");
+	assert_int_equal(write(fd, "\x6f", 1), 1);
+	end = proc_now_ms() + WEDGE_HOLD_MS;
+	while (proc_now_ms() < end) {
+		assert_string_equal(ctl(f, "relay"), "on");
+		assert_int_equal(state_long(f, "power"), 1);
+		poll(NULL, 0, 10);
+	}
+	assert_string_equal(ctl(f, "relay off"), "error: relay is wedged");
+	memset(chunk, 0x65, sizeof(chunk));
+	while ((w = write(fd, chunk, sizeof(chunk))) > 0 && total < (1L << 20))
+		total += w;
+	assert_int_equal(w, -1);
+	assert_true(errno == EAGAIN || errno == EWOULDBLOCK);
+	assert_string_equal(ctl(f, "relay"), "on");
+	assert_string_equal(ctl(f, "relayfault ok"), "ok");
+	assert_string_equal(ctl(f, "relay"), "off");
+	wait_event(f, "relay obeys again (relays off)");
+	/* all logged before "relayfault ok" answered: one answer has them */
+	assert_non_null(strstr(f->resp, " relay wedged (bytes not read)\n"));
+	assert_non_null(
+	    strstr(f->resp, " relay off (board reset after wedge)\n"));
+	assert_null(strstr(f->resp, "(byte 0x6f)"));
+	assert_int_equal(write(fd, "\x65", 1), 1);
+	wait_answer(f, "relay", "on");
+	close(fd);
+}
+
 /* ---- motor power options ------------------------------------------------ */
 
 /* --no-amp-undervoltage --power-output 2: the state line shows the output,
@@ -743,6 +794,7 @@ int main(void)
 	    T(test_ihs_and_iha),
 	    T(test_ih_close_after_reply),
 	    T(test_relay_over_pty),
+	    T(test_relay_wedge),
 	    T(test_power_options),
 	    T(test_quit),
 	    T(test_sigterm),

@@ -283,6 +283,16 @@ static int req_link(struct sim *s, char **arg, int n, struct out *o)
 	return ok(o);
 }
 
+/* Why "relay on|off" cannot act: the board's fault. */
+static const char *fault_word(const struct sim_relay *r)
+{
+	switch (sim_relay_get_fault(r)) {
+	case SIM_RELAY_UNPLUG: return "unplugged";
+	case SIM_RELAY_WEDGE: return "wedged";
+	default: return "failing";
+	}
+}
+
 static int req_relay(struct sim *s, char **arg, int n, struct out *o)
 {
 	if (n == 0) {
@@ -292,10 +302,7 @@ static int req_relay(struct sim *s, char **arg, int n, struct out *o)
 	if (strcmp(arg[0], "on") && strcmp(arg[0], "off"))
 		return fail(o, "usage: relay [on|off]");
 	if (sim_relay_set(s->relay, !strcmp(arg[0], "on")) < 0)
-		return fail(o, "relay is %s",
-			    sim_relay_get_fault(s->relay) == SIM_RELAY_UNPLUG
-				? "unplugged"
-				: "failing");
+		return fail(o, "relay is %s", fault_word(s->relay));
 	return ok(o);
 }
 
@@ -311,8 +318,10 @@ static int req_relayfault(struct sim *s, char **arg, int n, struct out *o)
 		f = SIM_RELAY_UNPLUG;
 	else if (!strcmp(arg[0], "writefail"))
 		f = SIM_RELAY_WRITEFAIL;
+	else if (!strcmp(arg[0], "wedge"))
+		f = SIM_RELAY_WEDGE;
 	else
-		return fail(o, "usage: relayfault <ok|unplug|writefail>");
+		return fail(o, "usage: relayfault <ok|unplug|writefail|wedge>");
 	sim_event(s, "inject: relayfault %s", arg[0]);
 	if (sim_relay_set_fault(s->relay, f, err, sizeof(err)) < 0)
 		return fail(o, "%s", err);
@@ -497,7 +506,8 @@ static const struct request requests[] = {
     {"block", 2, 2, req_block, "block <A|B|C> <0|1>"},
     {"link", 1, 2, req_link, "link <ok|drop|stall|delay MS>"},
     {"relay", 0, 1, req_relay, "relay [on|off]"},
-    {"relayfault", 1, 1, req_relayfault, "relayfault <ok|unplug|writefail>"},
+    {"relayfault", 1, 1, req_relayfault,
+     "relayfault <ok|unplug|writefail|wedge>"},
     {"state", 0, 0, req_state, "state"},
     {"watch", 1, 1, req_watch, "watch <variable>"},
     {"unwatch", 1, 1, req_unwatch, "unwatch <variable>"},
