@@ -516,6 +516,11 @@ static int cmd_ti(struct ctrl_xc *x, const char *a, int amp)
 
 /* ---- DM DA LV LA LL ------------------------------------------------------ */
 
+/*
+ * DM name[n],name2[m] (command reference DM): each array in turn; an array
+ * that exists is not re-dimensioned (ctrl_array_dim(): same size nothing,
+ * another size TC 57). DM ? / DM alone answers the free array space (_DM).
+ */
 static int cmd_dm(struct ctrl_xc *x, const char *a)
 {
 	uint64_t key;
@@ -593,27 +598,41 @@ static int da_one(struct ctrl_vars *vs, const char *a, size_t len, int arr)
 	return 0;
 }
 
+/*
+ * DA (command reference DA): "name" a variable, "name[]" an array, "*"
+ * every variable, "*[]" every array, several separated by commas. The
+ * brackets may hold anything but a comma (the reference writes "Cars[0]",
+ * "*[0]"). "DA ?" answers the free array slots (_DA). An unknown variable
+ * is TC 9, an unknown array TC 57 (choice: the reference is silent).
+ */
 static int cmd_da(struct ctrl_xc *x, const char *a)
 {
 	size_t len;
 	int rc, arr;
 
 	a = ctrl_skip(a);
+	if (*a == '?' && *ctrl_skip(a + 1) == '\0') {
+		ctrl_buf_printf(&x->c->tmp, " %d\r\n",
+				ctrl_arrays_free(&x->c->vars));
+		return 0;
+	}
 	while (*a) {
+		const char *name = a;
+
 		len = *a == '*' ? 1 : ctrl_ident_len(a);
 		if (!len)
 			return 1;
 		arr = a[len] == '[';
-		rc = da_one(&x->c->vars, a, len, arr);
-		if (rc)
-			return rc;
 		a += len;
 		if (arr) {
-			a = strchr(a, ']');
-			if (!a)
+			a += strcspn(a, "],");
+			if (*a != ']')
 				return 55;
 			a++;
 		}
+		rc = da_one(&x->c->vars, name, len, arr);
+		if (rc)
+			return rc;
 		a = ctrl_skip(a);
 		if (*a == ',')
 			a = ctrl_skip(a + 1);

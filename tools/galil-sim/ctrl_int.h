@@ -118,6 +118,7 @@ int ctrl_var_set(struct ctrl_vars *vs, uint64_t key, double v, int *slot);
 struct ctrl_array *ctrl_array_find(struct ctrl_vars *vs, uint64_t key);
 int ctrl_array_dim(struct ctrl_vars *vs, uint64_t key, int n);
 int ctrl_array_free(struct ctrl_vars *vs, uint64_t key);
+int ctrl_arrays_free(const struct ctrl_vars *vs);
 void ctrl_vars_clear(struct ctrl_vars *vs);
 int ctrl_vars_copy(struct ctrl_vars *dst, const struct ctrl_vars *src);
 
