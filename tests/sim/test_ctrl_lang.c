@@ -172,6 +172,59 @@ static void test_arrays(void **state)
 	expect_error(p, "MG arr[0]", 57);
 }
 
+/* DM of an array that exists: the same size changes nothing (values
+ * kept), another size is refused with TC 57 and the array stays; a program
+ * gets the same error. DA first, then DM, re-dimensions. */
+static void test_dm_existing_array(void **state)
+{
+	struct tplant *p = *state;
+	char resp[128];
+
+	expect_reply(p, "DM a[5];a[0]=7;DM a[5];MG a[0],a[-1],_DM",
+		     "::: 7.0000 5.0000 23995.0000\r\n");
+	expect_error(p, "DM a[8]", 57);
+	assert_int_equal(tp_cmd(p, "DM a[6]", resp, sizeof(resp)), GL_ERR_CTRL);
+	assert_int_equal(tp_cmd(p, "TC 1", resp, sizeof(resp)), GL_OK);
+	assert_string_equal(resp, " 57 Bad function or array\r\n");
+	expect_reply(p, "MG a[0],a[-1],_DM,_DA",
+		     " 7.0000 5.0000 23995.0000 29.0000\r\n");
+	expect_reply(p, "DA a[];DM a[8];MG a[0],a[-1],_DM",
+		     ":: 0.0000 8.0000 23992.0000\r\n");
+	assert_int_equal(tp_load(p, "#P\rDM a[8]\rDM a[9]\rok=1\rEN\r"), GL_OK);
+	expect_reply(p, "ok=0;XQ #P", ":");
+	tp_step(p, 5);
+	assert_true(tp_has_event(p, "program error thread 0 line 2 TC 57 Bad "
+				    "function or array"));
+	expect_reply(p, "MG ok,a[-1]", " 0.0000 8.0000\r\n");
+}
+
+/* DA as the DMC-40x0 reference writes it: name[] or name[0] for an array,
+ * *[] or *[0] for every array, * for every variable; DA ? the free array
+ * slots. */
+static void test_da_forms(void **state)
+{
+	struct tplant *p = *state;
+
+	expect_reply(p, "DM Cars[40],Salesmen[50],keep[2];Total=70", ":");
+	expect_reply(p, "DA ?", " 27\r\n");
+	expect_reply(p, "DA Cars[0],Salesmen[],Total;MG _DA,_DM,_UL",
+		     ": 29.0000 23998.0000 510.0000\r\n");
+	expect_error(p, "MG Cars[0]", 57);
+	expect_error(p, "MG Total", 1);
+	expect_reply(p, "MG keep[-1]", " 2.0000\r\n");
+	expect_reply(p, "DM b[3],c[4];v=1;DA *[0];MG _DA,_DM,v",
+		     "::: 30.0000 24000.0000 1.0000\r\n");
+	expect_reply(p, "DM b[3];DA *;MG _DA,_UL,b[-1]",
+		     ":: 29.0000 510.0000 3.0000\r\n");
+	expect_reply(p, "DA*[];DA ?", ": 30\r\n");
+	expect_error(p, "DA nope[]", 57);
+	expect_error(p, "DA nope", 9);
+	expect_reply(p, "DM b[3]", "");
+	expect_error(p, "DA b[0", 55);
+	expect_error(p, "DA b[,c[]", 55);
+	expect_reply(p, "MG b[-1]", " 3.0000\r\n");
+}
+
 /* Lower case commands, unknown commands and operands used as commands. */
 static void test_bad_commands(void **state)
 {
@@ -568,6 +621,9 @@ int main(void)
 	    cmocka_unit_test_setup_teardown(test_mg_formats, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_variables, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_arrays, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_dm_existing_array, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_da_forms, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_bad_commands, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_nested_if, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_if_without_endif, setup,

@@ -11,6 +11,7 @@
 #include <setjmp.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 #include <cmocka.h>
 
 #include "test_ctrl_util.h"
@@ -297,6 +298,76 @@ static void test_abort(void **state)
 	assert_int_equal(ctrl_threads(p->c), 0);
 }
 
+/* Is @text exactly one of the events? */
+static int has_line(const struct tplant *p, const char *text)
+{
+	for (int i = 0; i < p->nevents; i++)
+		if (!strcmp(p->events[i], text))
+			return 1;
+	return 0;
+}
+
+static int count_prefix(const struct tplant *p, const char *prefix)
+{
+	int n = 0;
+
+	for (int i = 0; i < p->nevents; i++)
+		n += !strncmp(p->events[i], prefix, strlen(prefix));
+	return n;
+}
+
+static void expect_event(const struct tplant *p, const char *text)
+{
+	if (!has_line(p, text))
+		fail_msg("no event '%s'", text);
+}
+
+/* Events of SH MO BG ST AB HX and a PT start name who commanded them: a
+ * program thread and its line, a host handle, the private port. */
+static void test_event_sources(void **state)
+{
+	static const char prog[] = "#T\rSHA\rPRA=5000\rBGA\rWT 5\rSTA\r"
+				   "AMA\rSHA\rJGA=1000;BGA\rWT 5\rAB 1\r"
+				   "MOA\rEN\r#L;WT 1;JP #L\r";
+	struct tplant *p = *state;
+	char out[256];
+
+	assert_int_equal(tp_load(p, prog), GL_OK);
+	ok(p, "XQ #T,2");
+	tp_step(p, 200);
+	assert_int_equal(ctrl_threads(p->c), 0);
+	expect_event(p, "axis A motor on: SH (thread 2 line 1)");
+	expect_event(p, "axis A begin (thread 2 line 3)");
+	expect_event(p, "axis A stop: ST (thread 2 line 5)");
+	expect_event(p, "axis A begin (thread 2 line 8)");
+	expect_event(p, "axis A abort: AB (thread 2 line 10)");
+	expect_event(p, "axis A motor off: MO (thread 2 line 11)");
+	assert_int_equal(count_prefix(p, "axis A motor on"), 1);
+
+	tp_send(p, 1, "SHB;PRB=1000;BGB;STB\r");
+	assert_string_equal((tp_out(p, 1, out, sizeof(out)), out), "::::");
+	expect_event(p, "axis B motor on: SH (handle B)");
+	expect_event(p, "axis B begin (handle B)");
+	expect_event(p, "axis B stop: ST (handle B)");
+	tp_step(p, 100);
+	tp_send(p, 1, "OEB=1;JGB=500;BGB;AB 1\r");
+	expect_event(p, "axis B abort: AB (handle B)");
+	expect_event(p, "axis B motor off: abort with OE set (handle B)");
+	tp_send(p, 1, "SHC;PTC=1;PAC=100;PAC=200\r");
+	expect_event(p, "axis C begin PT (handle B)");
+	assert_int_equal(count_prefix(p, "axis C begin"), 1);
+
+	ok(p, "XQ #L,1;XQ #L,3");
+	tp_send(p, 1, "HX 1\r");
+	expect_event(p, "thread 1 stopped: halted by HX (handle B)");
+	tp_send(p, 2, "AB\r");
+	expect_event(p, "thread 3 stopped: aborted by AB (handle C)");
+	ok(p, "XQ #L,4;ST");
+	expect_event(p, "thread 4 stopped: halted by ST (private port)");
+	ok(p, "MO C");
+	expect_event(p, "axis C motor off: MO (private port)");
+}
+
 /* KP KI KD TL are stored, reported, range-checked; OV <= TL. */
 static void test_gains(void **state)
 {
@@ -391,6 +462,8 @@ int main(void)
 	    cmocka_unit_test_setup_teardown(test_amp_power, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_refusals, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_abort, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_event_sources, setup,
+					    teardown),
 	    cmocka_unit_test_setup_teardown(test_gains, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_trippoints, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_mc_timeout, setup, teardown),

@@ -147,7 +147,7 @@ static void test_errors(void **state)
 	ctl_err(f, "relay toggle", "error: usage: relay [on|off]");
 	ctl_err(f, "relayfault melt",
 		"error: usage: relayfault <ok|unplug|"
-		"writefail>");
+		"writefail|wedge>");
 	ctl_err(f, "watch bad;name", "error: bad variable name 'bad;name'");
 	ctl_err(f, "unwatch x", "error: 'x' is not watched");
 	ctl_err(f, "a b c d e f g h i", "error: too many words");
@@ -168,12 +168,12 @@ static void copy(char *dst, size_t cap, const char *src)
 static void test_state_line_format(void **state)
 {
 	static const char *const keys[] = {
-	    "time",  "relay", "power", "link",	     "threads", "A.pos",
-	    "A.ref", "A.vel", "A.pot", "A.mo",	     "A.sc",	"A.lf",
-	    "A.lr",  "A.act", "B.pos", "B.ref",	     "B.vel",	"B.pot",
-	    "B.mo",  "B.sc",  "B.lf",  "B.lr",	     "B.act",	"C.pos",
-	    "C.ref", "C.vel", "C.pot", "C.mo",	     "C.sc",	"C.lf",
-	    "C.lr",  "C.act", "var.x", "var.arr[2]",
+	    "time",  "relay", "power", "pout",	"link",	      "threads",
+	    "A.pos", "A.ref", "A.vel", "A.pot", "A.mo",	      "A.sc",
+	    "A.lf",  "A.lr",  "A.act", "B.pos", "B.ref",      "B.vel",
+	    "B.pot", "B.mo",  "B.sc",  "B.lf",	"B.lr",	      "B.act",
+	    "C.pos", "C.ref", "C.vel", "C.pot", "C.mo",	      "C.sc",
+	    "C.lf",  "C.lr",  "C.act", "var.x", "var.arr[2]",
 	};
 	struct fx *f = *state;
 	char line[2048], *save = NULL, *tok;
@@ -197,7 +197,7 @@ static void test_state_line_format(void **state)
 	assert_int_equal(k, sizeof(keys) / sizeof(keys[0]));
 	copy(line, sizeof(line), ctl(f, "state"));
 	assert_non_null(strstr(line,
-			       "time=5 relay=off power=0 link=ok "
+			       "time=5 relay=off power=0 pout=- link=ok "
 			       "threads=- A.pos=0 A.ref=0 A.vel=0 A.pot=2.5"));
 	assert_non_null(strstr(line, " A.mo=1 A.sc="));
 	assert_non_null(strstr(line, " var.x=? var.arr[2]=?"));
@@ -353,6 +353,130 @@ static void test_power_and_motion(void **state)
 	ctl_err(f, "relay on", "error: relay is failing");
 }
 
+/* The events since the last call contain @text as a whole line. */
+static int has_event(struct fx *f, const char *text)
+{
+	const char *ev = ctl(f, "events"), *p = ev;
+	size_t n = strlen(text);
+
+	while ((p = strstr(p, text)) != NULL) {
+		if (p > ev && p[-1] == ' ' && (p[n] == '\n' || p[n] == '\0'))
+			return 1;
+		p += n;
+	}
+	return 0;
+}
+
+/* amp_undervoltage off: the relay cuts motor power, the motor stops where
+ * it is, and the controller sees nothing: no under-voltage bit, no
+ * #AMPERR, no stop code 15, the servo stays on; back on, it moves again. */
+static void test_amp_undervoltage_off(void **state)
+{
+	static const char prog[] = "#AMPERR\ramperr=amperr+1\rRE\r";
+	struct fx *f = *state;
+	struct ctrl *c = sim_ctrl(f->s);
+	char resp[128];
+	double act;
+
+	assert_int_equal(sim_plant_set_amp_undervoltage(sim_get_plant(f->s), 0),
+			 0);
+	assert_int_equal(ctrl_download(c, prog, strlen(prog), NULL), 0);
+	sim_advance_ms(f->s, 1);
+	ctl(f, "relay on");
+	assert_int_equal(ctrl_command(c,
+				      "amperr=0;OE 1,1,1;SH ABC;JG 2000;BG A",
+				      resp, sizeof(resp)),
+			 0);
+	sim_advance_ms(f->s, 200);
+	ctl(f, "events");
+	ctl(f, "relay off");
+	sim_advance_ms(f->s, 1);
+	act = state_num(f, "A.act");
+	sim_advance_ms(f->s, 300);
+	assert_int_equal(state_num(f, "power"), 0);
+	assert_float_equal(state_num(f, "A.act"), act, 0);
+	assert_float_equal(state_num(f, "A.vel"), 0, 0);
+	assert_int_equal(state_num(f, "A.mo"), 0);
+	assert_int_equal(state_num(f, "A.sc"), 0); /* still jogging */
+	assert_float_equal(mg(f, "MG _TA0"), 0, 0);
+	assert_float_equal(mg(f, "MG _MOA"), 0, 0);
+	assert_float_equal(mg(f, "MG _BGA"), 1, 0);
+	assert_float_equal(mg(f, "MG amperr"), 0, 0);
+	assert_true(state_num(f, "A.ref") - state_num(f, "A.pos") > 500);
+	assert_true(has_event(f, "motor power lost (amplifiers report "
+				 "nothing: under-voltage model off)"));
+	ctl(f, "relay on");
+	sim_advance_ms(f->s, 100);
+	assert_true(state_num(f, "A.act") > act + 100);
+	assert_true(has_event(f, "motor power restored (under-voltage model "
+				 "off)"));
+	ctl(f, "events");
+	/* the same with the model on: the controller reacts */
+	assert_int_equal(sim_plant_set_amp_undervoltage(sim_get_plant(f->s), 1),
+			 0);
+	ctl(f, "relay off");
+	sim_advance_ms(f->s, 20);
+	assert_float_equal(mg(f, "MG _TA0"), 8, 0);
+	assert_float_equal(mg(f, "MG _SCA"), 15, 0);
+	assert_float_equal(mg(f, "MG amperr"), 1, 0);
+	assert_true(has_event(f, "amplifier power lost (under-voltage)"));
+}
+
+/* power_output 3: motor power needs the relay and output 3; the state
+ * line shows it as pout, and each change is an event. */
+static void test_power_output(void **state)
+{
+	struct fx *f = *state;
+	struct ctrl *c = sim_ctrl(f->s);
+	char resp[128];
+
+	sim_advance_ms(f->s, 1);
+	assert_non_null(strstr(ctl(f, "state"), " power=0 pout=- link="));
+	assert_int_equal(sim_plant_set_power_output(sim_get_plant(f->s), 3), 0);
+	ctl(f, "relay on");
+	sim_advance_ms(f->s, 1);
+	assert_int_equal(state_num(f, "power"), 0);
+	assert_int_equal(state_num(f, "pout"), 0);
+	assert_int_equal(sim_power(f->s), 0);
+	ctl(f, "events");
+	assert_int_equal(
+	    ctrl_command(c, "SB 3;OE 1;SH A;PR 1000;BG A", resp, sizeof(resp)),
+	    0);
+	sim_advance_ms(f->s, 1);
+	assert_int_equal(state_num(f, "power"), 1);
+	assert_int_equal(state_num(f, "pout"), 1);
+	assert_true(has_event(f, "power output 3 set"));
+	sim_advance_ms(f->s, 500);
+	assert_float_equal(state_num(f, "A.act"), 1000, 1);
+	assert_int_equal(ctrl_command(c, "CB 3", resp, sizeof(resp)), 0);
+	sim_advance_ms(f->s, 2);
+	assert_int_equal(state_num(f, "power"), 0);
+	assert_int_equal(state_num(f, "pout"), 0);
+	assert_string_equal(ctl(f, "relay"), "on");
+	assert_float_equal(mg(f, "MG _SCA"), 15, 0); /* the model is on */
+	ctl(f, "events");
+	assert_int_equal(ctrl_command(c, "OB 3,1", resp, sizeof(resp)), 0);
+	sim_advance_ms(f->s, 1);
+	assert_int_equal(state_num(f, "power"), 1);
+	assert_int_equal(ctrl_command(c, "OP 0", resp, sizeof(resp)), 0);
+	sim_advance_ms(f->s, 1);
+	assert_int_equal(state_num(f, "power"), 0);
+	ctl(f, "events"); /* drop the events so far */
+	assert_int_equal(ctrl_command(c, "SB 3", resp, sizeof(resp)), 0);
+	sim_advance_ms(f->s, 1);
+	assert_true(has_event(f, "power output 3 set"));
+	assert_int_equal(ctrl_command(c, "CB 3", resp, sizeof(resp)), 0);
+	sim_advance_ms(f->s, 1);
+	assert_true(has_event(f, "power output 3 cleared (motor power cut by "
+				 "the controller)"));
+	/* output set, relay off: no power */
+	assert_int_equal(ctrl_command(c, "SB 3", resp, sizeof(resp)), 0);
+	ctl(f, "relay off");
+	sim_advance_ms(f->s, 1);
+	assert_int_equal(state_num(f, "power"), 0);
+	assert_int_equal(state_num(f, "pout"), 1);
+}
+
 /* A jammed axis: the reference moves on, the motor does not. */
 static void test_block_stops_motor(void **state)
 {
@@ -458,6 +582,8 @@ int main(void)
 	    T(test_joy_and_inputs_seen_by_controller),
 	    T(test_pot_fault_in_state),
 	    T(test_power_and_motion),
+	    T(test_amp_undervoltage_off),
+	    T(test_power_output),
 	    T(test_block_stops_motor),
 	    T(test_link_requests),
 	    T(test_power_cycle),

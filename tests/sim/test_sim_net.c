@@ -332,6 +332,141 @@ static void test_power_cycle_closes(void **state)
 	close(fd);
 }
 
+/* ---- IH closing and connection events ---------------------------------- */
+
+/* The events since the last call, into f->resp, each line ending with a
+ * newline (so that " text\n" matches a whole event text). */
+static const char *events(struct fx *f)
+{
+	int n = proc_ctl_request_multi(f->ctl, "events", f->resp,
+				       sizeof(f->resp) - 1, REPLY_MS);
+
+	if (n < 0)
+		fail_msg("no answer to 'events'");
+	if (n > 0)
+		strcat(f->resp, "\n");
+	return f->resp;
+}
+
+/* " handle A opened from 127.0.0.1:<local port of fd>\n" is in @ev. */
+static void expect_opened(const char *ev, char handle, int fd)
+{
+	struct sockaddr_in sa;
+	socklen_t len = sizeof(sa);
+	char want[64];
+
+	assert_int_equal(getsockname(fd, (struct sockaddr *)&sa, &len), 0);
+	snprintf(want, sizeof(want), " handle %c opened from 127.0.0.1:%d\n",
+		 handle, ntohs(sa.sin_port));
+	if (!strstr(ev, want))
+		fail_msg("no '%s' in the events:\n%s", want, ev);
+}
+
+/* "cmd\r" on @fd answers exactly @want (the reply up to ':' or '?'). */
+static void expect_reply(int fd, const char *cmd, const char *want)
+{
+	char buf[256], line[64];
+
+	snprintf(line, sizeof(line), "%s\r", cmd);
+	send_cmd(fd, line);
+	assert_true(read_reply(fd, buf, sizeof(buf), REPLY_MS) > 0);
+	assert_string_equal(buf, want);
+}
+
+/* IHT=>-3 from handle B closes handle A (EOF), B goes on; the handle is
+ * free again (_IHA2 = 0) and the next connection takes it. */
+static void test_iht_closes_others(void **state)
+{
+	struct fx *f = *state;
+	int a = cmd_connect(f), b;
+	const char *ev;
+
+	expect_mg1(a); /* a is handle A */
+	b = cmd_connect(f);
+	expect_mg1(b); /* b is handle B */
+	expect_reply(b, "WH", "IHB\r\n:");
+	expect_reply(b, "MG _IHA2,_IHB2", " 2.0000 2.0000\r\n:");
+	expect_reply(b, "IHT=>-3", ":");
+	expect_closed(a);
+	expect_mg1(b);
+	expect_reply(b, "MG _IHA2,_IHB2", " 0.0000 2.0000\r\n:");
+	ev = events(f);
+	expect_opened(ev, 'A', a);
+	expect_opened(ev, 'B', b);
+	assert_non_null(strstr(ev, " handle A closed by IHT from handle B\n"));
+	assert_null(strstr(ev, "handle B closed"));
+	close(a);
+	a = cmd_connect(f);
+	expect_reply(a, "WH", "IHA\r\n:");
+	expect_opened(events(f), 'A', a);
+	close(a);
+	close(b);
+}
+
+/* Wait until the events include " @text\n" (deadline). */
+static void wait_event(struct fx *f, const char *text)
+{
+	long long end = proc_now_ms() + REPLY_MS;
+	char want[128];
+
+	snprintf(want, sizeof(want), " %s\n", text);
+	while (!strstr(events(f), want)) {
+		if (proc_now_ms() > end)
+			fail_msg("no event '%s'", text);
+		poll(NULL, 0, 5);
+	}
+}
+
+/* IHS=>-2 closes the sender after its reply; IHA=>-2 closes handle A; a
+ * client that leaves is "closed (peer)". */
+static void test_ihs_and_iha(void **state)
+{
+	struct fx *f = *state;
+	int a = cmd_connect(f), b, c;
+	const char *ev;
+
+	expect_mg1(a);
+	b = cmd_connect(f);
+	expect_mg1(b);
+	expect_reply(b, "IHA=>-2", ":");
+	expect_closed(a);
+	expect_reply(b, "IHS=>-2", ":");
+	expect_closed(b);
+	c = cmd_connect(f);
+	expect_reply(c, "WH", "IHA\r\n:");
+	expect_reply(c, "MG _IHA2,_IHB2", " 2.0000 0.0000\r\n:");
+	ev = events(f);
+	assert_non_null(strstr(ev, " handle A closed by IHA from handle B\n"));
+	assert_non_null(strstr(ev, " handle B closed by IHS from handle B\n"));
+	close(c);
+	wait_event(f, "handle A closed (peer)");
+	close(a);
+	close(b);
+}
+
+/* The close waits for the IH reply: with replies held back 300 ms, handle
+ * A stays open until handle B has its ':'. */
+static void test_ih_close_after_reply(void **state)
+{
+	struct fx *f = *state;
+	int a = cmd_connect(f), b;
+	struct pollfd p;
+	char buf[16];
+
+	expect_mg1(a);
+	b = cmd_connect(f);
+	expect_mg1(b);
+	assert_string_equal(ctl(f, "link delay 300"), "ok");
+	send_cmd(b, "IHT=>-3\r");
+	p = (struct pollfd){a, POLLIN, 0};
+	assert_int_equal(poll(&p, 1, 200), 0); /* still open, nothing sent */
+	assert_true(read_reply(b, buf, sizeof(buf), REPLY_MS) > 0);
+	assert_string_equal(buf, ":");
+	expect_closed(a);
+	close(a);
+	close(b);
+}
+
 /* ---- the relay behind its link ----------------------------------------- */
 
 static int open_relay(const char *path)
@@ -385,6 +520,99 @@ static void test_relay_over_pty(void **state)
 	assert_non_null(strstr(f->resp, " relay on (byte 0x65)\n"));
 	assert_non_null(strstr(f->resp, " inject: relayfault unplug\n"));
 	assert_non_null(strstr(f->resp, " relay plugged in at /dev/pts/"));
+}
+
+#define WEDGE_HOLD_MS 200 /* a wedge is judged over this */
+
+/*
+ * relayfault wedge: the board stops reading its pty. A host (raw termios,
+ * O_NONBLOCK) writes "relay off": for WEDGE_HOLD_MS the relay still
+ * answers on and the state says power=1; "relay off" from the control port
+ * is refused; the host's writes end up refused (EAGAIN). relayfault ok:
+ * the queue is discarded unread, the relay is off, the board obeys again.
+ */
+static void test_relay_wedge(void **state)
+{
+	struct fx *f = *state;
+	int fd = open_relay(f->link);
+	long long end;
+	uint8_t chunk[256];
+	long total = 1;
+	ssize_t w;
+
+	assert_true(fd >= 0);
+	assert_int_equal(fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK),
+			 0);
+	assert_int_equal(write(fd, "\x65", 1), 1);
+	wait_answer(f, "relay", "on");
+	assert_string_equal(ctl(f, "relayfault wedge"), "ok");
+	assert_int_equal(write(fd, "\x6f", 1), 1);
+	end = proc_now_ms() + WEDGE_HOLD_MS;
+	while (proc_now_ms() < end) {
+		assert_string_equal(ctl(f, "relay"), "on");
+		assert_int_equal(state_long(f, "power"), 1);
+		poll(NULL, 0, 10);
+	}
+	assert_string_equal(ctl(f, "relay off"), "error: relay is wedged");
+	memset(chunk, 0x65, sizeof(chunk));
+	while ((w = write(fd, chunk, sizeof(chunk))) > 0 && total < (1L << 20))
+		total += w;
+	assert_int_equal(w, -1);
+	assert_true(errno == EAGAIN || errno == EWOULDBLOCK);
+	assert_string_equal(ctl(f, "relay"), "on");
+	assert_string_equal(ctl(f, "relayfault ok"), "ok");
+	assert_string_equal(ctl(f, "relay"), "off");
+	wait_event(f, "relay obeys again (relays off)");
+	/* all logged before "relayfault ok" answered: one answer has them */
+	assert_non_null(strstr(f->resp, " relay wedged (bytes not read)\n"));
+	assert_non_null(
+	    strstr(f->resp, " relay off (board reset after wedge)\n"));
+	assert_null(strstr(f->resp, "(byte 0x6f)"));
+	assert_int_equal(write(fd, "\x65", 1), 1);
+	wait_answer(f, "relay", "on");
+	close(fd);
+}
+
+/* ---- motor power options ------------------------------------------------ */
+
+/* --no-amp-undervoltage --power-output 2: the state line shows the output,
+ * SB 2 / CB 2 over the command port switch motor power (events), and the
+ * controller sees no under-voltage when power goes. */
+static void test_power_options(void **state)
+{
+	static char *const extra[] = {(char *)"--no-amp-undervoltage",
+				      (char *)"--power-output", (char *)"2",
+				      NULL};
+	struct fx *f = *state;
+	int fd;
+
+	proc_kill(&f->sim.p);
+	close(f->ctl);
+	f->ctl = -1;
+	assert_int_equal(
+	    proc_sim_start(&f->sim, bin_dir(), NULL, extra, START_MS), 0);
+	f->ctl = proc_ctl_connect(f->sim.ctl_port, REPLY_MS);
+	assert_true(f->ctl >= 0);
+	fd = cmd_connect(f);
+	assert_string_equal(ctl(f, "relay on"), "ok");
+	assert_int_equal(state_long(f, "pout"), 0);
+	assert_int_equal(state_long(f, "power"), 0);
+	expect_reply(fd, "SB 2", ":");
+	wait_event(f, "power output 2 set");
+	assert_int_equal(state_long(f, "pout"), 1);
+	assert_int_equal(state_long(f, "power"), 1);
+	expect_reply(fd, "CB 2", ":");
+	wait_event(f, "power output 2 cleared (motor power cut by the "
+		      "controller)");
+	assert_int_equal(state_long(f, "power"), 0);
+	events(f); /* drop what came so far */
+	expect_reply(fd, "SB 2", ":");
+	wait_event(f, "power output 2 set");
+	assert_string_equal(ctl(f, "relay off"), "ok");
+	wait_event(f, "motor power lost (amplifiers report nothing: "
+		      "under-voltage model off)");
+	expect_reply(fd, "MG _TA0", " 0.0000\r\n:");
+	close(fd);
 }
 
 /* ---- ending ------------------------------------------------------------- */
@@ -488,6 +716,9 @@ static void test_usage_errors(void **state)
 		   "galil-sim: bad port '70000'\ntry 'galil-sim --help'\n");
 	run_expect((char *const[]){(char *)"extra", NULL}, 2,
 		   "galil-sim: unexpected argument 'extra'\n");
+	run_expect(
+	    (char *const[]){(char *)"--power-output", (char *)"9", NULL}, 2,
+	    "galil-sim: bad power output '9' (0..8)\ntry 'galil-sim --help'\n");
 }
 
 /* A relay link path holding a regular file is refused: exit 1, the file
@@ -559,7 +790,12 @@ int main(void)
 	    T(test_link_drop),
 	    T(test_eight_handles),
 	    T(test_power_cycle_closes),
+	    T(test_iht_closes_others),
+	    T(test_ihs_and_iha),
+	    T(test_ih_close_after_reply),
 	    T(test_relay_over_pty),
+	    T(test_relay_wedge),
+	    T(test_power_options),
 	    T(test_quit),
 	    T(test_sigterm),
 	    cmocka_unit_test(test_bad_plant_file),

@@ -287,6 +287,49 @@ static void test_motion_needs_power(void **state)
 	assert_int_equal(f->in.amp_power, 0);
 }
 
+/* amp_undervoltage false: without power nothing moves, and the
+ * amplifiers still report power to the controller. */
+static void test_amp_undervoltage_off(void **state)
+{
+	struct fx *f = *state;
+	const double ref[3] = {1000, 1000, 1000};
+
+	sim_plant_sense(f->p, 0, &f->in);
+	assert_int_equal(f->in.amp_power, 0); /* the default model */
+	assert_int_equal(sim_plant_set_amp_undervoltage(f->p, 0), 0);
+	assert_int_equal(sim_plant_get_cfg(f->p)->amp_undervoltage, 0);
+	run(f, ref, 0, 100);
+	assert_int_equal(f->in.amp_power, 1);
+	for (int i = 0; i < 3; i++)
+		assert_true(axis(f, i).pos == 0);
+	run(f, ref, 1, 100);
+	assert_int_equal(f->in.amp_power, 1);
+	assert_float_equal(axis(f, 0).pos, 1000, 0.5); /* moved with power */
+	assert_int_equal(sim_plant_set_amp_undervoltage(f->p, 2), GL_ERR_ARG);
+	assert_int_equal(sim_plant_get_cfg(f->p)->amp_undervoltage, 0);
+}
+
+/* power_output N: motor power needs the relay and output N (bit N-1). */
+static void test_power_output(void **state)
+{
+	struct fx *f = *state;
+
+	assert_int_equal(sim_plant_motor_power(f->p, 1, 0), 1);
+	assert_int_equal(sim_plant_motor_power(f->p, 0, 0xFF), 0);
+	assert_int_equal(sim_plant_set_power_output(f->p, 3), 0);
+	assert_int_equal(sim_plant_motor_power(f->p, 1, 0), 0);
+	assert_int_equal(sim_plant_motor_power(f->p, 1, 0xFB), 0);
+	assert_int_equal(sim_plant_motor_power(f->p, 1, 0x04), 1);
+	assert_int_equal(sim_plant_motor_power(f->p, 0, 0x04), 0);
+	assert_int_equal(sim_plant_set_power_output(f->p, 8), 0);
+	assert_int_equal(sim_plant_motor_power(f->p, 1, 0x80), 1);
+	assert_int_equal(sim_plant_set_power_output(f->p, 9), GL_ERR_ARG);
+	assert_int_equal(sim_plant_set_power_output(f->p, -1), GL_ERR_ARG);
+	assert_int_equal(sim_plant_get_cfg(f->p)->power_output, 8);
+	assert_int_equal(sim_plant_set_power_output(f->p, 0), 0);
+	assert_int_equal(sim_plant_motor_power(f->p, 1, 0), 1);
+}
+
 /* Motor off: nothing moves. */
 static void test_motion_needs_motor_on(void **state)
 {
@@ -493,6 +536,8 @@ static void assert_cfg_equal(const struct sim_plant_cfg *a,
 		assert_int_equal(a->joy_input[j], b->joy_input[j]);
 	assert_int_equal(a->joy_closed_level, b->joy_closed_level);
 	assert_int_equal(a->seed, b->seed);
+	assert_int_equal(a->amp_undervoltage, b->amp_undervoltage);
+	assert_int_equal(a->power_output, b->power_output);
 }
 
 /* config/plant.yaml is the commented copy of the built-in defaults. */
@@ -524,6 +569,8 @@ static void test_config_file_is_the_default(void **state)
 		file.joy_input[j] = 21 + j % 10;
 	file.joy_closed_level = 0;
 	file.seed = 99;
+	file.amp_undervoltage = 0;
+	file.power_output = 5;
 	assert_int_equal(sim_plant_cfg_load(&file, path, err, sizeof(err)), 0);
 	assert_string_equal(err, "");
 	assert_cfg_equal(&file, &def);
@@ -557,6 +604,14 @@ static void test_config_overrides(void **state)
 	assert_int_equal(c.joy_input[10], 30);
 	assert_int_equal(c.joy_input[11], 31);
 	assert_int_equal(c.joy_input[0], 1);
+	assert_int_equal(c.amp_undervoltage, 1); /* defaults */
+	assert_int_equal(c.power_output, 0);
+	assert_int_equal(
+	    parse(&c, "amp_undervoltage: false\npower_output: 3\n", err), 0);
+	assert_int_equal(c.amp_undervoltage, 0);
+	assert_int_equal(c.power_output, 3);
+	assert_int_equal(parse(&c, "amp_undervoltage: true\n", err), 0);
+	assert_int_equal(c.amp_undervoltage, 1);
 }
 
 struct bad_case {
@@ -606,6 +661,14 @@ static const struct bad_case bad_cases[] = {
     {"joystick:\n  closed_level: 2\n",
      "p.yaml:2:3: joystick closed_level must be 0 or 1"},
     {"seed: -1\n", "p.yaml:1:7: 'seed' must be >= 0"},
+    {"amp_undervoltage: no\n",
+     "p.yaml:1:19: 'amp_undervoltage' must be 'false' or 'true'"},
+    {"power_output: 9\n",
+     "p.yaml:1:15: power_output 9 outside 0 (none) or 1..8"},
+    {"seed: 2\npower_output: -1\n",
+     "p.yaml:2:15: power_output -1 outside 0 (none) or 1..8"},
+    {"power_output: two\n",
+     "p.yaml:1:15: 'power_output' must be an integer, not 'two'"},
     {"axes: [A]\n", "p.yaml:1:7: axes must be a mapping"},
     {"axes:\n  A:\n    fwd_limit: [1]\n",
      "p.yaml:3:16: 'fwd_limit' must be a number"},
@@ -661,6 +724,8 @@ int main(void)
 	    T(test_motion_follows_reference),
 	    T(test_motion_max_speed),
 	    T(test_motion_needs_power),
+	    T(test_amp_undervoltage_off),
+	    T(test_power_output),
 	    T(test_motion_needs_motor_on),
 	    T(test_block),
 	    T(test_encoder_stuck),

@@ -292,6 +292,93 @@ static void test_writefail(void **state)
 	assert_int_equal(sim_relay_power(f->r), 1);
 }
 
+#define WEDGE_HOLD_MS 200 /* a wedge is judged over this */
+
+/* A second host descriptor: plain raw termios, non-blocking. */
+static int open_host_nonblock(const char *path)
+{
+	struct termios tio;
+	int fd = open(path, O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+
+	if (fd < 0)
+		return -1;
+	tcgetattr(fd, &tio);
+	cfmakeraw(&tio);
+	tcsetattr(fd, TCSANOW, &tio);
+	return fd;
+}
+
+/*
+ * Wedged: the board reads nothing. A byte the host writes stays queued in
+ * the pty (checked for WEDGE_HOLD_MS, the board serviced meanwhile), the
+ * relay keeps its state (on: motor power stays), the control port cannot
+ * switch it, and the host's writes end up refused (EAGAIN: they would
+ * block). Repaired: what was queued is discarded unread, relays off, the
+ * board reads again.
+ */
+static void test_wedge(void **state)
+{
+	struct fx *f = *state;
+	long long end;
+	char err[256];
+	uint8_t chunk[256];
+	long total = 1;
+	ssize_t w;
+	int fd;
+
+	say(f, (const uint8_t[]){0x65}, 1);
+	assert_int_equal(
+	    sim_relay_set_fault(f->r, SIM_RELAY_WEDGE, err, sizeof(err)), 0);
+	assert_int_equal(sim_relay_get_fault(f->r), SIM_RELAY_WEDGE);
+	assert_int_equal(sim_relay_fd(f->r), -1);
+	assert_int_equal(sim_relay_power(f->r), 1);
+	fd = open_host_nonblock(f->link);
+	assert_true(fd >= 0);
+	assert_int_equal(write(fd, "\x6f", 1), 1); /* relay off: not read */
+	/* the pty hands the byte to the board's side asynchronously */
+	end = now_ms() + DEADLINE_MS;
+	while (sim_relay_queued(f->r) < 1) {
+		if (now_ms() > end)
+			fail_msg("the byte never reached the board's side");
+		poll(NULL, 0, 1);
+	}
+	end = now_ms() + WEDGE_HOLD_MS;
+	while (now_ms() < end) {
+		assert_int_equal(sim_relay_service(f->r), 0);
+		assert_int_equal(sim_relay_queued(f->r), 1);
+		assert_int_equal(sim_relay_power(f->r), 1);
+		poll(NULL, 0, 10);
+	}
+	assert_int_equal(sim_relay_set(f->r, 0), GL_ERR_RELAY);
+	memset(chunk, 0x65, sizeof(chunk)); /* relay on, if ever read */
+	while ((w = write(fd, chunk, sizeof(chunk))) > 0 && total < (1L << 20))
+		total += w;
+	assert_int_equal(w, -1); /* refused well before 1 MiB */
+	assert_true(errno == EAGAIN || errno == EWOULDBLOCK);
+	assert_int_equal(sim_relay_power(f->r), 1);
+
+	assert_int_equal(
+	    sim_relay_set_fault(f->r, SIM_RELAY_OK, err, sizeof(err)), 0);
+	assert_int_equal(sim_relay_power(f->r), 0);
+	assert_true(sim_relay_fd(f->r) >= 0);
+	/* nothing of what was queued arrives afterwards */
+	end = now_ms() + QUIET_MS;
+	while (now_ms() < end) {
+		assert_int_equal(sim_relay_service(f->r), 0);
+		assert_int_equal(sim_relay_power(f->r), 0);
+		poll(NULL, 0, 10);
+	}
+	assert_non_null(strstr(f->events,
+			       "relay wedged (bytes not read)\n"
+			       "relay discarded the bytes queued while wedged\n"
+			       "relay off (board reset after wedge)\n"
+			       "relay obeys again (relays off)\n"));
+	assert_null(strstr(f->events, "(byte 0x6f)"));
+	say(f, (const uint8_t[]){0x65}, 1);
+	assert_int_equal(sim_relay_power(f->r), 1);
+	close(fd);
+}
+
 /* The control port switches the relay directly. */
 static void test_set_direct(void **state)
 {
@@ -473,6 +560,7 @@ int main(void)
 	    T(test_devantech_unknown_byte_ignored, devantech),
 	    T(test_unplug_and_replug, devantech),
 	    T(test_writefail, devantech),
+	    T(test_wedge, devantech),
 	    T(test_set_direct, devantech),
 	    T(test_icstation_handshake_and_states, icstation),
 	    T(test_icstation_replug_needs_handshake, icstation),

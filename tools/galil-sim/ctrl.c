@@ -388,6 +388,11 @@ int ctrl_axis_info(const struct ctrl *c, int axis, struct ctrl_axis_info *out)
 	return GL_OK;
 }
 
+uint32_t ctrl_outputs(const struct ctrl *c)
+{
+	return c ? c->outputs : 0;
+}
+
 unsigned ctrl_threads(const struct ctrl *c)
 {
 	unsigned m = 0;

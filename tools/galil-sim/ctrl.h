@@ -84,6 +84,9 @@ int ctrl_input(struct ctrl *c, int h, const uint8_t *buf, size_t len);
  */
 size_t ctrl_output(struct ctrl *c, int h, uint8_t *buf, size_t cap);
 
+/* ctrl_output_pending() - bytes ctrl_output() would give for handle h. */
+size_t ctrl_output_pending(const struct ctrl *c, int h);
+
 /*
  * ctrl_step() - one servo sample: read @in, update profilers, servo and
  * protection (limits, OE, OA, amplifier), run the program threads for one
@@ -119,6 +122,10 @@ int ctrl_set_var(struct ctrl *c, const char *name, double v);
 /* ctrl_axis_info() - state of axis 0..2. Return 0 or GL_ERR_ARG. */
 int ctrl_axis_info(const struct ctrl *c, int axis, struct ctrl_axis_info *out);
 
+/* ctrl_outputs() - the digital outputs now, bit n-1 = output n (SB, CB,
+ * OB, OP, also between samples). */
+uint32_t ctrl_outputs(const struct ctrl *c);
+
 /* ctrl_threads() - bit n = thread n running. */
 unsigned ctrl_threads(const struct ctrl *c);
 
@@ -132,9 +139,19 @@ void ctrl_power_cycle(struct ctrl *c);
 /*
  * ctrl_handle_close_wanted() - 1 when the controller wants the connection
  * on handle @h closed (IHS=>-3, IHT=>-3, IHB=>-2 ..., or a power cycle):
- * the network layer closes the socket and calls ctrl_handle_close().
+ * the network layer closes the socket and calls ctrl_handle_close(), which
+ * records the event "handle A closed by IHT from handle B".
  */
 int ctrl_handle_close_wanted(const struct ctrl *c, int h);
+
+/*
+ * ctrl_handle_close_by() - for a handle whose close is wanted: the handle
+ * (0..7, or 8 for ctrl_command()'s private port) whose IH command asked
+ * for it. The close is due once that handle's reply has been sent (IHS:
+ * the handle's own reply). Return: the handle, or -1 when there is no
+ * reply to wait for (a program's IH, a power cycle, no close wanted).
+ */
+int ctrl_handle_close_by(const struct ctrl *c, int h);
 
 /*
  * ctrl_handle_lost() - the TCP connection of handle @h failed (peer gone

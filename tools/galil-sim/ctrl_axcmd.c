@@ -8,6 +8,7 @@
  */
 #include <math.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "ctrl_int.h"
@@ -206,6 +207,20 @@ static int cmd_ipar(struct ctrl_xc *x, const struct ipar_desc *d, const char *a)
 
 /* ---- PA PR JG PT DP ZA --------------------------------------------------- */
 
+/* PA in position tracking: a move that starts from rest is an event
+ * "axis A begin PT (thread 1 line 80)". */
+static void pt_target(struct ctrl_xc *x, int i, double target)
+{
+	char who[CTRL_WHO_LEN];
+	int was = x->c->ax[i].profiling;
+
+	ctrl_motion_pt_target(x->c, i, target);
+	if (was || !x->c->ax[i].profiling)
+		return;
+	ctrl_xc_who(x, who, sizeof(who));
+	ctrl_event(x->c, "axis %c begin PT (%s)", 'A' + i, who);
+}
+
 static int cmd_pa(struct ctrl_xc *x, const char *a)
 {
 	struct ctrl *c = x->c;
@@ -230,7 +245,7 @@ static int cmd_pa(struct ctrl_xc *x, const char *a)
 		if (args.set[i] != 1)
 			continue;
 		if (c->ax[i].pt) {
-			ctrl_motion_pt_target(c, i, floor(args.v[i]));
+			pt_target(x, i, floor(args.v[i]));
 		} else {
 			c->ax[i].pa = floor(args.v[i]);
 			c->ax[i].next_mode = CTRL_MODE_PA;
@@ -373,8 +388,11 @@ static double *za_slot(struct ctrl *c, int axis, const void *ud)
 
 /* ---- BG ST AB SH MO ------------------------------------------------------ */
 
+/* BG: every axis of the mask is checked first; each start is an event
+ * "axis A begin (handle B)". */
 static int cmd_bg(struct ctrl_xc *x, const char *a)
 {
+	char who[CTRL_WHO_LEN];
 	unsigned mask;
 	int i, rc = ctrl_parse_mask(x, a, &mask);
 
@@ -384,30 +402,46 @@ static int cmd_bg(struct ctrl_xc *x, const char *a)
 		if ((mask & (1u << i)) &&
 		    (rc = ctrl_motion_begin(x->c, i, 1)) != 0)
 			return rc;
-	for (i = 0; i < CTRL_AXES; i++)
-		if (mask & (1u << i))
-			ctrl_motion_begin(x->c, i, 0);
+	ctrl_xc_who(x, who, sizeof(who));
+	for (i = 0; i < CTRL_AXES; i++) {
+		if (!(mask & (1u << i)))
+			continue;
+		ctrl_motion_begin(x->c, i, 0);
+		ctrl_event(x->c, "axis %c begin (%s)", 'A' + i, who);
+	}
 	return 0;
 }
 
+/* ST: each axis that was moving is an event "axis A stop: ST (handle B)". */
 static int cmd_st(struct ctrl_xc *x, const char *a)
 {
+	char who[CTRL_WHO_LEN], why[CTRL_WHO_LEN + 16];
 	unsigned mask;
 	int i, rc = ctrl_parse_mask(x, a, &mask);
 
 	if (rc)
 		return rc;
-	for (i = 0; i < CTRL_AXES; i++)
-		if (mask & (1u << i))
-			ctrl_motion_stop(x->c, i, 4, x->c->ax[i].p.dc);
+	ctrl_xc_who(x, who, sizeof(who));
+	for (i = 0; i < CTRL_AXES; i++) {
+		struct ctrl_axis *ax = &x->c->ax[i];
+
+		if (!(mask & (1u << i)))
+			continue;
+		if (ax->profiling && !ax->stopping)
+			ctrl_event(x->c, "axis %c stop: ST (%s)", 'A' + i, who);
+		ctrl_motion_stop(x->c, i, 4, ax->p.dc);
+	}
 	/* a bare ST from a host also stops the program */
-	if (x->thread < 0 && *ctrl_skip(a) == '\0')
-		ctrl_threads_halt_all(x->c, "halted by ST from a host");
+	if (x->thread < 0 && *ctrl_skip(a) == '\0') {
+		snprintf(why, sizeof(why), "halted by ST (%s)", who);
+		ctrl_threads_halt_all(x->c, why);
+	}
 	return 0;
 }
 
 static int cmd_ab(struct ctrl_xc *x, const char *a)
 {
+	char who[CTRL_WHO_LEN], why[CTRL_WHO_LEN + 16];
 	double v = 0;
 	int i, rc = ctrl_num_list(x, a, &v, 1, NULL);
 
@@ -415,18 +449,23 @@ static int cmd_ab(struct ctrl_xc *x, const char *a)
 		return rc;
 	if (v != 0 && v != 1)
 		return 6;
+	ctrl_xc_who(x, who, sizeof(who));
 	for (i = 0; i < CTRL_AXES; i++)
-		ctrl_motion_abort(x->c, i);
+		ctrl_motion_abort(x->c, i, who);
 	if (v == 0) {
-		ctrl_threads_halt_all(x->c, "aborted by AB");
+		snprintf(why, sizeof(why), "aborted by AB (%s)", who);
+		ctrl_threads_halt_all(x->c, why);
 		return x->thread >= 0 ? CTRL_STOP : 0;
 	}
 	return 0;
 }
 
+/* SH (@on) / MO: events "axis A motor on: SH (handle B)", "axis A motor
+ * off: MO (thread 0 line 57)" for each axis whose state changes. */
 static int cmd_shmo(struct ctrl_xc *x, const char *a, int on)
 {
 	struct ctrl *c = x->c;
+	char who[CTRL_WHO_LEN], why[CTRL_WHO_LEN + 8];
 	unsigned mask;
 	int i, rc = ctrl_parse_mask(x, a, &mask);
 
@@ -435,6 +474,8 @@ static int cmd_shmo(struct ctrl_xc *x, const char *a, int on)
 	for (i = 0; i < CTRL_AXES; i++)
 		if ((mask & (1u << i)) && c->ax[i].profiling)
 			return 7;
+	ctrl_xc_who(x, who, sizeof(who));
+	snprintf(why, sizeof(why), "MO (%s)", who);
 	for (i = 0; i < CTRL_AXES; i++) {
 		struct ctrl_axis *ax = &c->ax[i];
 
@@ -442,9 +483,12 @@ static int cmd_shmo(struct ctrl_xc *x, const char *a, int on)
 			continue;
 		if (!on) {
 			if (!ax->p.motor_off)
-				ctrl_motion_off(c, i, -1, "MO");
+				ctrl_motion_off(c, i, -1, why);
 			continue;
 		}
+		if (ax->p.motor_off)
+			ctrl_event(c, "axis %c motor on: SH (%s)", 'A' + i,
+				   who);
 		ax->p.motor_off = 0;
 		ax->ref = ax->enc;
 		ax->target = ax->enc;

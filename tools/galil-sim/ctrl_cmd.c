@@ -421,11 +421,26 @@ static int cmd_cw(struct ctrl_xc *x, const char *a)
 	return 0;
 }
 
-/* IHh=>p closes handles: h = A..H, S (the sender), T (all but the sender) */
+/* Does "IH@h" sent on handle @sender name handle @i? */
+static int ih_names(char h, int i, int sender)
+{
+	if (h == 'T')
+		return i != sender;
+	if (h == 'S')
+		return i == sender;
+	return h == 'A' + i;
+}
+
+/*
+ * IHh=>r closes handles: h = A..H, S (the sender), T (every other one);
+ * r = -2 / -3 TCP (-1 UDP: the simulator has none, nothing to close). The
+ * network layer closes them once the sender's reply has gone
+ * (ctrl_handle_close_by()); the event names the command and its sender.
+ */
 static int cmd_ih(struct ctrl_xc *x, const char *a)
 {
 	struct ctrl *c = x->c;
-	char h;
+	char h, who[CTRL_WHO_LEN];
 	int i;
 
 	a = ctrl_skip(a);
@@ -436,17 +451,21 @@ static int cmd_ih(struct ctrl_xc *x, const char *a)
 	a = ctrl_skip(a + 2);
 	if (strcmp(a, "-1") && strcmp(a, "-2") && strcmp(a, "-3"))
 		return 6;
-	if (!strcmp(a, "-1"))
-		return 0; /* UDP handles: the simulator has none */
-	for (i = 0; i < CTRL_HANDLES; i++) {
-		if (!c->h[i].open)
-			continue;
-		if ((h == 'T' && i != x->handle) ||
-		    (h == 'S' && i == x->handle) || h == 'A' + i)
-			c->h[i].close_wanted = 1;
-	}
 	if (h != 'S' && h != 'T' && (h < 'A' || h >= 'A' + CTRL_HANDLES))
 		return 6;
+	if (!strcmp(a, "-1"))
+		return 0;
+	ctrl_xc_who(x, who, sizeof(who));
+	for (i = 0; i < CTRL_HANDLES; i++) {
+		struct ctrl_handle *hd = &c->h[i];
+
+		if (!hd->open || hd->close_wanted || !ih_names(h, i, x->handle))
+			continue;
+		hd->close_wanted = 1;
+		hd->close_by = x->handle;
+		snprintf(hd->close_why, sizeof(hd->close_why), "IH%c from %s",
+			 h, who);
+	}
 	return 0;
 }
 
@@ -497,6 +516,11 @@ static int cmd_ti(struct ctrl_xc *x, const char *a, int amp)
 
 /* ---- DM DA LV LA LL ------------------------------------------------------ */
 
+/*
+ * DM name[n],name2[m] (command reference DM): each array in turn; an array
+ * that exists is not re-dimensioned (ctrl_array_dim(): same size nothing,
+ * another size TC 57). DM ? / DM alone answers the free array space (_DM).
+ */
 static int cmd_dm(struct ctrl_xc *x, const char *a)
 {
 	uint64_t key;
@@ -574,27 +598,41 @@ static int da_one(struct ctrl_vars *vs, const char *a, size_t len, int arr)
 	return 0;
 }
 
+/*
+ * DA (command reference DA): "name" a variable, "name[]" an array, "*"
+ * every variable, "*[]" every array, several separated by commas. The
+ * brackets may hold anything but a comma (the reference writes "Cars[0]",
+ * "*[0]"). "DA ?" answers the free array slots (_DA). An unknown variable
+ * is TC 9, an unknown array TC 57 (choice: the reference is silent).
+ */
 static int cmd_da(struct ctrl_xc *x, const char *a)
 {
 	size_t len;
 	int rc, arr;
 
 	a = ctrl_skip(a);
+	if (*a == '?' && *ctrl_skip(a + 1) == '\0') {
+		ctrl_buf_printf(&x->c->tmp, " %d\r\n",
+				ctrl_arrays_free(&x->c->vars));
+		return 0;
+	}
 	while (*a) {
+		const char *name = a;
+
 		len = *a == '*' ? 1 : ctrl_ident_len(a);
 		if (!len)
 			return 1;
 		arr = a[len] == '[';
-		rc = da_one(&x->c->vars, a, len, arr);
-		if (rc)
-			return rc;
 		a += len;
 		if (arr) {
-			a = strchr(a, ']');
-			if (!a)
+			a += strcspn(a, "],");
+			if (*a != ']')
 				return 55;
 			a++;
 		}
+		rc = da_one(&x->c->vars, name, len, arr);
+		if (rc)
+			return rc;
 		a = ctrl_skip(a);
 		if (*a == ',')
 			a = ctrl_skip(a + 1);

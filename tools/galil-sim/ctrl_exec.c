@@ -78,6 +78,22 @@ const char *ctrl_tc_text(int tc)
 	return "";
 }
 
+/*
+ * ctrl_xc_who() - who runs the statement of @x, as events name it: "handle
+ * B" (a host), "thread 0 line 57" (a program thread, 0-based line) or
+ * "private port" (ctrl_command()). @buf gets at most @cap bytes.
+ */
+void ctrl_xc_who(const struct ctrl_xc *x, char *buf, size_t cap)
+{
+	if (x->thread >= 0)
+		snprintf(buf, cap, "thread %d line %d", x->thread,
+			 x->c->th[x->thread].line);
+	else if (x->handle >= 0 && x->handle < CTRL_HANDLES)
+		snprintf(buf, cap, "handle %c", 'A' + x->handle);
+	else
+		snprintf(buf, cap, "private port");
+}
+
 /* ---- statements ------------------------------------------------------ */
 
 static int var_query(struct ctrl_xc *x, double v)

@@ -287,11 +287,14 @@ static int cmd_xq(struct ctrl_xc *x, const char *a)
 
 static int cmd_hx(struct ctrl_xc *x, const char *a)
 {
+	char who[CTRL_WHO_LEN], why[CTRL_WHO_LEN + 16];
 	double v = -1;
 	int rc;
 
+	ctrl_xc_who(x, who, sizeof(who));
+	snprintf(why, sizeof(why), "halted by HX (%s)", who);
 	if (*ctrl_skip(a) == '\0') {
-		ctrl_threads_halt_all(x->c, "halted by HX");
+		ctrl_threads_halt_all(x->c, why);
 		return 0;
 	}
 	rc = ctrl_num_list(x, a, &v, 1, NULL);
@@ -299,7 +302,7 @@ static int cmd_hx(struct ctrl_xc *x, const char *a)
 		return rc;
 	if (v != (int)v || v < 0 || v >= CTRL_THREADS)
 		return 6;
-	ctrl_thread_halt(x->c, (int)v, "halted by HX");
+	ctrl_thread_halt(x->c, (int)v, why);
 	return 0;
 }
 

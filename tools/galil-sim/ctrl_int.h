@@ -118,6 +118,7 @@ int ctrl_var_set(struct ctrl_vars *vs, uint64_t key, double v, int *slot);
 struct ctrl_array *ctrl_array_find(struct ctrl_vars *vs, uint64_t key);
 int ctrl_array_dim(struct ctrl_vars *vs, uint64_t key, int n);
 int ctrl_array_free(struct ctrl_vars *vs, uint64_t key);
+int ctrl_arrays_free(const struct ctrl_vars *vs);
 void ctrl_vars_clear(struct ctrl_vars *vs);
 int ctrl_vars_copy(struct ctrl_vars *dst, const struct ctrl_vars *src);
 
@@ -278,7 +279,9 @@ enum ctrl_hmode {
 struct ctrl_handle {
 	int open;
 	int close_wanted;
-	int mode; /* enum ctrl_hmode */
+	int close_by;	    /* handle whose IH asked, -1: none to wait for */
+	char close_why[48]; /* "IHT from handle B", for the event */
+	int mode;	    /* enum ctrl_hmode */
 	char line[CTRL_LINE_MAX + 1];
 	size_t len;	    /* characters in line */
 	int overflow;	    /* line longer than CTRL_LINE_MAX */
@@ -358,6 +361,11 @@ struct ctrl_xc {
 
 #define CTRL_ROUTE_DEFAULT (-2)
 
+/* "handle B", "thread 0 line 57" or "private port": who ran a statement,
+ * as the events name it. */
+#define CTRL_WHO_LEN 32
+void ctrl_xc_who(const struct ctrl_xc *x, char *buf, size_t cap);
+
 /* ---- expressions (ctrl_expr.c) ---------------------------------------- */
 
 int ctrl_expr(struct ctrl_xc *x, const char **p, double *out);
@@ -426,7 +434,7 @@ void ctrl_motion_sense(struct ctrl *c, const struct ctrl_sense *in);
 void ctrl_motion_drive(struct ctrl *c, struct ctrl_drive *out);
 int ctrl_motion_begin(struct ctrl *c, int axis, int dry_run);
 void ctrl_motion_stop(struct ctrl *c, int axis, int code, double dec);
-void ctrl_motion_abort(struct ctrl *c, int axis);
+void ctrl_motion_abort(struct ctrl *c, int axis, const char *who);
 void ctrl_motion_off(struct ctrl *c, int axis, int code, const char *why);
 int ctrl_motion_pt_target(struct ctrl *c, int axis, double target);
 double ctrl_axis_tv(const struct ctrl_axis *a, double dt);

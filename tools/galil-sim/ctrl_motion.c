@@ -140,10 +140,14 @@ void ctrl_motion_stop(struct ctrl *c, int i, int code, double dec)
 	a->stop_code = code;
 }
 
-/* ctrl_motion_abort() - AB: the reference stops at once; OE: motor off. */
-void ctrl_motion_abort(struct ctrl *c, int i)
+/*
+ * ctrl_motion_abort() - AB: the reference stops at once (event "axis A
+ * abort: AB (@who)"); with OE set the motor goes off. @who: "handle B" ...
+ */
+void ctrl_motion_abort(struct ctrl *c, int i, const char *who)
 {
 	struct ctrl_axis *a = &c->ax[i];
+	char why[CTRL_WHO_LEN + 32];
 
 	a->pt = 0;
 	if (a->profiling) {
@@ -153,9 +157,12 @@ void ctrl_motion_abort(struct ctrl *c, int i)
 		a->stop_code = 7;
 		a->pa_last = a->ref;
 		a->target = a->ref;
+		ctrl_event(c, "axis %c abort: AB (%s)", axis_name(i), who);
 	}
-	if (a->p.oe && !a->p.motor_off)
-		ctrl_motion_off(c, i, -1, "abort with OE set");
+	if (a->p.oe && !a->p.motor_off) {
+		snprintf(why, sizeof(why), "abort with OE set (%s)", who);
+		ctrl_motion_off(c, i, -1, why);
+	}
 }
 
 /*

@@ -57,7 +57,6 @@ static int digit_op(struct ctrl_xc *x, const char *code, int d, double *v)
 static int plain_op(struct ctrl_xc *x, const char *code, double *v)
 {
 	struct ctrl *c = x->c;
-	int i, n = 0;
 
 	if (!strcmp(code, "TC"))
 		*v = c->tc;
@@ -89,11 +88,9 @@ static int plain_op(struct ctrl_xc *x, const char *code, double *v)
 		*v = CTRL_LABELS - c->prog.nlabels;
 	else if (!strcmp(code, "DM"))
 		*v = CTRL_ARRAY_SPACE - c->vars.arr_used;
-	else if (!strcmp(code, "DA")) {
-		for (i = 0; i < CTRL_ARRAYS; i++)
-			n += c->vars.arr[i].key == 0;
-		*v = n;
-	} else if (!strcmp(code, "TB"))
+	else if (!strcmp(code, "DA"))
+		*v = ctrl_arrays_free(&c->vars);
+	else if (!strcmp(code, "TB"))
 		*v = (thread_mask(c) ? 128 : 0);
 	else if (!strcmp(code, "RS"))
 		*v = 0;

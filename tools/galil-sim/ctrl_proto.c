@@ -41,6 +41,8 @@ void ctrl_handle_open(struct ctrl *c, int h)
 	ctrl_buf_clear(&hd->dl);
 	hd->open = 1;
 	hd->close_wanted = 0;
+	hd->close_by = -1;
+	hd->close_why[0] = '\0';
 	hd->mode = CTRL_H_CMD;
 	hd->len = 0;
 	hd->overflow = 0;
@@ -56,8 +58,12 @@ void ctrl_handle_close(struct ctrl *c, int h)
 	hd = &c->h[h];
 	if (hd->mode == CTRL_H_DL)
 		ctrl_event(c, "download on handle %c abandoned", 'A' + h);
+	if (hd->open && hd->close_wanted && hd->close_why[0])
+		ctrl_event(c, "handle %c closed by %s", 'A' + h, hd->close_why);
 	hd->open = 0;
 	hd->close_wanted = 0;
+	hd->close_by = -1;
+	hd->close_why[0] = '\0';
 	hd->mode = CTRL_H_CMD;
 	hd->len = 0;
 	ctrl_buf_clear(&hd->out);
@@ -81,6 +87,11 @@ void ctrl_handle_lost(struct ctrl *c, int h)
 int ctrl_handle_close_wanted(const struct ctrl *c, int h)
 {
 	return valid_handle(h) && c->h[h].open && c->h[h].close_wanted;
+}
+
+int ctrl_handle_close_by(const struct ctrl *c, int h)
+{
+	return ctrl_handle_close_wanted(c, h) ? c->h[h].close_by : -1;
 }
 
 void ctrl_handle_peer(struct ctrl *c, int h, int local_port, uint32_t peer_ip,
@@ -338,6 +349,13 @@ size_t ctrl_output(struct ctrl *c, int h, uint8_t *buf, size_t cap)
 	return ctrl_buf_take(&c->h[h].out, buf, cap);
 }
 
+size_t ctrl_output_pending(const struct ctrl *c, int h)
+{
+	if (!c || !valid_handle(h))
+		return 0;
+	return ctrl_buf_pending(&c->h[h].out);
+}
+
 /* ctrl_serial_output() - what was routed to the (absent) serial port. */
 size_t ctrl_serial_output(struct ctrl *c, uint8_t *buf, size_t cap)
 {
@@ -359,8 +377,12 @@ void ctrl_proto_reset(struct ctrl *c)
 		hd->overflow = 0;
 		ctrl_buf_clear(&hd->dl);
 		ctrl_buf_clear(&hd->out);
-		if (hd->open && h < CTRL_HANDLES)
+		if (hd->open && h < CTRL_HANDLES) {
 			hd->close_wanted = 1;
+			hd->close_by = -1;
+			snprintf(hd->close_why, sizeof(hd->close_why),
+				 "power cycle");
+		}
 	}
 	ctrl_buf_clear(&c->serial);
 }

@@ -118,10 +118,24 @@ int ctrl_array_free(struct ctrl_vars *vs, uint64_t key)
 	return 0;
 }
 
+/* Number of free array slots (_DA, DA ?). */
+int ctrl_arrays_free(const struct ctrl_vars *vs)
+{
+	int i, n = 0;
+
+	for (i = 0; i < CTRL_ARRAYS; i++)
+		n += vs->arr[i].key == 0;
+	return n;
+}
+
 /*
- * ctrl_array_dim() - DM name[n]: a new array of zeros; an existing array
- * of that name is replaced.
- * Return: 0, TC 6 (size), TC 66 (array space full), TC 67 (too many).
+ * ctrl_array_dim() - DM name[n]: a new array of zeros. An array of that
+ * name that exists already is never re-dimensioned (the reference is
+ * silent; docs/galil-sim-controller.md, difference 23): with the same size
+ * the DM changes nothing (its elements keep their values), with another
+ * size it is refused with TC 57 and the array is left as it is.
+ * Return: 0, TC 6 (size), TC 57 (exists with another size), TC 66 (array
+ * space full), TC 67 (too many arrays).
  */
 int ctrl_array_dim(struct ctrl_vars *vs, uint64_t key, int n)
 {
@@ -130,8 +144,9 @@ int ctrl_array_dim(struct ctrl_vars *vs, uint64_t key, int n)
 
 	if (n < 1 || n > CTRL_ARRAY_SPACE)
 		return 6;
-	if (ctrl_array_find(vs, key))
-		ctrl_array_free(vs, key);
+	a = ctrl_array_find(vs, key);
+	if (a)
+		return a->n == n ? 0 : 57;
 	if (vs->arr_used + n > CTRL_ARRAY_SPACE)
 		return 66;
 	for (i = 0; i < CTRL_ARRAYS && vs->arr[i].key; i++)

@@ -17,6 +17,7 @@
 #include "sim.h"
 #include "sim_bench.h"
 #include "sim_net.h"
+#include "sim_plant.h"
 #include "sim_relay.h"
 
 #define SIM_VERSION	     "1.0"
@@ -31,7 +32,9 @@ struct opts {
 	const char *plant, *relay_link, *protocol;
 	unsigned long seed;
 	int have_seed, verbose;
-	double bench_s; /* > 0: run the speed bench instead */
+	double bench_s;	  /* > 0: run the speed bench instead */
+	int no_amp_uv;	  /* --no-amp-undervoltage */
+	int power_output; /* --power-output N, -1: the plant file's */
 };
 
 static volatile sig_atomic_t stop;
@@ -49,6 +52,7 @@ static void usage(FILE *f)
 	    "usage: galil-sim [--port N] [--control-port M] [--plant FILE]\n"
 	    "                 [--relay-link PATH | --no-relay-link]\n"
 	    "                 [--relay-protocol NAME] [--seed N] [--verbose]\n"
+	    "                 [--no-amp-undervoltage] [--power-output N]\n"
 	    "       galil-sim --bench [SECONDS]\n"
 	    "       galil-sim --help | --version\n"
 	    "  --port N            command port on 127.0.0.1 (default %d, 0 = "
@@ -64,6 +68,10 @@ static void usage(FILE *f)
 	    "  --seed N            potentiometer noise seed (default: plant "
 	    "file, 1)\n"
 	    "  --verbose           print every event on stderr\n"
+	    "  --no-amp-undervoltage  losing motor power is not reported to "
+	    "the controller\n"
+	    "  --power-output N    motor power also needs controller output "
+	    "N (1..8; 0 = none)\n"
 	    "  --bench [SECONDS]   measure virtual-time speed with 8 busy "
 	    "threads\n",
 	    DEFAULT_PORT, DEFAULT_CONTROL_PORT, DEFAULT_RELAY_LINK,
@@ -100,6 +108,16 @@ static int parse_opt(int c, const char *arg, struct opts *o)
 	case 'n': o->relay_link = ""; return 0;
 	case 'r': o->protocol = arg; return 0;
 	case 'v': o->verbose = 1; return 0;
+	case 'u': o->no_amp_uv = 1; return 0;
+	case 'o':
+		if (parse_ulong(arg, SIM_PLANT_POWER_OUTPUTS, &v) < 0) {
+			fprintf(stderr,
+				"galil-sim: bad power output '%s' (0..%d)\n",
+				arg, SIM_PLANT_POWER_OUTPUTS);
+			return -1;
+		}
+		o->power_output = (int)v;
+		return 0;
 	case 's':
 		if (parse_ulong(arg, 0xFFFFFFFFUL, &o->seed) < 0) {
 			fprintf(stderr, "galil-sim: bad seed '%s'\n", arg);
@@ -131,6 +149,8 @@ static int parse_args(int argc, char **argv, struct opts *o)
 	    {"relay-protocol", required_argument, NULL, 'r'},
 	    {"seed", required_argument, NULL, 's'},
 	    {"verbose", no_argument, NULL, 'v'},
+	    {"no-amp-undervoltage", no_argument, NULL, 'u'},
+	    {"power-output", required_argument, NULL, 'o'},
 	    {"bench", optional_argument, NULL, 'b'},
 	    {"help", no_argument, NULL, 'h'},
 	    {"version", no_argument, NULL, 'V'},
@@ -246,7 +266,9 @@ int main(int argc, char **argv)
 			 0,
 			 0,
 			 0,
-			 0};
+			 0,
+			 0,
+			 -1};
 	char err[ERR_LEN];
 	struct sim *s;
 	int rc = parse_args(argc, argv, &o);
@@ -262,6 +284,10 @@ int main(int argc, char **argv)
 	}
 	if (o.have_seed)
 		sim_seed(s, o.seed);
+	if (o.no_amp_uv)
+		sim_plant_set_amp_undervoltage(sim_get_plant(s), 0);
+	if (o.power_output >= 0)
+		sim_plant_set_power_output(sim_get_plant(s), o.power_output);
 	if (o.verbose)
 		sim_set_event_hook(s, print_event, NULL);
 	rc = sim_attach_relay(s, o.protocol, o.relay_link, err, sizeof(err));

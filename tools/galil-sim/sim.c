@@ -195,11 +195,46 @@ static void watch_changes(struct sim *s)
 	}
 }
 
+/* Motor power now: the relay, and the controller's power output if the
+ * plant has one (power_output). */
+static int motor_power(const struct sim *s)
+{
+	return sim_plant_motor_power(s->plant, sim_relay_power(s->relay),
+				     ctrl_outputs(s->ctrl));
+}
+
+/*
+ * The power path as events: the controller's power output changing, and,
+ * with the amplifiers' under-voltage model off, motor power itself (the
+ * controller then reports nothing of it).
+ */
+static void watch_power(struct sim *s, int power)
+{
+	const struct sim_plant_cfg *pc = sim_plant_get_cfg(s->plant);
+	int n = pc->power_output;
+	int out = n > 0 && ((ctrl_outputs(s->ctrl) >> (n - 1)) & 1);
+
+	if (n > 0 && out != s->prev_pout)
+		sim_event(s,
+			  out ? "power output %d set"
+			      : "power output %d cleared (motor power cut by "
+				"the controller)",
+			  n);
+	s->prev_pout = out;
+	if (!pc->amp_undervoltage && power != s->prev_power)
+		sim_event(s, power ? "motor power restored (under-voltage "
+				     "model off)"
+				   : "motor power lost (amplifiers report "
+				     "nothing: under-voltage model off)");
+	s->prev_power = power;
+}
+
 void sim_step(struct sim *s)
 {
-	int power = sim_relay_power(s->relay);
+	int power = motor_power(s);
 	double dt_ms = ctrl_sample_ms(s->ctrl);
 
+	watch_power(s, power);
 	sim_plant_sense(s->plant, power, &s->sense);
 	ctrl_step(s->ctrl, &s->sense, &s->drive);
 	sim_plant_move(s->plant, &s->drive, power, dt_ms);
@@ -240,7 +275,7 @@ void sim_power_cycle(struct sim *s)
 
 int sim_power(const struct sim *s)
 {
-	return sim_relay_power(s->relay);
+	return motor_power(s);
 }
 
 enum sim_link sim_link(const struct sim *s, double *delay_ms)

@@ -91,7 +91,10 @@ double sim_time_ms(const struct sim *s);
  */
 void sim_power_cycle(struct sim *s);
 
-/* sim_power() - 1 when motor power is on (relay energised and healthy). */
+/*
+ * sim_power() - 1 when motor power is on: relay energised on a working
+ * board and, when the plant has a power_output, that controller output set.
+ */
 int sim_power(const struct sim *s);
 
 /*

@@ -283,6 +283,16 @@ static int req_link(struct sim *s, char **arg, int n, struct out *o)
 	return ok(o);
 }
 
+/* Why "relay on|off" cannot act: the board's fault. */
+static const char *fault_word(const struct sim_relay *r)
+{
+	switch (sim_relay_get_fault(r)) {
+	case SIM_RELAY_UNPLUG: return "unplugged";
+	case SIM_RELAY_WEDGE: return "wedged";
+	default: return "failing";
+	}
+}
+
 static int req_relay(struct sim *s, char **arg, int n, struct out *o)
 {
 	if (n == 0) {
@@ -292,10 +302,7 @@ static int req_relay(struct sim *s, char **arg, int n, struct out *o)
 	if (strcmp(arg[0], "on") && strcmp(arg[0], "off"))
 		return fail(o, "usage: relay [on|off]");
 	if (sim_relay_set(s->relay, !strcmp(arg[0], "on")) < 0)
-		return fail(o, "relay is %s",
-			    sim_relay_get_fault(s->relay) == SIM_RELAY_UNPLUG
-				? "unplugged"
-				: "failing");
+		return fail(o, "relay is %s", fault_word(s->relay));
 	return ok(o);
 }
 
@@ -311,8 +318,10 @@ static int req_relayfault(struct sim *s, char **arg, int n, struct out *o)
 		f = SIM_RELAY_UNPLUG;
 	else if (!strcmp(arg[0], "writefail"))
 		f = SIM_RELAY_WRITEFAIL;
+	else if (!strcmp(arg[0], "wedge"))
+		f = SIM_RELAY_WEDGE;
 	else
-		return fail(o, "usage: relayfault <ok|unplug|writefail>");
+		return fail(o, "usage: relayfault <ok|unplug|writefail|wedge>");
 	sim_event(s, "inject: relayfault %s", arg[0]);
 	if (sim_relay_set_fault(s->relay, f, err, sizeof(err)) < 0)
 		return fail(o, "%s", err);
@@ -368,6 +377,16 @@ static void put_axis(struct sim *s, int i, struct out *o)
 	    a, ps.pos);
 }
 
+/* "1" / "0": the plant's power output set / cleared; "-": none. */
+static const char *power_output_state(struct sim *s)
+{
+	int n = sim_plant_get_cfg(s->plant)->power_output;
+
+	if (n == 0)
+		return "-";
+	return (ctrl_outputs(s->ctrl) >> (n - 1)) & 1 ? "1" : "0";
+}
+
 static int req_state(struct sim *s, char **arg, int n, struct out *o)
 {
 	static const char *const links[] = {"ok", "drop", "stall", "delay"};
@@ -379,9 +398,9 @@ static int req_state(struct sim *s, char **arg, int n, struct out *o)
 	(void)arg;
 	(void)n;
 	sim_fmt_ms(t, sizeof(t), s->time_us);
-	put(o, "time=%s relay=%s power=%d link=%s threads=", t,
+	put(o, "time=%s relay=%s power=%d pout=%s link=%s threads=", t,
 	    sim_relay_power(s->relay) ? "on" : "off", sim_power(s),
-	    links[s->link]);
+	    power_output_state(s), links[s->link]);
 	for (int i = 0; i < CTRL_THREADS; i++) {
 		if (th & (1u << i)) {
 			put(o, "%s%d", any ? "," : "", i);
@@ -487,7 +506,8 @@ static const struct request requests[] = {
     {"block", 2, 2, req_block, "block <A|B|C> <0|1>"},
     {"link", 1, 2, req_link, "link <ok|drop|stall|delay MS>"},
     {"relay", 0, 1, req_relay, "relay [on|off]"},
-    {"relayfault", 1, 1, req_relayfault, "relayfault <ok|unplug|writefail>"},
+    {"relayfault", 1, 1, req_relayfault,
+     "relayfault <ok|unplug|writefail|wedge>"},
     {"state", 0, 0, req_state, "state"},
     {"watch", 1, 1, req_watch, "watch <variable>"},
     {"unwatch", 1, 1, req_unwatch, "unwatch <variable>"},

@@ -45,6 +45,8 @@ struct sim {
 
 	/* limit switches at the previous sample, to log changes */
 	int prev_lf[CTRL_AXES], prev_lr[CTRL_AXES];
+	/* motor power and the power output at the previous sample */
+	int prev_power, prev_pout;
 };
 
 /* sim_fmt_ms() - simulated time for messages: "1234" or "1234.5". */

@@ -7,6 +7,11 @@
  * (a half-open link: both directions lost), and leaves new connections in
  * the listen backlog; DELAY holds each reply back by the delay before it is
  * written.
+ *
+ * IH closing: a handle the controller marks (ctrl_handle_close_wanted()) is
+ * closed after the reply of the IH command has gone to its sender. Opening
+ * and closing a connection are events ("handle A opened from ...",
+ * "handle A closed (peer)").
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -107,9 +112,15 @@ static int listen_on(int port, int *bound, char *err, size_t errlen)
 
 /* ---- command connections ---------------------------------------------- */
 
-static void conn_close(struct sim_net *n, int h)
+/*
+ * Close the connection of handle @h. @why names the cause for the event
+ * "handle A closed (<why>)"; NULL for none (an IH close: the controller
+ * records "handle A closed by IHT from handle B" itself).
+ */
+static void conn_close(struct sim_net *n, int h, const char *why)
 {
 	struct net_conn *c = &n->conn[h];
+	struct ctrl *ctl = sim_ctrl(n->sim);
 
 	if (c->fd < 0)
 		return;
@@ -117,28 +128,42 @@ static void conn_close(struct sim_net *n, int h)
 	c->fd = -1;
 	c->out_len = 0;
 	c->nchunk = 0;
-	ctrl_handle_close(sim_ctrl(n->sim), h);
+	if (why && !ctrl_handle_close_wanted(ctl, h))
+		sim_event(n->sim, "handle %c closed (%s)", 'A' + h, why);
+	ctrl_handle_close(ctl, h);
 }
 
+/* The disconnect callback of sim.h: a link drop or a power cycle. */
 static void disconnect_all(void *ud)
 {
 	struct sim_net *n = ud;
+	const char *why = sim_link(n->sim, NULL) == SIM_LINK_DROP
+			      ? "link drop"
+			      : "power cycle";
 
 	for (int h = 0; h < CTRL_HANDLES; h++)
-		conn_close(n, h);
+		conn_close(n, h, why);
 }
 
 static void conn_accept(struct sim_net *n)
 {
-	int one = 1, h, fd = accept(n->lfd, NULL, NULL);
+	struct sockaddr_in sa;
+	socklen_t len = sizeof(sa);
+	int one = 1, h, fd = accept(n->lfd, (struct sockaddr *)&sa, &len);
+	char ip[INET_ADDRSTRLEN] = "?";
 
 	if (fd < 0)
 		return;
+	inet_ntop(AF_INET, &sa.sin_addr, ip, sizeof(ip));
 	for (h = 0; h < CTRL_HANDLES && n->conn[h].fd >= 0; h++)
 		;
 	if (h == CTRL_HANDLES || sim_link(n->sim, NULL) == SIM_LINK_DROP) {
 		close(fd); /* all handles busy, or the link is down */
 		n->stats.refused++;
+		sim_event(n->sim, "connection from %s:%d refused (%s)", ip,
+			  ntohs(sa.sin_port),
+			  h == CTRL_HANDLES ? "all 8 handles busy"
+					    : "link drop");
 		return;
 	}
 	set_nonblock(fd);
@@ -147,6 +172,10 @@ static void conn_accept(struct sim_net *n)
 	n->conn[h].out_len = 0;
 	n->conn[h].nchunk = 0;
 	ctrl_handle_open(sim_ctrl(n->sim), h);
+	ctrl_handle_peer(sim_ctrl(n->sim), h, n->port,
+			 ntohl(sa.sin_addr.s_addr), ntohs(sa.sin_port));
+	sim_event(n->sim, "handle %c opened from %s:%d", 'A' + h, ip,
+		  ntohs(sa.sin_port));
 }
 
 static void conn_read(struct sim_net *n, int h)
@@ -158,7 +187,7 @@ static void conn_read(struct sim_net *n, int h)
 	    (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR))
 		return;
 	if (r <= 0) {
-		conn_close(n, h);
+		conn_close(n, h, r == 0 ? "peer" : strerror(errno));
 		return;
 	}
 	if (sim_link(n->sim, NULL) == SIM_LINK_STALL)
@@ -211,7 +240,7 @@ static void conn_flush(struct sim_net *n, int h, int64_t now)
 	    (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR))
 		return;
 	if (w < 0) {
-		conn_close(n, h);
+		conn_close(n, h, strerror(errno));
 		return;
 	}
 	memmove(c->out, c->out + w, c->out_len - (size_t)w);
@@ -379,7 +408,7 @@ void sim_net_free(struct sim_net *n)
 		return;
 	sim_set_disconnect(n->sim, NULL, NULL);
 	for (int h = 0; h < CTRL_HANDLES; h++)
-		conn_close(n, h);
+		conn_close(n, h, NULL);
 	for (int i = 0; i < SIM_NET_CONTROL_CLIENTS; i++)
 		client_close(&n->client[i]);
 	if (n->lfd >= 0)
@@ -527,6 +556,28 @@ static void dispatch(struct sim_net *n, int slot)
 	}
 }
 
+/* Has everything the controller queued for handle @by been sent? A
+ * program, the private port or a gone sender leave nothing to wait for. */
+static int reply_gone(struct sim_net *n, int by)
+{
+	return by < 0 || by >= CTRL_HANDLES || n->conn[by].fd < 0 ||
+	       (n->conn[by].out_len == 0 &&
+		ctrl_output_pending(sim_ctrl(n->sim), by) == 0);
+}
+
+/* IH closing: a handle the controller wants closed is closed once the
+ * reply of the IH command has been sent to its sender (IHS: to itself). */
+static void close_wanted(struct sim_net *n)
+{
+	struct ctrl *c = sim_ctrl(n->sim);
+
+	for (int h = 0; h < CTRL_HANDLES; h++) {
+		if (n->conn[h].fd >= 0 && ctrl_handle_close_wanted(c, h) &&
+		    reply_gone(n, ctrl_handle_close_by(c, h)))
+			conn_close(n, h, NULL);
+	}
+}
+
 static void flush_all(struct sim_net *n)
 {
 	int64_t now = now_us();
@@ -537,6 +588,7 @@ static void flush_all(struct sim_net *n)
 		conn_fill(n, h, now);
 		conn_flush(n, h, now);
 	}
+	close_wanted(n);
 	for (int i = 0; i < SIM_NET_CONTROL_CLIENTS; i++)
 		client_flush(n, &n->client[i]);
 }

@@ -82,6 +82,8 @@ void sim_plant_cfg_default(struct sim_plant_cfg *cfg)
 	memcpy(cfg->joy_input, default_joy, sizeof(default_joy));
 	cfg->joy_closed_level = 1;
 	cfg->seed = 1;
+	cfg->amp_undervoltage = 1;
+	cfg->power_output = 0;
 }
 
 static int check_pot(const struct sim_plant_pot_cfg *pot, char *err,
@@ -172,6 +174,23 @@ static int check_joy(const struct sim_plant_cfg *cfg, char *err, size_t errlen)
 	return 0;
 }
 
+static int check_power(const struct sim_plant_cfg *cfg, char *err,
+		       size_t errlen)
+{
+	if (cfg->amp_undervoltage != 0 && cfg->amp_undervoltage != 1) {
+		snprintf(err, errlen, "amp_undervoltage must be true or false");
+		return GL_ERR_CONFIG;
+	}
+	if (cfg->power_output < 0 ||
+	    cfg->power_output > SIM_PLANT_POWER_OUTPUTS) {
+		snprintf(err, errlen,
+			 "power_output %d outside 0 (none) or 1..%d",
+			 cfg->power_output, SIM_PLANT_POWER_OUTPUTS);
+		return GL_ERR_CONFIG;
+	}
+	return 0;
+}
+
 int sim_plant_cfg_check(const struct sim_plant_cfg *cfg, char *err,
 			size_t errlen)
 {
@@ -193,6 +212,8 @@ int sim_plant_cfg_check(const struct sim_plant_cfg *cfg, char *err,
 			}
 		}
 	}
+	if (check_power(cfg, err, errlen) < 0)
+		return GL_ERR_CONFIG;
 	return check_joy(cfg, err, errlen);
 }
 
@@ -362,7 +383,31 @@ void sim_plant_sense(struct sim_plant *p, int power, struct ctrl_sense *out)
 			out->an_v[n] = p->an_v[n];
 	}
 	out->inputs = input_word(p);
-	out->amp_power = power ? 1 : 0;
+	out->amp_power = power || !p->cfg.amp_undervoltage;
+}
+
+int sim_plant_motor_power(const struct sim_plant *p, int relay_on,
+			  uint32_t outputs)
+{
+	int n = p->cfg.power_output;
+
+	return relay_on && (n == 0 || ((outputs >> (n - 1)) & 1));
+}
+
+int sim_plant_set_amp_undervoltage(struct sim_plant *p, int on)
+{
+	if (on != 0 && on != 1)
+		return GL_ERR_ARG;
+	p->cfg.amp_undervoltage = on;
+	return 0;
+}
+
+int sim_plant_set_power_output(struct sim_plant *p, int output)
+{
+	if (output < 0 || output > SIM_PLANT_POWER_OUTPUTS)
+		return GL_ERR_ARG;
+	p->cfg.power_output = output;
+	return 0;
 }
 
 /* ---- motion ----------------------------------------------------------- */

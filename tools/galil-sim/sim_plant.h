@@ -59,7 +59,15 @@ struct sim_plant_cfg {
 	int joy_input[SIM_PLANT_SWITCHES]; /* digital input 1..32 */
 	int joy_closed_level; /* @IN level of a closed switch: 1 or 0 */
 	unsigned long seed;   /* noise generator seed */
+	/* 1: the amplifiers report a loss of motor power to the controller
+	 * (under-voltage); 0: they keep quiet (logic supply kept) */
+	int amp_undervoltage;
+	/* 0: none; 1..SIM_PLANT_POWER_OUTPUTS: a controller digital output
+	 * that must be set, besides the relay, for motor power */
+	int power_output;
 };
+
+#define SIM_PLANT_POWER_OUTPUTS 8 /* power_output: outputs 1..8 */
 
 enum sim_plant_pot_fault {
 	SIM_PLANT_POT_OK,
@@ -139,9 +147,28 @@ void sim_plant_seed(struct sim_plant *p, unsigned long seed);
 /*
  * sim_plant_sense() - what the controller reads now: encoders, limit
  * switches, analog inputs (pots + forced values), digital inputs (joystick
- * switches + forced levels), and @power as amp_power. Draws new noise.
+ * switches + forced levels), and what the amplifiers report as amp_power:
+ * @power (motor power present), or always 1 when amp_undervoltage is 0.
+ * Draws new noise.
  */
 void sim_plant_sense(struct sim_plant *p, int power, struct ctrl_sense *out);
+
+/*
+ * sim_plant_motor_power() - 1 when the motors have power: the relay is on
+ * (@relay_on) and, when power_output is configured, that bit of the
+ * controller's digital outputs @outputs (bit n-1 = output n) is set.
+ */
+int sim_plant_motor_power(const struct sim_plant *p, int relay_on,
+			  uint32_t outputs);
+
+/*
+ * sim_plant_set_amp_undervoltage() / sim_plant_set_power_output() -
+ * override amp_undervoltage (0 or 1) and power_output (0..8) of the
+ * configuration (galil-sim --no-amp-undervoltage, --power-output N).
+ * Return: 0 or GL_ERR_ARG for a value out of range.
+ */
+int sim_plant_set_amp_undervoltage(struct sim_plant *p, int on);
+int sim_plant_set_power_output(struct sim_plant *p, int output);
 
 /*
  * sim_plant_move() - one sample of @dt_ms under the controller's @drive.

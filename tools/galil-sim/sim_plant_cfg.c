@@ -20,7 +20,17 @@
 
 #define PLANT_FILE_MAX (1 << 20) /* bytes */
 
-enum ftype { F_DOUBLE, F_INT, F_SEED, F_KIND, F_NOISE, F_MAP, F_AXES, F_JOYIN };
+enum ftype {
+	F_DOUBLE,
+	F_INT,
+	F_BOOL,
+	F_SEED,
+	F_KIND,
+	F_NOISE,
+	F_MAP,
+	F_AXES,
+	F_JOYIN
+};
 
 struct field {
 	const char *key;
@@ -73,6 +83,8 @@ static const struct field root_fields[] = {
     {"seed", F_SEED, CFG(seed), NULL},
     {"axes", F_AXES, CFG(axis), NULL},
     {"joystick", F_MAP, 0, joy_fields},
+    {"amp_undervoltage", F_BOOL, CFG(amp_undervoltage), NULL},
+    {"power_output", F_INT, CFG(power_output), NULL},
     {NULL, F_INT, 0, NULL},
 };
 
@@ -276,6 +288,8 @@ static int set_field(struct ycx *cx, const struct field *f, yaml_node_t *v,
 			return yerr(cx, v, "'%s' must be >= 0", f->key);
 		*(unsigned long *)dst = (unsigned long)l;
 		return 0;
+	case F_BOOL:
+		return get_word(cx, v, f->key, "false", "true", (int *)dst);
 	case F_KIND:
 		/* rotary is 1: "linear" -> 0, "rotary" -> 1 */
 		return get_word(cx, v, f->key, "linear", "rotary", (int *)dst);
@@ -316,13 +330,20 @@ static int walk_map(struct ycx *cx, yaml_node_t *map, const struct field *table,
 	return 0;
 }
 
-/* Where a failed whole-config check points: the axis or joystick node. */
+/* Where a failed whole-config check points: the value of the top-level
+ * key its message starts with ("axis B: ..." -> axes, "joystick input ...",
+ * "power_output 9 ..."), else the whole document. */
 static yaml_node_t *section_node(struct ycx *cx, yaml_node_t *root,
 				 const char *msg)
 {
-	const char *sect = !strncmp(msg, "axis ", 5) ? "axes" : "joystick";
+	char sect[32];
 	yaml_node_pair_t *p;
 
+	if (!strncmp(msg, "axis ", 5))
+		snprintf(sect, sizeof(sect), "axes");
+	else
+		snprintf(sect, sizeof(sect), "%.*s", (int)strcspn(msg, " "),
+			 msg);
 	for (p = root->data.mapping.pairs.start;
 	     p < root->data.mapping.pairs.top; p++) {
 		if (!strcmp(scalar(yaml_document_get_node(cx->doc, p->key)),

@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <termios.h>
 #include <unistd.h>
@@ -318,12 +319,22 @@ const char *sim_relay_tty(const struct sim_relay *r)
 
 int sim_relay_fd(const struct sim_relay *r)
 {
-	return r->master;
+	return r->fault == SIM_RELAY_WEDGE ? -1 : r->master;
+}
+
+int sim_relay_queued(const struct sim_relay *r)
+{
+	int n = 0;
+
+	if (r->master < 0 || ioctl(r->master, FIONREAD, &n) < 0)
+		return 0;
+	return n;
 }
 
 int sim_relay_power(const struct sim_relay *r)
 {
-	return r->fault == SIM_RELAY_OK && (r->dec.states & 1);
+	return (r->fault == SIM_RELAY_OK || r->fault == SIM_RELAY_WEDGE) &&
+	       (r->dec.states & 1);
 }
 
 static void feed_byte(struct sim_relay *r, uint8_t b)
@@ -348,7 +359,7 @@ int sim_relay_service(struct sim_relay *r)
 	int total = 0;
 	ssize_t n;
 
-	if (r->master < 0)
+	if (r->master < 0 || r->fault == SIM_RELAY_WEDGE)
 		return 0;
 	for (;;) {
 		n = read(r->master, buf, sizeof(buf));
@@ -381,10 +392,37 @@ int sim_relay_set(struct sim_relay *r, int on)
 	return 0;
 }
 
+/*
+ * A wedged board is reset: what the host queued meanwhile is discarded
+ * unread (TCIFLUSH empties the line discipline and the tty buffers still
+ * on their way to it), a frame begun before the wedge is dropped, every
+ * relay is off.
+ */
+static void unwedge(struct sim_relay *r)
+{
+	int before = sim_relay_power(r);
+
+	if (r->master >= 0)
+		tcflush(r->master, TCIFLUSH);
+	r->dec.states = 0;
+	r->dec.nframe = 0;
+	if (r->dec.proto != SIM_RELAY_ICSTATION)
+		r->dec.stage = 0; /* devantech: a pending 0x5C mask byte */
+	r->fault = SIM_RELAY_OK;
+	relay_event(r, "relay discarded the bytes queued while wedged");
+	if (before)
+		relay_event(r, "relay off (board reset after wedge)");
+	relay_event(r, "relay obeys again (relays off)");
+}
+
 static int repair(struct sim_relay *r, char *err, size_t errlen)
 {
 	int rc;
 
+	if (r->fault == SIM_RELAY_WEDGE) {
+		unwedge(r);
+		return 0;
+	}
 	if (r->fault == SIM_RELAY_UNPLUG) {
 		sim_relay_dec_reset(&r->dec, r->dec.proto);
 		if (r->had_pty) {
@@ -413,6 +451,12 @@ int sim_relay_set_fault(struct sim_relay *r, enum sim_relay_fault f, char *err,
 		return repair(r, err, errlen);
 	if (r->fault == SIM_RELAY_UNPLUG)
 		return 0; /* an unplugged board cannot also fail */
+	if (f == SIM_RELAY_WEDGE) {
+		if (r->fault != SIM_RELAY_WEDGE)
+			relay_event(r, "relay wedged (bytes not read)");
+		r->fault = SIM_RELAY_WEDGE;
+		return 0; /* the relays keep their state */
+	}
 	r->dec.states = 0;
 	if (f == SIM_RELAY_UNPLUG) {
 		close_pty(r);

@@ -24,6 +24,8 @@ enum sim_relay_fault {
 	SIM_RELAY_OK,	     /* present and obeying */
 	SIM_RELAY_UNPLUG,    /* pty closed, device node and link gone */
 	SIM_RELAY_WRITEFAIL, /* device present, bytes ignored, power off */
+	SIM_RELAY_WEDGE,     /* device present, bytes left unread in the
+			      * pty, relay state kept as it was */
 };
 
 /* The protocol state of one relay board. */
@@ -84,26 +86,37 @@ int sim_relay_attach(struct sim_relay *r, const char *link_path, char *err,
 /* sim_relay_tty() - the slave path ("/dev/pts/N"), "" without a pty. */
 const char *sim_relay_tty(const struct sim_relay *r);
 
-/* sim_relay_fd() - the master fd to poll for input, -1 without a pty. */
+/*
+ * sim_relay_fd() - the master fd to poll for input: -1 without a pty, and
+ * while wedged (the board reads nothing; polling would spin).
+ */
 int sim_relay_fd(const struct sim_relay *r);
+
+/*
+ * sim_relay_queued() - bytes the host has written that the board has not
+ * read yet (FIONREAD on the master); 0 without a pty.
+ */
+int sim_relay_queued(const struct sim_relay *r);
 
 /*
  * sim_relay_service() - read every pending byte from the pty (without
  * blocking), decode it, answer. Under SIM_RELAY_WRITEFAIL bytes are read
- * and discarded.
+ * and discarded; under SIM_RELAY_WEDGE nothing is read.
  * Return: the number of bytes read (>= 0), or GL_ERR_SYS.
  */
 int sim_relay_service(struct sim_relay *r);
 
 /*
  * sim_relay_power() - 1 when relay 1 is energised and the board is
- * present and working: motor power is on.
+ * present and working (or wedged: its relays keep their state): motor
+ * power is on.
  */
 int sim_relay_power(const struct sim_relay *r);
 
 /*
  * sim_relay_set() - switch relay 1 directly (control port "relay on|off").
- * Return: 0, or GL_ERR_RELAY when the board is unplugged or failing.
+ * Return: 0, or GL_ERR_RELAY when the board is unplugged, failing or
+ * wedged.
  */
 int sim_relay_set(struct sim_relay *r, int on);
 
@@ -111,9 +124,12 @@ int sim_relay_set(struct sim_relay *r, int on);
  * sim_relay_set_fault() - inject a fault or repair.
  * SIM_RELAY_UNPLUG closes the pty (node vanishes, host writes get EIO) and
  * removes the link; SIM_RELAY_WRITEFAIL keeps the device but ignores every
- * byte; both cut power. SIM_RELAY_OK plugs a fresh board back in (a new pty
- * and link if one was attached before; every relay off, icstation
- * handshake needed again) or lets a failing board obey again (relays off).
+ * byte; both cut power. SIM_RELAY_WEDGE stops reading the pty: the host's
+ * bytes stay queued (until its writes would block) and the relays keep
+ * their state, power included. SIM_RELAY_OK plugs a fresh board back in
+ * (a new pty and link if one was attached before; every relay off,
+ * icstation handshake needed again) or lets a failing or wedged board obey
+ * again (relays off; what was queued while wedged is discarded unread).
  * Return: 0 or GL_ERR_SYS (pty could not be recreated; @err says why).
  */
 int sim_relay_set_fault(struct sim_relay *r, enum sim_relay_fault f, char *err,
