@@ -180,8 +180,9 @@ static void test_dm_existing_array(void **state)
 	struct tplant *p = *state;
 	char resp[128];
 
-	expect_reply(p, "DM a[5];a[0]=7;DM a[5];MG a[0],a[-1],_DM",
-		     "::: 7.0000 5.0000 23995.0000\r\n");
+	expect_reply(p, "DM a[5];a[0]=7;MG a[0],a[-1],_DM",
+		     ":: 7.0000 5.0000 23995.0000\r\n");
+	expect_error(p, "DM a[5]", 57); /* even the same size */
 	expect_error(p, "DM a[8]", 57);
 	assert_int_equal(tp_cmd(p, "DM a[6]", resp, sizeof(resp)), GL_ERR_CTRL);
 	assert_int_equal(tp_cmd(p, "TC 1", resp, sizeof(resp)), GL_OK);
@@ -190,10 +191,11 @@ static void test_dm_existing_array(void **state)
 		     " 7.0000 5.0000 23995.0000 29.0000\r\n");
 	expect_reply(p, "DA a[];DM a[8];MG a[0],a[-1],_DM",
 		     ":: 0.0000 8.0000 23992.0000\r\n");
-	assert_int_equal(tp_load(p, "#P\rDM a[8]\rDM a[9]\rok=1\rEN\r"), GL_OK);
+	assert_int_equal(
+	    tp_load(p, "#P\rDA a[]\rDM a[8]\rDM a[9]\rok=1\rEN\r"), GL_OK);
 	expect_reply(p, "ok=0;XQ #P", ":");
 	tp_step(p, 5);
-	assert_true(tp_has_event(p, "program error thread 0 line 2 TC 57 Bad "
+	assert_true(tp_has_event(p, "program error thread 0 line 3 TC 57 Bad "
 				    "function or array"));
 	expect_reply(p, "MG ok,a[-1]", " 0.0000 8.0000\r\n");
 }

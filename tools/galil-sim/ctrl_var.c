@@ -131,11 +131,11 @@ int ctrl_arrays_free(const struct ctrl_vars *vs)
 /*
  * ctrl_array_dim() - DM name[n]: a new array of zeros. An array of that
  * name that exists already is never re-dimensioned (the reference is
- * silent; docs/galil-sim-controller.md, difference 23): with the same size
- * the DM changes nothing (its elements keep their values), with another
- * size it is refused with TC 57 and the array is left as it is.
- * Return: 0, TC 6 (size), TC 57 (exists with another size), TC 66 (array
- * space full), TC 67 (too many arrays).
+ * silent; docs/galil-sim-controller.md, difference 23): the DM is refused
+ * with TC 57 whatever its size, and the array is left as it is (the
+ * fail-safe reading; dmc/roboelf.dmc deallocates with DA *[] first).
+ * Return: 0, TC 6 (size), TC 57 (exists), TC 66 (array space full), TC 67
+ * (too many arrays).
  */
 int ctrl_array_dim(struct ctrl_vars *vs, uint64_t key, int n)
 {
@@ -146,7 +146,7 @@ int ctrl_array_dim(struct ctrl_vars *vs, uint64_t key, int n)
 		return 6;
 	a = ctrl_array_find(vs, key);
 	if (a)
-		return a->n == n ? 0 : 57;
+		return 57;
 	if (vs->arr_used + n > CTRL_ARRAY_SPACE)
 		return 66;
 	for (i = 0; i < CTRL_ARRAYS && vs->arr[i].key; i++)
