@@ -80,6 +80,21 @@ static int real_relay_off(void *ud)
 	return r->relay ? re_relay_off(r->relay) : GL_ERR_RELAY;
 }
 
+static int real_relay_off_start(void *ud)
+{
+	struct re_io_real *r = ud;
+
+	return r->relay ? re_relay_off_start(r->relay) : GL_ERR_RELAY;
+}
+
+static int real_relay_off_finish(void *ud, int deadline_ms)
+{
+	struct re_io_real *r = ud;
+
+	return r->relay ? re_relay_off_finish(r->relay, deadline_ms)
+			: GL_ERR_RELAY;
+}
+
 static enum re_relay_state real_relay_state(void *ud)
 {
 	struct re_io_real *r = ud;
@@ -124,6 +139,8 @@ static const struct re_io_ops real_ops = {
     .message = real_message,
     .relay_check = real_relay_check,
     .relay_off = real_relay_off,
+    .relay_off_start = real_relay_off_start,
+    .relay_off_finish = real_relay_off_finish,
     .relay_state = real_relay_state,
     .log = real_log,
     .now_ns = real_now_ns,

@@ -43,8 +43,17 @@ struct re_io_ops {
 	int (*message)(void *ud, char *line, size_t cap);
 	/* re_relay_check(): GL_OK or GL_ERR_RELAY with @why filled. */
 	int (*relay_check)(void *ud, char *why, size_t cap);
-	/* re_relay_off(): GL_OK or GL_ERR_RELAY. */
+	/* re_relay_off(): start and confirm within relay.off_deadline_ms.
+	 * GL_OK; GL_ERR_TIMEOUT (not confirmed by then); GL_ERR_RELAY. */
 	int (*relay_off)(void *ud);
+	/* re_relay_off_start(): hand "off" to the driver without waiting,
+	 * so that the controller can be stopped while the bytes travel.
+	 * GL_OK, or GL_ERR_RELAY (relay_off_finish reopens and retries);
+	 * relay_off_finish must follow. */
+	int (*relay_off_start)(void *ud);
+	/* re_relay_off_finish(): confirm that "off" within @deadline_ms
+	 * (from the call). Return: as relay_off. */
+	int (*relay_off_finish)(void *ud, int deadline_ms);
 	/* re_relay_state(): what was last confirmed written. */
 	enum re_relay_state (*relay_state)(void *ud);
 	/* re_log: one event; RE_LOG_FAULT is on disk (fsync) on return. */

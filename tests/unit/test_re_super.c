@@ -167,6 +167,23 @@ static int f_relay_off(void *ud)
 	return fk.relay_off_rc;
 }
 
+/* Not used by the cycle yet (it calls relay_off): recorded if called. */
+static int f_relay_off_start(void *ud)
+{
+	(void)ud;
+	fk.n_relay_off++;
+	seq_add("relay_off_start");
+	return fk.relay_off_rc;
+}
+
+static int f_relay_off_finish(void *ud, int deadline_ms)
+{
+	(void)ud;
+	(void)deadline_ms;
+	seq_add("relay_off_finish");
+	return fk.relay_off_rc;
+}
+
 static enum re_relay_state f_relay_state(void *ud)
 {
 	(void)ud;
@@ -198,8 +215,18 @@ static void f_sleep_until(void *ud, int64_t t)
 }
 
 static const struct re_io_ops fake_ops = {
-    f_record,	 f_command,	f_ctrl_error, f_message, f_relay_check,
-    f_relay_off, f_relay_state, f_log,	      f_now,	 f_sleep_until,
+    .record = f_record,
+    .command = f_command,
+    .ctrl_error = f_ctrl_error,
+    .message = f_message,
+    .relay_check = f_relay_check,
+    .relay_off = f_relay_off,
+    .relay_off_start = f_relay_off_start,
+    .relay_off_finish = f_relay_off_finish,
+    .relay_state = f_relay_state,
+    .log = f_log,
+    .now_ns = f_now,
+    .sleep_until = f_sleep_until,
 };
 
 /* ---- fixtures ------------------------------------------------------------ */
