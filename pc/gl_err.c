@@ -23,6 +23,7 @@ const char *gl_strerror(int err)
 	case GL_ERR_RELAY: return "relay failure";
 	case GL_ERR_NOENT: return "not found";
 	case GL_ERR_OVERFLOW: return "buffer too small";
+	case GL_ERR_BUSY: return "in use by another process";
 	}
 	return "unknown error";
 }

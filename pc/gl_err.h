@@ -29,6 +29,7 @@ enum gl_err {
 	GL_ERR_RELAY = -16,    /* E-stop relay failed */
 	GL_ERR_NOENT = -17,    /* file, label or variable not found */
 	GL_ERR_OVERFLOW = -18, /* buffer or table too small */
+	GL_ERR_BUSY = -19,     /* held by another process (a lock) */
 };
 
 /*
