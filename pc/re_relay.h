@@ -216,7 +216,8 @@ int re_relay_close_start(re_relay *r);
 /*
  * re_relay_close_finish() - confirm "off" (starting it if
  * re_relay_close_start() was not called), close the port and free.
- * @deadline_ms: for the "off", as re_relay_off_finish().
+ * @deadline_ms: for the "off", as re_relay_off_finish() (< 0 is taken as
+ *               0: the handle is freed anyway).
  * An output queue still holding bytes at the deadline is discarded before
  * the port is closed: close() of a real serial port would otherwise wait
  * for it up to the driver's closing_wait (30 s by default). NULL is a no-op.
