@@ -137,9 +137,8 @@ __attribute__((format(printf, 2, 3))) static void err_put(char *err,
 	va_end(ap);
 }
 
-/* Split "host", "host:port", "[v6]" or "[v6]:port". */
-static int addr_split(const char *addr, char *host, size_t hcap, char *port,
-		      size_t pcap)
+int gl_link_addr_split(const char *addr, char *host, size_t hcap, char *port,
+		       size_t pcap)
 {
 	const char *h = addr, *colon;
 	size_t hl;
@@ -243,7 +242,8 @@ static int link_connect(gl_link *l, const char *addr, int timeout_ms, char *err)
 	int64_t deadline = now_ms() + timeout_ms;
 	int rc = GL_ERR_SYS, grc;
 
-	if (addr_split(addr, host, sizeof(host), port, sizeof(port)) < 0) {
+	if (gl_link_addr_split(addr, host, sizeof(host), port, sizeof(port)) <
+	    0) {
 		err_put(err, "invalid address '%s'", addr);
 		return GL_ERR_ARG;
 	}

@@ -38,6 +38,19 @@ typedef struct gl_link gl_link;
 int gl_link_open(gl_link **out, const char *addr, int timeout_ms,
 		 char err[GL_ERRTEXT_LEN]);
 
+/*
+ * gl_link_addr_split() - split a controller address as gl_link_open() does.
+ * @addr: "host", "host:port", "[v6]" or "[v6]:port"; a bare IPv6 address
+ *        (more than one ':') needs the brackets.
+ * @host: [out] the host without brackets, NUL-terminated; @hcap bytes.
+ * @port: [out] the port as written (digits only, 1..65535), or
+ *        GL_DEFAULT_PORT when none is given; @pcap bytes.
+ * Return: GL_OK, or GL_ERR_ARG for anything gl_link_open() refuses as
+ *         "invalid address" (empty host or port, a bad port, too long).
+ */
+int gl_link_addr_split(const char *addr, char *host, size_t hcap, char *port,
+		       size_t pcap);
+
 /* gl_link_close() - close both handles and free. NULL is a no-op. */
 void gl_link_close(gl_link *l);
 

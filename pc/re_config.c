@@ -683,6 +683,7 @@ static const struct field relay_fields[] = {
 	E(struct re_config_relay, backend, backend_names, 2),
 	I(struct re_config_relay, baud, 1200, 115200),
 	I(struct re_config_relay, write_timeout_ms, 1, 1000),
+	I(struct re_config_relay, off_deadline_ms, 10, 1000),
 	B(struct re_config_relay, readback),
 	I(struct re_config_relay, readback_timeout_ms, 10, 5000),
 	S(struct re_config_relay, icstation_state, 1),
@@ -1163,7 +1164,8 @@ static void relay_defaults(struct re_config_relay *r)
 	r->backend = RE_RELAY_BACKEND_AUTO;
 	r->baud = 9600;
 	r->write_timeout_ms = 100;
-	r->readback = true; /* devantech; see auto_defaults() */
+	r->off_deadline_ms = 50; /* docs/config.md: 9600 baud, USB, read-back */
+	r->readback = true;	 /* devantech; see auto_defaults() */
 	r->readback_timeout_ms = 500;
 	snprintf(r->icstation_state, sizeof(r->icstation_state), "%s",
 		 "/tmp/roboelf-icstation.state");
@@ -1412,6 +1414,7 @@ void re_config_relay_cfg(const struct re_config *cfg, struct re_relay_cfg *out)
 	out->baud = r->baud;
 	out->clinical = cfg->mode == RE_MODE_CLINICAL;
 	out->write_timeout_ms = r->write_timeout_ms;
+	out->off_deadline_ms = r->off_deadline_ms;
 	out->readback = r->readback;
 	out->readback_timeout_ms = r->readback_timeout_ms;
 	memcpy(out->on, r->on, sizeof(out->on));

@@ -51,9 +51,10 @@ struct re_config_relay {
 	enum re_relay_proto protocol;
 	int channel; /* 1..8 */
 	enum re_relay_backend backend;
-	int baud; /* bits/s */
-	int write_timeout_ms;
-	bool readback; /* Devantech state query */
+	int baud;	      /* bits/s */
+	int write_timeout_ms; /* deadline of "on", ms */
+	int off_deadline_ms;  /* deadline of "off" confirmed, ms */
+	bool readback;	      /* Devantech state query */
 	int readback_timeout_ms;
 	uint8_t on[RE_RELAY_CODE_MAX]; /* protocol {on:, off:} only */
 	size_t on_len;

@@ -84,18 +84,15 @@ static int real_relay_off_start(void *ud)
 {
 	struct re_io_real *r = ud;
 
-	return r->relay ? re_relay_off(r->relay) : GL_ERR_RELAY;
+	return r->relay ? re_relay_off_start(r->relay) : GL_ERR_RELAY;
 }
 
 static int real_relay_off_finish(void *ud, int deadline_ms)
 {
 	struct re_io_real *r = ud;
 
-	(void)deadline_ms;
-	if (!r->relay)
-		return GL_ERR_RELAY;
-	return re_relay_state(r->relay) == RE_RELAY_OFF ? GL_OK
-							 : GL_ERR_RELAY;
+	return r->relay ? re_relay_off_finish(r->relay, deadline_ms)
+			: GL_ERR_RELAY;
 }
 
 /* A new connection, the command on it, and it replaces the old link. */

@@ -45,15 +45,16 @@ struct re_io_ops {
 	int (*message)(void *ud, char *line, size_t cap);
 	/* re_relay_check(): GL_OK or GL_ERR_RELAY with @why filled. */
 	int (*relay_check)(void *ud, char *why, size_t cap);
-	/* re_relay_off(): GL_OK or GL_ERR_RELAY / GL_ERR_TIMEOUT; bounded by
-	 * the relay's own deadline. */
+	/* re_relay_off(): start and confirm within relay.off_deadline_ms.
+	 * GL_OK; GL_ERR_TIMEOUT (not confirmed by then); GL_ERR_RELAY. */
 	int (*relay_off)(void *ud);
-	/* Optional (NULL: relay_off is used). re_relay_off_start(): begin
-	 * switching motor power off without waiting for anything. */
+	/* re_relay_off_start(): hand "off" to the driver without waiting,
+	 * so that the controller can be stopped while the bytes travel.
+	 * GL_OK, or GL_ERR_RELAY (relay_off_finish reopens and retries);
+	 * relay_off_finish must follow. */
 	int (*relay_off_start)(void *ud);
-	/* Optional, with relay_off_start. re_relay_off_finish(): wait at most
-	 * @deadline_ms for the off state to be written and, where the board
-	 * answers, confirmed. Return: GL_OK or an error. */
+	/* re_relay_off_finish(): confirm that "off" within @deadline_ms
+	 * (from the call). Return: as relay_off. */
 	int (*relay_off_finish)(void *ud, int deadline_ms);
 	/* Optional (NULL: not attempted). Deliver one command line over a new
 	 * connection to the controller (the old one is out of step or gone),

@@ -81,7 +81,7 @@ void re_plan_make(const struct re_config *cfg, int mainms,
 	out->uncmd_grace_ns =
 	    (int64_t)(2 * ms + DECEL_MS + 50) * NS_PER_MS + 2 * p_ns;
 	out->fresh_stop_ms = 2 * cfg->controller.timeout_ms;
-	out->relay_off_ms = cfg->relay.write_timeout_ms;
+	out->relay_off_ms = cfg->relay.off_deadline_ms;
 }
 
 void re_plan_super_cfg(const struct re_plan *p, const struct re_config *cfg,

@@ -4,18 +4,33 @@
  * Safety decisions (docs/config.md, "E-stop relay"):
  * - Opening switches the relay off first; only re_relay_on() switches it
  *   on, and it refuses when the link check fails.
- * - re_relay_off() always writes, and on failure reopens the port once and
- *   writes again (but never on a different pseudo-terminal: pty numbers are
- *   reused by unrelated programs); only a written and drained message counts
- *   as "off".
+ * - Nothing waits without a deadline. Bytes are handed to the driver
+ *   without waiting (the back-ends never block); re_relay_*_finish() then
+ *   polls, sleeping at most 1 ms at a time, for the message to be
+ *   accepted, the driver's output queue to empty and (Devantech read-back)
+ *   the board's report, and gives up at its deadline with GL_ERR_TIMEOUT.
+ *   An empty queue means the bytes left the PC; the USB adapter's own FIFO
+ *   still needs about 1 ms per byte at 9600 baud, and only the read-back
+ *   shows that the board switched.
+ * - "off" always writes, and after a failed write reopens the port once
+ *   and writes again (but never on a different pseudo-terminal: pty
+ *   numbers are reused by unrelated programs). A deadline that passes with
+ *   "off" still queued reopens nothing: the queued bytes are the safe
+ *   message, and a wedged queue is not cured by a reopen. Only a confirmed
+ *   message counts as "off".
+ * - An "on" that was not confirmed is discarded from the output queue (it
+ *   must not reach the board later), and "off" discards an unconfirmed
+ *   "on" before writing.
  * - re_relay_check() never writes a state byte. It looks at the descriptor
- *   (fcntl, poll with timeout 0: hang-up/error), the device node (stat: still
- *   there, same st_rdev, inode and change time as at open, so a pty number
- *   reused by someone else or a re-plugged adapter is noticed) and, for
- *   Devantech boards with read-back enabled, the board's own report of its
- *   relays: the query byte 0x5B is sent in one cycle and its answer read
- *   without waiting in a later one, so the check never blocks on the 9600
- *   baud line.
+ *   (fcntl, poll with timeout 0: hang-up/error), the device node (stat:
+ *   still there, same st_rdev, inode and change time as at open, so a pty
+ *   number reused by someone else or a re-plugged adapter is noticed) and,
+ *   for Devantech boards with read-back enabled, the board's own report of
+ *   its relays: the query byte 0x5B is sent in one cycle and its answer
+ *   read without waiting in a later one, so the check never blocks on the
+ *   9600 baud line. The node is stat()ed only after an inotify event that
+ *   may change it (re_pathwatch.h), at least once a second, and in every
+ *   call after a failed stat() check.
  * - ICStation boards take the handshake (0x50, answer 0xAB/0xAD/0xAC, then
  *   0x51) once per power-up; sent again, 0x50 is a relay state byte that
  *   switches relays 1-4, 6 and 8 ON. A board's power-up is identified by its
@@ -43,6 +58,7 @@
 #include <unistd.h>
 
 #include "gl_err.h"
+#include "re_pathwatch.h"
 #include "re_relay_be.h"
 
 #define DEVANTECH_QUERY 0x5B /* answer: bit n-1 set = relay n on */
@@ -52,22 +68,36 @@
 #define ICS_REPLY_MS	500  /* deadline of the identification answer */
 #define PTY_MAJOR_MIN	136  /* Unix98 pty slaves: majors 136..143 */
 #define PTY_MAJOR_MAX	143
+#define NS_PER_MS	1000000LL
+#define NAP_NS		NS_PER_MS    /* longest sleep while waiting */
+#define FULL_CHECK_NS	1000000000LL /* stat() the port at least this often */
+#define STALE_CHUNKS	4 /* x 16 bytes of stale input dropped per call */
+
+enum re_relay_op { OP_NONE = 0, OP_ON, OP_OFF };
 
 struct re_relay {
 	struct re_relay_cfg cfg;
 	const struct re_relay_be_ops *ops;
 	struct re_relay_io io;
-	bool linked;	      /* io is open */
-	dev_t rdev;	      /* device opened ... */
-	ino_t ino;	      /* ... its node (a pty number reused later */
-	struct timespec ctim; /* has the same rdev and inode) */
+	bool linked;		/* io is open */
+	dev_t rdev;		/* device opened ... */
+	ino_t ino;		/* ... its node (a pty number reused later */
+	struct timespec ctim;	/* has the same rdev and inode) */
+	struct re_pathwatch pw; /* events that may change what port names */
+	int64_t next_full_ns;	/* next stat() of the port, CLOCK_MONOTONIC */
+	bool node_suspect;	/* the last stat() check failed */
 	enum re_relay_state state;
 	uint8_t msg_on[RE_RELAY_CODE_MAX];
 	uint8_t msg_off[RE_RELAY_CODE_MAX];
 	size_t on_len, off_len;
-	bool rb_pending; /* query sent, answer awaited */
-	bool rb_discard; /* the awaited answer predates a write */
-	struct timespec rb_sent;
+	const uint8_t *out;	  /* the message being written ... */
+	size_t out_len, out_done; /* ... its length, bytes accepted */
+	enum re_relay_op op;	  /* switching started, not finished */
+	bool on_unconfirmed;	  /* "on" handed over, not confirmed */
+	bool reopen;		  /* "off" could not be written */
+	int rb_due;		  /* state queries sent, not answered */
+	bool rb_discard;	  /* the answers due predate a write */
+	struct timespec rb_sent;  /* the oldest query due was sent */
 	char err[RE_RELAY_ERR_MAX];
 };
 
@@ -180,6 +210,45 @@ static bool same_node(const struct re_relay *r, const struct stat *st)
 	       st->st_ctim.tv_nsec == r->ctim.tv_nsec;
 }
 
+/* ---- time ---- */
+
+static int64_t now_ns(void)
+{
+	struct timespec t;
+
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+}
+
+static int64_t deadline_in(int ms)
+{
+	return now_ns() + (int64_t)ms * NS_PER_MS;
+}
+
+/* Sleep NAP_NS at most, and never past @deadline. */
+static void nap(int64_t deadline)
+{
+	int64_t t = now_ns() + NAP_NS;
+	struct timespec ts;
+
+	if (t > deadline)
+		t = deadline;
+	ts.tv_sec = (time_t)(t / 1000000000LL);
+	ts.tv_nsec = (long)(t % 1000000000LL);
+	while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) ==
+	       EINTR)
+		;
+}
+
+/* ---- the port and its output ---- */
+
+static void out_set(struct re_relay *r, const uint8_t *msg, size_t len)
+{
+	r->out = msg;
+	r->out_len = len;
+	r->out_done = 0;
+}
+
 /* Open the back-end and remember which device was opened. */
 static int link_open(struct re_relay *r)
 {
@@ -205,34 +274,241 @@ static int link_open(struct re_relay *r)
 		r->ino = st.st_ino;
 		r->ctim = st.st_ctim;
 	}
-	r->rb_pending = false;
+	/* Without a watch every check stat()s; the first check stat()s
+	 * anyway (the node may have changed before the watch existed). */
+	re_pathwatch_open(&r->pw, r->cfg.port);
+	r->next_full_ns = 0;
+	r->node_suspect = false;
+	r->rb_due = 0;
+	out_set(r, NULL, 0);
 	return GL_OK;
 }
 
+/* Close without waiting: a non-empty output queue is discarded first
+ * (close() would wait for it up to the driver's closing_wait). */
 static void link_close(struct re_relay *r)
 {
-	if (r->linked)
+	if (r->linked) {
+		if (r->ops->queued(&r->io, NULL, 0) != 0)
+			r->ops->discard(&r->io);
 		r->ops->close(&r->io);
+	}
 	r->linked = false;
+	re_pathwatch_close(&r->pw);
 }
 
-static int send_msg(struct re_relay *r, const uint8_t *msg, size_t len)
+/* Hand the driver what it takes of the message now: GL_OK (perhaps only
+ * part of it) or GL_ERR_SYS with the message. */
+static int out_push(struct re_relay *r)
 {
+	int n;
+
 	if (!r->linked)
-		return set_err(r, GL_ERR_RELAY, "write failed: port not open");
-	if (r->ops->send(&r->io, msg, len, r->cfg.write_timeout_ms, r->err,
-			 sizeof(r->err)))
-		return GL_ERR_RELAY;
+		return set_err(r, GL_ERR_SYS, "write failed: port not open");
+	while (r->out_done < r->out_len) {
+		n = r->ops->write(&r->io, r->out + r->out_done,
+				  r->out_len - r->out_done, r->err,
+				  sizeof(r->err));
+		if (n < 0)
+			return GL_ERR_SYS;
+		if (n == 0)
+			break; /* the driver's buffer is full: later */
+		r->out_done += (size_t)n;
+	}
 	return GL_OK;
+}
+
+/*
+ * Wait until the message (@what) is accepted and the output queue is
+ * empty, until @deadline (@ms from the caller's start, for the message).
+ * Return: GL_OK; GL_ERR_SYS (I/O error); GL_ERR_TIMEOUT, never before
+ * @deadline.
+ */
+static int out_wait(struct re_relay *r, const char *what, int64_t deadline,
+		    int ms)
+{
+	int q = 0;
+
+	for (;;) {
+		if (out_push(r))
+			return GL_ERR_SYS;
+		if (r->out_done == r->out_len) {
+			q = r->ops->queued(&r->io, r->err, sizeof(r->err));
+			if (q <= 0)
+				return q < 0 ? GL_ERR_SYS : GL_OK;
+		}
+		if (now_ns() >= deadline)
+			break;
+		nap(deadline);
+	}
+	if (r->out_done < r->out_len)
+		return set_err(r, GL_ERR_TIMEOUT,
+			       "%s not confirmed: only %zu of %zu bytes "
+			       "accepted by the driver within %d ms",
+			       what, r->out_done, r->out_len, ms);
+	return set_err(r, GL_ERR_TIMEOUT,
+		       "%s not confirmed: %d byte%s still queued after %d ms",
+		       what, q, q == 1 ? "" : "s", ms);
+}
+
+/* Drop what the board sent before now (bounded). GL_OK or GL_ERR_SYS. */
+static int drop_input(struct re_relay *r)
+{
+	uint8_t junk[16];
+	int i, n;
+
+	for (i = 0; i < STALE_CHUNKS; i++) {
+		n = r->ops->read(&r->io, junk, sizeof(junk), r->err,
+				 sizeof(r->err));
+		if (n <= 0)
+			return n < 0 ? GL_ERR_SYS : GL_OK;
+	}
+	return GL_OK;
+}
+
+/* One byte within @ms: 1, 0 (none came) or GL_ERR_SYS. */
+static int read_byte(struct re_relay *r, uint8_t *b, int ms)
+{
+	int64_t deadline = deadline_in(ms);
+	int n;
+
+	for (;;) {
+		n = r->ops->read(&r->io, b, 1, r->err, sizeof(r->err));
+		if (n != 0 || now_ns() >= deadline)
+			return n;
+		nap(deadline);
+	}
+}
+
+/* The state query goes out (or is due): count the answer owed. */
+static void rb_sent_one(struct re_relay *r)
+{
+	if (!r->rb_due++)
+		clock_gettime(CLOCK_MONOTONIC, &r->rb_sent);
+}
+
+/* Does a state-query answer show the channel @on? */
+static bool rb_shows(const struct re_relay *r, uint8_t b, bool on)
+{
+	return ((b >> (r->cfg.channel - 1)) & 1) == on;
+}
+
+/* The read-back of @what had no answer by its deadline: the answers stay
+ * due; a query the driver never took is dropped (a lone byte). */
+static int rb_timeout(struct re_relay *r, const char *what, int ms)
+{
+	r->rb_discard = true;
+	if (r->out_done < r->out_len) {
+		out_set(r, NULL, 0);
+		return set_err(r, GL_ERR_TIMEOUT,
+			       "%s not confirmed: the state query (0x5B) was "
+			       "not accepted by the driver within %d ms",
+			       what, ms);
+	}
+	return set_err(r, GL_ERR_TIMEOUT,
+		       "%s not confirmed: no answer to the state query (0x5B) "
+		       "within %d ms",
+		       what, ms);
+}
+
+/*
+ * Devantech read-back until @deadline: send the state query and read the
+ * answers. Answers still due to queries of re_relay_check() arrive first:
+ * one showing the channel @on confirms as well (only this call switches the
+ * relay, so a state seen after the write started still holds); one showing
+ * the other state is judged only when it must be the answer to this
+ * query. On a timeout the answers stay due, timed from the oldest query,
+ * so that re_relay_check() reports a silent board after
+ * readback_timeout_ms.
+ */
+static int readback_wait(struct re_relay *r, const char *what, bool on,
+			 int64_t deadline, int ms)
+{
+	static const uint8_t query = DEVANTECH_QUERY;
+	int skip = r->rb_due, n = 0;
+	uint8_t b = 0;
+
+	if (!skip && drop_input(r))
+		return GL_ERR_SYS;
+	out_set(r, &query, 1);
+	for (;;) {
+		if (out_push(r))
+			return GL_ERR_SYS;
+		if (r->out == &query && r->out_done) {
+			rb_sent_one(r);
+			out_set(r, NULL, 0);
+		}
+		if (!r->out)
+			n = r->ops->read(&r->io, &b, 1, r->err, sizeof(r->err));
+		if (n < 0)
+			return GL_ERR_SYS;
+		if (n == 1 && r->rb_due)
+			r->rb_due--;
+		if (n == 1 && rb_shows(r, b, on)) {
+			r->rb_due = 0; /* the rest, if any, agrees */
+			return GL_OK;
+		}
+		if (n == 1 && !skip--)
+			return set_err(r, GL_ERR_RELAY,
+				       "%s not confirmed: read-back shows "
+				       "channel %d %s",
+				       what, r->cfg.channel, on ? "off" : "on");
+		if (n == 1)
+			continue;
+		if (now_ns() >= deadline)
+			break;
+		nap(deadline);
+	}
+	return rb_timeout(r, what, ms);
+}
+
+/* After writing @what: sent, and read back where the board can. */
+static int confirm(struct re_relay *r, const char *what, bool on,
+		   int64_t deadline, int ms)
+{
+	int rc = out_wait(r, what, deadline, ms);
+
+	if (rc == GL_OK && r->cfg.readback)
+		rc = readback_wait(r, what, on, deadline, ms);
+	return rc;
+}
+
+/* Write a message and wait until it is sent, within @ms (open only). */
+static int send_wait(struct re_relay *r, const uint8_t *msg, size_t len,
+		     const char *what, int ms)
+{
+	out_set(r, msg, len);
+	return out_wait(r, what, deadline_in(ms), ms) ? GL_ERR_RELAY : GL_OK;
 }
 
 /* ---- link check ---- */
+
+/* The device node by stat(): after a watch event, once a second, and in
+ * every call while it fails. */
+static int node_check(struct re_relay *r)
+{
+	int64_t now = now_ns();
+	struct stat st;
+
+	if (!re_pathwatch_changed(&r->pw) && !r->node_suspect &&
+	    now < r->next_full_ns)
+		return GL_OK;
+	r->next_full_ns = now + FULL_CHECK_NS;
+	r->node_suspect = true;
+	if (stat(r->cfg.port, &st) < 0)
+		return set_err(r, GL_ERR_RELAY, "device node is gone: %s",
+			       strerror(errno));
+	if (!same_node(r, &st))
+		return set_err(r, GL_ERR_RELAY,
+			       "the port now names another device");
+	r->node_suspect = false;
+	return GL_OK;
+}
 
 /* Descriptor, hang-up and device node; no byte written. */
 static int link_check(struct re_relay *r)
 {
 	struct pollfd p = {.events = POLLIN};
-	struct stat st;
 	int fd;
 
 	if (!r->linked)
@@ -249,36 +525,39 @@ static int link_check(struct re_relay *r)
 		return set_err(r, GL_ERR_RELAY, "link lost (hang-up)");
 	if (p.revents & (POLLERR | POLLNVAL))
 		return set_err(r, GL_ERR_RELAY, "link error");
-	if (stat(r->cfg.port, &st) < 0)
-		return set_err(r, GL_ERR_RELAY, "device node is gone: %s",
-			       strerror(errno));
-	if (!same_node(r, &st))
-		return set_err(r, GL_ERR_RELAY,
-			       "the port now names another device");
-	return GL_OK;
+	return node_check(r);
 }
 
-/* Devantech read-back: one step per check, never waiting. */
+/*
+ * Devantech read-back: one step per check, never waiting. The board must
+ * answer within readback_timeout_ms whatever the state; the answer is
+ * judged against the state last confirmed (not while UNKNOWN, not when
+ * it predates a write). Nothing is sent while a message is half written.
+ */
 static int readback_step(struct re_relay *r)
 {
 	static const uint8_t query = DEVANTECH_QUERY;
 	uint8_t b;
-	int n, bit, want;
+	bool on;
+	int n;
 
-	if (!r->cfg.readback || r->state == RE_RELAY_UNKNOWN)
+	if (!r->cfg.readback || r->out_done < r->out_len)
 		return GL_OK;
-	if (!r->rb_pending) {
-		while (r->ops->recv(&r->io, &b, 1, 0, r->err, sizeof(r->err)) >
-		       0)
-			; /* drop stale bytes */
-		if (r->ops->send(&r->io, &query, 1, 0, r->err, sizeof(r->err)))
+	if (!r->rb_due) {
+		if (drop_input(r))
 			return GL_ERR_RELAY;
-		clock_gettime(CLOCK_MONOTONIC, &r->rb_sent);
-		r->rb_pending = true;
+		n = r->ops->write(&r->io, &query, 1, r->err, sizeof(r->err));
+		if (n < 0)
+			return GL_ERR_RELAY;
+		if (n == 0)
+			return set_err(r, GL_ERR_RELAY,
+				       "the state query (0x5B) was not "
+				       "accepted: output buffer full");
+		rb_sent_one(r);
 		r->rb_discard = false;
 		return GL_OK;
 	}
-	n = r->ops->recv(&r->io, &b, 1, 0, r->err, sizeof(r->err));
+	n = r->ops->read(&r->io, &b, 1, r->err, sizeof(r->err));
 	if (n < 0)
 		return GL_ERR_RELAY;
 	if (n == 0) {
@@ -289,17 +568,14 @@ static int readback_step(struct re_relay *r)
 			       "(0x5B) within %d ms",
 			       r->cfg.readback_timeout_ms);
 	}
-	r->rb_pending = false;
-	if (r->rb_discard)
-		return GL_OK;
-	bit = (b >> (r->cfg.channel - 1)) & 1;
-	want = r->state == RE_RELAY_ON;
-	if (bit != want)
+	if (--r->rb_due || r->rb_discard || r->state == RE_RELAY_UNKNOWN)
+		return GL_OK; /* an older answer, or nothing to compare */
+	on = r->state == RE_RELAY_ON;
+	if (!rb_shows(r, b, on))
 		return set_err(r, GL_ERR_RELAY,
-			       "read-back shows channel %d "
-			       "%s, expected %s",
-			       r->cfg.channel, bit ? "on" : "off",
-			       want ? "on" : "off");
+			       "read-back shows channel %d %s, expected %s",
+			       r->cfg.channel, on ? "off" : "on",
+			       on ? "on" : "off");
 	return GL_OK;
 }
 
@@ -373,22 +649,22 @@ static int ics_handshake(struct re_relay *r)
 {
 	static const uint8_t id_req = ICS_ID, start = ICS_START;
 	static const uint8_t all_off = ICS_ALL_OFF;
+	const int ms = r->cfg.write_timeout_ms;
 	char id[160];
-	uint8_t b;
+	uint8_t b = 0;
 	int n;
 
 	if (ics_identity(r, id, sizeof(id)))
 		return GL_ERR_RELAY;
 	if (ics_recorded(r, id))
 		return GL_OK;
-	while (r->ops->recv(&r->io, &b, 1, 0, r->err, sizeof(r->err)) > 0)
-		; /* drop stale bytes */
-	if (send_msg(r, &id_req, 1))
+	if (drop_input(r) ||
+	    send_wait(r, &id_req, 1, "icstation handshake", ms))
 		return GL_ERR_RELAY;
-	n = r->ops->recv(&r->io, &b, 1, ICS_REPLY_MS, r->err, sizeof(r->err));
+	n = read_byte(r, &b, ICS_REPLY_MS);
 	if (n != 1 || (b != 0xAB && b != 0xAD && b != 0xAC)) {
 		/* 0x50 may just have switched relays on: all off, now. */
-		send_msg(r, &all_off, 1);
+		send_wait(r, &all_off, 1, "off", r->cfg.off_deadline_ms);
 		if (n == 1)
 			return set_err(r, GL_ERR_RELAY,
 				       "unexpected answer "
@@ -400,7 +676,7 @@ static int ics_handshake(struct re_relay *r)
 			       "initialised?): unplug and re-plug the relay",
 			       ICS_REPLY_MS);
 	}
-	if (send_msg(r, &start, 1))
+	if (send_wait(r, &start, 1, "icstation handshake", ms))
 		return GL_ERR_RELAY;
 	return ics_record(r, id, b);
 }
@@ -418,8 +694,8 @@ static int check_cfg(struct re_relay *r)
 		return set_err(r, GL_ERR_ARG,
 			       "the tty back-end is not "
 			       "allowed in clinical mode");
-	if (c->write_timeout_ms <= 0 || c->baud <= 0 ||
-	    (c->readback && c->proto != RE_RELAY_DEVANTECH))
+	if (c->write_timeout_ms <= 0 || c->off_deadline_ms <= 0 ||
+	    c->baud <= 0 || (c->readback && c->proto != RE_RELAY_DEVANTECH))
 		return set_err(r, GL_ERR_ARG, "invalid settings");
 	n = re_relay_message(c, true, r->msg_on);
 	if (n > 0)
@@ -432,6 +708,18 @@ static int check_cfg(struct re_relay *r)
 			       "message",
 			       c->channel);
 	r->off_len = (size_t)n;
+	return GL_OK;
+}
+
+/* The "off" of the open: as re_relay_off_finish(), without a reopen. */
+static int first_off(struct re_relay *r)
+{
+	const int ms = r->cfg.off_deadline_ms;
+
+	out_set(r, r->msg_off, r->off_len);
+	if (confirm(r, "off", false, deadline_in(ms), ms))
+		return GL_ERR_RELAY;
+	r->state = RE_RELAY_OFF;
 	return GL_OK;
 }
 
@@ -453,6 +741,7 @@ int re_relay_open(re_relay **out, const struct re_relay_cfg *cfg, char *err,
 	r->cfg.port[sizeof(r->cfg.port) - 1] = '\0';
 	r->io.path = r->cfg.port;
 	r->io.fd = -1;
+	re_pathwatch_init(&r->pw);
 	rc = check_cfg(r);
 	if (rc)
 		goto out_free;
@@ -461,10 +750,9 @@ int re_relay_open(re_relay **out, const struct re_relay_cfg *cfg, char *err,
 	if (!rc && r->cfg.proto == RE_RELAY_ICSTATION)
 		rc = ics_handshake(r);
 	if (!rc)
-		rc = send_msg(r, r->msg_off, r->off_len);
+		rc = first_off(r);
 	if (rc)
 		goto out_close;
-	r->state = RE_RELAY_OFF;
 	*out = r;
 	return GL_OK;
 out_close:
@@ -476,23 +764,70 @@ out_free:
 	return rc;
 }
 
-int re_relay_on(re_relay *r)
+/* An "on" handed over but not confirmed must never reach the board. */
+static void drop_on(struct re_relay *r)
+{
+	if (!r->on_unconfirmed)
+		return;
+	if (r->linked)
+		r->ops->discard(&r->io);
+	r->on_unconfirmed = false;
+	out_set(r, NULL, 0);
+}
+
+int re_relay_on_start(re_relay *r)
 {
 	if (!r)
 		return GL_ERR_ARG;
-	if (link_check(r)) {
+	r->op = OP_NONE;
+	if (r->out_done < r->out_len)
+		set_err(r, GL_ERR_RELAY,
+			"on refused: the last message is not written yet");
+	else if (!link_check(r))
+		r->op = OP_ON;
+	if (r->op != OP_ON) {
 		r->state = RE_RELAY_UNKNOWN;
 		return GL_ERR_RELAY;
 	}
-	if (r->rb_pending)
+	if (r->rb_due)
 		r->rb_discard = true;
-	if (send_msg(r, r->msg_on, r->on_len)) {
-		r->state = RE_RELAY_UNKNOWN;
+	r->state = RE_RELAY_UNKNOWN;
+	r->on_unconfirmed = true;
+	out_set(r, r->msg_on, r->on_len);
+	if (out_push(r)) {
+		drop_on(r);
+		r->op = OP_NONE;
 		return GL_ERR_RELAY;
 	}
+	return GL_OK;
+}
+
+int re_relay_on_finish(re_relay *r, int deadline_ms)
+{
+	int64_t deadline;
+	int rc;
+
+	if (!r || r->op != OP_ON || deadline_ms < 0)
+		return GL_ERR_ARG;
+	deadline = deadline_in(deadline_ms);
+	r->op = OP_NONE;
+	rc = confirm(r, "on", true, deadline, deadline_ms);
+	if (rc) {
+		drop_on(r);
+		r->state = RE_RELAY_UNKNOWN;
+		return rc == GL_ERR_TIMEOUT ? rc : GL_ERR_RELAY;
+	}
+	r->on_unconfirmed = false;
 	r->state = RE_RELAY_ON;
 	r->err[0] = '\0';
 	return GL_OK;
+}
+
+int re_relay_on(re_relay *r)
+{
+	int rc = re_relay_on_start(r);
+
+	return rc ? rc : re_relay_on_finish(r, r->cfg.write_timeout_ms);
 }
 
 /*
@@ -516,18 +851,19 @@ static bool reopen_allowed(struct re_relay *r)
 	return false;
 }
 
-/* Reopen once after a failed "off" and try again; keep both reasons. */
-static int off_again(struct re_relay *r)
+/* "off" could not be written: reopen once and hand it over again; on
+ * failure keep both reasons. */
+static int off_reopen(struct re_relay *r)
 {
 	char first[RE_RELAY_ERR_MAX], second[RE_RELAY_ERR_MAX];
 	size_t skip = strlen(r->cfg.port) + 10; /* "relay '...': " */
 
 	snprintf(first, sizeof(first), "%s", r->err);
 	link_close(r);
-	if (reopen_allowed(r) && !link_open(r) &&
-	    !send_msg(r, r->msg_off, r->off_len)) {
-		r->state = RE_RELAY_OFF;
-		return GL_OK;
+	if (reopen_allowed(r) && !link_open(r)) {
+		out_set(r, r->msg_off, r->off_len);
+		if (!out_push(r))
+			return GL_OK;
 	}
 	if (strlen(r->err) < skip)
 		skip = 0;
@@ -537,30 +873,83 @@ static int off_again(struct re_relay *r)
 	return GL_ERR_RELAY;
 }
 
+int re_relay_off_start(re_relay *r)
+{
+	bool partial;
+
+	if (!r)
+		return GL_ERR_ARG;
+	if (r->rb_due)
+		r->rb_discard = true;
+	r->state = RE_RELAY_UNKNOWN;
+	r->op = OP_OFF;
+	drop_on(r);
+	/* A half-written "off" is completed, never interleaved. */
+	partial =
+	    r->out == r->msg_off && r->out_done > 0 && r->out_done < r->out_len;
+	if (!partial)
+		out_set(r, r->msg_off, r->off_len);
+	r->reopen = out_push(r) != GL_OK;
+	return r->reopen ? GL_ERR_RELAY : GL_OK;
+}
+
+int re_relay_off_finish(re_relay *r, int deadline_ms)
+{
+	int64_t deadline;
+	bool reopened;
+	int rc;
+
+	if (!r || r->op != OP_OFF || deadline_ms < 0)
+		return GL_ERR_ARG;
+	deadline = deadline_in(deadline_ms);
+	r->op = OP_NONE;
+	reopened = r->reopen;
+	r->reopen = false;
+	if (reopened && off_reopen(r))
+		return GL_ERR_RELAY;
+	rc = confirm(r, "off", false, deadline, deadline_ms);
+	if (rc == GL_ERR_SYS && !reopened) /* I/O error: reopen once */
+		rc = off_reopen(r)
+			 ? GL_ERR_RELAY
+			 : confirm(r, "off", false, deadline, deadline_ms);
+	if (rc == GL_OK)
+		r->state = RE_RELAY_OFF;
+	return rc == GL_ERR_SYS ? GL_ERR_RELAY : rc;
+}
+
 int re_relay_off(re_relay *r)
 {
 	if (!r)
 		return GL_ERR_ARG;
-	if (r->rb_pending)
-		r->rb_discard = true;
-	r->state = RE_RELAY_UNKNOWN;
-	if (!send_msg(r, r->msg_off, r->off_len)) {
-		r->state = RE_RELAY_OFF;
-		return GL_OK;
-	}
-	return off_again(r);
+	re_relay_off_start(r); /* a failed write is retried by finish */
+	return re_relay_off_finish(r, r->cfg.off_deadline_ms);
 }
 
-int re_relay_close(re_relay *r)
+int re_relay_close_start(re_relay *r)
+{
+	return r ? re_relay_off_start(r) : GL_OK;
+}
+
+int re_relay_close_finish(re_relay *r, int deadline_ms)
 {
 	int rc;
 
 	if (!r)
 		return GL_OK;
-	rc = re_relay_off(r);
+	if (r->op != OP_OFF)
+		re_relay_off_start(r);
+	rc = re_relay_off_finish(r, deadline_ms < 0 ? 0 : deadline_ms);
 	link_close(r);
 	free(r);
 	return rc;
+}
+
+int re_relay_close(re_relay *r)
+{
+	if (!r)
+		return GL_OK;
+	re_relay_close_start(r);
+	return re_relay_close_finish(r, r->cfg.off_deadline_ms);
 }
 
 enum re_relay_state re_relay_state(const re_relay *r)

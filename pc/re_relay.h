@@ -14,11 +14,28 @@
  *   tty        - plain POSIX termios, for the simulator's pseudo-terminal
  *                (libserialport cannot open a pty: relays-and-serial.md).
  *
+ * Every operation is bounded: nothing waits without a deadline (no drain,
+ * no blocking read or write). Switching is split in two so that a caller
+ * can do other work (stop the controller) while the bytes travel:
+ *   re_relay_off_start()  - hands the "off" bytes to the driver, never
+ *                           waits; what the driver does not accept at
+ *                           once is retried by ...
+ *   re_relay_off_finish() - ... which waits, with sleeps of at most 1 ms,
+ *                           until every byte was accepted, the driver's
+ *                           output queue is empty and (Devantech with
+ *                           read-back) the board reports the relay off,
+ *                           or until its deadline: GL_ERR_TIMEOUT.
+ * re_relay_off() is both with relay.off_deadline_ms; the same pairs exist
+ * for "on" (deadline relay.write_timeout_ms) and for closing.
+ *
  * Errors: functions return GL_OK or a negative gl_err code (pc/gl_err.h);
  * the handle keeps a message such as
  *   "relay '/tmp/roboelf-relay': write failed: Input/output error"
- * readable with re_relay_errmsg(). Nothing here prints. Only re_relay_open()
- * allocates; on/off/check run in the supervisor's cycle without allocating.
+ *   "relay '/dev/ttyUSB0': off not confirmed: 1 byte still queued after
+ *    50 ms"
+ * readable with re_relay_errmsg(). Nothing here prints. re_relay_open()
+ * allocates, and so does the reopen after a failed "off" (libserialport);
+ * on/off/check in the supervisor's cycle do not allocate.
  */
 #ifndef RE_RELAY_H
 #define RE_RELAY_H
@@ -50,7 +67,9 @@ enum re_relay_backend {
 
 /* What was last confirmed written to the relay. */
 enum re_relay_state {
-	RE_RELAY_UNKNOWN = 0, /* nothing confirmed yet, or a write failed */
+	RE_RELAY_UNKNOWN = 0, /* nothing confirmed yet: switching started
+			       * and not (yet) confirmed, a write failed, or
+			       * its deadline passed */
 	RE_RELAY_OFF,
 	RE_RELAY_ON,
 };
@@ -63,7 +82,10 @@ struct re_relay_cfg {
 	enum re_relay_backend backend;
 	int baud;		 /* bits/s, 8N1, no flow control */
 	bool clinical;		 /* clinical mode: tty back-end refused */
-	int write_timeout_ms;	 /* deadline for one message, ms */
+	int write_timeout_ms;	 /* deadline of "on" and of the ICStation
+				  * handshake bytes, ms */
+	int off_deadline_ms;	 /* deadline of every "off" (open, off,
+				  * close), ms */
 	bool readback;		 /* Devantech: query the state (0x5B)
 				  * from re_relay_check() */
 	int readback_timeout_ms; /* answer deadline of that query, ms */
@@ -89,54 +111,131 @@ typedef struct re_relay re_relay;
  * The relay is switched off at once (a relay left on by a crashed process is
  * not trusted). The ICStation handshake is done here when, and only when, the
  * board has not been through it since it was powered up. Allocates.
+ * The first "off" is confirmed as re_relay_off_finish() does, within
+ * off_deadline_ms (without the reopen).
  * Return: GL_OK; GL_ERR_ARG (bad @cfg, or tty back-end in clinical mode);
  *         GL_ERR_RELAY (open, configure, handshake or the first "off"
- *         failed; the port is closed again); GL_ERR_NOMEM.
+ *         failed or was not confirmed; the port is closed again);
+ *         GL_ERR_NOMEM.
  */
 int re_relay_open(re_relay **out, const struct re_relay_cfg *cfg, char *err,
 		  size_t errlen);
 
 /*
- * re_relay_on() - switch motor power on (close the relay).
+ * re_relay_on_start() - start switching motor power on (close the relay).
  * Only for the operator's explicit start-up; never call it from a fault or
- * recovery path. Written and drained before returning.
- * Return: GL_OK; GL_ERR_RELAY (write failed or short; state UNKNOWN).
+ * recovery path. Refused when re_relay_check() fails or an earlier message
+ * is still half written. Never waits. The state is UNKNOWN until
+ * re_relay_on_finish() confirms.
+ * Return: GL_OK (call re_relay_on_finish()); GL_ERR_ARG (@r NULL);
+ *         GL_ERR_RELAY (refused, or the write failed; nothing is retried).
+ */
+int re_relay_on_start(re_relay *r);
+
+/*
+ * re_relay_on_finish() - confirm the "on" started by re_relay_on_start().
+ * @deadline_ms: how long to wait from this call, ms (>= 0; 0: look once).
+ * Waits (sleeps of at most 1 ms) until the message was accepted, the
+ * output queue is empty and, with read-back, the board reports the channel
+ * on. On any failure the output queue is discarded, so that an "on" that
+ * was not confirmed never reaches the board later.
+ * Return: GL_OK (state ON); GL_ERR_TIMEOUT (not confirmed within
+ *         @deadline_ms, never earlier: "on not confirmed: ..."); GL_ERR_RELAY
+ *         (I/O error, or read-back shows the channel off); GL_ERR_ARG (no
+ *         "on" started, or @deadline_ms < 0). State UNKNOWN on failure.
+ */
+int re_relay_on_finish(re_relay *r, int deadline_ms);
+
+/*
+ * re_relay_on() - re_relay_on_start() and re_relay_on_finish() with the
+ * configured write_timeout_ms. Return: as those.
  */
 int re_relay_on(re_relay *r);
 
 /*
- * re_relay_off() - cut motor power (open the relay).
- * Always tries to write, even when an earlier call or check failed; on a
- * failed write it reopens the port once and tries again, unless the path
- * now names a different pseudo-terminal (pty numbers are reused).
- * Return: GL_OK when the message was written and drained; GL_ERR_RELAY when
- *         that could not be confirmed (the caller must then stop the motors
- *         by other means, e.g. through the controller).
+ * re_relay_off_start() - start cutting motor power (open the relay).
+ * Never waits: hands the "off" bytes to the driver; bytes it does not
+ * accept at once, and a write that failed, are retried by
+ * re_relay_off_finish(), which must follow. An "on" not yet confirmed is
+ * discarded first. The state is UNKNOWN until confirmed.
+ * Return: GL_OK; GL_ERR_RELAY (the write failed: re_relay_off_finish()
+ *         reopens the port once and writes again); GL_ERR_ARG (@r NULL).
+ */
+int re_relay_off_start(re_relay *r);
+
+/*
+ * re_relay_off_finish() - confirm the "off" started by re_relay_off_start().
+ * @deadline_ms: how long to wait from this call, ms (>= 0; 0: look once).
+ * After a failed write it first reopens the port once and writes again,
+ * unless the path now names a different pseudo-terminal (pty numbers are
+ * reused). Then it waits (sleeps of at most 1 ms) until every byte was
+ * accepted, the output queue is empty and, with read-back, the board
+ * reports the channel off. Bytes still queued at the deadline stay queued:
+ * they are the safe message.
+ * Return: GL_OK (state OFF); GL_ERR_TIMEOUT (not confirmed within
+ *         @deadline_ms, never earlier, e.g. "off not confirmed: 1 byte
+ *         still queued after 50 ms"); GL_ERR_RELAY (write or reopen failed,
+ *         or read-back shows the channel on); GL_ERR_ARG (no "off" started,
+ *         or @deadline_ms < 0). On failure the state is UNKNOWN and the
+ *         caller must stop the motors by other means (the controller).
+ *         The reopen's system calls (open, tcsetattr) are not bounded by
+ *         @deadline_ms; it only follows a failed write (adapter gone).
+ */
+int re_relay_off_finish(re_relay *r, int deadline_ms);
+
+/*
+ * re_relay_off() - re_relay_off_start() and re_relay_off_finish() with the
+ * configured off_deadline_ms. Always tries to write, even when an earlier
+ * call or check failed.
+ * Return: as re_relay_off_finish().
  */
 int re_relay_off(re_relay *r);
 
 /*
  * re_relay_check() - is the relay link still sound? For every cycle.
  * Writes no state byte and never re-energises anything; does not block
- * (poll with timeout 0, stat, fstat, and for a Devantech read-back one query
- * byte written and its answer read without waiting). Checks: the descriptor
- * is valid, no hang-up or error is pending, the device node still exists and
- * is the same node (st_rdev, inode, change time) as the one opened, and
- * (read-back) the board reports the channel in the state last written.
+ * (poll with timeout 0, fcntl, one non-blocking read of inotify events,
+ * and for a Devantech read-back one query byte written and its answer read
+ * without waiting). Checks: the descriptor is valid, no hang-up or error is
+ * pending, the device node still exists and is the same node (st_rdev,
+ * inode, change time) as the one opened, and (read-back) the board reports
+ * the channel in the state last confirmed. The node is stat()ed after an
+ * inotify event on the path, its links or the node (re_pathwatch.h), and
+ * at least once a second (an ancestor directory renamed is not watched);
+ * after a failed stat() check, in every call until it passes again.
  * Return: GL_OK; GL_ERR_RELAY with the reason in re_relay_errmsg().
  */
 int re_relay_check(re_relay *r);
 
 /*
- * re_relay_close() - switch the relay off, close the port and free.
- * NULL is a no-op (returns GL_OK).
- * Return: GL_OK when "off" was confirmed before closing, else GL_ERR_RELAY
+ * re_relay_close_start() - re_relay_off_start(), for re_relay_close_finish().
+ * NULL is a no-op. Return: as re_relay_off_start(); GL_OK for NULL.
+ */
+int re_relay_close_start(re_relay *r);
+
+/*
+ * re_relay_close_finish() - confirm "off" (starting it if
+ * re_relay_close_start() was not called), close the port and free.
+ * @deadline_ms: for the "off", as re_relay_off_finish() (< 0 is taken as
+ *               0: the handle is freed anyway).
+ * An output queue still holding bytes at the deadline is discarded before
+ * the port is closed: close() of a real serial port would otherwise wait
+ * for it up to the driver's closing_wait (30 s by default). NULL is a no-op.
+ * Return: GL_OK when "off" was confirmed, else its error (the handle is
+ *         freed either way).
+ */
+int re_relay_close_finish(re_relay *r, int deadline_ms);
+
+/*
+ * re_relay_close() - re_relay_close_start() and re_relay_close_finish() with
+ * the configured off_deadline_ms. NULL is a no-op (returns GL_OK).
+ * Return: GL_OK when "off" was confirmed before closing, else its error
  *         (the handle is freed either way).
  */
 int re_relay_close(re_relay *r);
 
-/* re_relay_state() - what was last confirmed written (UNKNOWN after a
- * failure). */
+/* re_relay_state() - what was last confirmed (UNKNOWN while switching,
+ * and after a failure or an unconfirmed switch). */
 enum re_relay_state re_relay_state(const re_relay *r);
 
 /* re_relay_errmsg() - the last error message ("" if none); never NULL. */

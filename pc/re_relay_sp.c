@@ -5,6 +5,12 @@
  * (sp_last_error_code() is errno on Unix); we format strerror(errno)
  * ourselves rather than call sp_last_error_message(), which allocates and
  * shows a stale errno after SP_ERR_ARG (relays-and-serial.md).
+ *
+ * Only calls that return at once are used (re_relay_be.h): sp_open leaves
+ * the descriptor O_NONBLOCK, writes and reads are sp_nonblocking_*, the
+ * output queue is sp_output_waiting (TIOCOUTQ) and sp_flush; never
+ * sp_drain or sp_blocking_*, whose waits have no deadline or hold the
+ * caller for the whole timeout.
  */
 #include <errno.h>
 #include <libserialport.h>
@@ -81,55 +87,63 @@ out_free:
 	return ret;
 }
 
-static int spb_send(struct re_relay_io *io, const uint8_t *buf, size_t len,
-		    int timeout_ms, char *err, size_t errlen)
+/* Not open: the same message a failed call would give. */
+static int spb_closed(const struct re_relay_io *io, const char *what, char *err,
+		      size_t errlen)
 {
-	enum sp_return rc;
-
-	if (!io->port) {
-		errno = EBADF;
-		return sp_fail(io, "write failed", SP_ERR_FAIL, err, errlen);
-	}
-	if (timeout_ms > 0)
-		rc = sp_blocking_write(io->port, buf, len,
-				       (unsigned int)timeout_ms);
-	else
-		rc = sp_nonblocking_write(io->port, buf, len);
-	if (rc < 0)
-		return sp_fail(io, "write failed", rc, err, errlen);
-	if ((size_t)rc < len) {
-		if (err && errlen)
-			snprintf(err, errlen,
-				 "relay '%s': write failed: only "
-				 "%d of %zu bytes written within %d ms",
-				 io->path, (int)rc, len, timeout_ms);
-		return GL_ERR_TIMEOUT;
-	}
-	if (timeout_ms > 0) {
-		rc = sp_drain(io->port);
-		if (rc != SP_OK)
-			return sp_fail(io, "drain failed", rc, err, errlen);
-	}
-	return GL_OK;
+	errno = EBADF;
+	return sp_fail(io, what, SP_ERR_FAIL, err, errlen);
 }
 
-static int spb_recv(struct re_relay_io *io, uint8_t *buf, size_t len,
-		    int timeout_ms, char *err, size_t errlen)
+/*
+ * libserialport 0.1.1 passes write()'s EAGAIN on as SP_ERR_FAIL (later
+ * versions return 0): either way, "the driver's buffer is full".
+ */
+static int spb_write(struct re_relay_io *io, const uint8_t *buf, size_t len,
+		     char *err, size_t errlen)
 {
 	enum sp_return rc;
 
-	if (!io->port) {
-		errno = EBADF;
-		return sp_fail(io, "read failed", SP_ERR_FAIL, err, errlen);
-	}
-	if (timeout_ms > 0)
-		rc = sp_blocking_read(io->port, buf, len,
-				      (unsigned int)timeout_ms);
-	else
-		rc = sp_nonblocking_read(io->port, buf, len);
+	if (!io->port)
+		return spb_closed(io, "write failed", err, errlen);
+	rc = sp_nonblocking_write(io->port, buf, len);
+	if (rc == SP_ERR_FAIL && (errno == EAGAIN || errno == EWOULDBLOCK))
+		return 0;
+	if (rc < 0)
+		return sp_fail(io, "write failed", rc, err, errlen);
+	return (int)rc;
+}
+
+/* TIOCOUTQ: the USB-serial driver's buffer and its transfers in flight. */
+static int spb_queued(struct re_relay_io *io, char *err, size_t errlen)
+{
+	enum sp_return rc;
+
+	if (!io->port)
+		return spb_closed(io, "output queue unreadable", err, errlen);
+	rc = sp_output_waiting(io->port);
+	if (rc < 0)
+		return sp_fail(io, "output queue unreadable", rc, err, errlen);
+	return (int)rc;
+}
+
+static int spb_read(struct re_relay_io *io, uint8_t *buf, size_t len, char *err,
+		    size_t errlen)
+{
+	enum sp_return rc;
+
+	if (!io->port)
+		return spb_closed(io, "read failed", err, errlen);
+	rc = sp_nonblocking_read(io->port, buf, len);
 	if (rc < 0)
 		return sp_fail(io, "read failed", rc, err, errlen);
 	return (int)rc;
+}
+
+static void spb_discard(struct re_relay_io *io)
+{
+	if (io->port)
+		sp_flush(io->port, SP_BUF_OUTPUT);
 }
 
 static int spb_fd(const struct re_relay_io *io)
@@ -153,8 +167,10 @@ static void spb_close(struct re_relay_io *io)
 const struct re_relay_be_ops re_relay_be_serialport = {
     .name = "serialport",
     .open = spb_open,
-    .send = spb_send,
-    .recv = spb_recv,
+    .write = spb_write,
+    .queued = spb_queued,
+    .read = spb_read,
+    .discard = spb_discard,
     .fd = spb_fd,
     .close = spb_close,
 };

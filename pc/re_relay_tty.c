@@ -3,15 +3,16 @@
  *
  * For galil-sim's virtual relay, a pseudo-terminal that libserialport
  * refuses (relays-and-serial.md); works on /dev/ttyUSB* too, but clinical
- * mode never uses it. The descriptor is non-blocking; deadlines use poll().
+ * mode never uses it. The descriptor is non-blocking and no call here
+ * waits: no tcdrain() (it has no deadline); the output queue is read with
+ * TIOCOUTQ and emptied with tcflush() (re_relay_be.h).
  */
 #include <errno.h>
 #include <fcntl.h>
-#include <poll.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/ioctl.h>
 #include <termios.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "gl_err.h"
@@ -72,115 +73,69 @@ out_close:
 	return tty_fail(io, "cannot configure", err, errlen);
 }
 
-static long ms_left(const struct timespec *deadline)
+static int tty_write(struct re_relay_io *io, const uint8_t *buf, size_t len,
+		     char *err, size_t errlen)
 {
-	struct timespec now;
-
-	clock_gettime(CLOCK_MONOTONIC, &now);
-	return (deadline->tv_sec - now.tv_sec) * 1000L +
-	       (deadline->tv_nsec - now.tv_nsec) / 1000000L;
-}
-
-static void deadline_in(struct timespec *d, int ms)
-{
-	clock_gettime(CLOCK_MONOTONIC, d);
-	d->tv_sec += ms / 1000;
-	d->tv_nsec += (long)(ms % 1000) * 1000000L;
-	if (d->tv_nsec >= 1000000000L) {
-		d->tv_sec++;
-		d->tv_nsec -= 1000000000L;
-	}
-}
-
-/* Wait for @events on the descriptor until @deadline; 1 ready, 0 not. */
-static int tty_wait(const struct re_relay_io *io, short events,
-		    const struct timespec *deadline)
-{
-	struct pollfd p = {.fd = io->fd, .events = events};
-	long left = deadline ? ms_left(deadline) : 0;
-	int rc;
-
-	do
-		rc = poll(&p, 1, left > 0 ? (int)left : 0);
-	while (rc < 0 && errno == EINTR);
-	if (rc < 0)
-		return -1;
-	if (rc > 0 && (p.revents & (POLLERR | POLLNVAL)))
-		return 1; /* let the read/write report the error */
-	return rc > 0;
-}
-
-static int tty_send(struct re_relay_io *io, const uint8_t *buf, size_t len,
-		    int timeout_ms, char *err, size_t errlen)
-{
-	struct timespec deadline;
-	size_t done = 0;
 	ssize_t n;
 
 	if (io->fd < 0) {
 		errno = EBADF;
 		return tty_fail(io, "write failed", err, errlen);
 	}
-	deadline_in(&deadline, timeout_ms);
-	while (done < len) {
-		n = write(io->fd, buf + done, len - done);
-		if (n > 0) {
-			done += (size_t)n;
-			continue;
-		}
-		if (n < 0 && errno != EAGAIN && errno != EINTR)
-			return tty_fail(io, "write failed", err, errlen);
-		if (timeout_ms <= 0 || ms_left(&deadline) <= 0 ||
-		    tty_wait(io, POLLOUT, &deadline) <= 0)
-			break;
+	do
+		n = write(io->fd, buf, len);
+	while (n < 0 && errno == EINTR);
+	if (n >= 0)
+		return (int)n;
+	if (errno == EAGAIN || errno == EWOULDBLOCK)
+		return 0; /* the driver's buffer is full */
+	return tty_fail(io, "write failed", err, errlen);
+}
+
+/* TIOCOUTQ: bytes the driver still holds for the wire. A pty reports 0
+ * at once (its bytes go straight to the master's input); a USB-serial
+ * driver counts its buffer and the transfers in flight. */
+static int tty_queued(struct re_relay_io *io, char *err, size_t errlen)
+{
+	int n = 0;
+
+	if (io->fd < 0) {
+		errno = EBADF;
+		return tty_fail(io, "output queue unreadable", err, errlen);
 	}
-	if (done < len) {
-		if (err && errlen)
-			snprintf(err, errlen,
-				 "relay '%s': write failed: only "
-				 "%zu of %zu bytes written within %d ms",
-				 io->path, done, len, timeout_ms);
-		return GL_ERR_TIMEOUT;
-	}
-	if (timeout_ms > 0 && tcdrain(io->fd) < 0)
-		return tty_fail(io, "drain failed", err, errlen);
-	return GL_OK;
+	if (ioctl(io->fd, TIOCOUTQ, &n) < 0)
+		return tty_fail(io, "output queue unreadable", err, errlen);
+	return n;
 }
 
 /*
- * With VMIN = VTIME = 0 a read with nothing waiting returns 0 (not EAGAIN),
- * so poll() tells "no data yet" (wait) from a hang-up (EIO).
+ * With VMIN = VTIME = 0 a read with nothing waiting returns 0 (or EAGAIN
+ * on the non-blocking descriptor): both mean "nothing yet". A hang-up is
+ * EIO here, and POLLHUP for re_relay_check().
  */
-static int tty_recv(struct re_relay_io *io, uint8_t *buf, size_t len,
-		    int timeout_ms, char *err, size_t errlen)
+static int tty_read(struct re_relay_io *io, uint8_t *buf, size_t len, char *err,
+		    size_t errlen)
 {
-	struct pollfd p = {.fd = io->fd, .events = POLLIN};
-	struct timespec deadline;
 	ssize_t n;
-	long left;
 
 	if (io->fd < 0) {
 		errno = EBADF;
 		return tty_fail(io, "read failed", err, errlen);
 	}
-	deadline_in(&deadline, timeout_ms);
-	for (;;) {
+	do
 		n = read(io->fd, buf, len);
-		if (n > 0)
-			return (int)n;
-		if (n < 0 && errno != EAGAIN && errno != EINTR)
-			return tty_fail(io, "read failed", err, errlen);
-		left = ms_left(&deadline);
-		if (timeout_ms <= 0 || left <= 0)
-			return 0;
-		if (poll(&p, 1, (int)left) <= 0)
-			return 0;
-		if ((p.revents & (POLLHUP | POLLERR)) &&
-		    !(p.revents & POLLIN)) {
-			errno = EIO;
-			return tty_fail(io, "read failed", err, errlen);
-		}
-	}
+	while (n < 0 && errno == EINTR);
+	if (n >= 0)
+		return (int)n;
+	if (errno == EAGAIN || errno == EWOULDBLOCK)
+		return 0;
+	return tty_fail(io, "read failed", err, errlen);
+}
+
+static void tty_discard(struct re_relay_io *io)
+{
+	if (io->fd >= 0)
+		tcflush(io->fd, TCOFLUSH);
 }
 
 static int tty_fd(const struct re_relay_io *io)
@@ -198,8 +153,10 @@ static void tty_close(struct re_relay_io *io)
 const struct re_relay_be_ops re_relay_be_tty = {
     .name = "tty",
     .open = tty_open,
-    .send = tty_send,
-    .recv = tty_recv,
+    .write = tty_write,
+    .queued = tty_queued,
+    .read = tty_read,
+    .discard = tty_discard,
     .fd = tty_fd,
     .close = tty_close,
 };

@@ -44,6 +44,7 @@
 #include "re_console.h"
 #include "re_ctl.h"
 #include "re_io.h"
+#include "re_lock.h"
 #include "re_log.h"
 #include "re_plan.h"
 #include "re_relay.h"
@@ -70,6 +71,7 @@ struct app {
 	struct re_log log;
 	struct re_console con;
 	re_relay *relay;
+	struct re_lock lock_ctl, lock_relay; /* one supervisor per each */
 	struct re_io_real real; /* real.link: the command link */
 	struct re_io io;
 	struct re_ctl_info info;
@@ -320,6 +322,37 @@ static int fail(struct app *a, const char *what)
 	re_console_msg(&a->con, "roboelf: error: %s", what);
 	re_log_msg(&a->log, RE_LOG_WARN, "start-up refused: %s", what);
 	return EXIT_CONNECT;
+}
+
+/* One supervisor per controller and per relay: both locks before the
+ * relay is opened (opening switches it off: a second roboelf must not cut
+ * the first one's motor power) and before the controller is touched. */
+static int take_locks(struct app *a)
+{
+	char key[RE_LOCK_PATH_MAX];
+	const char *port = re_config_relay_port(&a->cfg);
+
+	if (re_lock_controller_key(a->cfg.controller.address, key,
+				   sizeof(key)) != GL_OK) {
+		snprintf(a->err, sizeof(a->err),
+			 "bad controller address '%s'",
+			 a->cfg.controller.address);
+		return fail(a, a->err);
+	}
+	if (re_lock_acquire(&a->lock_ctl, "controller", key, a->err,
+			    sizeof(a->err)) != GL_OK)
+		return fail(a, a->err);
+	if (re_lock_relay_key(port, key, sizeof(key)) != GL_OK) {
+		snprintf(a->err, sizeof(a->err),
+			 "cannot open the E-stop relay '%s': %s (is galil-sim "
+			 "running, or the relay plugged in?)",
+			 port, strerror(errno));
+		return fail(a, a->err);
+	}
+	if (re_lock_acquire(&a->lock_relay, "relay", key, a->err,
+			    sizeof(a->err)) != GL_OK)
+		return fail(a, a->err);
+	return 0;
 }
 
 /* The relay opened (which switches it off) and kept off. */
@@ -716,8 +749,10 @@ static int arm(struct app *a)
 
 static int startup(struct app *a)
 {
-	int rc = start_relay(a);
+	int rc = take_locks(a);
 
+	if (!rc)
+		rc = start_relay(a);
 	if (!rc)
 		rc = start_link(a);
 	if (!rc && !quit_signal)
@@ -858,6 +893,8 @@ static int cleanup(struct app *a)
 	int latched = a->sup && a->sup->latched;
 
 	power_off(a, latched);
+	re_lock_release(&a->lock_relay);
+	re_lock_release(&a->lock_ctl);
 	re_console_close(&a->con);
 	re_log_close(&a->log);
 	free(a->sup);
@@ -881,6 +918,8 @@ static int supervise(struct app *a)
 		return EXIT_USAGE;
 	}
 	a->real.log = &a->log;
+	re_lock_init(&a->lock_ctl);
+	re_lock_init(&a->lock_relay);
 	re_io_bind(&a->io, &a->real);
 	install_signals();
 	rc = startup(a);

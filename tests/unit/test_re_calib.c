@@ -253,6 +253,19 @@ static int f_relay_off(void *ud)
 	return GL_OK;
 }
 
+static int f_relay_off_start(void *ud)
+{
+	(void)ud;
+	return GL_OK;
+}
+
+static int f_relay_off_finish(void *ud, int deadline_ms)
+{
+	(void)ud;
+	(void)deadline_ms;
+	return GL_OK;
+}
+
 static enum re_relay_state f_relay_state(void *ud)
 {
 	(void)ud;
@@ -287,6 +300,8 @@ static const struct re_io_ops ops = {
     .message = f_message,
     .relay_check = f_relay_check,
     .relay_off = f_relay_off,
+    .relay_off_start = f_relay_off_start,
+    .relay_off_finish = f_relay_off_finish,
     .relay_state = f_relay_state,
     .log = f_log,
     .now_ns = f_now,

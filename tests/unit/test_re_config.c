@@ -106,6 +106,10 @@ static const struct bad_case bad_cases[] = {
     {"bad_nan.yaml", 4, 9, "expected a number for 'kp', got '.nan'"},
     {"bad_noncritical_after.yaml", 4, 23,
      "'critical_factor' (2) must be greater than 'noncritical_factor' (2)"},
+    {"bad_off_deadline_high.yaml", 3, 20,
+     "'off_deadline_ms' must be between 10 and 1000, got 1001"},
+    {"bad_off_deadline_low.yaml", 3, 20,
+     "'off_deadline_ms' must be between 10 and 1000, got 9"},
     {"bad_ot_range.yaml", 5, 21,
      "'time_samples' must be between 2 and 32000, got 1"},
     {"bad_period_high.yaml", 2, 12,
@@ -218,6 +222,7 @@ static void test_defaults_documented(void **state)
 	assert_int_equal(c.relay.backend, RE_RELAY_BACKEND_AUTO);
 	assert_int_equal(c.relay.baud, 9600);
 	assert_int_equal(c.relay.write_timeout_ms, 100);
+	assert_int_equal(c.relay.off_deadline_ms, 50);
 	assert_true(c.relay.readback);
 	assert_int_equal(c.relay.readback_timeout_ms, 500);
 	assert_string_equal(c.relay.icstation_state,
@@ -402,8 +407,9 @@ static void emit(struct sbuf *b, const struct re_config *c)
 	}
 	put(b, "  channel: %d\n  backend: %s\n  baud: %d\n", c->relay.channel,
 	    be[c->relay.backend], c->relay.baud);
-	put(b, "  write_timeout_ms: %d\n  readback: %s\n",
-	    c->relay.write_timeout_ms, tf(c->relay.readback));
+	put(b, "  write_timeout_ms: %d\n  off_deadline_ms: %d\n",
+	    c->relay.write_timeout_ms, c->relay.off_deadline_ms);
+	put(b, "  readback: %s\n", tf(c->relay.readback));
 	put(b, "  readback_timeout_ms: %d\n  icstation_state: \"%s\"\n",
 	    c->relay.readback_timeout_ms, c->relay.icstation_state);
 	put(b,
@@ -451,6 +457,7 @@ static void changed(struct re_config *c)
 	c->relay.backend = RE_RELAY_BACKEND_SERIALPORT;
 	c->relay.baud = 19200;
 	c->relay.write_timeout_ms = 40;
+	c->relay.off_deadline_ms = 35;
 	c->relay.readback = false;
 	c->relay.readback_timeout_ms = 300;
 	strcpy(c->relay.icstation_state, "/run/roboelf/ics.state");
@@ -620,6 +627,8 @@ static void test_clinical_accepted(void **state)
 	assert_int_equal(r.proto, RE_RELAY_DEVANTECH);
 	assert_int_equal(r.baud, 9600);
 	assert_true(r.readback);
+	assert_int_equal(r.write_timeout_ms, 100);
+	assert_int_equal(r.off_deadline_ms, 50);
 	c.mode = RE_MODE_DEVELOPMENT;
 	re_config_relay_cfg(&c, &r);
 	assert_string_equal(r.port, "/tmp/roboelf-relay");

@@ -6,6 +6,11 @@
  * slave, as galil-sim's virtual relay does. Bytes on the wire are asserted
  * exactly per protocol; a fake board thread answers the ICStation handshake
  * and the Devantech state query where a test needs answers.
+ *
+ * Linked with --wrap=ioctl and --wrap=stat (test_re_relay_tty.ldflags):
+ * ioctl(TIOCOUTQ) can be made to report bytes still queued (the pty driver
+ * always reports 0: its bytes go straight to the master), and stat() calls
+ * are counted (the cycle's check must not stat() the port every time).
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -20,6 +25,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <termios.h>
 #include <time.h>
@@ -31,6 +37,42 @@
 #include "re_relay.h"
 
 #define WAIT_MS 2000 /* generous deadline for expected bytes */
+#define LATE_MS 15   /* a timeout may come this much after its deadline */
+
+/* ---- wrapped system calls ---- */
+
+int __real_ioctl(int fd, unsigned long req, ...);
+int __wrap_ioctl(int fd, unsigned long req, ...);
+int __real_stat(const char *path, struct stat *st);
+int __wrap_stat(const char *path, struct stat *st);
+
+static int fake_outq = -1; /* >= 0: what TIOCOUTQ reports */
+static int n_outq;	   /* TIOCOUTQ calls */
+static int n_stat;	   /* stat() calls */
+
+int __wrap_ioctl(int fd, unsigned long req, ...)
+{
+	va_list ap;
+	void *arg;
+
+	va_start(ap, req);
+	arg = va_arg(ap, void *);
+	va_end(ap);
+	if (req == TIOCOUTQ) {
+		n_outq++;
+		if (fake_outq >= 0) {
+			memcpy(arg, &fake_outq, sizeof(int));
+			return 0;
+		}
+	}
+	return __real_ioctl(fd, req, arg);
+}
+
+int __wrap_stat(const char *path, struct stat *st)
+{
+	n_stat++;
+	return __real_stat(path, st);
+}
 
 /* ---- pseudo-terminal pairs ---- */
 
@@ -67,6 +109,26 @@ static long now_ms(void)
 
 	clock_gettime(CLOCK_MONOTONIC, &t);
 	return t.tv_sec * 1000L + t.tv_nsec / 1000000L;
+}
+
+static int64_t mono_ns(void)
+{
+	struct timespec t;
+
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+}
+
+/* A timeout came at its deadline: not before, at most LATE_MS after. */
+static void at_deadline(const char *what, int64_t t0, int deadline_ms)
+{
+	double ms = (double)(mono_ns() - t0) / 1e6;
+
+	print_message("%s: timed out after %.2f ms (deadline %d ms)\n", what,
+		      ms, deadline_ms);
+	if (ms < deadline_ms || ms > deadline_ms + LATE_MS)
+		fail_msg("%s: returned after %.2f ms, deadline %d ms", what, ms,
+			 deadline_ms);
 }
 
 /* ---- the fake board (thread on the master side) ---- */
@@ -223,6 +285,7 @@ static int setup(void **state)
 	f->cfg.backend = RE_RELAY_BACKEND_AUTO;
 	f->cfg.baud = 9600;
 	f->cfg.write_timeout_ms = 100;
+	f->cfg.off_deadline_ms = 200;
 	f->cfg.readback_timeout_ms = 200;
 	snprintf(f->cfg.icstation_state, sizeof(f->cfg.icstation_state), "%s",
 		 f->state);
@@ -234,6 +297,7 @@ static int teardown(void **state)
 {
 	struct fix *f = *state;
 
+	fake_outq = -1;
 	fake_stop(&f->fake);
 	pty_close(&f->pty);
 	unlink(f->link);
@@ -564,41 +628,161 @@ static void pty_fill(int slave)
 	fail_msg("pty never filled up");
 }
 
-/* A board that stops reading: writes time out; off retries via reopen. */
+/* The board reads again: take everything it was sent until the line has
+ * been quiet for 50 ms (bytes reach the master in bursts); return whether
+ * @b was among them. */
+static bool board_drain(int master, uint8_t b)
+{
+	struct pollfd p = {.fd = master, .events = POLLIN};
+	uint8_t buf[4096];
+	long end = now_ms() + WAIT_MS;
+	bool seen = false;
+	ssize_t n, i;
+
+	while (now_ms() < end) {
+		n = read(master, buf, sizeof(buf));
+		for (i = 0; i < n; i++)
+			seen = seen || buf[i] == b;
+		if (n > 0)
+			continue;
+		if (poll(&p, 1, 50) == 0)
+			return seen;
+	}
+	fail_msg("the pty never went quiet");
+	return seen;
+}
+
+/* A board that stops reading: "on" is not accepted and times out at its
+ * deadline, never to be written later; "off" works once it reads again. */
 static void test_write_timeout(void **state)
 {
 	static const uint8_t off[] = {0x6F};
 	struct fix *f = *state;
-	uint8_t junk[4096];
 	re_relay *r;
-	char err[RE_RELAY_ERR_MAX], want[RE_RELAY_ERR_MAX];
-	long t0;
+	char want[RE_RELAY_ERR_MAX];
+	int64_t t0;
 
 	f->cfg.write_timeout_ms = 30;
-	assert_int_equal(re_relay_open(&r, &f->cfg, err, sizeof(err)), GL_OK);
+	open_ok(f, &r);
 	wire_expect(f->pty.master, off, 1);
 	pty_fill(f->pty.slave);
-	t0 = now_ms();
-	assert_int_equal(re_relay_on(r), GL_ERR_RELAY);
-	assert_true(now_ms() - t0 >= 25);
+	t0 = mono_ns();
+	assert_int_equal(re_relay_on(r), GL_ERR_TIMEOUT);
+	at_deadline("on, pty full", t0, 30);
 	snprintf(want, sizeof(want),
-		 "relay '%s': write failed: only 0 of 1 "
-		 "bytes written within 30 ms",
+		 "relay '%s': on not confirmed: only 0 of 1 bytes accepted by "
+		 "the driver within 30 ms",
 		 f->link);
 	assert_string_equal(re_relay_errmsg(r), want);
 	assert_int_equal(re_relay_state(r), RE_RELAY_UNKNOWN);
-	assert_int_equal(re_relay_off(r), GL_ERR_RELAY);
-	snprintf(want, sizeof(want),
-		 "relay '%s': write failed: only 0 of 1 "
-		 "bytes written within 30 ms; reopen: write failed: only 0 of "
-		 "1 bytes written within 30 ms",
-		 f->link);
-	assert_string_equal(re_relay_errmsg(r), want);
-	while (read(f->pty.master, junk, sizeof(junk)) > 0)
-		; /* the board reads again */
+	assert_false(board_drain(f->pty.master, 0x65)); /* never "on" */
 	assert_int_equal(re_relay_off(r), GL_OK);
 	assert_int_equal(re_relay_state(r), RE_RELAY_OFF);
 	wire_expect(f->pty.master, off, 1);
+	assert_int_equal(re_relay_close(r), GL_OK);
+}
+
+/* A pty whose master nobody reads (buffer full): "off" returns the
+ * timeout at its deadline; the state is not "off"; once the board reads
+ * again, "off" is confirmed. */
+static void test_off_pty_full(void **state)
+{
+	static const uint8_t off[] = {0x6F}, on[] = {0x65};
+	struct fix *f = *state;
+	re_relay *r;
+	char want[RE_RELAY_ERR_MAX];
+	int64_t t0;
+
+	f->cfg.off_deadline_ms = 20;
+	open_ok(f, &r);
+	wire_expect(f->pty.master, off, 1);
+	assert_int_equal(re_relay_on(r), GL_OK);
+	wire_expect(f->pty.master, on, 1);
+	pty_fill(f->pty.slave);
+	t0 = mono_ns();
+	assert_int_equal(re_relay_off(r), GL_ERR_TIMEOUT);
+	at_deadline("off, pty full", t0, 20);
+	snprintf(want, sizeof(want),
+		 "relay '%s': off not confirmed: only 0 of 1 bytes accepted "
+		 "by the driver within 20 ms",
+		 f->link);
+	assert_string_equal(re_relay_errmsg(r), want);
+	assert_int_equal(re_relay_state(r), RE_RELAY_UNKNOWN);
+	t0 = mono_ns();
+	assert_int_equal(re_relay_off_start(r), GL_OK);
+	assert_true(mono_ns() - t0 < 5000000); /* start never waits */
+	assert_int_equal(re_relay_off_finish(r, 20), GL_ERR_TIMEOUT);
+	at_deadline("off split, pty full", t0, 20);
+	board_drain(f->pty.master, 0);
+	assert_int_equal(re_relay_off(r), GL_OK);
+	assert_int_equal(re_relay_state(r), RE_RELAY_OFF);
+	wire_expect(f->pty.master, off, 1);
+	assert_int_equal(re_relay_close(r), GL_OK);
+}
+
+/* A byte that stays in the output queue (TIOCOUTQ reports 1; simulated,
+ * the pty driver always reports 0): "off" times out at its deadline; the
+ * byte itself was handed over. Close discards the queue, without waiting
+ * beyond its own deadline. */
+static void test_off_byte_queued(void **state)
+{
+	static const uint8_t off[] = {0x6F}, on[] = {0x65};
+	struct fix *f = *state;
+	re_relay *r;
+	char want[RE_RELAY_ERR_MAX];
+	int64_t t0;
+
+	f->cfg.off_deadline_ms = 20;
+	open_ok(f, &r);
+	wire_expect(f->pty.master, off, 1);
+	assert_int_equal(re_relay_on(r), GL_OK);
+	wire_expect(f->pty.master, on, 1);
+	fake_outq = 1;
+	n_outq = 0;
+	t0 = mono_ns();
+	assert_int_equal(re_relay_off(r), GL_ERR_TIMEOUT);
+	at_deadline("off, byte queued", t0, 20);
+	assert_true(n_outq >= 10); /* polled about every ms */
+	snprintf(want, sizeof(want),
+		 "relay '%s': off not confirmed: 1 byte still queued after "
+		 "20 ms",
+		 f->link);
+	assert_string_equal(re_relay_errmsg(r), want);
+	assert_int_equal(re_relay_state(r), RE_RELAY_UNKNOWN);
+	wire_expect(f->pty.master, off, 1);
+	t0 = mono_ns();
+	assert_int_equal(re_relay_close(r), GL_ERR_TIMEOUT);
+	at_deadline("close, byte queued", t0, 20);
+	fake_outq = -1;
+}
+
+/* A healthy relay confirms at once: without read-back, and with the
+ * Devantech read-back answered by the board. */
+static void test_off_confirms_quickly(void **state)
+{
+	struct fix *f = *state;
+	re_relay *r;
+	double ms_plain, ms_rb;
+	int64_t t0;
+
+	open_ok(f, &r);
+	t0 = mono_ns();
+	assert_int_equal(re_relay_off(r), GL_OK);
+	ms_plain = (double)(mono_ns() - t0) / 1e6;
+	assert_int_equal(re_relay_close(r), GL_OK);
+	f->cfg.readback = true;
+	fake_start(&f->fake, f->pty.master, FAKE_DEVANTECH);
+	open_ok(f, &r);
+	assert_int_equal(re_relay_on(r), GL_OK);
+	t0 = mono_ns();
+	assert_int_equal(re_relay_off(r), GL_OK);
+	ms_rb = (double)(mono_ns() - t0) / 1e6;
+	assert_int_equal(re_relay_state(r), RE_RELAY_OFF);
+	print_message("off confirmed in %.3f ms (tty), %.3f ms with the "
+		      "read-back\n",
+		      ms_plain, ms_rb);
+	assert_true(ms_plain < 5.0);
+	assert_true(ms_rb < 50.0); /* a thread on a busy 2-core machine */
 	assert_int_equal(re_relay_close(r), GL_OK);
 }
 
@@ -683,6 +867,104 @@ static void test_check_nonblocking(void **state)
 	re_relay_close(r);
 }
 
+/* Wait (deadline WAIT_MS) until the coarse clock that stamps inode change
+ * times has passed @path's change time, so that a change is visible. */
+static void ctime_passes(const char *path)
+{
+	struct timespec now;
+	struct stat st;
+	long end = now_ms() + WAIT_MS;
+
+	assert_int_equal(__real_stat(path, &st), 0);
+	while (now_ms() < end) {
+		clock_gettime(CLOCK_REALTIME_COARSE, &now);
+		if (now.tv_sec > st.st_ctim.tv_sec ||
+		    (now.tv_sec == st.st_ctim.tv_sec &&
+		     now.tv_nsec > st.st_ctim.tv_nsec))
+			return;
+		usleep(500);
+	}
+	fail_msg("the clock never passed the change time of '%s'", path);
+}
+
+/*
+ * The cycle's check does not stat() the port path every call: inotify
+ * says when to (at most one stat() a second otherwise). A change of the
+ * node (chmod: new change time) is still seen at the next check, and the
+ * check keeps failing (by stat() in every call) while it lasts.
+ */
+static void test_check_stat_on_event(void **state)
+{
+	struct fix *f = *state;
+	re_relay *r;
+	char want[RE_RELAY_ERR_MAX];
+	long t0;
+	int i;
+
+	open_ok(f, &r);
+	assert_int_equal(re_relay_check(r), GL_OK); /* the first one stat()s */
+	n_stat = 0;
+	t0 = now_ms();
+	for (i = 0; i < 1000; i++)
+		assert_int_equal(re_relay_check(r), GL_OK);
+	print_message("1000 checks in %ld ms: %d stat() calls\n", now_ms() - t0,
+		      n_stat);
+	assert_true(n_stat <= (now_ms() - t0) / 1000 + 1);
+	ctime_passes(f->pty.name);
+	assert_int_equal(chmod(f->pty.name, 0600), 0);
+	n_stat = 0;
+	assert_int_equal(re_relay_check(r), GL_ERR_RELAY);
+	snprintf(want, sizeof(want),
+		 "relay '%s': the port now names another device", f->link);
+	assert_string_equal(re_relay_errmsg(r), want);
+	assert_int_equal(n_stat, 1);
+	assert_int_equal(re_relay_check(r), GL_ERR_RELAY);
+	assert_int_equal(n_stat, 2);
+	assert_string_equal(re_relay_errmsg(r), want);
+	re_relay_close(r);
+}
+
+/*
+ * A directory above the watched ones renamed (dir/sub/relay -> the path
+ * no longer exists, no inotify event reaches the watches on dir/sub and
+ * /dev/pts): the once-a-second stat() finds it within 1 s.
+ */
+static void test_check_ancestor_moved(void **state)
+{
+	struct fix *f = *state;
+	char sub[160], link[192], moved[96], want[RE_RELAY_ERR_MAX];
+	re_relay *r;
+	long t0, t1, end;
+	int rc = GL_OK;
+
+	snprintf(sub, sizeof(sub), "%s/sub", f->dir);
+	snprintf(link, sizeof(link), "%s/relay", sub);
+	snprintf(moved, sizeof(moved), "%s.moved", f->dir);
+	assert_int_equal(mkdir(sub, 0700), 0);
+	assert_int_equal(symlink(f->pty.name, link), 0);
+	snprintf(f->cfg.port, sizeof(f->cfg.port), "%s", link);
+	open_ok(f, &r);
+	assert_int_equal(re_relay_check(r), GL_OK);
+	t0 = now_ms();
+	assert_int_equal(rename(f->dir, moved), 0);
+	for (end = t0 + WAIT_MS; rc == GL_OK && now_ms() < end;) {
+		rc = re_relay_check(r);
+		usleep(1000);
+	}
+	t1 = now_ms();
+	assert_int_equal(rename(moved, f->dir), 0);
+	print_message("ancestor renamed: seen after %ld ms\n", t1 - t0);
+	assert_int_equal(rc, GL_ERR_RELAY);
+	snprintf(want, sizeof(want),
+		 "relay '%s': device node is gone: No such file or directory",
+		 link);
+	assert_string_equal(re_relay_errmsg(r), want);
+	assert_true(t1 - t0 <= 1000 + 100); /* + a loop step, scheduling */
+	re_relay_close(r);
+	unlink(link);
+	rmdir(sub);
+}
+
 /* Clinical mode never uses the tty back-end, even for a pty path. */
 static void test_clinical_refuses_tty(void **state)
 {
@@ -753,8 +1035,17 @@ int main(void)
 					    teardown),
 	    cmocka_unit_test_setup_teardown(test_write_timeout, setup,
 					    teardown),
+	    cmocka_unit_test_setup_teardown(test_off_pty_full, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_off_byte_queued, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_off_confirms_quickly, setup,
+					    teardown),
 	    cmocka_unit_test_setup_teardown(test_readback, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_check_nonblocking, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_check_stat_on_event, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_check_ancestor_moved, setup,
 					    teardown),
 	    cmocka_unit_test_setup_teardown(test_clinical_refuses_tty, setup,
 					    teardown),

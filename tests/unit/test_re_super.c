@@ -170,6 +170,23 @@ static int f_relay_off(void *ud)
 	return fk.relay_off_rc;
 }
 
+/* Not used by the cycle yet (it calls relay_off): recorded if called. */
+static int f_relay_off_start(void *ud)
+{
+	(void)ud;
+	fk.n_relay_off++;
+	seq_add("relay_off_start");
+	return fk.relay_off_rc;
+}
+
+static int f_relay_off_finish(void *ud, int deadline_ms)
+{
+	(void)ud;
+	(void)deadline_ms;
+	seq_add("relay_off_finish");
+	return fk.relay_off_rc;
+}
+
 static enum re_relay_state f_relay_state(void *ud)
 {
 	(void)ud;
@@ -207,6 +224,8 @@ static const struct re_io_ops fake_ops = {
     .message = f_message,
     .relay_check = f_relay_check,
     .relay_off = f_relay_off,
+    .relay_off_start = f_relay_off_start,
+    .relay_off_finish = f_relay_off_finish,
     .relay_state = f_relay_state,
     .log = f_log,
     .now_ns = f_now,
@@ -344,7 +363,8 @@ static void test_super_encpot_fault_order(void **state)
 	assert_int_equal(step(), RE_FAULT);
 	/* relay, stop, motors read back, the program's own verdict asked
 	 * (a consequence to name), then the log */
-	assert_string_equal(fk.seq, "relay_off,cmd:AB 1;MO ABC;pcflt=1,"
+	assert_string_equal(fk.seq, "relay_off_start,cmd:AB 1;MO ABC;pcflt=1,"
+				    "relay_off_finish,"
 				    "cmd:MG _MOA,cmd:MG _MOB,cmd:MG _MOC,"
 				    "cmd:MG fcode,log:FAULT");
 	assert_non_null(strstr(re_super_fault_line(&sup),
@@ -470,9 +490,11 @@ static void test_super_settle_program_verdict(void **state)
 	fk.fcode_val = 3;
 	snprintf(fk.mg_fdet, sizeof(fk.mg_fdet), " 1.0000");
 	assert_int_equal(step(), RE_FAULT);
-	assert_string_equal(fk.seq, "relay_off,cmd:AB 1;MO ABC,cmd:MG fcode,"
+	assert_string_equal(fk.seq, "relay_off_start,cmd:AB 1;MO ABC,"
+				    "cmd:MG fcode,"
 				    "cmd:MG fcode,cmd:MG fcode,cmd:MG fcode,"
 				    "cmd:MG faxis,cmd:MG fdet,cmd:pcflt=1,"
+				    "relay_off_finish,"
 				    "cmd:MG _MOA,cmd:MG _MOB,cmd:MG _MOC,"
 				    "log:FAULT");
 	assert_int_equal(sup.fault.id, RE_F_CTRL_INPUT);
@@ -593,7 +615,8 @@ static void test_super_shutdown(void **state)
 	assert_int_equal(re_super_shutdown(&sup, what, sizeof(what)), GL_OK);
 	assert_string_equal(fk.seq,
 			    "cmd:offreq=1,cmd:AB 1;MO ABC,cmd:MG _MOA,"
-			    "cmd:MG _MOB,cmd:MG _MOC,relay_off");
+			    "cmd:MG _MOB,cmd:MG _MOC,relay_off_start,"
+			    "relay_off_finish");
 	assert_string_equal(what, "motors off: confirmed; motor power off "
 				  "(relay): confirmed");
 }
