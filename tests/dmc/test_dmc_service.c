@@ -778,6 +778,38 @@ static void test_arm_from_service(void **state)
 	assert_int_equal(dmc_h_fault_lines(h, NULL, NULL, NULL), 0);
 }
 
+/*
+ * Arming from service right after a fast service move (svmax 3 * vmax, as
+ * calibration moves may be): the axis is at rest when the arm request
+ * comes (its move ended, ownership released), so arming must succeed and
+ * hold. TV, a 256-sample average, still remembers the service speed for a
+ * while; a speed limit of vover * vmax applied to that memory would latch
+ * fault 13 detail 2 on an axis that does not move.
+ */
+static void test_arm_after_fast_move(void **state)
+{
+	struct dmc_h *h = *state;
+	struct dmc_h_params p;
+
+	params_service(&p);
+	p.svmax[0] = 3 * p.vmax[0];
+	DMC_H_CHECK(h, open_configured(h, &p));
+	DMC_H_CHECK(h, dmc_h_service(h));
+	DMC_H_CHECK(h, dmc_h_move(h, 0, 20000, p.svmax[0], 5000));
+	wait_move_done(h, 0, 2000);
+	print_message("measured: TV at the arm request %.0f counts/s (limit "
+		      "armed %.0f)\n",
+		      mg(h, "_TVA"), p.vmax[0] * dmc_h_var(h, "vover"));
+	DMC_H_CHECK(h, dmc_h_arm(h));
+	dmc_h_advance(h, 500);
+	if (dmc_h_var(h, "state") != 1)
+		fail_msg("armed after a fast service move, then fault %g axis "
+			 "%g detail %g with every axis at rest",
+			 dmc_h_var(h, "fcode"), dmc_h_var(h, "faxis"),
+			 dmc_h_var(h, "fdet"));
+	assert_int_equal(dmc_h_fault_lines(h, NULL, NULL, NULL), 0);
+}
+
 /* armreq=1 while a service move runs: refused with fault 1, check 17 (no
  * profiler may run when arming), axis 0; everything stops and goes off. */
 static void test_arm_refused_moving(void **state)
@@ -881,6 +913,8 @@ int main(void)
 					    dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_arm_from_service, dmc_h_fx_new,
 					    dmc_h_fx_free),
+	    cmocka_unit_test_setup_teardown(test_arm_after_fast_move,
+					    dmc_h_fx_new, dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_arm_refused_moving, fx_service,
 					    dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_halted_poserr, fx_service,
