@@ -443,6 +443,32 @@ static void test_refuse_bounds(void **state)
 	}
 }
 
+/* A request for two axes with one bad (B above svmax): every requested
+ * axis is checked before any starts, so A (valid) never moves either. */
+static void test_refuse_one_of_two(void **state)
+{
+	struct dmc_h *h = *state;
+	double mainms = dmc_h_var(h, "mainms"), t0;
+
+	DMC_H_CHECK(h, set_i(h, "mvax", 0, 1));
+	DMC_H_CHECK(h, set_i(h, "mvax", 1, 1));
+	DMC_H_CHECK(h, set_i(h, "mvax", 2, 0));
+	DMC_H_CHECK(h, set_i(h, "mvtg", 0, 5000));
+	DMC_H_CHECK(h, set_i(h, "mvsp", 0, 5000));
+	DMC_H_CHECK(h, set_i(h, "mvtg", 1, 5000));
+	DMC_H_CHECK(h, set_i(h, "mvsp", 1, var_i(h, "svmax", 1) + 2));
+	DMC_H_CHECK(h, dmc_h_set(h, "mvto", 5000));
+	t0 = dmc_h_now(h);
+	DMC_H_CHECK(h, dmc_h_set(h, "mvreq", 1));
+	while (dmc_h_var(h, "state") != 2 && dmc_h_now(h) - t0 <= mainms + 1) {
+		dmc_h_advance(h, 1);
+		assert_int_equal(dmc_h_axis(h, 0).moving, 0);
+		assert_int_equal(dmc_h_axis(h, 1).moving, 0);
+	}
+	assert_latched(h, 15, 2, 2);
+	assert_true(fabs(dmc_h_axis(h, 0).enc) < 1);
+}
+
 /* Detail 1: a request for an axis whose profiler still runs (a move in
  * flight) is refused; the moving axis is stopped and switched off, the
  * others never start. */
@@ -531,37 +557,55 @@ static void test_time_limit(void **state)
 }
 
 /*
- * Detail 7: a fast request from outside the near zone (A at 0, 2.55 V)
- * with its target deep inside it (-44000, 0.74 V) is taken, and latched as
- * fault 15 detail 7 within one main loop (+1 sample) of the first sample in
- * which the potentiometer reads below pnlo (noise off, so the crossing is
- * one instant); the axis stops short of its target.
+ * Detail 7: a fast request from outside the near zone (the pot reads about
+ * 2.55 V at 0) with its target deep inside it (44000 counts from the
+ * centre: 0.74 V toward the reverse switch, 4.36 V toward the forward one)
+ * is taken, and latched as fault 15 detail 7 after the first sample in
+ * which the potentiometer reads past pnlo (moving in reverse) or pnhi
+ * (forward; noise off, so the crossing is one instant) within one main
+ * loop plus the part of a pass from #GUARD's @AN read to #MVSUP's latch
+ * (about 60 program lines: at most 4 samples at galil-sim's 16 lines per
+ * sample). The axis stops short of its target.
  */
-static void test_fast_into_zone(void **state)
+static void fast_into_zone(struct dmc_h *h, int ax, int dir)
 {
-	struct dmc_h *h = *state;
-	double pnlo = dmc_h_var(h, "pnlo[0]"), mainms = dmc_h_var(h, "mainms");
-	double t_zone = -1, t_f, t0;
+	double mainms = dmc_h_var(h, "mainms"), t_zone = -1, t_f, t0, zone;
+	char req[32], an[16];
 
-	DMC_H_CHECK(h, dmc_h_control(h, "pot A noise 0"));
-	DMC_H_CHECK(h,
-		    dmc_h_move(h, 0, -44000, dmc_h_var(h, "svmax[0]"), 20000));
+	zone = var_i(h, dir < 0 ? "pnlo" : "pnhi", ax);
+	snprintf(req, sizeof(req), "pot %c noise 0", 'A' + ax);
+	snprintf(an, sizeof(an), "@AN[%d]", (int)var_i(h, "potin", ax));
+	DMC_H_CHECK(h, dmc_h_control(h, req));
+	DMC_H_CHECK(
+	    h, dmc_h_move(h, ax, dir * 44000, var_i(h, "svmax", ax), 20000));
 	t0 = dmc_h_now(h);
 	while (dmc_h_var(h, "state") == 3 && dmc_h_now(h) - t0 < 6000) {
 		dmc_h_advance(h, 1);
-		if (t_zone < 0 && mg(h, "@AN[1]") < pnlo)
+		if (t_zone < 0 && (mg(h, an) - zone) * dir > 0)
 			t_zone = dmc_h_now(h);
 	}
 	t_f = dmc_h_now(h);
 	assert_true(t_zone > 0);
-	print_message("measured: fast move in the near zone latched %.0f ms "
-		      "after the pot crossed pnlo (at %.0f counts)\n",
-		      t_f - t_zone, dmc_h_axis(h, 0).enc);
-	assert_true(t_f - t_zone <= mainms + 1);
-	assert_latched(h, 15, 1, 7);
+	print_message("measured: fast move in the near zone (axis %c) latched "
+		      "%.0f ms after the pot crossed %.1f V (at %.0f counts)\n",
+		      'A' + ax, t_f - t_zone, zone, dmc_h_axis(h, ax).enc);
+	assert_true(t_f - t_zone <= mainms + 4);
+	assert_latched(h, 15, ax + 1, 7);
 	dmc_h_advance(h, 100);
-	assert_int_equal(dmc_h_axis(h, 0).moving, 0);
-	assert_true(dmc_h_axis(h, 0).enc > -40000);
+	assert_int_equal(dmc_h_axis(h, ax).moving, 0);
+	assert_true(dmc_h_axis(h, ax).enc * dir < 40000);
+}
+
+/* Detail 7 toward the reverse switch (A, below pnlo). */
+static void test_fast_into_zone_rev(void **state)
+{
+	fast_into_zone(*state, 0, -1);
+}
+
+/* Detail 7 toward the forward switch (B, above pnhi). */
+static void test_fast_into_zone_fwd(void **state)
+{
+	fast_into_zone(*state, 1, 1);
 }
 
 /*
@@ -877,6 +921,33 @@ static void test_halted_poserr(void **state)
 	assert_int_equal(ctrl_threads(h->ctrl), 0u);
 }
 
+/*
+ * prun=0 and HX in service, then motor power lost (relay off): #AMPERR
+ * runs in thread 0 and, halted, only stops, switches the motors off, opens
+ * the power output and ends: no fault, no count (namp), no FAULT line, no
+ * program error event, no thread left running.
+ */
+static void test_halted_amperr(void **state)
+{
+	struct dmc_h *h = *state;
+	double namp = dmc_h_var(h, "namp");
+
+	DMC_H_CHECK(h, dmc_h_set(h, "prun", 0));
+	DMC_H_CHECK(h, dmc_h_cmd(h, "HX", NULL, 0));
+	h->hb_on = 0;
+	dmc_h_advance(h, 5);
+	events_check(h, NULL);
+	DMC_H_CHECK(h, dmc_h_control(h, "relay off"));
+	assert_true(dmc_h_wait_motor_off(h, 7, 50) >= 0);
+	dmc_h_advance(h, 20);
+	assert_true(out_level(h, PWROUT) == 0);
+	assert_true(dmc_h_var(h, "fcode") == 0);
+	assert_true(dmc_h_var(h, "namp") == namp);
+	assert_int_equal(dmc_h_fault_lines(h, NULL, NULL, NULL), 0);
+	assert_true(events_check(h, "#AMPERR running in thread 0"));
+	assert_int_equal(ctrl_threads(h->ctrl), 0u);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -889,13 +960,17 @@ int main(void)
 	    cmocka_unit_test_setup_teardown(test_move_two_axes, fx_service,
 					    dmc_h_fx_free),
 	    cmocka_unit_test(test_refuse_bounds),
+	    cmocka_unit_test_setup_teardown(test_refuse_one_of_two, fx_service,
+					    dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_refuse_moving, fx_service,
 					    dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_refuse_near_switch, fx_service,
 					    dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_time_limit, fx_service,
 					    dmc_h_fx_free),
-	    cmocka_unit_test_setup_teardown(test_fast_into_zone, fx_service,
+	    cmocka_unit_test_setup_teardown(test_fast_into_zone_rev, fx_service,
+					    dmc_h_fx_free),
+	    cmocka_unit_test_setup_teardown(test_fast_into_zone_fwd, fx_service,
 					    dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_fast_into_zone_mvsp_rewritten,
 					    fx_service, dmc_h_fx_free),
@@ -918,6 +993,8 @@ int main(void)
 	    cmocka_unit_test_setup_teardown(test_arm_refused_moving, fx_service,
 					    dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_halted_poserr, fx_service,
+					    dmc_h_fx_free),
+	    cmocka_unit_test_setup_teardown(test_halted_amperr, fx_service,
 					    dmc_h_fx_free),
 	};
 
