@@ -23,8 +23,7 @@
 
 #include "dmc_h.h"
 
-/* ---- helpers --------------------------------------------------------------
- */
+/* ---- helpers ------------------------------------------------------------- */
 
 /* A value the controller computes, read with a host MG (NAN on error). */
 static double mg(struct dmc_h *h, const char *expr)
@@ -90,8 +89,7 @@ static void assert_latched(struct dmc_h *h, int code, int axis, double det,
 		assert_int_equal(dmc_h_axis(h, i).motor_off, 1);
 }
 
-/* ---- motion the program did not command (fault 13) ------------------------
- */
+/* ---- motion the program did not command (fault 13) ----------------------- */
 
 /*
  * A host's PA + BG on an axis at rest, which the program does not own:
@@ -310,8 +308,7 @@ static void test_hb_wrap(void **state)
 	assert_int_equal(dmc_h_fault_lines(h, NULL, NULL, NULL), 0);
 }
 
-/* ---- foreign connections (fault 14, detail = new handles) -----------------
- */
+/* ---- foreign connections (fault 14, detail = new handles) ---------------- */
 
 /*
  * A connection opened while armed (the harness holds A and B since before
@@ -364,8 +361,7 @@ static void test_handle_reused(void **state)
 	assert_latched(h, 14, 0, 2, 0);
 }
 
-/* ---- potentiometer range (fault 16) ----------------------------------------
- */
+/* ---- potentiometer range (fault 16) -------------------------------------- */
 
 struct potcase {
 	const char *req; /* control request */
@@ -549,8 +545,7 @@ static void test_two_transients(void **state)
 	assert_latched(h, 3, 0, 1, 0);
 }
 
-/* ---- position-tracking targets inside FL/BL --------------------------------
- */
+/* ---- position-tracking targets inside FL/BL ------------------------------ */
 
 /*
  * Jogging into the forward soft limit with FL = sfwd (as the supervisor
@@ -611,8 +606,7 @@ static void test_pt_inside_bl(void **state)
 	assert_int_equal(dmc_h_fault_lines(h, NULL, NULL, NULL), 0);
 }
 
-/* ---- encoder failure at rest (fault 9) ------------------------------------
- */
+/* ---- encoder failure at rest (fault 9) ----------------------------------- */
 
 /*
  * An encoder failure at rest: A with OA 1 (OT 30 samples, OV 0.9438 V, the

@@ -26,8 +26,7 @@
 
 static char events[SIM_RESPONSE_MAX];
 
-/* ---- helpers --------------------------------------------------------------
- */
+/* ---- helpers ------------------------------------------------------------- */
 
 /* The default parameters with the motor-power output wired to PWROUT. */
 static void params_service(struct dmc_h_params *p)
@@ -175,12 +174,12 @@ static int events_check(struct dmc_h *h, const char *want)
 	return want && strstr(events, want) != NULL;
 }
 
-/* ---- entering the service state --------------------------------------------
- */
+/* ---- entering the service state ------------------------------------------ */
 
 /*
- * svcreq=1 in the safe state: state 3 within one main loop of the request,
- * svcreq back to 0, every motor on, one "SERVICE" line, no FAULT line, the
+ * svcreq=1 in the safe state: state 3 (after the whole parameter check,
+ * which no header bounds: within the supervisor's deadline of 1 s), svcreq
+ * back to 0, every motor on, one "SERVICE" line, no FAULT line, the
  * motor-power output closed (SB pwrout, read as @OUT[pwrout] and in _OP0)
  * and open before; AC = DC = acfact * svmax (#GOON(1)); thread 1 does not
  * run (no jogging in service).
@@ -189,7 +188,7 @@ static void test_enter(void **state)
 {
 	struct dmc_h *h = *state;
 	struct dmc_h_params p;
-	double t0, t;
+	double t;
 
 	params_service(&p);
 	p.svmax[0] = 20000; /* AC differs from the armed value 10 * vmax */
@@ -199,14 +198,11 @@ static void test_enter(void **state)
 	h->hb_on = 1;
 	h->hb_next_ms = dmc_h_now(h);
 	dmc_h_advance(h, 1);
-	t0 = dmc_h_now(h);
 	DMC_H_CHECK(h, dmc_h_set(h, "svcreq", 1));
 	t = dmc_h_wait_var(h, "state", 3, 100);
 	print_message("measured: svcreq -> state 3 in %.0f ms\n", t);
-	/* #SVCIN runs the whole parameter check (#PCHK) first; no header
-	 * bounds it: the supervisor's deadline (re_ctl.c) is 1 s */
+	/* the supervisor's deadline: ARM_WAIT_MS in pc/re_ctl.c */
 	assert_true(t >= 0 && t <= 1000);
-	(void)t0;
 	dmc_h_advance(h, 5);
 	assert_true(dmc_h_var(h, "svcreq") == 0);
 	assert_true(dmc_h_unsol_has(h, "SERVICE"));
@@ -244,8 +240,7 @@ static void test_enter_no_output(void **state)
 	assert_int_equal(dmc_h_axis(h, 0).motor_off, 0);
 }
 
-/* ---- moves -----------------------------------------------------------------
- */
+/* ---- moves --------------------------------------------------------------- */
 
 /*
  * A move request taken: mvreq back to 0 within one main loop, mvn + 1,
@@ -255,9 +250,9 @@ static void test_enter_no_output(void **state)
  * window), the profile ends at d/v + v/AC (a trapezoid with AC = DC, the
  * controller's AC read back) within 3 ms (start and end seen at 1 ms
  * steps, and the profiler's last sample jumps onto the target), the
- * encoder settles within 1 count of the target, and the
- * ownership is released within one main loop (+1 sample) of the profile's
- * end. The other axes do not move.
+ * encoder settles within 1 count of the target, and the ownership is
+ * released within one main loop (+1 sample) of the profile's end. The
+ * other axes do not move.
  */
 static void test_move_taken(void **state)
 {
@@ -346,8 +341,7 @@ static void test_move_two_axes(void **state)
 	assert_int_equal(dmc_h_fault_lines(h, NULL, NULL, NULL), 0);
 }
 
-/* ---- refusals (fault 15, detail 1..5) -------------------------------------
- */
+/* ---- refusals (fault 15, detail 1..5) ------------------------------------ */
 
 /*
  * Write the request and advance until the program latched (at most two
@@ -527,8 +521,7 @@ static void test_refuse_near_switch(void **state)
 	assert_true(fabs(dmc_h_axis(h, 0).enc + 42000) <= 1);
 }
 
-/* ---- supervision of a move in flight (detail 6, 7) ------------------------
- */
+/* ---- supervision of a move in flight (detail 6, 7) ----------------------- */
 
 /*
  * Detail 6: a slow long move (20000 counts at 2000 counts/s, 10 s) with a
@@ -559,7 +552,7 @@ static void test_time_limit(void **state)
 /*
  * Detail 7: a fast request from outside the near zone (the pot reads about
  * 2.55 V at 0) with its target deep inside it (44000 counts from the
- * centre: 0.74 V toward the reverse switch, 4.36 V toward the forward one)
+ * centre: 0.75 V toward the reverse switch, 4.27 V toward the forward one)
  * is taken, and latched as fault 15 detail 7 after the first sample in
  * which the potentiometer reads past pnlo (moving in reverse) or pnhi
  * (forward; noise off, so the crossing is one instant) within one main
@@ -639,8 +632,7 @@ static void test_fast_into_zone_mvsp_rewritten(void **state)
 	assert_true(dmc_h_axis(h, 0).enc > -40000);
 }
 
-/* ---- heartbeat and joystick in service ------------------------------------
- */
+/* ---- heartbeat and joystick in service ----------------------------------- */
 
 /*
  * The heartbeat stops in service: nothing happens before wdto - mainms;
@@ -732,7 +724,7 @@ static void test_joy_valid_no_motion(void **state)
 	assert_int_equal(dmc_h_fault_lines(h, NULL, NULL, NULL), 0);
 }
 
-/* ---- #OFF --------------------------------------------------------------- */
+/* ---- #OFF ---------------------------------------------------------------- */
 
 /*
  * offreq=1 in service: within one main loop (+1) state 0, offreq 0, every
@@ -790,8 +782,7 @@ static void test_off_during_move(void **state)
 	assert_int_equal(dmc_h_fault_lines(h, NULL, NULL, NULL), 0);
 }
 
-/* ---- arming from service --------------------------------------------------
- */
+/* ---- arming from service ------------------------------------------------- */
 
 /*
  * armreq=1 in service arms (#SVC -> #ARM): state 1, "ARMED", thread 1
@@ -879,8 +870,7 @@ static void test_arm_refused_moving(void **state)
 	assert_int_equal(ctrl_threads(h->ctrl) & 2u, 0u);
 }
 
-/* ---- the program halted on purpose ----------------------------------------
- */
+/* ---- the program halted on purpose --------------------------------------- */
 
 /*
  * prun=0 and HX (as galil-load and the supervisor do before they halt the
