@@ -667,6 +667,33 @@ int re_ctl_service(const struct re_io *io, long *hbpc, struct re_fault *fault,
 	return rc;
 }
 
+/* The arm check (17) wants every axis at rest, TV included: TV averages
+ * 256 samples, so it remembers the last service move for a while. */
+static int wait_still(const struct re_io *io, char *err, size_t errlen)
+{
+	static const char *const tv[RE_AXES] = {"_TVA", "_TVB", "_TVC"};
+	int64_t deadline = now_ns(io) + ARM_WAIT_MS * NS_PER_MS;
+	double vstill = 0, v = 0;
+	int rc = read_err(io, "vstill", &vstill, err, errlen), i = 0;
+
+	while (rc == GL_OK && i < RE_AXES) {
+		rc = read_err(io, tv[i], &v, err, errlen);
+		if (rc != GL_OK || fabs(v) <= vstill) {
+			i++;
+			continue;
+		}
+		if (now_ns(io) >= deadline) {
+			seterr(err, errlen,
+			       "axis %c still moving (TV %g counts/s) %d ms "
+			       "after the service moves ended",
+			       AXES[i], v, ARM_WAIT_MS);
+			return GL_ERR_TIMEOUT;
+		}
+		pause_ms(io, POLL_MS);
+	}
+	return rc;
+}
+
 int re_ctl_arm(const struct re_io *io, const struct re_calset *cal,
 	       long *hbpc, struct re_fault *fault, char *err, size_t errlen)
 {
@@ -682,6 +709,8 @@ int re_ctl_arm(const struct re_io *io, const struct re_calset *cal,
 		rc = write_param(io, &p[k], err, errlen);
 	for (int k = 0; rc == GL_OK && k < 2; k++)
 		rc = check_param(io, &p[k], err, errlen);
+	if (rc == GL_OK)
+		rc = wait_still(io, err, errlen);
 	snprintf(line, sizeof(line), "hbpc=%ld;armreq=1", *hbpc);
 	if (rc == GL_OK)
 		rc = cmd(io, line, err, errlen);

@@ -141,7 +141,9 @@ int re_ctl_set_limits(const struct re_io *io, const struct re_calset *cal,
 
 /*
  * re_ctl_arm() - arm from the safe state: FL/BL and srev/sfwd from @cal
- * (read back), armreq=1, records carrying the heartbeat until state 1 (1 s).
+ * (read back), every axis at rest (TV of each at most the program's vstill,
+ * within 1 s: the arm check 17), armreq=1, records carrying the heartbeat
+ * until state 1 (1 s).
  * Return: as re_ctl_service().
  */
 int re_ctl_arm(const struct re_io *io, const struct re_calset *cal,

@@ -815,16 +815,19 @@ static void test_arm_from_service(void **state)
 
 /*
  * Arming from service right after a fast service move (svmax 3 * vmax, as
- * calibration moves may be): the axis is at rest when the arm request
- * comes (its move ended, ownership released), so arming must succeed and
- * hold. TV, a 256-sample average, still remembers the service speed for a
- * while; a speed limit of vover * vmax applied to that memory would latch
- * fault 13 detail 2 on an axis that does not move.
+ * calibration moves may be): TV, a 256-sample average, still remembers the
+ * service speed for a while, so "at rest" for the arm check 17 includes
+ * TV below vstill. Right after the move the arm is refused (fault 1,
+ * check 17) instead of arming and then seeing a speed its limit does not
+ * allow; once TV has decayed (within tvwin), arming succeeds and holds
+ * with no false fault 13. The supervisor waits for TV itself before it
+ * asks (re_ctl_arm).
  */
 static void test_arm_after_fast_move(void **state)
 {
 	struct dmc_h *h = *state;
 	struct dmc_h_params p;
+	double t0, vstill, tvwin;
 
 	params_service(&p);
 	p.svmax[0] = 3 * p.vmax[0];
@@ -832,9 +835,28 @@ static void test_arm_after_fast_move(void **state)
 	DMC_H_CHECK(h, dmc_h_service(h));
 	DMC_H_CHECK(h, dmc_h_move(h, 0, 20000, p.svmax[0], 5000));
 	wait_move_done(h, 0, 2000);
-	print_message("measured: TV at the arm request %.0f counts/s (limit "
-		      "armed %.0f)\n",
-		      mg(h, "_TVA"), p.vmax[0] * dmc_h_var(h, "vover"));
+	vstill = dmc_h_var(h, "vstill");
+	tvwin = dmc_h_var(h, "tvwin");
+	print_message("measured: TV at the end of the move %.0f counts/s "
+		      "(vstill %.0f)\n",
+		      mg(h, "_TVA"), vstill);
+	assert_true(mg(h, "_TVA") > vstill);
+	assert_int_equal(dmc_h_arm(h), GL_ERR_CTRL);
+	assert_true(dmc_h_var(h, "fcode") == 1);
+	assert_true(dmc_h_var(h, "fdet") == 17);
+
+	/* again, this time waiting for TV as the supervisor does */
+	dmc_h_close(h);
+	DMC_H_CHECK(h, open_configured(h, &p));
+	DMC_H_CHECK(h, dmc_h_service(h));
+	DMC_H_CHECK(h, dmc_h_move(h, 0, 20000, p.svmax[0], 5000));
+	wait_move_done(h, 0, 2000);
+	t0 = dmc_h_now(h);
+	while (mg(h, "_TVA") > vstill && dmc_h_now(h) - t0 < tvwin)
+		dmc_h_advance(h, 1);
+	print_message("measured: TV below vstill %.0f ms after the move\n",
+		      dmc_h_now(h) - t0);
+	assert_true(dmc_h_now(h) - t0 < tvwin);
 	DMC_H_CHECK(h, dmc_h_arm(h));
 	dmc_h_advance(h, 500);
 	if (dmc_h_var(h, "state") != 1)
