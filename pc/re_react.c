@@ -195,14 +195,19 @@ static int motors_off(struct re_super *s)
 /* ---- root cause ---------------------------------------------------------- */
 
 /* Motor power lost on every axis while the relay was meant closed: when
- * the relay board does not confirm its state, the relay is the cause. */
+ * the relay board does not confirm its state - its off just now was not
+ * confirmed, or its check fails - the relay is the cause, not the E-stop
+ * button or the supply. */
 static void relay_or_power(struct re_super *s, struct re_fault *f)
 {
 	char why[sizeof(f->s)];
 
 	if (f->id != RE_F_CTRL_POWER)
 		return;
-	if (s->io.ops->relay_check(s->io.ud, why, sizeof(why)) == GL_OK)
+	if (s->confirm.relay_rc != GL_OK)
+		snprintf(why, sizeof(why), "its off was not confirmed: %s",
+			 gl_strerror(s->confirm.relay_rc));
+	else if (s->io.ops->relay_check(s->io.ud, why, sizeof(why)) == GL_OK)
 		return;
 	re_fault_set(f, RE_F_RELAY_POWER, -1);
 	snprintf(f->s, sizeof(f->s), "%s", why);
