@@ -211,7 +211,9 @@ static void ctrl_text(const struct re_status *st, char *buf, size_t cap)
 			 st->za.faxis);
 	else
 		snprintf(buf, cap, "%s",
-			 st->za.state == RE_DMC_ARMED ? "armed" : "unarmed");
+			 st->za.state == RE_DMC_ARMED	  ? "armed"
+			 : st->za.state == RE_DMC_SERVICE ? "service"
+							  : "safe");
 }
 
 static const char *motion_text(const struct re_axis_status *a)
