@@ -1086,6 +1086,19 @@ static int check_clinical(struct pctx *c, const struct re_config *cfg)
 	return GL_OK;
 }
 
+/* The slow speed near a switch is not faster than the travel speed. */
+static int check_calibration(struct pctx *c, const struct re_config *cfg)
+{
+	const struct re_config_calibration *k = &cfg->calibration;
+
+	if (k->seek_cps && k->travel_cps && k->seek_cps > k->travel_cps)
+		return fail_at(c, later_mark(c, &k->seek_cps, &k->travel_cps),
+			       "'seek_cps' (%d) must not exceed 'travel_cps' "
+			       "(%d): it is the slow speed near a switch",
+			       k->seek_cps, k->travel_cps);
+	return GL_OK;
+}
+
 static int check_all(struct pctx *c, const struct re_config *cfg)
 {
 	int i, rc = check_table(c, root_fields, cfg);
@@ -1094,6 +1107,8 @@ static int check_all(struct pctx *c, const struct re_config *cfg)
 		rc = check_axis(c, &cfg->axes[i]);
 	if (!rc)
 		rc = check_axes_distinct(c, cfg);
+	if (!rc)
+		rc = check_calibration(c, cfg);
 	if (!rc)
 		rc = check_joystick(c, &cfg->joystick);
 	if (!rc)

@@ -90,6 +90,9 @@ static const struct bad_case bad_cases[] = {
     {"bad_pot_span.yaml", 7, 18,
      "'forward_v' - 'reverse_v' (3 V) must agree with 'expected_range_v' "
      "(4 V) within 'range_tolerance'"},
+    {"bad_seek_fast.yaml", 4, 13,
+     "'seek_cps' (9000) must not exceed 'travel_cps' (8000): it is the "
+     "slow speed near a switch"},
     {"bad_power_output.yaml", 3, 17,
      "'power_output' must be between 0 and 8, got 9"},
     {"bad_invalid_timeout.yaml", 3, 23,
