@@ -409,7 +409,7 @@ int dmc_h_service(struct dmc_h *h)
 int dmc_h_move(struct dmc_h *h, int axis, double target, double speed,
 	       double limit_ms)
 {
-	char name[16];
+	char name[32];
 	double t0;
 	int rc = 0;
 
