@@ -69,7 +69,9 @@ void re_plan_make(const struct re_config *cfg, int mainms,
 	out->pwrout = cfg->controller.power_output;
 	out->move_timeout_ms = cfg->calibration.move_timeout_ms;
 	out->period_ns = p_ns;
-	out->sample_ns = (int64_t)RE_PLAN_SAMPLE_MS * NS_PER_MS;
+	/* never slower than the period: the watchdog limits are the
+	 * period's */
+	out->sample_ns = (int64_t)fastest * NS_PER_MS;
 	out->sample_limit_ns = (int64_t)(crit * (double)p_ns);
 	out->hb_limit_ns =
 	    (int64_t)(crit * (double)(ms * NS_PER_MS > p_ns ? ms * NS_PER_MS

@@ -37,7 +37,8 @@ struct re_plan {
 	int pwrout;	   /* motor-power output (DMC pwrout), 0: none */
 	int move_timeout_ms;	  /* one service move (DMC mvto) */
 	int64_t period_ns;	  /* supervisor cycle */
-	int64_t sample_ns;	  /* cycle while calibrating */
+	int64_t sample_ns;	  /* cycle while calibrating: the period
+				   * or RE_PLAN_SAMPLE_MS, the shorter */
 	int64_t hb_limit_ns;	  /* program heartbeat frozen: fault */
 	int64_t sample_limit_ns;  /* record sample number frozen: fault */
 	int64_t uncmd_grace_ns;	  /* motion not commanded: fault after */

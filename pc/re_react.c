@@ -15,9 +15,10 @@
 #include "re_super.h"
 
 #define NS_PER_MS 1000000LL
-/* The stop (re_io.h; the DMC's own #FAULT uses the same two commands), and
- * the program told to latch in the same line. */
-#define FAULT_CMD RE_STOP_ALL ";pcflt=1"
+/* The program told to latch, and the stop (re_io.h; the DMC's own #FAULT
+ * uses the same two commands), in one line: pcflt first, so that the
+ * program's next pass latches 12 rather than finding our motor-off. */
+#define FAULT_CMD "pcflt=1;" RE_STOP_ALL
 
 static int64_t now_ns(const struct re_super *s)
 {
@@ -213,8 +214,17 @@ static void relay_or_power(struct re_super *s, struct re_fault *f)
 	snprintf(f->s, sizeof(f->s), "%s", why);
 }
 
+/* A program fault that our own stop caused: 12 (pcflt), or a motor found
+ * off by the stop or abort command (fault 10, stop code 4 or 7). */
+static int own_doing(const struct re_za *za, double det)
+{
+	return za->fcode == RE_DMC_F_SUPERVISOR ||
+	       (za->fcode == RE_DMC_F_MOTOROFF && (det == 4 || det == 7));
+}
+
 /* What the controller did on its own (its latched fault) when that is not
- * the cause reported: a consequence, said after it. */
+ * the cause reported nor the result of our stop: a consequence, said
+ * after it. */
 static void consequences(struct re_super *s, const struct re_fault *f)
 {
 	struct re_fault c;
@@ -223,7 +233,8 @@ static void consequences(struct re_super *s, const struct re_fault *f)
 
 	s->then[0] = '\0';
 	if (s->confirm.stop_rc < 0 || re_fault_is_ctrl(f->id) ||
-	    program_fault(s, &za, &det) != GL_OK || !za.fcode)
+	    program_fault(s, &za, &det) != GL_OK || !za.fcode ||
+	    own_doing(&za, det))
 		return;
 	re_ctrl_fault(&za, (long long)det, &c);
 	if (re_fault_what(&c, s->cfg.axis_names, s->then, sizeof(s->then)) ==

@@ -12,7 +12,7 @@
  * commanded it, and the E-stop relay link.
  *
  * On the first fault, in the same cycle: the relay is told to open (never
- * waiting), "AB 1;MO ABC;pcflt=1" goes to the controller at once - over a
+ * waiting), "pcflt=1;AB 1;MO ABC" goes to the controller at once - over a
  * new connection within a deadline when the old one is out of step or gone
  * - then the relay's off is confirmed within its deadline, the motors' off
  * is read back, the fault is latched and the log entry written and fsync'ed
@@ -53,7 +53,7 @@ struct re_super_cfg {
 	struct re_encpot_cfg encpot[RE_SUPER_AXES];
 	const char *axis_names[RE_SUPER_AXES];
 	int pot_input[RE_SUPER_AXES]; /* analog input 1..8; 0: axis + 1 */
-	int fault_cmd_timeout_ms;     /* "AB 1;MO ABC;pcflt=1" deadline */
+	int fault_cmd_timeout_ms;     /* "pcflt=1;AB 1;MO ABC" deadline */
 	int fresh_stop_ms; /* the stop over a new connection: connect and
 			    * reply within this, ms; 0: never tried */
 	int relay_off_ms;  /* relay off confirmed within this, ms */

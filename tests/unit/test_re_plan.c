@@ -101,6 +101,7 @@ static void test_plan_variant(void **state)
 	/* the heartbeat limit follows the slower of the period and mainms */
 	assert_int_equal(p.hb_limit_ns, (int64_t)(2.5 * 30 * MS));
 	assert_int_equal(p.sample_limit_ns, 5 * MS);
+	assert_int_equal(p.sample_ns, 2 * MS); /* never slower than P */
 	assert_int_equal(p.settle_ms, 65);
 	assert_int_equal(p.uncmd_grace_ns, (60 + 150) * MS + 4 * MS);
 	re_plan_super_cfg(&p, &c, names, &sc);

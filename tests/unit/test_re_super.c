@@ -2,7 +2,7 @@
  * test_re_super.c - the supervisor cycle (re_super) against a fake
  * controller, relay, log and clock behind struct re_io: no sockets, no
  * sleeping. Covers one round trip per cycle, every fault path and its
- * reaction order (relay off, then "AB 1;MO ABC;pcflt=1", then the fsync'ed
+ * reaction order (relay off, then "pcflt=1;AB 1;MO ABC", then the fsync'ed
  * log entry), the latch, the watchdog levels, the schedule (overruns) and
  * that the cycle allocates nothing.
  */
@@ -363,7 +363,7 @@ static void test_super_encpot_fault_order(void **state)
 	assert_int_equal(step(), RE_FAULT);
 	/* relay, stop, motors read back, the program's own verdict asked
 	 * (a consequence to name), then the log */
-	assert_string_equal(fk.seq, "relay_off_start,cmd:AB 1;MO ABC;pcflt=1,"
+	assert_string_equal(fk.seq, "relay_off_start,cmd:pcflt=1;AB 1;MO ABC,"
 				    "relay_off_finish,"
 				    "cmd:MG _MOA,cmd:MG _MOB,cmd:MG _MOC,"
 				    "cmd:MG fcode,log:FAULT");
@@ -438,7 +438,7 @@ static void test_super_relay_lost(void **state)
 	fk.relay_off_rc = GL_ERR_RELAY;
 	assert_int_equal(step(), RE_FAULT);
 	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT ESTOP: ", 13));
-	assert_string_equal(fk.commands[0], "AB 1;MO ABC;pcflt=1");
+	assert_string_equal(fk.commands[0], "pcflt=1;AB 1;MO ABC");
 	assert_non_null(strstr(fault_log(), "relay off: NOT confirmed"));
 }
 
@@ -452,7 +452,7 @@ static void test_super_controller_fault(void **state)
 	fk.rec.axis[1].status |= GL_AXST_MOTOR_OFF;
 	snprintf(fk.mg_fdet, sizeof(fk.mg_fdet), " 5012.0000");
 	assert_int_equal(step(), RE_FAULT);
-	assert_string_equal(fk.commands[0], "AB 1;MO ABC;pcflt=1");
+	assert_string_equal(fk.commands[0], "pcflt=1;AB 1;MO ABC");
 	assert_string_equal(fk.commands[1], "MG fdet");
 	assert_int_equal(sup.fault.id, RE_F_CTRL_POSERR);
 	assert_int_equal(sup.fault.axis, 1);
@@ -570,7 +570,7 @@ static void test_super_latch(void **state)
 	fk.record_rc = GL_ERR_CLOSED;
 	assert_int_equal(step(), RE_FAULT);
 	n = fk.n_commands;
-	assert_string_equal(fk.commands[0], "AB 1;MO ABC;pcflt=1");
+	assert_string_equal(fk.commands[0], "pcflt=1;AB 1;MO ABC");
 	fk.record_rc = GL_OK;
 	fk.relay_check_rc = GL_ERR_RELAY;
 	assert_int_equal(run(20), RE_OK);
