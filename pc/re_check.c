@@ -137,8 +137,8 @@ static const struct re_fault_msg re_fault_table[] = {
 	{RE_F_CTRL_FOREIGN_HB, RE_FC_FOREIGN,
 	 "the controller received a heartbeat that is not this supervisor's (out of sequence): another program writes to the controller",
 	 "keep the E-stop pressed, close every other program connected to the controller (another roboelf, a terminal), then restart roboelf"},
-	{RE_F_CTRL_FOREIGN_CONN, RE_FC_FOREIGN,
-	 "another program connected to the controller (handle {s}) while the motors were on",
+	{RE_F_CTRL_FOREIGN_SET, RE_FC_FOREIGN,
+	 "the controller's safety settings were changed while the motors were on ({s}): another program sent commands to the controller",
 	 "keep the E-stop pressed, close every other program connected to the controller (another roboelf, galil-load, a terminal), then restart roboelf"},
 	{RE_F_CTRL_SVCMOVE, RE_FC_MOTION,
 	 "axis {a}: the controller stopped an automatic move: {s}",
@@ -621,7 +621,7 @@ static enum re_fault_id re_ctrl_fault_id(int fcode)
 	case RE_DMC_F_THREAD: return RE_F_CTRL_THREAD;
 	case RE_DMC_F_SUPERVISOR: return RE_F_CTRL_SUPERVISOR;
 	case RE_DMC_F_UNCMD: return RE_F_CTRL_UNCMD;
-	case RE_DMC_F_FOREIGN: return RE_F_CTRL_FOREIGN_CONN;
+	case RE_DMC_F_FOREIGN: return RE_F_CTRL_FOREIGN_SET;
 	case RE_DMC_F_SVCMOVE: return RE_F_CTRL_SVCMOVE;
 	case RE_DMC_F_POTRANGE: return RE_F_CTRL_POTRANGE;
 	default: return RE_F_CTRL_UNKNOWN;
@@ -656,22 +656,17 @@ static const char *re_svc_reason(long long det)
 	return det >= 1 && det <= 7 ? why[det] : why[0];
 }
 
-/* Fault 14's detail: 1 heartbeat, else the mask of the new handles. */
+/* Fault 14's detail: 1 the heartbeat, 3 wdto or jto, 4 OE. */
 static void re_foreign(long long det, struct re_fault *f)
 {
-	size_t n = 0;
-
 	if (det == 1) {
 		f->id = RE_F_CTRL_FOREIGN_HB;
 		return;
 	}
-	for (int h = 0; h < 8 && det > 0 && det != RE_VAL_UNKNOWN; h++)
-		if ((det >> h) & 1 && n + 2 < sizeof(f->s)) {
-			f->s[n++] = (char)('A' + h);
-			f->s[n] = '\0';
-		}
-	if (n == 0)
-		snprintf(f->s, sizeof(f->s), "unknown");
+	snprintf(f->s, sizeof(f->s), "%s",
+		 det == 3   ? "the watchdog or the joystick timeout"
+		 : det == 4 ? "off-on-error switched off"
+			    : "which one is not known");
 }
 
 /* The text and values of the version 2.00 faults 13..16. */
@@ -688,7 +683,7 @@ static void re_ctrl_fault_v2(long long fdet, struct re_fault *f)
 			 : fdet == 2 ? "faster than allowed"
 				     : "reason unknown");
 		break;
-	case RE_F_CTRL_FOREIGN_CONN: re_foreign(fdet, f); break;
+	case RE_F_CTRL_FOREIGN_SET: re_foreign(fdet, f); break;
 	case RE_F_CTRL_SVCMOVE:
 		snprintf(f->s, sizeof(f->s), "%s", re_svc_reason(fdet));
 		break;

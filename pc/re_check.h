@@ -123,7 +123,8 @@ enum re_fclass {
  *   RE_F_CTRL_SAFE_ON    FOREIGN; (fault 13 detail 3: a motor switched on
  *                        in the safe state)
  *   RE_F_CTRL_FOREIGN_HB FOREIGN; (fault 14 detail 1: heartbeat not ours)
- *   RE_F_CTRL_FOREIGN_CONN FOREIGN; s: handle letters (fault 14)
+ *   RE_F_CTRL_FOREIGN_SET FOREIGN; s: what was changed (fault 14 detail
+ *                        3 wdto/jto, 4 OE)
  *   RE_F_CTRL_SVCMOVE    MOTION; a; s: why (fault 15, detail 1..7)
  *   RE_F_CTRL_POTRANGE   ENCODER; a; f0 volts (fault 16)
  *   RE_F_UNCMD           MOTION; a; s: what the supervisor saw
@@ -174,7 +175,7 @@ enum re_fault_id {
 	RE_F_CTRL_UNCMD,
 	RE_F_CTRL_SAFE_ON,
 	RE_F_CTRL_FOREIGN_HB,
-	RE_F_CTRL_FOREIGN_CONN,
+	RE_F_CTRL_FOREIGN_SET,
 	RE_F_CTRL_SVCMOVE,
 	RE_F_CTRL_POTRANGE,
 	RE_F_UNCMD,
@@ -399,7 +400,7 @@ enum re_dmc_fcode {
 	RE_DMC_F_THREAD = 11,
 	RE_DMC_F_SUPERVISOR = 12,
 	RE_DMC_F_UNCMD = 13,	/* motion the program did not command */
-	RE_DMC_F_FOREIGN = 14,	/* heartbeat out of sequence, new handle */
+	RE_DMC_F_FOREIGN = 14,	/* heartbeat out of sequence, settings */
 	RE_DMC_F_SVCMOVE = 15,	/* a service move out of its bounds */
 	RE_DMC_F_POTRANGE = 16, /* potentiometer outside its range */
 	RE_DMC_F_MAX = 16,

@@ -266,7 +266,24 @@ static size_t confirm_text(const struct re_super *s, char *buf, size_t cap)
 	    c->stop_rc < 0 ? " the controller did not answer." : "");
 }
 
-/* "FAULT CLASS: what[. Then: consequence]. <confirm>. Recovery: ..." */
+/* " Another program had connected to the controller (handle C)." */
+static size_t foreign_text(unsigned mask, char *buf, size_t cap)
+{
+	char hs[9];
+	int n = 0;
+
+	for (int h = 0; h < 8; h++)
+		if (mask >> h & 1)
+			hs[n++] = (char)('A' + h);
+	hs[n] = '\0';
+	return (size_t)snprintf(buf, cap,
+				" Another program had connected to the "
+				"controller (handle %s).",
+				hs);
+}
+
+/* "FAULT CLASS: what[. Then: consequence][. Another program ...].
+ * <confirm>. Recovery: ..." */
 static void compose_line(struct re_super *s)
 {
 	char *line = s->fault_line, *rec;
@@ -287,6 +304,8 @@ static void compose_line(struct re_super *s)
 	if (s->then[0] && n < cap)
 		n += (size_t)snprintf(line + n, cap - n, " Then: %s.",
 				      s->then);
+	if (s->foreign && n < cap)
+		n += foreign_text(s->foreign, line + n, cap - n);
 	if (n < cap)
 		n += confirm_text(s, line + n, cap - n);
 	if (n < cap)

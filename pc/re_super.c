@@ -79,9 +79,12 @@ void re_super_start(struct re_super *s, const struct re_caltable *const *tables,
 	s->expect = expect;
 	s->armed = expect == RE_DMC_ARMED;
 	s->own_mask = 0;
+	s->have_handles = 0;
 	s->hbpc = hbpc;
 	s->last_good_ns = now_ns(s);
-	s->last_end_ns = 0;
+	/* the stall check counts from here: a stall before the first cycle
+	 * is one too */
+	s->last_end_ns = s->last_good_ns;
 	s->deadline_ns = s->last_good_ns + s->period_ns;
 	re_alive_reset(&s->alive);
 }
@@ -306,6 +309,37 @@ static int check_uncmd(struct re_super *s, struct re_fault *f)
 	return RE_OK;
 }
 
+/* Another program connected (a handle open that was not at the start):
+ * not itself a fault - a second supervisor or galil-load may look - but
+ * logged and shown, and named in a fault that follows. */
+static void watch_handles(struct re_super *s)
+{
+	unsigned mask = 0, fresh;
+	char hs[9];
+	int n = 0;
+
+	for (int h = 0; h < 8; h++)
+		if (s->rec.handles[h])
+			mask |= 1u << h;
+	if (!s->have_handles) {
+		s->handles_known = mask;
+		s->have_handles = 1;
+		return;
+	}
+	fresh = mask & ~s->handles_known;
+	s->handles_known = mask;
+	if (!fresh)
+		return;
+	s->foreign |= fresh;
+	for (int h = 0; h < 8; h++)
+		if (fresh >> h & 1)
+			hs[n++] = (char)('A' + h);
+	hs[n] = '\0';
+	re_io_logf(&s->io, RE_LOG_WARN,
+		   "another program connected to the controller (handle %s)",
+		   hs);
+}
+
 static void drain_messages(struct re_super *s)
 {
 	for (int i = 0; i < RE_SUPER_MSGS; i++) {
@@ -382,6 +416,8 @@ static int cycle_checks(struct re_super *s)
 		return re_super_fault(s, &f);
 	v = exchange(s, &f);
 	warn = s->link_ok && s->age_last_ns > s->noncrit_ns;
+	if (s->link_ok)
+		watch_handles(s);
 	rv = check_relay(s, &rf);
 	if (rv == RE_FAULT)
 		return re_super_fault(s, &rf);
@@ -458,6 +494,7 @@ void re_super_status(const struct re_super *s, struct re_status *st)
 	st->armed = s->armed;
 	st->expect = s->expect;
 	st->log_failing = s->log_failing;
+	st->foreign = s->foreign;
 	st->link_ok = s->link_ok;
 	st->za = s->za;
 	st->have_za = s->have_za;

@@ -119,6 +119,7 @@ struct re_status {
 	int latched;
 	const char *fault_line; /* "" when none */
 	int log_failing;	/* a log entry could not be written */
+	unsigned foreign;	/* handles another program opened (1 = A) */
 	double uptime_s;
 };
 
@@ -163,6 +164,11 @@ struct re_super {
 	unsigned own_mask;
 	int64_t cmd_ns[RE_SUPER_AXES];
 	int64_t moving_ns[RE_SUPER_AXES]; /* 0: at rest */
+	/* other programs at the controller: the handles open at the start
+	 * (and since), and those another program opened after it */
+	unsigned handles_known;
+	int have_handles;
+	unsigned foreign;
 	/* fault latch */
 	int latched;
 	struct re_fault fault;

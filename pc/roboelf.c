@@ -82,6 +82,7 @@ struct app {
 	long hbpc;
 	int calib;   /* the operator's choice: RE_CALIB_FULL / _FILE */
 	int powered; /* the relay was switched on at some point */
+	unsigned foreign_shown; /* other programs' handles already shown */
 	char err[RE_CONFIG_ERR_MAX];
 };
 
@@ -545,6 +546,28 @@ static void drop_backup(struct app *a)
 			   strerror(errno));
 }
 
+/* Another program connected to the controller: not a fault (it may only
+ * look), but the operator is told once per handle. */
+static void show_foreign(struct app *a, unsigned mask)
+{
+	unsigned fresh = mask & ~a->foreign_shown;
+	char hs[9];
+	int n = 0;
+
+	if (!fresh)
+		return;
+	a->foreign_shown |= fresh;
+	for (int h = 0; h < 8; h++)
+		if (fresh >> h & 1)
+			hs[n++] = (char)('A' + h);
+	hs[n] = '\0';
+	re_console_msg(&a->con,
+		       "roboelf: WARNING: another program connected to the "
+		       "controller (handle %s). roboelf still supervises; if "
+		       "nobody should be there, press q and find it.",
+		       hs);
+}
+
 /* The calibration's sampler: one supervised cycle per sample. */
 static int sample_cb(void *ud, const struct gl_record **rec)
 {
@@ -557,6 +580,7 @@ static int sample_cb(void *ud, const struct gl_record **rec)
 	re_super_wait(a->sup);
 	v = re_super_cycle(a->sup);
 	re_super_status(a->sup, &st);
+	show_foreign(a, st.foreign);
 	re_console_status(&a->con, &st, re_io_now_ns(), 0);
 	if (v == RE_FAULT) {
 		re_console_fault(&a->con, re_super_fault_line(a->sup));
@@ -830,6 +854,7 @@ static void run(struct app *a)
 		if (re_super_cycle(a->sup) == RE_FAULT)
 			re_console_fault(&a->con, re_super_fault_line(a->sup));
 		re_super_status(a->sup, &st);
+		show_foreign(a, st.foreign);
 		re_console_status(&a->con, &st, re_io_now_ns(), 0);
 		retry_log(a, &next_retry);
 		key = re_console_key(&a->con);

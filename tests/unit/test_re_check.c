@@ -477,6 +477,11 @@ static void test_ctrl_fault_mapping(void **state)
 	    {10, RE_F_CTRL_MOTOROFF, RE_FC_MOTION},
 	    {11, RE_F_CTRL_THREAD, RE_FC_PROGRAM},
 	    {12, RE_F_CTRL_SUPERVISOR, RE_FC_PROGRAM},
+	    {13, RE_F_CTRL_UNCMD, RE_FC_MOTION},
+	    {14, RE_F_CTRL_FOREIGN_SET, RE_FC_FOREIGN},
+	    {15, RE_F_CTRL_SVCMOVE, RE_FC_MOTION},
+	    {16, RE_F_CTRL_POTRANGE, RE_FC_ENCODER},
+	    {17, RE_F_CTRL_UNKNOWN, RE_FC_PROGRAM},
 	    {0, RE_F_CTRL_UNKNOWN, RE_FC_PROGRAM},
 	};
 	struct re_za z = {0};
@@ -563,6 +568,73 @@ static void test_ctrl_fault_texts(void **state)
 	assert_non_null(strstr(line, "FAULT PROGRAM: the controller latched "
 				     "unknown fault code 0 (axis 1, detail "
 				     "unknown). "));
+}
+
+/* The text of program fault @fcode, axis @faxis, detail @det. */
+static void v2_line(int fcode, int faxis, long long det, char *line,
+		    size_t cap, struct re_fault *f)
+{
+	struct re_za z = {0};
+
+	z.state = 2;
+	z.fcode = fcode;
+	z.faxis = faxis;
+	assert_int_equal(re_ctrl_fault(&z, det, f), GL_OK);
+	re_fault_format(f, NULL, line, cap);
+}
+
+/* Version 2.00's faults 13..16: each detail to its own id and words. */
+static void test_ctrl_fault_v2(void **state)
+{
+	struct re_fault f;
+	char line[512];
+
+	(void)state;
+	v2_line(13, 1, 1, line, sizeof(line), &f);
+	assert_int_equal(f.id, RE_F_CTRL_UNCMD);
+	assert_non_null(strstr(line, "FAULT MOTION: axis A: the controller "
+				     "stopped motion its program did not "
+				     "command: a move started by another "
+				     "program. "));
+	v2_line(13, 3, 2, line, sizeof(line), &f);
+	assert_non_null(strstr(line, "axis C: the controller stopped motion "
+				     "its program did not command: faster "
+				     "than allowed. "));
+	v2_line(13, 0, 3, line, sizeof(line), &f);
+	assert_int_equal(f.id, RE_F_CTRL_SAFE_ON);
+	assert_int_equal(f.axis, -1);
+	assert_non_null(strstr(line, "FAULT FOREIGN: a motor was switched on "
+				     "while the controller program held the "
+				     "robot in its safe state"));
+	v2_line(14, 0, 1, line, sizeof(line), &f);
+	assert_int_equal(f.id, RE_F_CTRL_FOREIGN_HB);
+	assert_non_null(strstr(line, "FAULT FOREIGN: the controller received "
+				     "a heartbeat that is not this "
+				     "supervisor's"));
+	v2_line(14, 0, 3, line, sizeof(line), &f);
+	assert_int_equal(f.id, RE_F_CTRL_FOREIGN_SET);
+	assert_non_null(strstr(line, "FAULT FOREIGN: the controller's safety "
+				     "settings were changed while the motors "
+				     "were on (the watchdog or the joystick "
+				     "timeout): another program sent commands "
+				     "to the controller. "));
+	v2_line(14, 0, 4, line, sizeof(line), &f);
+	assert_non_null(strstr(line, "were on (off-on-error switched off): "));
+	v2_line(14, 0, 9, line, sizeof(line), &f);
+	assert_non_null(strstr(line, "were on (which one is not known): "));
+	v2_line(15, 2, 7, line, sizeof(line), &f);
+	assert_int_equal(f.id, RE_F_CTRL_SVCMOVE);
+	assert_non_null(strstr(line, "FAULT MOTION: axis B: the controller "
+				     "stopped an automatic move: it moved "
+				     "fast near a limit switch. "));
+	v2_line(15, 2, 99, line, sizeof(line), &f);
+	assert_non_null(strstr(line, "automatic move: the reason is not "
+				     "known. "));
+	v2_line(16, 3, 140, line, sizeof(line), &f);
+	assert_int_equal(f.id, RE_F_CTRL_POTRANGE);
+	assert_non_null(strstr(line, "FAULT ENCODER: axis C: the "
+				     "potentiometer reads 0.140 V, outside "
+				     "the range it can read on this robot. "));
 }
 
 static void fill_record(struct gl_record *rec)
@@ -938,6 +1010,7 @@ int main(void)
 	    cmocka_unit_test(test_za_decode),
 	    cmocka_unit_test(test_ctrl_fault_mapping),
 	    cmocka_unit_test(test_ctrl_fault_texts),
+	    cmocka_unit_test(test_ctrl_fault_v2),
 	    cmocka_unit_test(test_check_motors),
 	    cmocka_unit_test(test_check_record),
 	    cmocka_unit_test(test_cal_point),
