@@ -87,8 +87,11 @@ int re_log_open(struct re_log *lg, const char *path,
 	return GL_OK;
 }
 
+/* All of @buf, or nothing: a line cut short (a full disk) is cut off
+ * again, so that the retry writes it whole; errno is the write's. */
 static int re_log_write_all(struct re_log *lg, const char *buf, size_t len)
 {
+	off_t start = lg->size;
 	ssize_t n;
 
 	while (len > 0) {
@@ -96,8 +99,11 @@ static int re_log_write_all(struct re_log *lg, const char *buf, size_t len)
 		if (n < 0 && errno == EINTR)
 			continue;
 		if (n <= 0) {
-			if (n == 0)
-				errno = EIO;
+			int e = n == 0 ? EIO : errno;
+
+			if (lg->size != start && ftruncate(lg->fd, start) == 0)
+				lg->size = start;
+			errno = e;
 			return GL_ERR_SYS;
 		}
 		buf += n;
@@ -235,7 +241,8 @@ int re_log_write_at(struct re_log *lg, enum re_log_level lvl,
 		lg->last_written_ns = mono_ns;
 	}
 	lg->line[len++] = '\n';
-	rc = re_log_put(lg, lg->line, len) ? GL_ERR_SYS : rc;
+	if (re_log_put(lg, lg->line, len) != GL_OK)
+		return GL_ERR_SYS; /* errno: the write's (ENOSPC, EIO ...) */
 	if (lvl == RE_LOG_FAULT && lg->fd >= 0 && fsync(lg->fd) != 0)
 		rc = GL_ERR_SYS;
 	return rc;

@@ -180,15 +180,24 @@ static int check_stall(struct re_super *s, struct re_fault *f)
 /* The round trip and the PC-side watchdog verdict on it. */
 static int exchange(struct re_super *s, struct re_fault *f)
 {
-	int64_t now, age = 0;
-	int rc, v;
+	int64_t now, age = 0, t0 = now_ns(s), over;
+	int rc, v, tmo = reply_timeout_ms(s);
 
 	s->hbpc = (s->hbpc + 1) % RE_HBPC_WRAP;
 	snprintf(s->prefix, sizeof(s->prefix), "hbpc=%ld", s->hbpc);
-	rc = s->io.ops->record(s->io.ud, s->prefix, &s->rec,
-			       reply_timeout_ms(s));
+	rc = s->io.ops->record(s->io.ud, s->prefix, &s->rec, tmo);
 	now = now_ns(s);
 	s->link_ok = rc == GL_OK;
+	/* The round trip waits at most tmo: a return later than that by more
+	 * than the critical limit means this process did not run meanwhile
+	 * (stopped inside the wait), whatever the link did. */
+	over = now - t0 - (int64_t)tmo * NS_PER_MS;
+	if (over > s->crit_ns) {
+		re_fault_set(f, RE_F_STALL, -1);
+		f->i[0] = over / NS_PER_MS;
+		f->i[1] = s->crit_ns / NS_PER_MS;
+		return RE_FAULT;
+	}
 	if (rc != GL_OK && rc != GL_ERR_TIMEOUT)
 		return comm_fault(rc, f);
 	v = re_check_reply_age(&s->cfg.wdog, s->last_good_ns, now, &age, f);

@@ -524,10 +524,10 @@ static void test_ctrl_fault_texts(void **state)
 	assert_string_equal(
 	    line,
 	    "FAULT MOTION: axis B: position error of at least 5012 counts, "
-	    "above its limit (blocked or jammed?). "
+	    "above its limit (blocked, jammed, or its encoder stuck?). "
 	    "Recovery: keep "
 	    "the E-stop pressed, check that axis B moves freely and nothing "
-	    "blocks it, then restart roboelf");
+	    "blocks it, then its encoder cable, then restart roboelf");
 	z.fcode = 3;
 	z.faxis = 0;
 	re_ctrl_fault(&z, 0x30c, &f);

@@ -13,6 +13,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <cmocka.h>
@@ -174,6 +176,52 @@ static void test_fault_is_fsynced(void **state)
 	assert_int_equal(fsync_calls, 2);
 }
 
+/*
+ * The disk fills in the middle of a FAULT line (RLIMIT_FSIZE 20 bytes
+ * above the file: write() stores 20 bytes, then fails with EFBIG): the
+ * call fails with errno EFBIG (not fsync's), the 20 bytes are cut off
+ * again, fsync is not called; once there is room the same entry is
+ * written whole, exactly once.
+ */
+static void test_partial_write_rolled_back(void **state)
+{
+	struct rlimit old, lim;
+	char before[1024], buf[2048];
+	long n0;
+	int rc, e;
+
+	(void)state;
+	assert_int_equal(re_log_open(&lg, path, NULL), GL_OK);
+	assert_int_equal(wr(RE_LOG_INFO, 0, "start"), GL_OK);
+	n0 = slurp(path, before, sizeof(before));
+	assert_true(n0 > 0);
+	assert_int_equal(getrlimit(RLIMIT_FSIZE, &old), 0);
+	signal(SIGXFSZ, SIG_IGN);
+	lim = old;
+	lim.rlim_cur = (rlim_t)n0 + 20;
+	assert_int_equal(setrlimit(RLIMIT_FSIZE, &lim), 0);
+	fsync_calls = 0;
+	errno = 0;
+	rc = wr(RE_LOG_FAULT, 10, "FAULT ESTOP: the relay does not answer");
+	e = errno;
+	assert_int_equal(setrlimit(RLIMIT_FSIZE, &old), 0);
+	signal(SIGXFSZ, SIG_DFL);
+	assert_int_equal(rc, GL_ERR_SYS);
+	assert_int_equal(e, EFBIG);
+	assert_int_equal(fsync_calls, 0);
+	assert_int_equal(slurp(path, buf, sizeof(buf)), n0);
+	assert_string_equal(buf, before);
+	/* room again: the retry writes it whole */
+	assert_int_equal(
+	    wr(RE_LOG_FAULT, 20, "FAULT ESTOP: the relay does not answer"),
+	    GL_OK);
+	assert_int_equal(fsync_calls, 1);
+	slurp(path, buf, sizeof(buf));
+	assert_string_equal(buf + n0 + 24,
+			    " FAULT FAULT ESTOP: the relay does not answer\n");
+	assert_int_equal(lg.size, (off_t)strlen(buf));
+}
+
 static void test_rotation(void **state)
 {
 	const struct re_log_cfg cfg = {4096, 2, 0};
@@ -326,6 +374,8 @@ int main(void)
 					    teardown),
 	    cmocka_unit_test_setup_teardown(test_fault_is_fsynced, setup,
 					    teardown),
+	    cmocka_unit_test_setup_teardown(test_partial_write_rolled_back,
+					    setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_rotation, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_rate_limit, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_rate_limit_off, setup,

@@ -58,6 +58,7 @@ struct fake {
 	struct gl_record rec; /* what the next QR returns */
 	int record_rc;	      /* GL_OK or an error to return */
 	int64_t delay_ns;     /* round-trip time */
+	int64_t stall_ns;     /* the process stopped inside the next QR */
 	int freeze_hb, freeze_sample;
 	int n_records;
 	char last_prefix[64];
@@ -97,6 +98,8 @@ static int f_record(void *ud, const char *prefix, struct gl_record *rec,
 	snprintf(fk.last_prefix, sizeof(fk.last_prefix), "%s",
 		 prefix ? prefix : "(none)");
 	fk.last_timeout_ms = timeout_ms;
+	fk.now += fk.stall_ns;
+	fk.stall_ns = 0;
 	if (fk.record_rc == GL_ERR_TIMEOUT ||
 	    fk.delay_ns > (int64_t)timeout_ms * MS) {
 		fk.now += (int64_t)timeout_ms * MS;
@@ -417,6 +420,32 @@ static void test_super_watchdog_critical(void **state)
 	assert_int_equal(fk.n_relay_off, 1);
 }
 
+/* The process stopped inside the round trip (SIGSTOP while waiting for the
+ * reply) for 2 s: the wait returned 1924 ms after its 76 ms timeout, so
+ * the supervisor names its own stall, whether the reply was there
+ * (rc OK) or not (timeout) - not the link. */
+static void test_super_stall_in_round_trip(void **state)
+{
+	static const int rcs[] = {GL_OK, GL_ERR_TIMEOUT};
+
+	for (size_t k = 0; k < 2; k++) {
+		setup(state);
+		assert_int_equal(run(2), RE_OK);
+		fk.stall_ns = 2000 * MS;
+		fk.record_rc = rcs[k];
+		assert_int_equal(step(), RE_FAULT);
+		assert_int_equal(fk.last_timeout_ms, 76);
+		assert_int_equal(sup.fault.id, RE_F_STALL);
+		assert_int_equal(sup.fault.i[0], k ? 2000 : 1924);
+		assert_non_null(strstr(re_super_fault_line(&sup),
+				       "FAULT WATCHDOG: this supervisor did "
+				       "not run for "));
+		assert_non_null(strstr(re_super_fault_line(&sup),
+				       " ms (limit 125 ms): the PC stalled"));
+		assert_int_equal(fk.n_relay_off, 1);
+	}
+}
+
 /* A closed connection: COMM fault. */
 static void test_super_comm_fault(void **state)
 {
@@ -702,6 +731,7 @@ int main(void)
 	    cmocka_unit_test_setup(test_super_encpot_transient, setup),
 	    cmocka_unit_test_setup(test_super_watchdog_noncritical, setup),
 	    cmocka_unit_test_setup(test_super_watchdog_critical, setup),
+	    cmocka_unit_test_setup(test_super_stall_in_round_trip, setup),
 	    cmocka_unit_test_setup(test_super_comm_fault, setup),
 	    cmocka_unit_test_setup(test_super_relay_lost, setup),
 	    cmocka_unit_test_setup(test_super_controller_fault, setup),
