@@ -1,0 +1,898 @@
+/*
+ * test_sys_master.c - "One master, and faults that name their real cause",
+ * on the whole system: galil-sim running dmc/ (downloaded by galil-load),
+ * roboelf supervising it through the virtual relay.
+ *
+ * One master:
+ *  - a second roboelf on the same controller or relay is refused at once by
+ *    the locks (exit 3, the holder's pid named) and the first runs on
+ *    undisturbed (no relay event, no connection, no FAULT, heartbeat
+ *    advancing, still armed, watched over >= 1 s);
+ *  - a second supervisor "on another host" (its own lock directory and
+ *    relay) is refused by the controller check, the first undisturbed;
+ *  - galil-load refuses an armed controller without --force (exit 5), and
+ *    with --force halts it: roboelf latches a fault;
+ *  - roboelf's start-up closes a client connected before it (IHT=>-3);
+ *  - a client that connects while armed and moves an axis: what the
+ *    operator sees, and how far the axis went;
+ *  - after roboelf is killed, a naive client writing hbpc=1, 2, 3 ... does
+ *    not keep the robot alive.
+ * Root cause: a jam and a stuck encoder on each axis, jogging and during
+ * the calibration; a relay board that swallows its bytes; the supervisor
+ * stopped for 2 s; controller and relay lost together; a full disk.
+ *
+ * Every case asserts the outcome, the exact text the operator sees (the
+ * whole line; "{n}" in a template stands for a number, "{t}" for a local
+ * time), and the reaction time from galil-sim's events (simulated ms),
+ * against the deadlines of docs/safety.md section 3 plus SLACK_MS. Each case
+ * prints a "[ MEASURE  ]" line; the group teardown prints a table
+ * case | outcome | reaction | text.
+ *
+ * Every roboelf started here gets ROBOELF_LOCK_DIR inside the temporary
+ * directory. Environment: ROBOELF_SYS_FILTER=PATTERN runs only the matching
+ * cases; ROBOELF_KEEP=1 keeps the temporary directory.
+ */
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <poll.h>
+#include <setjmp.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mount.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/statvfs.h>
+#include <unistd.h>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+
+#include <cmocka.h>
+
+#include "sys_h.h"
+
+#define SLACK_MS       25   /* scheduling allowance (docs/safety.md, 3) */
+#define HOLD_MS	       300  /* no motion over this after the safe state */
+#define FAULT_WAIT_MS  8000 /* a FAULT line, beyond any deadline */
+#define EXIT_WAIT_MS   5000 /* roboelf exits after SIGTERM */
+#define REFUSE_WAIT_MS 5000 /* a refused roboelf has exited */
+#define LOCK_REFUSE_MS 1000 /* a lock refusal: no I/O, no wait */
+#define WATCH_MS       1200 /* the first watched undisturbed (>= 1 s) */
+#define WATCH_STEP_MS  100  /* ... one state line this often */
+#define TEXT_MAX       2048
+
+static struct sys_env env;
+static int env_ok;
+static struct sys_case cs;	/* the first roboelf and its controller */
+static struct proc re2;		/* a second roboelf, or a galil-load */
+static struct proc_sim sim2;	/* a second controller and relay */
+static int raw_fd = -1;		/* a raw client of the controller */
+static char lock_dir[SYS_PATH_MAX], lock_dir2[SYS_PATH_MAX + 8];
+static char lock_env[SYS_PATH_MAX + 32], lock_env2[SYS_PATH_MAX + 40];
+static char *re_env[] = {lock_env, NULL};
+static char log_mnt[SYS_PATH_MAX + 8]; /* a tmpfs mounted here, or "" */
+
+/* ---- the summary table ---------------------------------------------------
+ */
+
+#define MAX_ROWS 40
+
+struct row {
+	char name[48];
+	char outcome[160];
+	char reaction[160];
+	char text[TEXT_MAX];
+};
+
+static struct row rows[MAX_ROWS];
+static int nrows;
+
+/* A new row, "FAILED" until row_pass(): a failed case leaves it so. */
+static struct row *row_begin(const char *name)
+{
+	static struct row spare;
+	struct row *r = nrows < MAX_ROWS ? &rows[nrows++] : &spare;
+
+	memset(r, 0, sizeof(*r));
+	snprintf(r->name, sizeof(r->name), "%s", name);
+	snprintf(r->outcome, sizeof(r->outcome), "FAILED (see above)");
+	snprintf(r->reaction, sizeof(r->reaction), "-");
+	return r;
+}
+
+static void row_set(char *dst, size_t cap, const char *fmt, va_list ap)
+{
+	vsnprintf(dst, cap, fmt, ap);
+}
+
+static void row_reaction(struct row *r, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+
+static void row_reaction(struct row *r, const char *fmt, ...)
+{
+	va_list ap;
+
+	va_start(ap, fmt);
+	row_set(r->reaction, sizeof(r->reaction), fmt, ap);
+	va_end(ap);
+	print_message("[ MEASURE  ] %s: %s\n", r->name, r->reaction);
+}
+
+static void row_text(struct row *r, const char *text)
+{
+	snprintf(r->text, sizeof(r->text), "%s", text);
+}
+
+static void row_pass(struct row *r, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+
+static void row_pass(struct row *r, const char *fmt, ...)
+{
+	va_list ap;
+
+	va_start(ap, fmt);
+	row_set(r->outcome, sizeof(r->outcome), fmt, ap);
+	va_end(ap);
+}
+
+static void print_table(void)
+{
+	print_message("[ SUMMARY  ] case | outcome | reaction | exact FAULT "
+		      "line or message\n");
+	for (int i = 0; i < nrows; i++)
+		print_message("[ SUMMARY  ] %s | %s | %s | %s\n", rows[i].name,
+			      rows[i].outcome, rows[i].reaction,
+			      rows[i].text[0] ? rows[i].text : "-");
+}
+
+/* ---- exact texts -----------------------------------------------------------
+ */
+
+/* Recovery texts and confirmations, as roboelf prints them (pc/re_check.c,
+ * pc/re_react.c; docs/operator.md section 7). */
+#define SAFE_OK " Safe state confirmed: motor power off (relay open), motors off."
+#define REC_FOREIGN                                                            \
+	" Recovery: keep the E-stop pressed, close every other program "      \
+	"connected to the controller (another roboelf, galil-load, a "         \
+	"terminal), then restart roboelf"
+
+/* One number: -?digits[.digits]. Return: its length, 0 when none. */
+static size_t number_len(const char *s)
+{
+	size_t n = *s == '-' ? 1 : 0, d = n;
+
+	while (s[n] >= '0' && s[n] <= '9')
+		n++;
+	if (n == d)
+		return 0;
+	if (s[n] == '.' && s[n + 1] >= '0' && s[n + 1] <= '9')
+		for (n++; s[n] >= '0' && s[n] <= '9'; n++)
+			;
+	return n;
+}
+
+/* "YYYY-MM-DD HH:MM:SS": 1 when @s starts with one. */
+static int is_time(const char *s)
+{
+	static const char shape[] = "dddd-dd-dd dd:dd:dd";
+
+	for (size_t i = 0; shape[i]; i++)
+		if (shape[i] == 'd' ? s[i] < '0' || s[i] > '9'
+				    : s[i] != shape[i])
+			return 0;
+	return 1;
+}
+
+/*
+ * tpl_match() - does @s match @tpl exactly? "{n}" in @tpl stands for one
+ * number (its value goes to @num, up to @max), "{t}" for a local time.
+ * Return: the count of numbers, or -1 (@at: [out] where they part).
+ */
+static int tpl_match(const char *tpl, const char *s, double *num, int max,
+		     size_t *at)
+{
+	const char *s0 = s;
+	int k = 0;
+
+	while (*tpl) {
+		size_t n;
+
+		if (!strncmp(tpl, "{n}", 3) && (n = number_len(s)) > 0) {
+			if (k < max)
+				num[k] = strtod(s, NULL);
+			k++;
+			s += n;
+			tpl += 3;
+		} else if (!strncmp(tpl, "{t}", 3) && is_time(s)) {
+			s += 19;
+			tpl += 3;
+		} else if (*tpl == *s) {
+			tpl++;
+			s++;
+		} else {
+			break;
+		}
+	}
+	*at = (size_t)(s - s0);
+	return *tpl || *s ? -1 : k;
+}
+
+/* Assert that @line is exactly @tpl; the numbers go to @num. */
+static int expect_text(const char *what, const char *tpl, const char *line,
+		       double *num, int max)
+{
+	size_t at;
+	int k = tpl_match(tpl, line, num, max, &at);
+
+	if (k < 0)
+		fail_msg("%s: not the exact text\n  got:      %s\n  expected: "
+			 "%s\n  they part at offset %zu: '%.40s'",
+			 what, line, tpl, at, line + at);
+	return k;
+}
+
+/* ---- fixtures ----------------------------------------------------------- */
+
+static void make_dir(const char *path)
+{
+	if (mkdir(path, 0700) < 0 && errno != EEXIST)
+		fail_msg("cannot make '%s': %s", path, strerror(errno));
+}
+
+/* Remove the files of a one-level directory, then the directory. */
+static void remove_dir(const char *path)
+{
+	char cmd[SYS_PATH_MAX * 2];
+
+	if (!path[0] || access(path, F_OK) < 0)
+		return;
+	snprintf(cmd, sizeof(cmd), "rm -rf -- '%s'", path);
+	if (system(cmd) != 0)
+		print_message("[   WARN   ] cannot remove '%s'\n", path);
+}
+
+static int group_setup(void **state)
+{
+	(void)state;
+	if (sys_env_init(&env) == 0) {
+		snprintf(lock_dir, sizeof(lock_dir), "%s/locks", env.dir);
+		snprintf(lock_dir2, sizeof(lock_dir2), "%s/locks-other-host",
+			 env.dir);
+		snprintf(lock_env, sizeof(lock_env), "ROBOELF_LOCK_DIR=%s",
+			 lock_dir);
+		snprintf(lock_env2, sizeof(lock_env2), "ROBOELF_LOCK_DIR=%s",
+			 lock_dir2);
+		/* the calibration's roboelf inherits it */
+		if (mkdir(lock_dir, 0700) == 0 && mkdir(lock_dir2, 0700) == 0 &&
+		    setenv("ROBOELF_LOCK_DIR", lock_dir, 1) == 0 &&
+		    sys_env_calibrate(&env, 150000) == 0)
+			env_ok = 1;
+	}
+	print_message("[   INFO   ] full calibration %s in %.1f s (P %d ms, "
+		      "%s)\n",
+		      env_ok ? "done" : "FAILED", env.calib_s, env.period_ms,
+		      env.dir);
+	return 0;
+}
+
+static int group_teardown(void **state)
+{
+	(void)state;
+	print_table();
+	if (!env_ok)
+		env.keep = 1;
+	if (!env.keep) {
+		remove_dir(lock_dir);
+		remove_dir(lock_dir2);
+	}
+	sys_env_cleanup(&env);
+	return 0;
+}
+
+static void unmount_log(void)
+{
+	if (!log_mnt[0])
+		return;
+	if (umount2(log_mnt, MNT_DETACH) < 0)
+		print_message("[   WARN   ] cannot unmount '%s': %s\n", log_mnt,
+			      strerror(errno));
+	rmdir(log_mnt);
+	log_mnt[0] = '\0';
+}
+
+static int case_teardown(void **state)
+{
+	(void)state;
+	if (raw_fd >= 0)
+		close(raw_fd);
+	raw_fd = -1;
+	proc_kill(&re2);
+	memset(&re2, 0, sizeof(re2));
+	proc_kill(&sim2.p);
+	memset(&sim2, 0, sizeof(sim2));
+	sys_case_stop(&cs);
+	unmount_log();
+	return 0;
+}
+
+static void start_with(struct sys_case *c, struct sys_opts *o)
+{
+	if (!env_ok)
+		fail_msg("no calibrated environment: %s", env.err);
+	o->re_env = re_env;
+	if (sys_case_start(c, &env, o) < 0)
+		fail_msg("%s", c->err);
+}
+
+/* The first roboelf, armed; its heartbeat, state and fault watched. */
+static void start(struct sys_case *c)
+{
+	struct sys_opts o = {0};
+
+	start_with(c, &o);
+	if (sys_ctl(c, "watch state") < 0 || sys_ctl(c, "watch fcode") < 0 ||
+	    sys_ctl(c, "watch fdet") < 0 || sys_ctl(c, "watch hbpc") < 0)
+		fail_msg("%s", c->err);
+}
+
+/* A second galil-sim: another controller, and a relay of its own. */
+static void start_sim2(void)
+{
+	char link[SYS_PATH_MAX + 16];
+
+	snprintf(link, sizeof(link), "%s/relay-other", env.dir);
+	if (proc_sim_start(&sim2, env.bin, link, NULL, 10000) < 0)
+		fail_msg("a second galil-sim did not start");
+}
+
+static const char *sim2_relay(void)
+{
+	static char link[SYS_PATH_MAX + 16];
+
+	snprintf(link, sizeof(link), "%s/relay-other", env.dir);
+	return link;
+}
+
+/* ---- deadlines (docs/safety.md, section 3) --------------------------------
+ */
+
+static double P(void)
+{
+	return env.period_ms;
+}
+
+/* A fault the controller latches reaches the relay within M + 2P. */
+static double d_ctrl_to_relay(void)
+{
+	return SYS_MAINMS + 2.0 * P();
+}
+
+/* ---- events and the state line ---------------------------------------------
+ */
+
+/* Wait for an event at or after @after starting with @prefix and, when
+ * @sub is not NULL, containing @sub. Return: its index; fails the case on
+ * timeout. */
+static int wait_event(struct sys_case *c, const char *prefix, const char *sub,
+		      double after, int timeout_ms)
+{
+	long long deadline = proc_now_ms() + timeout_ms;
+	size_t k = strlen(prefix);
+
+	for (;;) {
+		for (size_t i = 0; i < c->nev; i++)
+			if (c->ev[i].t_ms >= after &&
+			    !strncmp(c->ev[i].text, prefix, k) &&
+			    (!sub || strstr(c->ev[i].text, sub)))
+				return (int)i;
+		if (proc_now_ms() > deadline)
+			fail_msg("no event '%s...%s' after %.0f ms within %d "
+				 "ms",
+				 prefix, sub ? sub : "", after, timeout_ms);
+		if (c->re_up)
+			proc_pump(&c->re, 0);
+		poll(NULL, 0, 15);
+		if (sys_events(c) < 0)
+			fail_msg("%s", c->err);
+	}
+}
+
+/* The first held event at or after @after starting with @prefix, or -1. */
+static int find_event(const struct sys_case *c, const char *prefix,
+		      double after)
+{
+	return sys_event_find(c, prefix, after);
+}
+
+/* Every motor off after @after: the time of the last one (fails). */
+static double wait_motors_off(struct sys_case *c, double after, int ms)
+{
+	long long deadline = proc_now_ms() + ms;
+
+	for (;;) {
+		double t = sys_motors_off_time(c, after);
+
+		if (t >= 0)
+			return t;
+		if (proc_now_ms() > deadline)
+			fail_msg("not every motor was switched off after %.0f "
+				 "ms (no 'axis <X> motor off' event for each "
+				 "axis within %d ms)",
+				 after, ms);
+		poll(NULL, 0, 15);
+		if (sys_events(c) < 0)
+			fail_msg("%s", c->err);
+	}
+}
+
+static double state_num(struct sys_case *c, const char *key)
+{
+	char st[TEXT_MAX];
+	double v;
+
+	if (sys_state(c, st, sizeof(st)) < 0)
+		fail_msg("%s", c->err);
+	v = sys_state_num(st, key);
+	if (isnan(v))
+		fail_msg("no '%s' in the state line: %s", key, st);
+	return v;
+}
+
+/* The handle letter galil-sim gave the connection @fd ("handle C opened
+ * from 127.0.0.1:<its port>"); @t: [out] the event's time. */
+static char handle_of(struct sys_case *c, int fd, double after, double *t)
+{
+	struct sockaddr_in sa;
+	socklen_t len = sizeof(sa);
+	char from[48];
+	int i;
+
+	if (getsockname(fd, (struct sockaddr *)&sa, &len) < 0)
+		fail_msg("getsockname: %s", strerror(errno));
+	snprintf(from, sizeof(from), " opened from 127.0.0.1:%u",
+		 (unsigned)ntohs(sa.sin_port));
+	i = wait_event(c, "handle ", from, after, 3000);
+	*t = c->ev[i].t_ms;
+	return c->ev[i].text[7];
+}
+
+/* ---- the first roboelf undisturbed ----------------------------------------
+ */
+
+/*
+ * For WATCH_MS of simulated time from @t0, a state line every
+ * WATCH_STEP_MS: relay on, motor power, every motor on, the program armed
+ * (state 1) without a fault, its supervisor's heartbeat hbpc advancing
+ * between every two lines; then no relay event, no FAULT line, and (when
+ * @no_connect) no connection to the controller since @t0.
+ */
+static void expect_undisturbed(struct sys_case *c, double t0, int no_connect)
+{
+	double hb_prev = NAN, t = t0;
+	char st[TEXT_MAX], line[TEXT_MAX];
+	int i;
+
+	while (t < t0 + WATCH_MS) {
+		double hb;
+
+		if (sys_wait_sim(c, t + WATCH_STEP_MS, 5000) < 0 ||
+		    sys_state(c, st, sizeof(st) - 1) < 0)
+			fail_msg("%s", c->err);
+		strcat(st, " ");
+		t = sys_state_num(st, "time");
+		hb = sys_state_num(st, "var.hbpc");
+		if (!strstr(st, " relay=on ") || !strstr(st, " power=1 ") ||
+		    !strstr(st, " A.mo=0 ") || !strstr(st, " B.mo=0 ") ||
+		    !strstr(st, " C.mo=0 ") ||
+		    !strstr(st, " var.state=1.0000 ") ||
+		    !strstr(st, " var.fcode=0.0000 ")) {
+			proc_pump(&c->re, 100);
+			if (proc_find_line(&c->re, PROC_STDOUT, "FAULT ", line,
+					   sizeof(line)) < 0)
+				snprintf(line, sizeof(line), "(none yet)");
+			fail_msg("the first roboelf was disturbed at %.0f ms "
+				 "(%.0f ms after the second one started): %s\n"
+				 "  its FAULT line: %s",
+				 t, t - t0, st, line);
+		}
+		if (!(hb != hb_prev))
+			fail_msg("the first roboelf's heartbeat hbpc did not "
+				 "advance within %d ms (%.0f): %s",
+				 WATCH_STEP_MS, hb, st);
+		hb_prev = hb;
+	}
+	if (sys_events(c) < 0)
+		fail_msg("%s", c->err);
+	i = find_event(c, "relay", t0);
+	if (i >= 0)
+		fail_msg("the relay was touched: '%s' at %.0f ms", c->ev[i].text,
+			 c->ev[i].t_ms);
+	i = find_event(c, "handle ", t0);
+	if (no_connect && i >= 0)
+		fail_msg("the second one reached the controller: '%s' at %.0f "
+			 "ms",
+			 c->ev[i].text, c->ev[i].t_ms);
+	proc_pump(&c->re, 0);
+	if (proc_find_line(&c->re, PROC_STDOUT, "FAULT ", line,
+			   sizeof(line)) == 0)
+		fail_msg("the first roboelf printed a FAULT line: %s", line);
+}
+
+/* ---- a second roboelf ------------------------------------------------------
+ */
+
+/*
+ * spawn_second() - start roboelf with @cfg (and --galil / --relay only
+ * when given), its own log, ROBOELF_LOCK_DIR from @lockenv.
+ */
+static void spawn_second(struct proc *p, const char *cfg, const char *galil,
+			 const char *relay, char *lockenv)
+{
+	char bin[SYS_PATH_MAX + 16], log[SYS_PATH_MAX + 16];
+	char *argv[16], *envv[] = {lockenv, NULL};
+	int n = 0;
+
+	snprintf(bin, sizeof(bin), "%s/roboelf", env.bin);
+	snprintf(log, sizeof(log), "%s/second.log", env.dir);
+	argv[n++] = bin;
+	argv[n++] = (char *)"-c";
+	argv[n++] = (char *)cfg;
+	if (galil) {
+		argv[n++] = (char *)"--galil";
+		argv[n++] = (char *)galil;
+	}
+	if (relay) {
+		argv[n++] = (char *)"--relay";
+		argv[n++] = (char *)relay;
+	}
+	argv[n++] = (char *)"--calibration";
+	argv[n++] = (char *)"file";
+	argv[n++] = (char *)"--log";
+	argv[n++] = log;
+	argv[n] = NULL;
+	if (proc_spawn(p, argv, envv) < 0)
+		fail_msg("cannot start '%s': %s", bin, strerror(errno));
+}
+
+/* A configuration copy naming controller @addr and relay @port. */
+static void write_config(const char *path, const char *addr, const char *port)
+{
+	char qa[SYS_PATH_MAX + 4], qp[SYS_PATH_MAX + 4];
+	struct sys_subst sub[] = {
+	    {"address", qa}, {"port_development", qp}, {NULL, NULL}};
+
+	snprintf(qa, sizeof(qa), "\"%s\"", addr);
+	snprintf(qp, sizeof(qp), "\"%s\"", port);
+	if (sys_env_write_config(&env, sub, path) < 0)
+		fail_msg("%s", env.err);
+}
+
+/*
+ * expect_refused() - @p exits 3 within REFUSE_WAIT_MS, having printed
+ * exactly @tpl as its "roboelf: error: " line.
+ * @line: [out] that line. Return: the wall ms from @w0 to its exit.
+ */
+static double expect_refused(struct proc *p, long long w0, const char *tpl,
+			     double *num, int max, char *line, size_t cap)
+{
+	int status;
+	double ms;
+
+	if (proc_wait_exit(p, REFUSE_WAIT_MS, &status) < 0)
+		fail_msg("the second roboelf was not refused: still running "
+			 "%d ms after its start\n--- stdout:\n%s",
+			 REFUSE_WAIT_MS, proc_output(p, PROC_STDOUT));
+	ms = (double)(proc_now_ms() - w0);
+	if (proc_exit_code(p) != 3)
+		fail_msg("the second roboelf exited with %d, not 3\n--- "
+			 "stdout:\n%s\n--- stderr:\n%s",
+			 proc_exit_code(p), proc_output(p, PROC_STDOUT),
+			 proc_output(p, PROC_STDERR));
+	if (proc_find_line(p, PROC_STDOUT, "roboelf: error: ", line, cap) < 0)
+		fail_msg("no 'roboelf: error: ' line from the second "
+			 "roboelf\n--- stdout:\n%s",
+			 proc_output(p, PROC_STDOUT));
+	expect_text("the refusal", tpl, line, num, max);
+	return ms;
+}
+
+/* A refusal by a lock: at once, before the relay or the controller. */
+static void refused_by_lock(struct row *r, const char *tpl, long long w0,
+			    double t0)
+{
+	char line[TEXT_MAX];
+	double pid = 0, ms;
+
+	ms = expect_refused(&re2, w0, tpl, &pid, 1, line, sizeof(line));
+	if ((long)pid != (long)cs.re.pid)
+		fail_msg("the refusal names pid %.0f, the first roboelf is "
+			 "%ld: %s",
+			 pid, (long)cs.re.pid, line);
+	if (proc_find_line(&re2, PROC_STDOUT, "roboelf: opening the E-stop "
+					      "relay",
+			   NULL, 0) == 0 ||
+	    proc_find_line(&re2, PROC_STDOUT, "roboelf: connecting", NULL,
+			   0) == 0)
+		fail_msg("the refused roboelf went on past the locks:\n%s",
+			 proc_output(&re2, PROC_STDOUT));
+	row_text(r, line);
+	row_reaction(r, "refused (exit 3) %.0f ms after its start (bound %d "
+			"ms, wall)",
+		     ms, LOCK_REFUSE_MS);
+	if (ms > LOCK_REFUSE_MS)
+		fail_msg("the lock refusal took %.0f ms (bound %d ms)", ms,
+			 LOCK_REFUSE_MS);
+	expect_undisturbed(&cs, t0, 1);
+}
+
+/* 1a. The same configuration (the same controller and relay): the
+ * controller lock, taken first, refuses it. */
+static void test_second_same_config(void **state)
+{
+	struct row *r = row_begin("1a second roboelf, same config");
+	char addr[32], tpl[256];
+	long long w0;
+	double t0;
+
+	(void)state;
+	start(&cs);
+	snprintf(addr, sizeof(addr), "127.0.0.1:%d", cs.sim.port);
+	snprintf(tpl, sizeof(tpl),
+		 "roboelf: error: controller %s is already supervised by "
+		 "roboelf (pid {n}, since {t})",
+		 addr);
+	t0 = sys_sim_time(&cs);
+	w0 = proc_now_ms();
+	spawn_second(&re2, cs.cfg, addr, cs.relay_link, lock_env);
+	refused_by_lock(r, tpl, w0, t0);
+	row_pass(r, "refused by the controller lock, exit 3; first "
+		    "undisturbed >= %d ms",
+		 WATCH_MS);
+}
+
+/* 1b. Another configuration file naming the same relay (by its device
+ * node, /dev/pts/N, where the first names galil-sim's link to it) and
+ * another controller (a second galil-sim): the relay lock refuses it. Had
+ * it opened the relay, it would have switched the first's motor power
+ * off. */
+static void test_second_same_relay(void **state)
+{
+	struct row *r = row_begin("1b second config, same relay");
+	char cfg[SYS_PATH_MAX + 16], addr[32], tpl[512];
+	long long w0;
+	double t0;
+
+	(void)state;
+	start(&cs);
+	start_sim2();
+	snprintf(cfg, sizeof(cfg), "%s/same-relay.yaml", env.dir);
+	snprintf(addr, sizeof(addr), "127.0.0.1:%d", sim2.port);
+	write_config(cfg, addr, cs.sim.relay);
+	snprintf(tpl, sizeof(tpl),
+		 "roboelf: error: relay %s is already supervised by roboelf "
+		 "(pid {n}, since {t})",
+		 cs.sim.relay);
+	t0 = sys_sim_time(&cs);
+	w0 = proc_now_ms();
+	spawn_second(&re2, cfg, NULL, NULL, lock_env);
+	refused_by_lock(r, tpl, w0, t0);
+	row_pass(r, "refused by the relay lock, exit 3; first undisturbed "
+		    ">= %d ms",
+		 WATCH_MS);
+}
+
+/* 1c. Another configuration file naming the same controller address and
+ * another relay (a second galil-sim's): the controller lock refuses it. */
+static void test_second_same_controller(void **state)
+{
+	struct row *r = row_begin("1c second config, same controller");
+	char cfg[SYS_PATH_MAX + 16], addr[32], tpl[256];
+	long long w0;
+	double t0;
+
+	(void)state;
+	start(&cs);
+	start_sim2();
+	snprintf(cfg, sizeof(cfg), "%s/same-controller.yaml", env.dir);
+	snprintf(addr, sizeof(addr), "127.0.0.1:%d", cs.sim.port);
+	write_config(cfg, addr, sim2_relay());
+	snprintf(tpl, sizeof(tpl),
+		 "roboelf: error: controller %s is already supervised by "
+		 "roboelf (pid {n}, since {t})",
+		 addr);
+	t0 = sys_sim_time(&cs);
+	w0 = proc_now_ms();
+	spawn_second(&re2, cfg, NULL, NULL, lock_env);
+	refused_by_lock(r, tpl, w0, t0);
+	row_pass(r, "refused by the controller lock, exit 3; first "
+		    "undisturbed >= %d ms",
+		 WATCH_MS);
+}
+
+/*
+ * 2. A second supervisor on another host: its own lock directory (the
+ * locks cannot see each other) and its own relay (a second galil-sim's),
+ * the same controller. The controller check must refuse it (the program
+ * armed, its heartbeat advancing), exit 3, and the first run on
+ * undisturbed. The check needs wdto + 50 ms by design (docs/supervisor.md,
+ * power-on step 2).
+ */
+static void test_second_other_host(void **state)
+{
+	struct row *r = row_begin("2 second supervisor, other host");
+	char cfg[SYS_PATH_MAX + 16], addr[32], line[TEXT_MAX];
+	static const char tpl[] =
+	    "roboelf: error: the controller's program is armed and its "
+	    "heartbeat is advancing: another supervisor is running the robot; "
+	    "quit it first (nothing was changed on the controller)";
+	long long w0;
+	double t0, ms, bound;
+
+	(void)state;
+	start(&cs);
+	start_sim2();
+	snprintf(cfg, sizeof(cfg), "%s/other-host.yaml", env.dir);
+	snprintf(addr, sizeof(addr), "127.0.0.1:%d", cs.sim.port);
+	write_config(cfg, addr, sim2_relay());
+	t0 = sys_sim_time(&cs);
+	w0 = proc_now_ms();
+	spawn_second(&re2, cfg, NULL, NULL, lock_env2);
+	ms = expect_refused(&re2, w0, tpl, NULL, 0, line, sizeof(line));
+	row_text(r, line);
+	bound = env.wdto_ms + 50 + 2000;
+	row_reaction(r, "refused (exit 3) %.0f ms after its start (bound "
+			"wdto + 50 + 2000 = %.0f ms, wall)",
+		     ms, bound);
+	if (ms > bound)
+		fail_msg("the refusal took %.0f ms (bound %.0f)", ms, bound);
+	expect_undisturbed(&cs, t0, 0);
+	row_pass(r, "refused by the controller check, exit 3; first "
+		    "undisturbed >= %d ms",
+		 WATCH_MS);
+}
+
+/* ---- galil-load on an armed controller ----------------------------------- */
+
+static void spawn_load(struct proc *p, int force)
+{
+	char bin[SYS_PATH_MAX + 16], addr[32], dmc[SYS_PATH_MAX + 8];
+	char *argv[8];
+	int n = 0;
+
+	snprintf(bin, sizeof(bin), "%s/galil-load", env.bin);
+	snprintf(addr, sizeof(addr), "127.0.0.1:%d", cs.sim.port);
+	snprintf(dmc, sizeof(dmc), "%s/dmc", env.top);
+	argv[n++] = bin;
+	argv[n++] = (char *)"-a";
+	argv[n++] = addr;
+	if (force)
+		argv[n++] = (char *)"--force";
+	argv[n++] = dmc;
+	argv[n] = NULL;
+	if (proc_spawn(p, argv, NULL) < 0)
+		fail_msg("cannot start '%s': %s", bin, strerror(errno));
+}
+
+/* galil-load's exit within @ms; its code. */
+static int load_exit(struct proc *p, int ms)
+{
+	int status;
+
+	if (proc_wait_exit(p, ms, &status) < 0)
+		fail_msg("galil-load did not exit within %d ms", ms);
+	return proc_exit_code(p);
+}
+
+/* 3a. Without --force: exit 5 with its message, nothing changed. */
+static void test_load_without_force(void **state)
+{
+	struct row *r = row_begin("3a galil-load, no --force");
+	static const char tpl[] =
+	    "galil-load: the controller's program is armed and its "
+	    "supervisor's heartbeat is advancing: roboelf is driving the "
+	    "robot. Loading halts the program: every axis stops, every motor "
+	    "is switched off and roboelf latches a fault. Quit roboelf first, "
+	    "or give --force to do exactly that";
+	char line[TEXT_MAX];
+	long long w0;
+	double t0;
+	int code;
+
+	(void)state;
+	start(&cs);
+	t0 = sys_sim_time(&cs);
+	w0 = proc_now_ms();
+	spawn_load(&re2, 0);
+	code = load_exit(&re2, 30000);
+	if (proc_find_line(&re2, PROC_STDERR, "galil-load: ", line,
+			   sizeof(line)) < 0)
+		snprintf(line, sizeof(line), "(no message on stderr)");
+	row_text(r, line);
+	row_reaction(r, "exit %d after %lld ms (wall)", code,
+		     proc_now_ms() - w0);
+	if (code != 5)
+		fail_msg("galil-load exited with %d, not 5\n--- stdout:\n%s\n"
+			 "--- stderr:\n%s",
+			 code, proc_output(&re2, PROC_STDOUT),
+			 proc_output(&re2, PROC_STDERR));
+	expect_text("galil-load's refusal", tpl, line, NULL, 0);
+	expect_undisturbed(&cs, t0, 0);
+	row_pass(r, "exit 5; first undisturbed >= %d ms", WATCH_MS);
+}
+
+/*
+ * 3b. With --force: galil-load halts the program (prun=0, HX, ST, MO) and
+ * downloads; roboelf latches a fault - the program's own check of a new
+ * connection (#FORGN, every mainms) sees galil-load's connection long
+ * before its busy check (250 ms) ends, so the fault is FOREIGN naming
+ * galil-load's handle. Deadlines from the connection: relay M + 2P,
+ * motors M + s.
+ */
+static void test_load_force(void **state)
+{
+	struct row *r = row_begin("3b galil-load --force");
+	char line[TEXT_MAX], tpl[1024], h;
+	double t0, t_conn, t_relay, t_mo;
+	int i, code;
+
+	(void)state;
+	start(&cs);
+	t0 = sys_sim_time(&cs);
+	spawn_load(&re2, 1);
+	i = wait_event(&cs, "handle ", " opened from ", t0, 5000);
+	h = cs.ev[i].text[7];
+	t_conn = cs.ev[i].t_ms;
+	if (sys_wait_fault(&cs, FAULT_WAIT_MS, line, sizeof(line)) < 0)
+		fail_msg("%s", cs.err);
+	row_text(r, line);
+	i = wait_event(&cs, "relay off", NULL, t_conn, 3000);
+	t_relay = cs.ev[i].t_ms;
+	t_mo = wait_motors_off(&cs, t_conn, 3000);
+	row_reaction(r, "from galil-load's connection (handle %c): relay off "
+			"%.0f ms (deadline %.0f), motors off %.0f ms "
+			"(deadline %d)",
+		     h, t_relay - t_conn, d_ctrl_to_relay(), t_mo - t_conn,
+		     SYS_MAINMS + 1);
+	snprintf(tpl, sizeof(tpl),
+		 "FAULT FOREIGN: another program connected to the controller "
+		 "(handle %c) while the motors were on." SAFE_OK REC_FOREIGN,
+		 h);
+	expect_text("roboelf's FAULT line", tpl, line, NULL, 0);
+	code = load_exit(&re2, 60000);
+	if (code != 0)
+		fail_msg("galil-load --force exited with %d, not 0\n--- "
+			 "stderr:\n%s",
+			 code, proc_output(&re2, PROC_STDERR));
+	if (sys_check_safe(&cs, 0, HOLD_MS) < 0)
+		fail_msg("%s", cs.err);
+	if (t_relay - t_conn > d_ctrl_to_relay() + SLACK_MS ||
+	    t_mo - t_conn > SYS_MAINMS + 1 + SLACK_MS)
+		fail_msg("too late: relay off %.0f ms, motors off %.0f ms",
+			 t_relay - t_conn, t_mo - t_conn);
+	row_pass(r, "FOREIGN latched, galil-load exit 0, safe state held");
+}
+
+#define T(f) cmocka_unit_test_teardown(f, case_teardown)
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	    T(test_second_same_config),
+	    T(test_second_same_relay),
+	    T(test_second_same_controller),
+	    T(test_second_other_host),
+	    T(test_load_without_force),
+	    T(test_load_force),
+	};
+	const char *filter = getenv("ROBOELF_SYS_FILTER");
+
+	if (filter && *filter)
+		cmocka_set_test_filter(filter);
+	return cmocka_run_group_tests(tests, group_setup, group_teardown);
+}
