@@ -239,12 +239,6 @@ static int expect_text(const char *what, const char *tpl, const char *line,
 
 /* ---- fixtures ----------------------------------------------------------- */
 
-static void make_dir(const char *path)
-{
-	if (mkdir(path, 0700) < 0 && errno != EEXIST)
-		fail_msg("cannot make '%s': %s", path, strerror(errno));
-}
-
 /* Remove the files of a one-level directory, then the directory. */
 static void remove_dir(const char *path)
 {
@@ -408,6 +402,21 @@ static int find_event(const struct sys_case *c, const char *prefix,
 		      double after)
 {
 	return sys_event_find(c, prefix, after);
+}
+
+/* The first held event at or after @after starting with @prefix and
+ * containing @sub, or -1. */
+static int find_event_sub(const struct sys_case *c, const char *prefix,
+			  const char *sub, double after)
+{
+	size_t k = strlen(prefix);
+
+	for (size_t i = 0; i < c->nev; i++)
+		if (c->ev[i].t_ms >= after &&
+		    !strncmp(c->ev[i].text, prefix, k) &&
+		    strstr(c->ev[i].text, sub))
+			return (int)i;
+	return -1;
 }
 
 /* Every motor off after @after: the time of the last one (fails). */
@@ -878,6 +887,306 @@ static void test_load_force(void **state)
 	row_pass(r, "FOREIGN latched, galil-load exit 0, safe state held");
 }
 
+/* ---- a raw client --------------------------------------------------------- */
+
+/* Wait until the peer closes @fd (EOF or reset). Return: 0, -1 on timeout
+ * or when data arrives instead. */
+static int wait_eof(int fd, int timeout_ms)
+{
+	long long deadline = proc_now_ms() + timeout_ms;
+
+	for (;;) {
+		struct pollfd pfd = {.fd = fd, .events = POLLIN};
+		long long left = deadline - proc_now_ms();
+		char ch;
+		ssize_t n;
+
+		if (left <= 0 || poll(&pfd, 1, (int)left) <= 0)
+			return -1;
+		n = recv(fd, &ch, 1, 0);
+		if (n == 0 || (n < 0 && errno == ECONNRESET))
+			return 0;
+		if (n < 0)
+			return -1;
+	}
+}
+
+/*
+ * raw_cmd() - send "@cmd\r" and collect the controller's answers: one
+ * terminator (':' or '?') per command of the line ('; ' separated).
+ * @ans: [out] the terminators in order, "EOF" when the connection closed,
+ * "timeout" when an answer did not come within @timeout_ms.
+ */
+static void raw_cmd(int fd, const char *cmd, int timeout_ms, char *ans,
+		    size_t cap)
+{
+	long long deadline = proc_now_ms() + timeout_ms;
+	size_t want = 1, n = 0;
+	char buf[256];
+	int len = snprintf(buf, sizeof(buf), "%s\r", cmd);
+
+	for (const char *p = cmd; *p; p++)
+		want += *p == ';';
+	ans[0] = '\0';
+	if (send(fd, buf, (size_t)len, MSG_NOSIGNAL) != len) {
+		snprintf(ans, cap, "EOF");
+		return;
+	}
+	while (n < want && n + 1 < cap) {
+		struct pollfd pfd = {.fd = fd, .events = POLLIN};
+		long long left = deadline - proc_now_ms();
+		char ch;
+		ssize_t got;
+
+		if (left <= 0 || poll(&pfd, 1, (int)left) <= 0) {
+			snprintf(ans + n, cap - n, "timeout");
+			return;
+		}
+		got = recv(fd, &ch, 1, 0);
+		if (got <= 0) {
+			snprintf(ans + n, cap - n, "EOF");
+			return;
+		}
+		if (ch == ':' || ch == '?') {
+			ans[n++] = ch;
+			ans[n] = '\0';
+		}
+	}
+}
+
+/*
+ * 4. A raw client connected to the controller before roboelf starts (the
+ * controller idle after a first roboelf quit cleanly) is closed by
+ * roboelf's start-up (IHT=>-3): the client sees EOF, galil-sim logs
+ * "handle X closed by IHT from handle Y" with Y roboelf's command handle;
+ * then roboelf arms. Reaction: from roboelf's connection to the close.
+ */
+static void test_startup_closes_client(void **state)
+{
+	struct row *r = row_begin("4 start-up closes a client");
+	char addr[32], want[64], text[SYS_EVT_TEXT], hx, hy;
+	double t0, t_y, t_close;
+	long long w0;
+	int i, status;
+
+	(void)state;
+	start(&cs);
+	proc_signal(&cs.re, SIGTERM);
+	if (proc_wait_exit(&cs.re, EXIT_WAIT_MS, &status) < 0 ||
+	    proc_exit_code(&cs.re) != 0)
+		fail_msg("the first roboelf did not quit cleanly (exit %d)",
+			 proc_exit_code(&cs.re));
+	t0 = sys_sim_time(&cs);
+	raw_fd = sys_cmd_open(&cs);
+	if (raw_fd < 0)
+		fail_msg("%s", cs.err);
+	hx = handle_of(&cs, raw_fd, t0, &t_y);
+	snprintf(addr, sizeof(addr), "127.0.0.1:%d", cs.sim.port);
+	w0 = proc_now_ms();
+	spawn_second(&re2, cs.cfg, addr, cs.relay_link, lock_env);
+	if (wait_eof(raw_fd, 5000) < 0)
+		fail_msg("the raw client (handle %c) was not closed within "
+			 "5000 ms of roboelf's start\n--- roboelf:\n%s",
+			 hx, proc_output(&re2, PROC_STDOUT));
+	print_message("[ MEASURE  ] 4: the client saw EOF %lld ms after "
+		      "roboelf's start (wall)\n",
+		      proc_now_ms() - w0);
+	snprintf(want, sizeof(want), "handle %c closed by IHT from handle ",
+		 hx);
+	i = wait_event(&cs, want, NULL, t0, 3000);
+	t_close = cs.ev[i].t_ms;
+	snprintf(text, sizeof(text), "%s", cs.ev[i].text);
+	hy = text[strlen(text) - 1];
+	snprintf(want, sizeof(want), "handle %c opened from ", hy);
+	i = wait_event(&cs, want, NULL, t_y, 1000);
+	row_text(r, text);
+	row_reaction(r, "closed %.0f ms after roboelf connected (handle %c)",
+		     t_close - cs.ev[i].t_ms, hy);
+	if (hy == hx)
+		fail_msg("closed by its own handle: %s", text);
+	if (proc_wait_line(&re2, PROC_STDOUT, "RoboELF Ready for Use", 20000,
+			   NULL, 0) < 0)
+		fail_msg("roboelf did not arm after closing the client\n%s",
+			 proc_output(&re2, PROC_STDOUT));
+	row_pass(r, "client got EOF; roboelf armed after it");
+}
+
+/*
+ * 5. While armed and at rest, a raw client connects and sends a motion
+ * command: the program checks new connections first (#FORGN, every
+ * mainms), so the operator sees FOREIGN naming the client's handle, within
+ * M + 2P (relay) and M + s (motors) of the connection. The axis may have
+ * begun the move only if BG ran before that check: then it moved for at
+ * most M + s from rest at AC = 10 vmax: 1/2 AC (M + s)^2 = 4.8 counts at
+ * the defaults; with the servo's dither of a count or two, TRAVEL_BOUND.
+ */
+#define TRAVEL_BOUND 10 /* counts */
+
+static void foreign_move(const char *name, const char *line1,
+			 const char *cmd1, const char *cmd2)
+{
+	struct row *r = row_begin(name);
+	char line[TEXT_MAX], tpl[1024], ans[64] = "", ans2[64] = "", h;
+	double t0, t_conn, t_relay, t_mo, a0, a1;
+	int i;
+
+	start(&cs);
+	a0 = state_num(&cs, "A.act");
+	t0 = sys_sim_time(&cs);
+	raw_fd = sys_cmd_open(&cs);
+	if (raw_fd < 0)
+		fail_msg("%s", cs.err);
+	raw_cmd(raw_fd, line1, 1000, ans, sizeof(ans));
+	if (ans[0] == '?') { /* the controller does not take the line */
+		raw_cmd(raw_fd, cmd1, 1000, ans, sizeof(ans));
+		raw_cmd(raw_fd, cmd2, 1000, ans2, sizeof(ans2));
+	}
+	h = handle_of(&cs, raw_fd, t0, &t_conn);
+	if (sys_wait_fault(&cs, FAULT_WAIT_MS, line, sizeof(line)) < 0)
+		fail_msg("%s", cs.err);
+	row_text(r, line);
+	i = wait_event(&cs, "relay off", NULL, t_conn, 3000);
+	t_relay = cs.ev[i].t_ms;
+	t_mo = wait_motors_off(&cs, t_conn, 3000);
+	if (sys_check_safe(&cs, 0, HOLD_MS) < 0)
+		fail_msg("%s", cs.err);
+	a1 = state_num(&cs, "A.act");
+	i = find_event(&cs, "axis A begin", t0);
+	row_reaction(r, "from the connection (handle %c): relay off %.0f ms "
+			"(deadline %.0f), motors off %.0f ms (deadline %d); "
+			"answers '%s%s%s'; axis A travel %.0f counts (bound "
+			"%d)%s",
+		     h, t_relay - t_conn, d_ctrl_to_relay(), t_mo - t_conn,
+		     SYS_MAINMS + 1, ans, ans2[0] ? "' then '" : "", ans2,
+		     a1 - a0, TRAVEL_BOUND,
+		     i >= 0 ? "; the move began" : "; no move began");
+	snprintf(tpl, sizeof(tpl),
+		 "FAULT FOREIGN: another program connected to the controller "
+		 "(handle %c) while the motors were on." SAFE_OK REC_FOREIGN,
+		 h);
+	expect_text("the FAULT line", tpl, line, NULL, 0);
+	if (fabs(a1 - a0) > TRAVEL_BOUND)
+		fail_msg("axis A travelled %.0f counts (bound %d)", a1 - a0,
+			 TRAVEL_BOUND);
+	if (t_relay - t_conn > d_ctrl_to_relay() + SLACK_MS ||
+	    t_mo - t_conn > SYS_MAINMS + 1 + SLACK_MS)
+		fail_msg("too late: relay off %.0f ms, motors off %.0f ms",
+			 t_relay - t_conn, t_mo - t_conn);
+	row_pass(r, "FOREIGN latched; travel %.0f counts", a1 - a0);
+}
+
+static void test_foreign_pa(void **state)
+{
+	(void)state;
+	foreign_move("5a client sends PA 30000;BG A", "PA 30000;BG A",
+		     "PA 30000", "BG A");
+}
+
+static void test_foreign_jg(void **state)
+{
+	(void)state;
+	foreign_move("5b client sends JG 8000;BG A", "JG 8000;BG A",
+		     "JG 8000", "BG A");
+}
+
+/*
+ * 6. roboelf SIGKILLed while armed; at once a naive program connects and
+ * writes hbpc=1, 2, 3 ... every 20 ms for NAIVE_MS. It must not keep the
+ * robot alive: the program latches FOREIGN (fault 14, detail 1: a
+ * heartbeat out of the dead session's sequence) - or, had the writes come
+ * too late, its watchdog (fault 2). Which one is asserted: 14 detail 1,
+ * because the first write comes within a few ms of the kill, long before
+ * wdto - mainms. The client's connection itself is not a new connection
+ * to #FORGN when it reuses a handle letter the dead supervisor had when
+ * the motors went on (hm0): the test reports which letter it got. Motors
+ * off within W + M + s of the kill, and off while the writes go on.
+ */
+#define NAIVE_MS     1500
+#define NAIVE_PERIOD 20
+
+/* The naive writer: hbpc=n every NAIVE_PERIOD ms for NAIVE_MS. Return:
+ * the writes the controller answered with ':'. */
+static int naive_heartbeat(int fd, int *refused, int *closed)
+{
+	long long t0 = proc_now_ms();
+	int ok = 0;
+
+	*refused = *closed = 0;
+	for (int n = 1; proc_now_ms() - t0 < NAIVE_MS; n++) {
+		char cmd[32], ans[16];
+		long long next = t0 + (long long)n * NAIVE_PERIOD;
+
+		snprintf(cmd, sizeof(cmd), "hbpc=%d", n);
+		raw_cmd(fd, cmd, 500, ans, sizeof(ans));
+		if (!strcmp(ans, ":"))
+			ok++;
+		else if (!strcmp(ans, "?"))
+			(*refused)++;
+		else {
+			*closed = 1;
+			break;
+		}
+		if (next > proc_now_ms())
+			poll(NULL, 0, (int)(next - proc_now_ms()));
+	}
+	return ok;
+}
+
+static void test_kill_naive_heartbeat(void **state)
+{
+	struct row *r = row_begin("6 killed, naive hbpc=n writer");
+	double t_kill, t_conn, t_off, hm0, fcode, fdet, d;
+	char h, st[TEXT_MAX], text[256];
+	int ok, refused, closed, i;
+
+	(void)state;
+	start(&cs);
+	if (sys_ctl(&cs, "watch hm0") < 0)
+		fail_msg("%s", cs.err);
+	hm0 = state_num(&cs, "var.hm0");
+	t_kill = sys_sim_time(&cs);
+	proc_signal(&cs.re, SIGKILL);
+	proc_wait_exit(&cs.re, EXIT_WAIT_MS, NULL);
+	raw_fd = sys_cmd_open(&cs);
+	if (raw_fd < 0)
+		fail_msg("%s", cs.err);
+	ok = naive_heartbeat(raw_fd, &refused, &closed);
+	h = handle_of(&cs, raw_fd, t_kill, &t_conn);
+	t_off = wait_motors_off(&cs, t_kill, 3000);
+	if (sys_check_safe(&cs, 1, HOLD_MS) < 0 ||
+	    sys_state(&cs, st, sizeof(st)) < 0)
+		fail_msg("%s", cs.err);
+	fcode = sys_state_num(st, "var.fcode");
+	fdet = sys_state_num(st, "var.fdet");
+	i = find_event_sub(&cs, "axis ", " motor on", t_off);
+	d = env.wdto_ms + SYS_MAINMS + 1;
+	snprintf(text, sizeof(text),
+		 "program fault %.0f detail %.0f; client handle %c (hm0 %.0f: "
+		 "%s), %d writes taken, %d refused%s",
+		 fcode, fdet, h, hm0,
+		 ((long)hm0 >> (h - 'A')) & 1 ? "a letter the dead supervisor "
+						"had"
+					      : "a new letter",
+		 ok, refused, closed ? ", then closed" : "");
+	row_text(r, text);
+	row_reaction(r, "motors off %.0f ms after the kill (deadline W + M + "
+			"s = %.0f), client connected %.0f ms after it",
+		     t_off - t_kill, d, t_conn - t_kill);
+	if (fcode != 14 || fdet != 1)
+		fail_msg("the program did not latch FOREIGN heartbeat (14, "
+			 "detail 1): %s",
+			 text);
+	if (i >= 0)
+		fail_msg("a motor went on again while the client wrote: '%s' "
+			 "at %.0f ms",
+			 cs.ev[i].text, cs.ev[i].t_ms);
+	if (t_off - t_kill > d + SLACK_MS)
+		fail_msg("motors off %.0f ms after the kill, deadline %.0f ms",
+			 t_off - t_kill, d);
+	row_pass(r, "FOREIGN heartbeat (14, 1) latched; motors off and "
+		    "kept off");
+}
+
 #define T(f) cmocka_unit_test_teardown(f, case_teardown)
 
 int main(void)
@@ -889,6 +1198,10 @@ int main(void)
 	    T(test_second_other_host),
 	    T(test_load_without_force),
 	    T(test_load_force),
+	    T(test_startup_closes_client),
+	    T(test_foreign_pa),
+	    T(test_foreign_jg),
+	    T(test_kill_naive_heartbeat),
 	};
 	const char *filter = getenv("ROBOELF_SYS_FILTER");
 
