@@ -191,18 +191,30 @@ static int is_time(const char *s)
 
 /*
  * tpl_match() - does @s match @tpl exactly? "{n}" in @tpl stands for one
- * number (its value goes to @num, up to @max), "{t}" for a local time.
- * Return: the count of numbers, or -1 (@at: [out] where they part).
+ * number (its value goes to @num, up to @max), "{t}" for a local time,
+ * "{s}" for a non-empty text (the shortest that lets the rest match).
+ * @k: numbers matched so far (0 at the top).
+ * @at: [in,out] the furthest offset of @s matched (for the message).
+ * Return: the count of numbers, or -1.
  */
-static int tpl_match(const char *tpl, const char *s, double *num, int max,
-		     size_t *at)
+static int tpl_match(const char *tpl, const char *s, const char *s0,
+		     double *num, int max, int k, size_t *at)
 {
-	const char *s0 = s;
-	int k = 0;
-
 	while (*tpl) {
 		size_t n;
 
+		if ((size_t)(s - s0) > *at)
+			*at = (size_t)(s - s0);
+		if (!strncmp(tpl, "{s}", 3)) {
+			for (n = 1; n <= strlen(s); n++) {
+				int r = tpl_match(tpl + 3, s + n, s0, num, max,
+						  k, at);
+
+				if (r >= 0)
+					return r;
+			}
+			return -1;
+		}
 		if (!strncmp(tpl, "{n}", 3) && (n = number_len(s)) > 0) {
 			if (k < max)
 				num[k] = strtod(s, NULL);
@@ -216,19 +228,18 @@ static int tpl_match(const char *tpl, const char *s, double *num, int max,
 			tpl++;
 			s++;
 		} else {
-			break;
+			return -1;
 		}
 	}
-	*at = (size_t)(s - s0);
-	return *tpl || *s ? -1 : k;
+	return *s ? -1 : k;
 }
 
 /* Assert that @line is exactly @tpl; the numbers go to @num. */
 static int expect_text(const char *what, const char *tpl, const char *line,
 		       double *num, int max)
 {
-	size_t at;
-	int k = tpl_match(tpl, line, num, max, &at);
+	size_t at = 0;
+	int k = tpl_match(tpl, line, line, num, max, 0, &at);
 
 	if (k < 0)
 		fail_msg("%s: not the exact text\n  got:      %s\n  expected: "
@@ -1187,6 +1198,442 @@ static void test_kill_naive_heartbeat(void **state)
 		    "kept off");
 }
 
+/* ---- root cause: a jam and a stuck encoder on each axis -------------------- */
+
+/* Jam (or stuck encoder) detection, docs/safety.md "E": the position error
+ * grows at vmin (every move here is at least that fast) to at most one
+ * step; ER < step trips, or OA first: 2L + vmin/(10 vmax) + step/vmin. */
+static double d_jam(void)
+{
+	return 2 * SYS_LOOPMS + 1000.0 * env.vmin_cps / (10.0 * env.vmax_cps) +
+	       1000.0 * env.step_counts / env.vmin_cps;
+}
+
+/* A stuck encoder while jogging: the pot disagrees once the axis moved
+ * the tolerance, "T_tol + (2 + k) P" of docs/safety.md. */
+static double d_enc_jog(void)
+{
+	double tol = (1.0 + env.allowed_error) * env.step_counts * 1.1;
+	double t_tol = SYS_LOOPMS +
+		       1000.0 * env.vmin_cps / (10.0 * env.vmax_cps) +
+		       1000.0 * tol / env.vmin_cps;
+
+	return t_tol + (2.0 + env.persistence) * P();
+}
+
+/* Inject @req; the simulated time of its "inject: " / "input: " event. */
+static double inject(struct sys_case *c, const char *evt, const char *req)
+{
+	char want[300];
+	double before = sys_sim_time(c);
+	int i;
+
+	if (before < 0 || sys_ctl(c, "%s", req) < 0)
+		fail_msg("%s", c->err);
+	snprintf(want, sizeof(want), "%s%s", evt, req);
+	i = wait_event(c, want, NULL, before, 2000);
+	return c->ev[i].t_ms;
+}
+
+/* The supervisor's own request (pcflt=1, the program's fault 12) is not a
+ * consequence of the cause: docs/supervisor.md, fault reaction step 5,
+ * names as "Then:" only a fault the controller latched by itself. */
+static void not_own_request(const char *line)
+{
+	if (strstr(line, "Then: the controller latched the supervisor's "
+			 "fault request"))
+		fail_msg("the FAULT line names the supervisor's own fault "
+			 "request (pcflt=1, fault 12) as a consequence:\n  %s",
+			 line);
+}
+
+/*
+ * A FAULT after @t_inj: the line exactly @tpl, relay off within @d_relay
+ * (< 0: not asserted; galil-sim cut the power itself) and every motor off
+ * within @d_motors, the safe state held, roboelf exits 4 on SIGTERM.
+ */
+static void expect_cause(struct row *r, double t_inj, const char *tpl,
+			 double d_relay, double d_motors, double *num, int max)
+{
+	char line[TEXT_MAX];
+	double t_relay = -1, t_mo;
+	int i, status;
+
+	if (sys_wait_fault(&cs, FAULT_WAIT_MS, line, sizeof(line)) < 0)
+		fail_msg("%s", cs.err);
+	row_text(r, line);
+	i = wait_event(&cs, "relay off", NULL, t_inj, 3000);
+	t_relay = cs.ev[i].t_ms - t_inj;
+	t_mo = wait_motors_off(&cs, t_inj, 3000) - t_inj;
+	row_reaction(r, "relay off %.0f ms (deadline %.0f), motors off %.0f "
+			"ms (deadline %.0f)",
+		     t_relay, d_relay, t_mo, d_motors);
+	not_own_request(line);
+	expect_text("the FAULT line", tpl, line, num, max);
+	if (sys_check_safe(&cs, 0, HOLD_MS) < 0)
+		fail_msg("%s", cs.err);
+	if (d_relay >= 0 && t_relay > d_relay + SLACK_MS)
+		fail_msg("relay off %.0f ms after the injection, deadline "
+			 "%.0f ms",
+			 t_relay, d_relay);
+	if (t_mo > d_motors + SLACK_MS)
+		fail_msg("motors off %.0f ms after the injection, deadline "
+			 "%.0f ms",
+			 t_mo, d_motors);
+	proc_signal(&cs.re, SIGTERM);
+	if (proc_wait_exit(&cs.re, EXIT_WAIT_MS, &status) < 0 ||
+	    proc_exit_code(&cs.re) != 4)
+		fail_msg("roboelf did not exit 4 after the fault (exit %d)",
+			 proc_exit_code(&cs.re));
+}
+
+/* Jogging: @req (e.g. "block B 1") at rest, then the joystick drives the
+ * axis forward; the deadline counts from the joystick command. */
+static double cause_jogging(int axis, const char *req)
+{
+	char joy[32];
+
+	start(&cs);
+	inject(&cs, "inject: ", req);
+	snprintf(joy, sizeof(joy), "joy %c fwd", 'A' + axis);
+	return inject(&cs, "input: ", joy);
+}
+
+/* During the full calibration: once the axis moves (its first, fast move
+ * toward the reverse switch), @req. */
+static double cause_calibrating(int axis, const char *req)
+{
+	struct sys_opts o = {.calibration = "full", .no_ready = 1};
+	char begin[32];
+
+	start_with(&cs, &o);
+	snprintf(begin, sizeof(begin), "axis %c begin", 'A' + axis);
+	wait_event(&cs, begin, NULL, 0, 20000);
+	if (sys_wait_moving(&cs, (char)('A' + axis), 2000, 10000) < 0)
+		fail_msg("%s", cs.err);
+	return inject(&cs, "inject: ", req);
+}
+
+/* The controller's position error (fault 4) on @axis: the limit ER. */
+static void tpl_poserr(char *tpl, size_t cap, int axis)
+{
+	snprintf(tpl, cap,
+		 "FAULT MOTION: axis %c: position error of at least %d counts, "
+		 "above its limit (blocked or jammed?)." SAFE_OK
+		 " Recovery: keep the E-stop pressed, check that axis %c moves "
+		 "freely and nothing blocks it, then restart roboelf",
+		 'A' + axis, env.er_counts, 'A' + axis);
+}
+
+static void jam(int axis, int calibrating)
+{
+	char name[48], req[32], tpl[1024];
+	double t;
+	struct row *r;
+
+	snprintf(name, sizeof(name), "7 jam axis %c, %s", 'A' + axis,
+		 calibrating ? "calibrating" : "jogging");
+	r = row_begin(name);
+	snprintf(req, sizeof(req), "block %c 1", 'A' + axis);
+	t = calibrating ? cause_calibrating(axis, req)
+			: cause_jogging(axis, req);
+	if (calibrating)
+		tpl_poserr(tpl, sizeof(tpl), axis);
+	else
+		snprintf(tpl, sizeof(tpl),
+			 "FAULT ENCODER: axis %c: the controller detected an "
+			 "encoder failure (stop code 12)." SAFE_OK
+			 " Recovery: keep the E-stop pressed, check the "
+			 "encoder cable and the motor of axis %c, restart "
+			 "roboelf and recalibrate",
+			 'A' + axis, 'A' + axis);
+	expect_cause(r, t, tpl, d_jam() + d_ctrl_to_relay(), d_jam(), NULL,
+		     0);
+	row_pass(r, "axis %c named (%s)", 'A' + axis,
+		 calibrating ? "MOTION position error" : "ENCODER, OA");
+}
+
+static void enc_stuck(int axis, int calibrating)
+{
+	char name[48], req[32], tpl[1024], act[8], pos[8];
+	double t, d, num[6], runaway;
+	struct row *r;
+
+	snprintf(name, sizeof(name), "7 encoder stuck %c, %s", 'A' + axis,
+		 calibrating ? "calibrating" : "jogging");
+	r = row_begin(name);
+	snprintf(act, sizeof(act), "%c.act", 'A' + axis);
+	snprintf(pos, sizeof(pos), "%c.pos", 'A' + axis);
+	snprintf(req, sizeof(req), "enc %c stuck", 'A' + axis);
+	t = calibrating ? cause_calibrating(axis, req)
+			: cause_jogging(axis, req);
+	d = calibrating ? d_jam() : d_enc_jog();
+	if (calibrating)
+		tpl_poserr(tpl, sizeof(tpl), axis);
+	else
+		snprintf(tpl, sizeof(tpl),
+			 "FAULT ENCODER: axis %c: potentiometer reads {n} V "
+			 "but {n} V is expected at encoder position {n} counts "
+			 "(difference {n} V above the tolerance {n} V for {n} "
+			 "cycles)." SAFE_OK " Recovery: keep the E-stop "
+			 "pressed, check the encoder and potentiometer cables "
+			 "of axis %c, restart roboelf and recalibrate",
+			 'A' + axis, 'A' + axis);
+	expect_cause(r, t, tpl, d + d_ctrl_to_relay(), d, num, 6);
+	if (!calibrating &&
+	    (fabs(num[0] - num[1]) <= num[4] || num[3] <= num[4] ||
+	     (int)num[5] != env.persistence + 1))
+		fail_msg("the values do not show a disagreement beyond the "
+			 "tolerance for persistence + 1 cycles: %s",
+			 r->text);
+	runaway = fabs(state_num(&cs, act) - state_num(&cs, pos));
+	row_pass(r, "axis %c named (%s); the motor ran %.0f counts past the "
+		    "frozen count",
+		 'A' + axis,
+		 calibrating ? "MOTION position error" : "ENCODER pot/encoder",
+		 runaway);
+}
+
+static void test_jam_jog_a(void **state) { (void)state; jam(0, 0); }
+static void test_jam_jog_b(void **state) { (void)state; jam(1, 0); }
+static void test_jam_jog_c(void **state) { (void)state; jam(2, 0); }
+static void test_jam_cal_a(void **state) { (void)state; jam(0, 1); }
+static void test_jam_cal_b(void **state) { (void)state; jam(1, 1); }
+static void test_jam_cal_c(void **state) { (void)state; jam(2, 1); }
+static void test_enc_jog_a(void **state) { (void)state; enc_stuck(0, 0); }
+static void test_enc_jog_b(void **state) { (void)state; enc_stuck(1, 0); }
+static void test_enc_jog_c(void **state) { (void)state; enc_stuck(2, 0); }
+static void test_enc_cal_a(void **state) { (void)state; enc_stuck(0, 1); }
+static void test_enc_cal_b(void **state) { (void)state; enc_stuck(1, 1); }
+static void test_enc_cal_c(void **state) { (void)state; enc_stuck(2, 1); }
+
+/* ---- root cause: the relay, the supervisor, the link, the disk ------------- */
+
+/* Wall ms (epoch) of the log's FAULT entry; waits up to @ms for it. */
+static double log_fault_wall(struct sys_case *c, const char *text, int ms)
+{
+	long long deadline = proc_now_ms() + ms;
+	double w;
+
+	while (sys_log_time_ms(c, text, &w) < 0) {
+		if (proc_now_ms() > deadline)
+			fail_msg("%s", c->err);
+		poll(NULL, 0, 20);
+	}
+	return w;
+}
+
+/*
+ * 7. The relay board swallows every byte (galil-sim cuts motor power at
+ * once; the controller sees every amplifier lose power). The cause named
+ * first is the relay board: FAULT ESTOP naming the relay. galil-sim's
+ * power cut is the "relay off" (0 ms), the controller's motors off within
+ * M; the supervisor's own reaction is measured on the wall clock from the
+ * injection to its FAULT log entry, deadline R + 3P (docs/safety.md D16).
+ */
+static void test_relay_writefail(void **state)
+{
+	struct row *r = row_begin("7 relay board write failing");
+	char tpl[2048], line[TEXT_MAX], later[TEXT_MAX];
+	double t, t_relay, t_mo, w0, w1, d_pc;
+	int i;
+
+	(void)state;
+	start(&cs);
+	w0 = sys_wall_ms();
+	t = inject(&cs, "inject: ", "relayfault writefail");
+	if (sys_wait_fault(&cs, FAULT_WAIT_MS, line, sizeof(line)) < 0)
+		fail_msg("%s", cs.err);
+	row_text(r, line);
+	i = wait_event(&cs, "relay off", NULL, t, 3000);
+	t_relay = cs.ev[i].t_ms - t;
+	t_mo = wait_motors_off(&cs, t, 3000) - t;
+	w1 = log_fault_wall(&cs, " FAULT FAULT ESTOP", 3000);
+	d_pc = env.readback_timeout_ms + 3 * P();
+	row_reaction(r, "power cut by the board %.0f ms, motors off %.0f ms "
+			"(deadline M + s = %d); the supervisor's FAULT entry "
+			"%.0f ms (deadline R + 3P = %.0f, wall)",
+		     t_relay, t_mo, SYS_MAINMS + 1, w1 - w0, d_pc);
+	/* what the log says of the relay afterwards, for the report */
+	if (sys_wait_sim(&cs, t + d_pc + SLACK_MS, 5000) == 0 &&
+	    sys_log_find(&cs, "while latched: FAULT ESTOP", NULL, later,
+			 sizeof(later)) == 0)
+		print_message("[   INFO   ] %s: then the log: %s\n", r->name,
+			      later);
+	snprintf(tpl, sizeof(tpl),
+		 "FAULT ESTOP: motor power lost on every axis and the E-stop "
+		 "relay board does not confirm its state (relay '%s': {s})."
+		 " NOT CONFIRMED: relay open not confirmed; motors off "
+		 "confirmed; PRESS THE HARDWARE E-STOP NOW. Recovery: press "
+		 "the hardware E-stop now, check the relay board, its USB "
+		 "cable and its power, then restart roboelf",
+		 cs.relay_link);
+	expect_text("the FAULT line", tpl, line, NULL, 0);
+	if (sys_check_safe(&cs, 0, HOLD_MS) < 0)
+		fail_msg("%s", cs.err);
+	if (t_mo > SYS_MAINMS + 1 + SLACK_MS || w1 - w0 > d_pc + SLACK_MS)
+		fail_msg("too late: motors off %.0f ms, FAULT entry %.0f ms",
+			 t_mo, w1 - w0);
+	row_pass(r, "the relay board named first");
+}
+
+/*
+ * 7. roboelf stopped (SIGSTOP) for 2 s while armed, then continued: the
+ * controller's watchdog switches every motor off within W + M + s of the
+ * stop; the supervisor's first cycle after SIGCONT names its own stall
+ * first (then the controller's watchdog) and cuts the relay within 2P.
+ */
+#define STALL_MS 2000
+
+static void sigstop(const char *name, int after_ready_ms)
+{
+	struct row *r = row_begin(name);
+	char line[TEXT_MAX], tpl[1024];
+	double t_stop, t_cont, t_relay, t_mo, num[3];
+	int i, status;
+
+	start(&cs);
+	if (sys_wait_sim(&cs, cs.t_ready_ms + after_ready_ms, 5000) < 0)
+		fail_msg("%s", cs.err);
+	t_stop = sys_sim_time(&cs);
+	proc_signal(&cs.re, SIGSTOP);
+	if (sys_wait_sim(&cs, t_stop + STALL_MS, STALL_MS + 5000) < 0)
+		fail_msg("%s", cs.err);
+	t_cont = sys_sim_time(&cs);
+	proc_signal(&cs.re, SIGCONT);
+	if (sys_wait_fault(&cs, FAULT_WAIT_MS, line, sizeof(line)) < 0)
+		fail_msg("%s", cs.err);
+	row_text(r, line);
+	t_mo = wait_motors_off(&cs, t_stop, 3000) - t_stop;
+	i = wait_event(&cs, "relay off", NULL, t_stop, 3000);
+	t_relay = cs.ev[i].t_ms - t_cont;
+	row_reaction(r, "motors off %.0f ms after SIGSTOP (deadline W + M + "
+			"s = %d), relay off %.0f ms after SIGCONT (deadline "
+			"2P = %.0f)",
+		     t_mo, env.wdto_ms + SYS_MAINMS + 1, t_relay, 2 * P());
+	snprintf(tpl, sizeof(tpl),
+		 "FAULT WATCHDOG: this supervisor did not run for {n} ms "
+		 "(limit %.0f ms): the PC stalled (suspended, overloaded or "
+		 "stopped in a debugger), not the link. Then: the controller "
+		 "stopped the robot: no heartbeat from this PC for {n} ms."
+		 SAFE_OK " Recovery: keep the E-stop pressed, find what "
+		 "stopped roboelf (Ctrl-Z, a debugger, CPU or disk load), then "
+		 "restart it",
+		 env.crit_factor * P());
+	expect_text("the FAULT line", tpl, line, num, 3);
+	if (num[0] < t_cont - t_stop - 2 * P())
+		fail_msg("the stall named is %.0f ms, it was stopped %.0f ms",
+			 num[0], t_cont - t_stop);
+	if (sys_check_safe(&cs, 0, HOLD_MS) < 0)
+		fail_msg("%s", cs.err);
+	if (t_mo > env.wdto_ms + SYS_MAINMS + 1 + SLACK_MS ||
+	    t_relay > 2 * P() + SLACK_MS)
+		fail_msg("too late: motors off %.0f ms after SIGSTOP, relay "
+			 "off %.0f ms after SIGCONT",
+			 t_mo, t_relay);
+	proc_signal(&cs.re, SIGTERM);
+	if (proc_wait_exit(&cs.re, EXIT_WAIT_MS, &status) < 0 ||
+	    proc_exit_code(&cs.re) != 4)
+		fail_msg("roboelf did not exit 4 (exit %d)",
+			 proc_exit_code(&cs.re));
+	row_pass(r, "the stall named first, the controller's watchdog as "
+		    "Then:");
+}
+
+/* Stopped in the middle of ordinary running (10 periods after Ready). */
+static void test_sigstop(void **state)
+{
+	(void)state;
+	sigstop("7 supervisor stopped 2 s", 10 * env.period_ms);
+}
+
+/* Stopped at once after "Ready" (before the first armed cycle): the stall
+ * is the same and must be named the same. */
+static void test_sigstop_first_cycle(void **state)
+{
+	(void)state;
+	sigstop("7 stopped 2 s before 1st cycle", 0);
+}
+
+/* Read one control-port answer line from @fd within @ms. */
+static int ctl_line(int fd, char *line, size_t cap, int ms)
+{
+	long long deadline = proc_now_ms() + ms;
+	size_t n = 0;
+
+	for (;;) {
+		struct pollfd pfd = {.fd = fd, .events = POLLIN};
+		long long left = deadline - proc_now_ms();
+		char ch;
+
+		if (left <= 0 || poll(&pfd, 1, (int)left) <= 0 ||
+		    recv(fd, &ch, 1, 0) != 1)
+			return -1;
+		if (ch == '\n')
+			break;
+		if (ch != '\r' && n + 1 < cap)
+			line[n++] = ch;
+	}
+	line[n] = '\0';
+	return 0;
+}
+
+/*
+ * 7. Controller and relay lost together: "link drop" and "relayfault
+ * unplug" in one write to the control port (one request burst). Nothing
+ * can be confirmed: the line must say NOT CONFIRMED and PRESS THE
+ * HARDWARE E-STOP NOW. galil-sim cuts the power at the unplug; the
+ * supervisor's reaction is measured on the wall clock to its FAULT entry,
+ * deadline 2P (a lost link or relay is seen in the next cycle).
+ */
+static void test_link_and_relay_lost(void **state)
+{
+	static const char burst[] = "link drop\nrelayfault unplug\n";
+	struct row *r = row_begin("7 controller and relay lost");
+	char a1[64], a2[64], line[TEXT_MAX], tpl[2048];
+	double t0, t_link, t_relay, w0, w1;
+	int i;
+
+	(void)state;
+	start(&cs);
+	t0 = sys_sim_time(&cs);
+	w0 = sys_wall_ms();
+	if (send(cs.ctl, burst, sizeof(burst) - 1, MSG_NOSIGNAL) !=
+		(ssize_t)(sizeof(burst) - 1) ||
+	    ctl_line(cs.ctl, a1, sizeof(a1), 2000) < 0 ||
+	    ctl_line(cs.ctl, a2, sizeof(a2), 2000) < 0 || strcmp(a1, "ok") ||
+	    strcmp(a2, "ok"))
+		fail_msg("the burst was not taken");
+	i = wait_event(&cs, "inject: link drop", NULL, t0, 2000);
+	t_link = cs.ev[i].t_ms;
+	i = wait_event(&cs, "inject: relayfault unplug", NULL, t0, 2000);
+	t_relay = cs.ev[i].t_ms;
+	if (sys_wait_fault(&cs, FAULT_WAIT_MS, line, sizeof(line)) < 0)
+		fail_msg("%s", cs.err);
+	row_text(r, line);
+	w1 = log_fault_wall(&cs, " FAULT FAULT ", 3000);
+	row_reaction(r, "both injected at %.0f / %.0f ms; the FAULT entry "
+			"%.0f ms after the burst (deadline 2P = %.0f, wall)",
+		     t_link - t0, t_relay - t0, w1 - w0, 2 * P());
+	if (!strstr(line, "NOT CONFIRMED") ||
+	    !strstr(line, "PRESS THE HARDWARE E-STOP NOW"))
+		fail_msg("the line does not say NOT CONFIRMED ... PRESS THE "
+			 "HARDWARE E-STOP NOW:\n  %s",
+			 line);
+	snprintf(tpl, sizeof(tpl),
+		 "FAULT ESTOP: the E-stop relay stopped answering (relay '%s': "
+		 "link lost (hang-up)). NOT CONFIRMED: relay open not "
+		 "confirmed; stop command not delivered; the controller did "
+		 "not answer. PRESS THE HARDWARE E-STOP NOW. Recovery: press "
+		 "the hardware E-stop now, check the relay's USB cable and "
+		 "power, then restart roboelf",
+		 cs.relay_link);
+	expect_text("the FAULT line", tpl, line, NULL, 0);
+	if (w1 - w0 > 2 * P() + SLACK_MS)
+		fail_msg("the FAULT entry came %.0f ms after the burst", w1 - w0);
+	row_pass(r, "NOT CONFIRMED, press the hardware E-stop");
+}
+
 #define T(f) cmocka_unit_test_teardown(f, case_teardown)
 
 int main(void)
@@ -1202,6 +1649,22 @@ int main(void)
 	    T(test_foreign_pa),
 	    T(test_foreign_jg),
 	    T(test_kill_naive_heartbeat),
+	    T(test_jam_jog_a),
+	    T(test_jam_jog_b),
+	    T(test_jam_jog_c),
+	    T(test_jam_cal_a),
+	    T(test_jam_cal_b),
+	    T(test_jam_cal_c),
+	    T(test_enc_jog_a),
+	    T(test_enc_jog_b),
+	    T(test_enc_jog_c),
+	    T(test_enc_cal_a),
+	    T(test_enc_cal_b),
+	    T(test_enc_cal_c),
+	    T(test_relay_writefail),
+	    T(test_sigstop),
+	    T(test_sigstop_first_cycle),
+	    T(test_link_and_relay_lost),
 	};
 	const char *filter = getenv("ROBOELF_SYS_FILTER");
 
