@@ -69,10 +69,10 @@
 
 static struct sys_env env;
 static int env_ok;
-static struct sys_case cs;	/* the first roboelf and its controller */
-static struct proc re2;		/* a second roboelf, or a galil-load */
-static struct proc_sim sim2;	/* a second controller and relay */
-static int raw_fd = -1;		/* a raw client of the controller */
+static struct sys_case cs;   /* the first roboelf and its controller */
+static struct proc re2;	     /* a second roboelf, or a galil-load */
+static struct proc_sim sim2; /* a second controller and relay */
+static int raw_fd = -1;	     /* a raw client of the controller */
 static char lock_dir[SYS_PATH_MAX], lock_dir2[SYS_PATH_MAX + 8];
 static char lock_env[SYS_PATH_MAX + 32], lock_env2[SYS_PATH_MAX + 40];
 static char *re_env[] = {lock_env, NULL};
@@ -86,7 +86,7 @@ static char log_mnt[SYS_PATH_MAX + 8]; /* a tmpfs mounted here, or "" */
 struct row {
 	char name[48];
 	char outcome[160];
-	char reaction[160];
+	char reaction[320];
 	char text[TEXT_MAX];
 };
 
@@ -156,9 +156,10 @@ static void print_table(void)
 
 /* Recovery texts and confirmations, as roboelf prints them (pc/re_check.c,
  * pc/re_react.c; docs/operator.md section 7). */
-#define SAFE_OK " Safe state confirmed: motor power off (relay open), motors off."
+#define SAFE_OK                                                                \
+	" Safe state confirmed: motor power off (relay open), motors off."
 #define REC_FOREIGN                                                            \
-	" Recovery: keep the E-stop pressed, close every other program "      \
+	" Recovery: keep the E-stop pressed, close every other program "       \
 	"connected to the controller (another roboelf, galil-load, a "         \
 	"terminal), then restart roboelf"
 
@@ -283,8 +284,8 @@ static void cal_fault_line(char *out, size_t cap)
 			continue;
 		p += 7;
 		end = strstr(p, " | ");
-		snprintf(out, cap, "%.*s", end ? (int)(end - p) : (int)strlen(p),
-			 p);
+		snprintf(out, cap, "%.*s",
+			 end ? (int)(end - p) : (int)strlen(p), p);
 		break;
 	}
 	if (f)
@@ -578,16 +579,16 @@ static void expect_undisturbed(struct sys_case *c, double t0, int no_connect)
 		fail_msg("%s", c->err);
 	i = find_event(c, "relay", t0);
 	if (i >= 0)
-		fail_msg("the relay was touched: '%s' at %.0f ms", c->ev[i].text,
-			 c->ev[i].t_ms);
+		fail_msg("the relay was touched: '%s' at %.0f ms",
+			 c->ev[i].text, c->ev[i].t_ms);
 	i = find_event(c, "handle ", t0);
 	if (no_connect && i >= 0)
 		fail_msg("the second one reached the controller: '%s' at %.0f "
 			 "ms",
 			 c->ev[i].text, c->ev[i].t_ms);
 	proc_pump(&c->re, 0);
-	if (proc_find_line(&c->re, PROC_STDOUT, "FAULT ", line,
-			   sizeof(line)) == 0)
+	if (proc_find_line(&c->re, PROC_STDOUT, "FAULT ", line, sizeof(line)) ==
+	    0)
 		fail_msg("the first roboelf printed a FAULT line: %s", line);
 }
 
@@ -698,16 +699,16 @@ static void refused_by_lock(struct row *r, const char *tpl, long long w0,
 		fail_msg("the refusal names pid %.0f, the first roboelf is "
 			 "%ld: %s",
 			 pid, (long)cs.re.pid, line);
-	if (proc_find_line(&re2, PROC_STDOUT, "roboelf: opening the E-stop "
-					      "relay",
-			   NULL, 0) == 0 ||
-	    proc_find_line(&re2, PROC_STDOUT, "roboelf: connecting", NULL,
-			   0) == 0)
+	if (proc_find_line(&re2, PROC_STDOUT,
+			   "roboelf: opening the E-stop relay", NULL, 0) == 0 ||
+	    proc_find_line(&re2, PROC_STDOUT, "roboelf: connecting", NULL, 0) ==
+		0)
 		fail_msg("the refused roboelf went on past the locks:\n%s",
 			 proc_output(&re2, PROC_STDOUT));
 	row_text(r, line);
-	row_reaction(r, "refused (exit 3) %.0f ms after its start (bound %d "
-			"ms, wall)",
+	row_reaction(r,
+		     "refused (exit 3) %.0f ms after its start (bound %d "
+		     "ms, wall)",
 		     ms, LOCK_REFUSE_MS);
 	if (ms > LOCK_REFUSE_MS)
 		fail_msg("the lock refusal took %.0f ms (bound %d ms)", ms,
@@ -735,8 +736,9 @@ static void test_second_same_config(void **state)
 	w0 = proc_now_ms();
 	spawn_second(&re2, cs.cfg, addr, cs.relay_link, lock_env);
 	refused_by_lock(r, tpl, w0, t0);
-	row_pass(r, "refused by the controller lock, exit 3; first "
-		    "undisturbed >= %d ms",
+	row_pass(r,
+		 "refused by the controller lock, exit 3; first "
+		 "undisturbed >= %d ms",
 		 WATCH_MS);
 }
 
@@ -766,8 +768,9 @@ static void test_second_same_relay(void **state)
 	w0 = proc_now_ms();
 	spawn_second(&re2, cfg, NULL, NULL, lock_env);
 	refused_by_lock(r, tpl, w0, t0);
-	row_pass(r, "refused by the relay lock, exit 3; first undisturbed "
-		    ">= %d ms",
+	row_pass(r,
+		 "refused by the relay lock, exit 3; first undisturbed "
+		 ">= %d ms",
 		 WATCH_MS);
 }
 
@@ -794,8 +797,9 @@ static void test_second_same_controller(void **state)
 	w0 = proc_now_ms();
 	spawn_second(&re2, cfg, NULL, NULL, lock_env);
 	refused_by_lock(r, tpl, w0, t0);
-	row_pass(r, "refused by the controller lock, exit 3; first "
-		    "undisturbed >= %d ms",
+	row_pass(r,
+		 "refused by the controller lock, exit 3; first "
+		 "undisturbed >= %d ms",
 		 WATCH_MS);
 }
 
@@ -830,14 +834,16 @@ static void test_second_other_host(void **state)
 	ms = expect_refused(&re2, w0, tpl, NULL, 0, line, sizeof(line));
 	row_text(r, line);
 	bound = env.wdto_ms + 50 + 2000;
-	row_reaction(r, "refused (exit 3) %.0f ms after its start (bound "
-			"wdto + 50 + 2000 = %.0f ms, wall)",
+	row_reaction(r,
+		     "refused (exit 3) %.0f ms after its start (bound "
+		     "wdto + 50 + 2000 = %.0f ms, wall)",
 		     ms, bound);
 	if (ms > bound)
 		fail_msg("the refusal took %.0f ms (bound %.0f)", ms, bound);
 	expect_undisturbed(&cs, t0, 0);
-	row_pass(r, "refused by the controller check, exit 3; first "
-		    "undisturbed >= %d ms",
+	row_pass(r,
+		 "refused by the controller check, exit 3; first "
+		 "undisturbed >= %d ms",
 		 WATCH_MS);
 }
 
@@ -938,9 +944,10 @@ static void test_load_force(void **state)
 	i = wait_event(&cs, "relay off", NULL, t_conn, 3000);
 	t_relay = cs.ev[i].t_ms;
 	t_mo = wait_motors_off(&cs, t_conn, 3000);
-	row_reaction(r, "from galil-load's connection (handle %c): relay off "
-			"%.0f ms (deadline %.0f), motors off %.0f ms "
-			"(deadline %d)",
+	row_reaction(r,
+		     "from galil-load's connection (handle %c): relay off "
+		     "%.0f ms (deadline %.0f), motors off %.0f ms "
+		     "(deadline %d)",
 		     h, t_relay - t_conn, d_ctrl_to_relay(), t_mo - t_conn,
 		     SYS_MAINMS + 1);
 	snprintf(tpl, sizeof(tpl),
@@ -962,7 +969,8 @@ static void test_load_force(void **state)
 	row_pass(r, "FOREIGN latched, galil-load exit 0, safe state held");
 }
 
-/* ---- a raw client --------------------------------------------------------- */
+/* ---- a raw client ---------------------------------------------------------
+ */
 
 /* Wait until the peer closes @fd (EOF or reset). Return: 0, -1 on timeout
  * or when data arrives instead. */
@@ -1097,8 +1105,8 @@ static void test_startup_closes_client(void **state)
  */
 #define TRAVEL_BOUND 10 /* counts */
 
-static void foreign_move(const char *name, const char *line1,
-			 const char *cmd1, const char *cmd2)
+static void foreign_move(const char *name, const char *line1, const char *cmd1,
+			 const char *cmd2)
 {
 	struct row *r = row_begin(name);
 	char line[TEXT_MAX], tpl[1024], ans[64] = "", ans2[64] = "", h;
@@ -1127,10 +1135,11 @@ static void foreign_move(const char *name, const char *line1,
 		fail_msg("%s", cs.err);
 	a1 = state_num(&cs, "A.act");
 	i = find_event(&cs, "axis A begin", t0);
-	row_reaction(r, "from the connection (handle %c): relay off %.0f ms "
-			"(deadline %.0f), motors off %.0f ms (deadline %d); "
-			"answers '%s%s%s'; axis A travel %.0f counts (bound "
-			"%d)%s",
+	row_reaction(r,
+		     "from the connection (handle %c): relay off %.0f ms "
+		     "(deadline %.0f), motors off %.0f ms (deadline %d); "
+		     "answers '%s%s%s'; axis A travel %.0f counts (bound "
+		     "%d)%s",
 		     h, t_relay - t_conn, d_ctrl_to_relay(), t_mo - t_conn,
 		     SYS_MAINMS + 1, ans, ans2[0] ? "' then '" : "", ans2,
 		     a1 - a0, TRAVEL_BOUND,
@@ -1160,8 +1169,8 @@ static void test_foreign_pa(void **state)
 static void test_foreign_jg(void **state)
 {
 	(void)state;
-	foreign_move("5b client sends JG 8000;BG A", "JG 8000;BG A",
-		     "JG 8000", "BG A");
+	foreign_move("5b client sends JG 8000;BG A", "JG 8000;BG A", "JG 8000",
+		     "BG A");
 }
 
 /*
@@ -1244,8 +1253,9 @@ static void test_kill_naive_heartbeat(void **state)
 					      : "a new letter",
 		 ok, refused, closed ? ", then closed" : "");
 	row_text(r, text);
-	row_reaction(r, "motors off %.0f ms after the kill (deadline W + M + "
-			"s = %.0f), client connected %.0f ms after it",
+	row_reaction(r,
+		     "motors off %.0f ms after the kill (deadline W + M + "
+		     "s = %.0f), client connected %.0f ms after it",
 		     t_off - t_kill, d, t_conn - t_kill);
 	if (fcode != 14 || fdet != 1)
 		fail_msg("the program did not latch FOREIGN heartbeat (14, "
@@ -1262,7 +1272,8 @@ static void test_kill_naive_heartbeat(void **state)
 		    "kept off");
 }
 
-/* ---- root cause: a jam and a stuck encoder on each axis -------------------- */
+/* ---- root cause: a jam and a stuck encoder on each axis --------------------
+ */
 
 /* Jam (or stuck encoder) detection, docs/safety.md "E": the position error
  * grows at vmin (every move here is at least that fast) to at most one
@@ -1329,8 +1340,9 @@ static void expect_cause(struct row *r, double t_inj, const char *tpl,
 	i = wait_event(&cs, "relay off", NULL, t_inj, 3000);
 	t_relay = cs.ev[i].t_ms - t_inj;
 	t_mo = wait_motors_off(&cs, t_inj, 3000) - t_inj;
-	row_reaction(r, "relay off %.0f ms (deadline %.0f), motors off %.0f "
-			"ms (deadline %.0f)",
+	row_reaction(r,
+		     "relay off %.0f ms (deadline %.0f), motors off %.0f "
+		     "ms (deadline %.0f)",
 		     t_relay, d_relay, t_mo, d_motors);
 	not_own_request(line);
 	expect_text("the FAULT line", tpl, line, num, max);
@@ -1411,8 +1423,7 @@ static void jam(int axis, int calibrating)
 			 "encoder cable and the motor of axis %c, restart "
 			 "roboelf and recalibrate",
 			 'A' + axis, 'A' + axis);
-	expect_cause(r, t, tpl, d_jam() + d_ctrl_to_relay(), d_jam(), NULL,
-		     0);
+	expect_cause(r, t, tpl, d_jam() + d_ctrl_to_relay(), d_jam(), NULL, 0);
 	row_pass(r, "axis %c named (%s)", 'A' + axis,
 		 calibrating ? "MOTION position error" : "ENCODER, OA");
 }
@@ -1451,27 +1462,77 @@ static void enc_stuck(int axis, int calibrating)
 			 "tolerance for persistence + 1 cycles: %s",
 			 r->text);
 	runaway = fabs(state_num(&cs, act) - state_num(&cs, pos));
-	row_pass(r, "axis %c named (%s); the motor ran %.0f counts past the "
-		    "frozen count",
+	row_pass(r,
+		 "axis %c named (%s); the motor ran %.0f counts past the "
+		 "frozen count",
 		 'A' + axis,
 		 calibrating ? "MOTION position error" : "ENCODER pot/encoder",
 		 runaway);
 }
 
-static void test_jam_jog_a(void **state) { (void)state; jam(0, 0); }
-static void test_jam_jog_b(void **state) { (void)state; jam(1, 0); }
-static void test_jam_jog_c(void **state) { (void)state; jam(2, 0); }
-static void test_jam_cal_a(void **state) { (void)state; jam(0, 1); }
-static void test_jam_cal_b(void **state) { (void)state; jam(1, 1); }
-static void test_jam_cal_c(void **state) { (void)state; jam(2, 1); }
-static void test_enc_jog_a(void **state) { (void)state; enc_stuck(0, 0); }
-static void test_enc_jog_b(void **state) { (void)state; enc_stuck(1, 0); }
-static void test_enc_jog_c(void **state) { (void)state; enc_stuck(2, 0); }
-static void test_enc_cal_a(void **state) { (void)state; enc_stuck(0, 1); }
-static void test_enc_cal_b(void **state) { (void)state; enc_stuck(1, 1); }
-static void test_enc_cal_c(void **state) { (void)state; enc_stuck(2, 1); }
+static void test_jam_jog_a(void **state)
+{
+	(void)state;
+	jam(0, 0);
+}
+static void test_jam_jog_b(void **state)
+{
+	(void)state;
+	jam(1, 0);
+}
+static void test_jam_jog_c(void **state)
+{
+	(void)state;
+	jam(2, 0);
+}
+static void test_jam_cal_a(void **state)
+{
+	(void)state;
+	jam(0, 1);
+}
+static void test_jam_cal_b(void **state)
+{
+	(void)state;
+	jam(1, 1);
+}
+static void test_jam_cal_c(void **state)
+{
+	(void)state;
+	jam(2, 1);
+}
+static void test_enc_jog_a(void **state)
+{
+	(void)state;
+	enc_stuck(0, 0);
+}
+static void test_enc_jog_b(void **state)
+{
+	(void)state;
+	enc_stuck(1, 0);
+}
+static void test_enc_jog_c(void **state)
+{
+	(void)state;
+	enc_stuck(2, 0);
+}
+static void test_enc_cal_a(void **state)
+{
+	(void)state;
+	enc_stuck(0, 1);
+}
+static void test_enc_cal_b(void **state)
+{
+	(void)state;
+	enc_stuck(1, 1);
+}
+static void test_enc_cal_c(void **state)
+{
+	(void)state;
+	enc_stuck(2, 1);
+}
 
-/* ---- root cause: the relay, the supervisor, the link, the disk ------------- */
+/* ---- root cause: the relay, the supervisor, the link, the disk -------------
+ */
 
 /* Wall ms (epoch) of the log's FAULT entry; waits up to @ms for it. */
 static double log_fault_wall(struct sys_case *c, const char *text, int ms)
@@ -1514,9 +1575,10 @@ static void test_relay_writefail(void **state)
 	t_mo = wait_motors_off(&cs, t, 3000) - t;
 	w1 = log_fault_wall(&cs, " FAULT FAULT ESTOP", 3000);
 	d_pc = env.readback_timeout_ms + 3 * P();
-	row_reaction(r, "power cut by the board %.0f ms, motors off %.0f ms "
-			"(deadline M + s = %d); the supervisor's FAULT entry "
-			"%.0f ms (deadline R + 3P = %.0f, wall)",
+	row_reaction(r,
+		     "power cut by the board %.0f ms, motors off %.0f ms "
+		     "(deadline M + s = %d); the supervisor's FAULT entry "
+		     "%.0f ms (deadline R + 3P = %.0f, wall)",
 		     t_relay, t_mo, SYS_MAINMS + 1, w1 - w0, d_pc);
 	/* what the log says of the relay afterwards, for the report */
 	if (sys_wait_sim(&cs, t + d_pc + SLACK_MS, 5000) == 0 &&
@@ -1598,9 +1660,9 @@ static void sigstop(const char *name, int phase_ms, int delay_ms)
 	int i, status;
 
 	start(&cs);
-	if (delay_ms > 0 && (sys_ctl(&cs, "link delay %d", delay_ms) < 0 ||
-			     sys_wait_sim(&cs, sys_sim_time(&cs) + 10 * P(),
-					  5000) < 0))
+	if (delay_ms > 0 &&
+	    (sys_ctl(&cs, "link delay %d", delay_ms) < 0 ||
+	     sys_wait_sim(&cs, sys_sim_time(&cs) + 10 * P(), 5000) < 0))
 		fail_msg("%s", cs.err);
 	if (phase_ms >= 0)
 		wait_sim_tight(&cs, next_heartbeat(&cs) + phase_ms, 2000);
@@ -1616,19 +1678,21 @@ static void sigstop(const char *name, int phase_ms, int delay_ms)
 	t_mo = wait_motors_off(&cs, t_stop, 3000) - t_stop;
 	i = wait_event(&cs, "relay off", NULL, t_stop, 3000);
 	t_relay = cs.ev[i].t_ms - t_cont;
-	row_reaction(r, "motors off %.0f ms after SIGSTOP (deadline W + M + "
-			"s = %d), relay off %.0f ms after SIGCONT (deadline "
-			"2P = %.0f)",
+	row_reaction(r,
+		     "motors off %.0f ms after SIGSTOP (deadline W + M + "
+		     "s = %d), relay off %.0f ms after SIGCONT (deadline "
+		     "2P = %.0f)",
 		     t_mo, env.wdto_ms + SYS_MAINMS + 1, t_relay, 2 * P());
-	snprintf(tpl, sizeof(tpl),
-		 "FAULT WATCHDOG: this supervisor did not run for {n} ms "
-		 "(limit %.0f ms): the PC stalled (suspended, overloaded or "
-		 "stopped in a debugger), not the link. Then: the controller "
-		 "stopped the robot: no heartbeat from this PC for {n} ms."
-		 SAFE_OK " Recovery: keep the E-stop pressed, find what "
-		 "stopped roboelf (Ctrl-Z, a debugger, CPU or disk load), then "
-		 "restart it",
-		 env.crit_factor * P());
+	snprintf(
+	    tpl, sizeof(tpl),
+	    "FAULT WATCHDOG: this supervisor did not run for {n} ms "
+	    "(limit %.0f ms): the PC stalled (suspended, overloaded or "
+	    "stopped in a debugger), not the link. Then: the controller "
+	    "stopped the robot: no heartbeat from this PC for {n} ms." SAFE_OK
+	    " Recovery: keep the E-stop pressed, find what "
+	    "stopped roboelf (Ctrl-Z, a debugger, CPU or disk load), then "
+	    "restart it",
+	    env.crit_factor * P());
 	expect_text("the FAULT line", tpl, line, num, 3);
 	if (num[0] < t_cont - t_stop - 2 * P())
 		fail_msg("the stall named is %.0f ms, it was stopped %.0f ms",
@@ -1732,10 +1796,11 @@ static void test_link_and_relay_lost(void **state)
 	i = wait_event(&cs, "relay off", NULL, t0, 3000);
 	t_off = cs.ev[i].t_ms - t_relay;
 	t_mo = wait_motors_off(&cs, t_relay, 3000) - t_relay;
-	row_reaction(r, "both injected at +%.0f / +%.0f ms; power cut %.0f ms "
-			"and motors off %.0f ms (deadline M + s = %d) after "
-			"the unplug; the FAULT entry %.0f ms after the burst "
-			"(deadline 2P = %.0f, wall)",
+	row_reaction(r,
+		     "both injected at +%.0f / +%.0f ms; power cut %.0f ms "
+		     "and motors off %.0f ms (deadline M + s = %d) after "
+		     "the unplug; the FAULT entry %.0f ms after the burst "
+		     "(deadline 2P = %.0f, wall)",
 		     t_link - t0, t_relay - t0, t_off, t_mo, SYS_MAINMS + 1,
 		     w1 - w0, 2 * P());
 	if (sys_check_safe(&cs, 0, HOLD_MS) < 0)
@@ -1757,7 +1822,8 @@ static void test_link_and_relay_lost(void **state)
 		 cs.relay_link);
 	expect_text("the FAULT line", tpl, line, NULL, 0);
 	if (w1 - w0 > 2 * P() + SLACK_MS)
-		fail_msg("the FAULT entry came %.0f ms after the burst", w1 - w0);
+		fail_msg("the FAULT entry came %.0f ms after the burst",
+			 w1 - w0);
 	row_pass(r, "NOT CONFIRMED, press the hardware E-stop");
 }
 
@@ -1828,8 +1894,9 @@ static void fill_disk(const char *log, const char *filler)
 		if (stat(log, &st) < 0)
 			fail_msg("stat '%s': %s", log, strerror(errno));
 		if (st.st_size % (off_t)vfs.f_bsize != 0)
-			pad_log(log, vfs.f_bsize -
-					 (size_t)(st.st_size % (off_t)vfs.f_bsize));
+			pad_log(log,
+				vfs.f_bsize -
+				    (size_t)(st.st_size % (off_t)vfs.f_bsize));
 		fill_fd(fd);
 		if (stat(log, &st) == 0 && st.st_size % (off_t)vfs.f_bsize == 0)
 			break;
@@ -1918,8 +1985,9 @@ static void test_log_full(void **state)
 		fail_msg("the log was not retried within %d ms", 2 * RETRY_MS);
 	w2 = proc_now_ms();
 	expect_text("the repeated log message", warn, msg, NULL, 0);
-	row_reaction(r, "%s: relay off %.0f ms (deadline %.0f), motors off "
-			"%.0f ms (deadline %.0f); log retried after %lld ms",
+	row_reaction(r,
+		     "%s: relay off %.0f ms (deadline %.0f), motors off "
+		     "%.0f ms (deadline %.0f); log retried after %lld ms",
 		     how, t_relay, d, t_mo, d + SYS_MAINMS, w2 - w1);
 	snprintf(tpl, sizeof(tpl),
 		 "FAULT ENCODER: axis A: potentiometer reads {n} V but {n} V "
