@@ -3,34 +3,41 @@
  * on the whole system: galil-sim running dmc/ (downloaded by galil-load),
  * roboelf supervising it through the virtual relay.
  *
- * One master:
- *  - a second roboelf on the same controller or relay is refused at once by
- *    the locks (exit 3, the holder's pid named) and the first runs on
- *    undisturbed (no relay event, no connection, no FAULT, heartbeat
- *    advancing, still armed, watched over >= 1 s);
- *  - a second supervisor "on another host" (its own lock directory and
- *    relay) is refused by the controller check, the first undisturbed;
- *  - galil-load refuses an armed controller without --force (exit 5), and
- *    with --force halts it: roboelf latches a fault;
- *  - roboelf's start-up closes a client connected before it (IHT=>-3);
- *  - a client that connects while armed and moves an axis: what the
- *    operator sees, and how far the axis went;
- *  - after roboelf is killed, a naive client writing hbpc=1, 2, 3 ... does
- *    not keep the robot alive.
- * Root cause: a jam and a stuck encoder on each axis, jogging and during
- * the calibration; a relay board that swallows its bytes; the supervisor
- * stopped for 2 s; controller and relay lost together; a full disk.
+ * One full calibration for the binary (group setup; its first try is case
+ * 0), then every case on a fresh galil-sim with `--calibration file`:
+ *  1. a second roboelf on the same controller or relay (the same
+ *     configuration; another file naming the same relay; another naming
+ *     the same controller) is refused at once by the locks (exit 3, the
+ *     holder's pid named), and the first runs on undisturbed: no relay
+ *     event, no connection, no FAULT, its heartbeat advancing, still armed,
+ *     watched over >= 1 s;
+ *  2. a second supervisor "on another host" (its own lock directory and
+ *     relay) is refused by the controller check, the first undisturbed;
+ *  3. galil-load refuses an armed controller without --force (exit 5,
+ *     nothing changed), and with --force halts it: roboelf latches FOREIGN;
+ *  4. roboelf's start-up closes a client connected before it (IHT=>-3);
+ *  5. a client that connects while armed and starts a move (PA or JG, BG):
+ *     FOREIGN naming its handle, and how far the axis went;
+ *  6. after roboelf is killed, a naive client writing hbpc=1, 2, 3 ...
+ *     does not keep the robot alive (FOREIGN heartbeat, motors off);
+ *  7. root cause: a jam and a stuck encoder on each axis, jogging and
+ *     during the calibration; a relay board that swallows its bytes; the
+ *     supervisor stopped for 2 s (in its sleep, before its first armed
+ *     cycle, awaiting a reply); controller and relay lost together; a full
+ *     disk.
  *
  * Every case asserts the outcome, the exact text the operator sees (the
- * whole line; "{n}" in a template stands for a number, "{t}" for a local
- * time), and the reaction time from galil-sim's events (simulated ms),
- * against the deadlines of docs/safety.md section 3 plus SLACK_MS. Each case
- * prints a "[ MEASURE  ]" line; the group teardown prints a table
- * case | outcome | reaction | text.
+ * whole line; in a template "{n}" stands for a number, "{t}" for a local
+ * time, "{s}" for a text), and the reaction time from galil-sim's events
+ * (simulated ms) against the deadlines of docs/safety.md section 3 plus
+ * SLACK_MS. Each case prints a "[ MEASURE  ]" line; the group teardown
+ * prints a table: case | outcome | reaction | exact FAULT line or message.
  *
  * Every roboelf started here gets ROBOELF_LOCK_DIR inside the temporary
- * directory. Environment: ROBOELF_SYS_FILTER=PATTERN runs only the matching
- * cases; ROBOELF_KEEP=1 keeps the temporary directory.
+ * directory. The full-disk case mounts a tmpfs when run as root (else the
+ * log is /dev/full). Environment: ROBOELF_SYS_FILTER=PATTERN runs only the
+ * matching cases; ROBOELF_KEEP=1 keeps the temporary directory;
+ * ROBOELF_SYS_CAL=FILE reuses a calibration (development).
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -1043,13 +1050,18 @@ static void raw_cmd(int fd, const char *cmd, int timeout_ms, char *ans,
  * roboelf's start-up (IHT=>-3): the client sees EOF, galil-sim logs
  * "handle X closed by IHT from handle Y" with Y roboelf's command handle;
  * then roboelf arms. Reaction: from roboelf's connection to the close.
+ * EOF_MS bounds roboelf's start to its IHT: the relay opened and read back
+ * (R = 500 ms), the connection (connect_timeout_ms = 2000), identification
+ * and an idle busy check (no wait), with margin.
  */
+#define EOF_MS 5000
+
 static void test_startup_closes_client(void **state)
 {
 	struct row *r = row_begin("4 start-up closes a client");
 	char addr[32], want[64], text[SYS_EVT_TEXT], hx, hy;
 	double t0, t_y, t_close;
-	long long w0;
+	long long w0, eof_ms;
 	int i, status;
 
 	(void)state;
@@ -1067,26 +1079,30 @@ static void test_startup_closes_client(void **state)
 	snprintf(addr, sizeof(addr), "127.0.0.1:%d", cs.sim.port);
 	w0 = proc_now_ms();
 	spawn_second(&re2, cs.cfg, addr, cs.relay_link, lock_env);
-	if (wait_eof(raw_fd, 5000) < 0)
+	if (wait_eof(raw_fd, EOF_MS) < 0)
 		fail_msg("the raw client (handle %c) was not closed within "
-			 "5000 ms of roboelf's start\n--- roboelf:\n%s",
-			 hx, proc_output(&re2, PROC_STDOUT));
-	print_message("[ MEASURE  ] 4: the client saw EOF %lld ms after "
-		      "roboelf's start (wall)\n",
-		      proc_now_ms() - w0);
+			 "%d ms of roboelf's start\n--- roboelf:\n%s",
+			 hx, EOF_MS, proc_output(&re2, PROC_STDOUT));
+	eof_ms = proc_now_ms() - w0;
 	snprintf(want, sizeof(want), "handle %c closed by IHT from handle ",
 		 hx);
 	i = wait_event(&cs, want, NULL, t0, 3000);
 	t_close = cs.ev[i].t_ms;
 	snprintf(text, sizeof(text), "%s", cs.ev[i].text);
+	row_text(r, text);
 	hy = text[strlen(text) - 1];
+	snprintf(want, sizeof(want), "handle %c closed by IHT from handle %c",
+		 hx, hy);
+	expect_text("the close event", want, text, NULL, 0);
 	snprintf(want, sizeof(want), "handle %c opened from ", hy);
 	i = wait_event(&cs, want, NULL, t_y, 1000);
-	row_text(r, text);
-	row_reaction(r, "closed %.0f ms after roboelf connected (handle %c)",
-		     t_close - cs.ev[i].t_ms, hy);
-	if (hy == hx)
-		fail_msg("closed by its own handle: %s", text);
+	row_reaction(r,
+		     "closed %.0f ms after roboelf connected (handle %c); "
+		     "the client saw EOF %lld ms after roboelf's start (bound "
+		     "%d, wall)",
+		     t_close - cs.ev[i].t_ms, hy, eof_ms, EOF_MS);
+	if (hy == hx || hy < 'A' || hy > 'H')
+		fail_msg("not closed by roboelf's handle: %s", text);
 	if (proc_wait_line(&re2, PROC_STDOUT, "RoboELF Ready for Use", 20000,
 			   NULL, 0) < 0)
 		fail_msg("roboelf did not arm after closing the client\n%s",
