@@ -214,12 +214,33 @@ static void relay_or_power(struct re_super *s, struct re_fault *f)
 	snprintf(f->s, sizeof(f->s), "%s", why);
 }
 
+/* The handles the program saw another program open while the motors were
+ * on (fhnew, version 2.00): a connection that came and went between two
+ * of our records is named too. Unreadable (link lost, an older program):
+ * what this supervisor saw itself stands. */
+static void foreign_from_program(struct re_super *s)
+{
+	double m = 0;
+
+	if (s->confirm.stop_rc < 0)
+		return;
+	if (re_io_read(&s->io, "fhnew", &m, s->cfg.fault_cmd_timeout_ms) ==
+		GL_OK &&
+	    m >= 1 && m <= 255)
+		s->foreign |= (unsigned)m;
+}
+
 /* A program fault that our own stop caused: 12 (pcflt), or a motor found
- * off by the stop or abort command (fault 10, stop code 4 or 7). */
+ * off (fault 10) whose stop code says nothing stopped it but a command:
+ * 1 at rest, 4 ST, 7 AB. Our "pcflt=1;AB 1;MO ABC" can land in the
+ * middle of the program's pass, after its pcflt check and before its
+ * motor check: then the program latches 10 first. A motor the servo or
+ * an amplifier switched off has its own code (8 ER, 12 OA ...) or fault. */
 static int own_doing(const struct re_za *za, double det)
 {
 	return za->fcode == RE_DMC_F_SUPERVISOR ||
-	       (za->fcode == RE_DMC_F_MOTOROFF && (det == 4 || det == 7));
+	       (za->fcode == RE_DMC_F_MOTOROFF &&
+		(det == 1 || det == 4 || det == 7));
 }
 
 /* What the controller did on its own (its latched fault) when that is not
@@ -232,7 +253,9 @@ static void consequences(struct re_super *s, const struct re_fault *f)
 	double det;
 
 	s->then[0] = '\0';
+	/* RELAY_POWER is the program's power loss, named with its cause */
 	if (s->confirm.stop_rc < 0 || re_fault_is_ctrl(f->id) ||
+	    f->id == RE_F_RELAY_POWER ||
 	    program_fault(s, &za, &det) != GL_OK || !za.fcode ||
 	    own_doing(&za, det))
 		return;
@@ -401,6 +424,7 @@ int re_super_fault(struct re_super *s, const struct re_fault *f)
 	    s->confirm.stop_rc >= 0 ? motors_off(s) : s->confirm.stop_rc;
 	relay_or_power(s, &fault);
 	consequences(s, &fault);
+	foreign_from_program(s);
 	s->latched = 1;
 	s->armed = 0;
 	s->fault = fault;

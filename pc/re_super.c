@@ -79,7 +79,9 @@ void re_super_start(struct re_super *s, const struct re_caltable *const *tables,
 	s->expect = expect;
 	s->armed = expect == RE_DMC_ARMED;
 	s->own_mask = 0;
-	s->have_handles = 0;
+	/* the handles known stay from the first record on (just after the
+	 * take-over closed the others): a program that connects between two
+	 * phases, e.g. just before the first armed cycle, is still new */
 	s->hbpc = hbpc;
 	s->last_good_ns = now_ns(s);
 	/* the stall check counts from here: a stall before the first cycle

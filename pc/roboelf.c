@@ -83,6 +83,7 @@ struct app {
 	int calib;   /* the operator's choice: RE_CALIB_FULL / _FILE */
 	int powered; /* the relay was switched on at some point */
 	unsigned foreign_shown; /* other programs' handles already shown */
+	int ctl_ours; /* the controller was taken over: ours to stop */
 	char err[RE_CONFIG_ERR_MAX];
 };
 
@@ -392,6 +393,7 @@ static int start_link(struct app *a)
 			      a->err, sizeof(a->err)) ||
 	    re_ctl_take_over(l, &a->info, a->err, sizeof(a->err)))
 		return fail(a, a->err);
+	a->ctl_ours = 1;
 	snprintf(id, sizeof(id), "%s, serial %ld, program id %016llX",
 		 a->info.model, a->info.serial,
 		 (unsigned long long)a->info.program_id);
@@ -886,8 +888,9 @@ static void power_off(struct app *a, int latched)
 
 	if (a->sup)
 		rc = re_super_shutdown(a->sup, what, sizeof(what));
-	else if (a->real.link)
+	else if (a->real.link && a->ctl_ours)
 		rc = re_ctl_stop(&a->io, a->cfg.controller.timeout_ms);
+	/* refused (busy, not identified): somebody else's, left alone */
 	if (a->relay && re_relay_close(a->relay) != GL_OK)
 		rc = rc ? rc : GL_ERR_RELAY;
 	a->relay = a->real.relay = NULL;

@@ -73,6 +73,8 @@ struct fake {
 	int fcode_val;	  /* then this */
 	int n_fcode;
 	int motors_on_after_stop; /* "MG _MOx" answers 0 (motor still on) */
+	int fhnew;		  /* "MG fhnew": another program's handles */
+	int faxis;		  /* "MG faxis" */
 	char logs[16][1024];
 	int log_level[16];
 	int n_logs;
@@ -131,7 +133,9 @@ static int f_command(void *ud, const char *cmd, char *resp, size_t cap,
 		snprintf(resp, cap, " %d.0000",
 			 fk.n_fcode++ < fk.fcode_after ? 0 : fk.fcode_val);
 	else if (!strcmp(cmd, "MG faxis"))
-		snprintf(resp, cap, " 0.0000");
+		snprintf(resp, cap, " %d.0000", fk.faxis);
+	else if (!strcmp(cmd, "MG fhnew"))
+		snprintf(resp, cap, " %d.0000", fk.fhnew);
 	else if (!strncmp(cmd, "MG _MO", 6))
 		snprintf(resp, cap, " %d.0000", fk.motors_on_after_stop ? 0 : 1);
 	else
@@ -365,11 +369,11 @@ static void test_super_encpot_fault_order(void **state)
 	assert_int_equal(fk.n_relay_off, 0);
 	assert_int_equal(step(), RE_FAULT);
 	/* relay, stop, motors read back, the program's own verdict asked
-	 * (a consequence to name), then the log */
+	 * (a consequence to name), another program's handles, then the log */
 	assert_string_equal(fk.seq, "relay_off_start,cmd:pcflt=1;AB 1;MO ABC,"
 				    "relay_off_finish,"
 				    "cmd:MG _MOA,cmd:MG _MOB,cmd:MG _MOC,"
-				    "cmd:MG fcode,log:FAULT");
+				    "cmd:MG fcode,cmd:MG fhnew,log:FAULT");
 	assert_non_null(strstr(re_super_fault_line(&sup),
 			       ". Safe state confirmed: motor power off "
 			       "(relay open), motors off. Recovery: "));
@@ -443,6 +447,76 @@ static void test_super_stall_in_round_trip(void **state)
 		assert_non_null(strstr(re_super_fault_line(&sup),
 				       " ms (limit 125 ms): the PC stalled"));
 		assert_int_equal(fk.n_relay_off, 1);
+	}
+}
+
+/*
+ * Another program: a handle that opens between two records is logged as a
+ * warning (no fault: it may only look) and shown in the status; a fault
+ * that follows names it, with the handles the program saw (fhnew) too.
+ */
+static void test_super_foreign_named(void **state)
+{
+	struct re_status st;
+
+	(void)state;
+	fk.rec.handles[0] = 2; /* ours */
+	assert_int_equal(run(2), RE_OK);
+	fk.rec.handles[2] = 2; /* C opens */
+	assert_int_equal(step(), RE_OK);
+	assert_int_equal(fk.n_relay_off, 0);
+	assert_int_equal(fk.n_logs, 1);
+	assert_int_equal(fk.log_level[0], RE_LOG_WARN);
+	assert_string_equal(fk.logs[0], "another program connected to the "
+					"controller (handle C)");
+	re_super_status(&sup, &st);
+	assert_int_equal(st.foreign, 4);
+	fk.rec.handles[2] = 0; /* C leaves; E came and went unseen */
+	fk.fhnew = 4 | 16;
+	assert_int_equal(step(), RE_OK);
+	assert_int_equal(fk.n_logs, 1);
+	fk.record_rc = GL_ERR_CLOSED;
+	assert_int_equal(step(), RE_FAULT);
+	assert_non_null(strstr(re_super_fault_line(&sup),
+			       ". Another program had connected to the "
+			       "controller (handle CE). "));
+}
+
+/*
+ * What the program latched after our stop is named as "Then:" only when it
+ * is not our doing: a motor found off with stop code 1 (at rest), 4 (ST)
+ * or 7 (AB) was switched off by our own "MO ABC" (it landed mid-pass);
+ * stop code 8 (the position error switched it off) is a consequence.
+ */
+static void test_super_consequences(void **state)
+{
+	static const struct {
+		const char *fdet;
+		int then;
+	} cases[] = {{" 1.0000", 0}, {" 4.0000", 0}, {" 7.0000", 0},
+		     {" 8.0000", 1}};
+
+	for (size_t k = 0; k < sizeof(cases) / sizeof(cases[0]); k++) {
+		const char *line;
+
+		setup(state);
+		assert_int_equal(run(2), RE_OK);
+		fk.fcode_val = 10;
+		fk.faxis = 1;
+		snprintf(fk.mg_fdet, sizeof(fk.mg_fdet), "%s", cases[k].fdet);
+		fk.record_rc = GL_ERR_CLOSED;
+		assert_int_equal(step(), RE_FAULT);
+		line = re_super_fault_line(&sup);
+		assert_true(!strncmp(line, "FAULT COMM: ", 12));
+		if (cases[k].then)
+			assert_non_null(strstr(line, ". Then: axis A: the "
+						     "controller "
+						     "found the motor off "
+						     "while armed: position "
+						     "error above the limit "
+						     "(stop code 8)."));
+		else
+			assert_null(strstr(line, "Then:"));
 	}
 }
 
@@ -525,7 +599,7 @@ static void test_super_settle_program_verdict(void **state)
 				    "cmd:MG faxis,cmd:MG fdet,cmd:pcflt=1,"
 				    "relay_off_finish,"
 				    "cmd:MG _MOA,cmd:MG _MOB,cmd:MG _MOC,"
-				    "log:FAULT");
+				    "cmd:MG fhnew,log:FAULT");
 	assert_int_equal(sup.fault.id, RE_F_CTRL_INPUT);
 	assert_int_equal(sup.fault.i[0], 1);
 	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT INPUT: ", 13));
@@ -547,8 +621,9 @@ static void test_super_settle_timeout(void **state)
 	assert_int_equal(step(), RE_FAULT);
 	assert_int_equal(sup.fault.id, RE_F_MOTOR_OFF);
 	assert_true(fk.now - t >= 25 * MS && fk.now - t < 80 * MS);
-	assert_string_equal(fk.commands[fk.n_commands - 5], "pcflt=1");
-	assert_string_equal(fk.commands[fk.n_commands - 4], "MG _MOA");
+	assert_string_equal(fk.commands[fk.n_commands - 6], "pcflt=1");
+	assert_string_equal(fk.commands[fk.n_commands - 5], "MG _MOA");
+	assert_string_equal(fk.commands[fk.n_commands - 1], "MG fhnew");
 	assert_non_null(strstr(re_super_fault_line(&sup), "position error"));
 	assert_non_null(strstr(fault_log(), "no program fault within 25 ms"));
 }
@@ -733,6 +808,8 @@ int main(void)
 	    cmocka_unit_test_setup(test_super_watchdog_critical, setup),
 	    cmocka_unit_test_setup(test_super_stall_in_round_trip, setup),
 	    cmocka_unit_test_setup(test_super_comm_fault, setup),
+	    cmocka_unit_test_setup(test_super_foreign_named, setup),
+	    cmocka_unit_test_setup(test_super_consequences, setup),
 	    cmocka_unit_test_setup(test_super_relay_lost, setup),
 	    cmocka_unit_test_setup(test_super_controller_fault, setup),
 	    cmocka_unit_test_setup(test_super_motor_off, setup),
