@@ -847,11 +847,13 @@ static void test_relay_unplug(void **state)
 static void test_relay_writefail(void **state)
 {
 	/* The relay drops motor power without the PC's write failing: the
-	 * program sees every amplifier lose power (CTRL_POWER) unless the
-	 * relay read-back finds it first (ESTOP_LOST); the read-back failure
-	 * is logged either way (as the fault, or "while latched"). */
-	static const enum re_fault_id ids[4] = {RE_F_ESTOP_LOST,
-						RE_F_CTRL_POWER, RE_F_NONE};
+	 * program sees every amplifier lose power (CTRL_POWER; RELAY_POWER
+	 * when the relay's off in the reaction is not confirmed either)
+	 * unless the relay read-back finds it first (ESTOP_LOST); the
+	 * read-back failure is logged either way (as the fault, or "while
+	 * latched"). */
+	static const enum re_fault_id ids[4] = {
+	    RE_F_ESTOP_LOST, RE_F_CTRL_POWER, RE_F_RELAY_POWER, RE_F_NONE};
 
 	(void)state;
 	/* R + 2P: the next state query within P, its answer timeout R, the
