@@ -1539,6 +1539,386 @@ static void test_fault_in_centring(void **state)
 	check_fails("fault-anywhere, centring");
 }
 
+/* ---- link loss with the amplifier model off ----------------------------- */
+
+/* The first "axis X motor off" of every axis after @after: the latest
+ * time, and each source ("handle A", "thread 0 line 381"). */
+static double who_off(const struct sys_case *c, double after,
+		      char by[3][48])
+{
+	double last = -1;
+
+	for (int a = 0; a < 3; a++) {
+		char pref[32];
+		int i;
+
+		snprintf(pref, sizeof(pref), "axis %c motor off", 'A' + a);
+		i = sys_event_find(c, pref, after);
+		if (i < 0)
+			return -1;
+		source_of(c->ev[i].text, by[a], sizeof(by[a]));
+		if (c->ev[i].t_ms > last)
+			last = c->ev[i].t_ms;
+	}
+	return last;
+}
+
+/* Start armed with galil-sim's amplifiers blind to motor power
+ * (--no-amp-undervoltage) and axis A jogging. */
+static void start_jogging_blind(void)
+{
+	struct ph_opts o = {.calibration = "file", .no_amp_uv = 1};
+
+	if (ph_start(&cs, &o) < 0 || wait_ready(&cs, READY_MS) < 0 ||
+	    inject(&cs, "joy A fwd") < 0 ||
+	    sys_wait_moving(&cs, 'A', 300, 5000) < 0)
+		fail_msg("%s", cs.err);
+}
+
+struct link_case {
+	const char *name;
+	const char *req;
+	int transient;	    /* "link ok" at once: only the sockets died */
+	int by_supervisor;  /* the supervisor's new connection stops */
+	enum re_fault_id id;
+	double d_relay;	    /* the supervisor's deadline to relay off */
+};
+
+/*
+ * With the amplifier model off, cutting motor power is invisible to the
+ * controller: no amplifier fault switches the motors off; only a stop
+ * command (the supervisor's, over a new connection) or the controller's
+ * watchdog can. Every motor must be off within the watchdog's deadline
+ * after the link went (D_CTRL_MS) whoever does it; the relay opens.
+ */
+static void link_loss(const struct link_case *lc)
+{
+	char line[1024], logline[4096], by[3][48];
+	enum re_fault_id ids[2] = {lc->id, RE_F_NONE};
+	double t_link, t_relay, t_mo;
+	int status;
+
+	start_jogging_blind();
+	t_link = inject(&cs, lc->req);
+	if (t_link < 0 || (lc->transient && sys_ctl(&cs, "link ok") < 0) ||
+	    sys_wait_fault(&cs, FAULT_WAIT_MS, line, sizeof(line)) < 0 ||
+	    sys_wait_event(&cs, "relay off", t_link, 3000, &t_relay) < 0)
+		fail_msg("%s: %s", lc->name, cs.err);
+	t_mo = wait_motors_off(&cs, t_link, 3000);
+	if (t_mo < 0 || who_off(&cs, t_link, by) < 0)
+		fail_msg("%s: not every motor was switched off", lc->name);
+	print_message("[ MEASURE  ] %s, amplifier model off: relay off %.0f ms"
+		      " (deadline %.0f), motors off %.0f ms (deadline %d) by "
+		      "A: %s, B: %s, C: %s\n[ MEASURE  ]   %s\n",
+		      lc->name, t_relay - t_link, lc->d_relay, t_mo - t_link,
+		      D_CTRL_MS, by[0], by[1], by[2], line);
+	if (sys_log_find(&cs, " FAULT ", line, logline, sizeof(logline)) < 0)
+		fail_msg("%s: %s", lc->name, cs.err);
+	print_message("[ MEASURE  ]   log: ...%s\n",
+		      strstr(logline, " | relay off: ")
+			  ? strstr(logline, " | relay off: ")
+			  : logline);
+	check_fault_line(&cs, lc->name, line, -1, ids);
+	for (int a = 0; a < 3; a++)
+		if (strncmp(by[a], lc->by_supervisor ? "handle " : "thread 0",
+			    lc->by_supervisor ? 7 : 8))
+			add_fail("%s: motor %c switched off by '%s', expected "
+				 "%s",
+				 lc->name, 'A' + a, by[a],
+				 lc->by_supervisor
+				     ? "the supervisor's new connection"
+				     : "the controller's watchdog (thread 0)");
+	if (sys_event_find(&cs, "motor power lost (amplifiers report nothing",
+			   t_link) < 0)
+		add_fail("%s: no 'motor power lost' event: was the amplifier "
+			 "model off?",
+			 lc->name);
+	if (lc->by_supervisor) {
+		if (!strstr(line, "Safe state confirmed") ||
+		    !strstr(logline, "delivered over a new connection"))
+			add_fail("%s: the stop over a new connection is not "
+				 "confirmed: %s",
+				 lc->name, logline);
+	} else if (!strstr(line, "NOT CONFIRMED") ||
+		   !strstr(line, "stop command not delivered") ||
+		   !strstr(line, "PRESS THE HARDWARE E-STOP NOW") ||
+		   !strstr(logline, "over a new connection") ||
+		   !strstr(logline, "motors off: NOT confirmed")) {
+		add_fail("%s: the FAULT line or the log does not say that the "
+			 "stop was not delivered:\n    %s",
+			 lc->name, logline);
+	}
+	if (t_relay - t_link > lc->d_relay + SLACK_MS)
+		add_fail("%s: relay off after %.0f ms, deadline %.0f ms",
+			 lc->name, t_relay - t_link, lc->d_relay);
+	if (t_mo - t_link > D_CTRL_MS)
+		add_fail("%s: motors off after %.0f ms, deadline %d ms",
+			 lc->name, t_mo - t_link, D_CTRL_MS);
+	if (sys_check_safe(&cs, 0, HOLD_MS) < 0)
+		add_fail("%s: %s", lc->name, cs.err);
+	proc_signal(&cs.re, SIGTERM);
+	if (proc_wait_exit(&cs.re, EXIT_WAIT_MS, &status) < 0 ||
+	    proc_exit_code(&cs.re) != 4)
+		add_fail("%s: no exit 4 within %d ms of SIGTERM", lc->name,
+			 EXIT_WAIT_MS);
+}
+
+static void test_link_loss_amp_model_off(void **state)
+{
+	/* a drop that lasts: galil-sim closes every new connection until
+	 * "link ok", so only the controller's watchdog can stop */
+	const struct link_case cases[] = {
+	    {"link drop (sockets reset, link back at once)", "link drop", 1, 1,
+	     RE_F_COMM, 2 * P()},
+	    {"link drop (lasting)", "link drop", 0, 0, RE_F_COMM, 2 * P()},
+	    {"link stall", "link stall", 0, 0, RE_F_WDOG_REPLY, C() + P()},
+	};
+
+	(void)state;
+	need_env();
+	reset_fails();
+	for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
+		link_loss(&cases[i]);
+		sys_case_stop(&cs);
+	}
+	check_fails("link loss, amplifier model off");
+}
+
+/* ---- a wedged relay board ----------------------------------------------- */
+
+/* The relay board hangs with the relay on (motor power stays on whatever
+ * roboelf writes), then @fault_req (or nothing: the read-back finds the
+ * board silent). The controller stop meets the fault's deadline, the FAULT
+ * line says the relay open was not confirmed and asks for the hardware
+ * E-stop, and roboelf still exits on SIGTERM at once with 4. */
+static void wedged(const char *name, const char *fault_req,
+		   enum re_fault_id id, int axis, double d_motors)
+{
+	enum re_fault_id ids[2] = {id, RE_F_NONE};
+	struct ph_opts o = {.calibration = "file"};
+	double t_w = -1, t_f, t_mo;
+	long long q0;
+	char line[1024], st[2048];
+	int status;
+
+	if (ph_start(&cs, &o) < 0 || wait_ready(&cs, READY_MS) < 0 ||
+	    (t_w = inject(&cs, "relayfault wedge")) < 0)
+		fail_msg("%s: %s", name, cs.err);
+	t_f = fault_req ? inject(&cs, fault_req) : t_w;
+	if (t_f < 0 || sys_wait_fault(&cs, FAULT_WAIT_MS, line, sizeof(line)) <
+			   0)
+		fail_msg("%s: %s", name, cs.err);
+	t_mo = wait_motors_off(&cs, t_f, 3000);
+	if (t_mo < 0)
+		fail_msg("%s: not every motor was switched off", name);
+	if (sys_state(&cs, st, sizeof(st)) < 0)
+		fail_msg("%s", cs.err);
+	print_message("[ MEASURE  ] %s: motors off %.0f ms after the %s "
+		      "(deadline %.0f); relay %s, power %s\n[ MEASURE  ]   "
+		      "%s\n",
+		      name, t_mo - t_f, fault_req ? "fault" : "wedge", d_motors,
+		      strstr(st, " relay=on ") ? "on" : "off",
+		      strstr(st, " power=1 ") ? "on" : "off", line);
+	check_fault_line(&cs, name, line, axis, ids);
+	if (!strstr(line, "NOT CONFIRMED: relay open not confirmed;") ||
+	    !strstr(line, "PRESS THE HARDWARE E-STOP NOW"))
+		add_fail("%s: the FAULT line does not say that the relay did "
+			 "not open: %s",
+			 name, line);
+	if (t_mo - t_f > d_motors + SLACK_MS)
+		add_fail("%s: motors off after %.0f ms, deadline %.0f ms", name,
+			 t_mo - t_f, d_motors);
+	/* the wedged board keeps motor power on: the motors are off */
+	if (sys_check_safe(&cs, 1, HOLD_MS) < 0)
+		add_fail("%s: %s", name, cs.err);
+	q0 = proc_now_ms();
+	proc_signal(&cs.re, SIGTERM);
+	if (proc_wait_exit(&cs.re, EXIT_WAIT_MS, &status) < 0) {
+		add_fail("%s: roboelf hangs: no exit within %d ms of SIGTERM",
+			 name, EXIT_WAIT_MS);
+		return;
+	}
+	line[0] = '\0';
+	proc_find_line(&cs.re, PROC_STDOUT, "roboelf: motors off", line,
+		       sizeof(line));
+	print_message("[ MEASURE  ] %s: exit %d %lld ms after SIGTERM: %s\n",
+		      name, proc_exit_code(&cs.re), proc_now_ms() - q0, line);
+	if (proc_exit_code(&cs.re) != 4)
+		add_fail("%s: exit %d, not 4", name, proc_exit_code(&cs.re));
+	if (!strstr(proc_output(&cs.re, PROC_STDOUT),
+		    "NOT ALL CONFIRMED: press the hardware E-stop"))
+		add_fail("%s: the quit message does not ask for the hardware "
+			 "E-stop",
+			 name);
+}
+
+static void test_wedged_relay(void **state)
+{
+	(void)state;
+	need_env();
+	reset_fails();
+	/* a fault while the board is wedged (before its read-back times
+	 * out): the encoder/pot deadline of test_sys_faults */
+	wedged("wedged relay, then pot offset", "pot A offset 0.5", RE_F_ENCPOT,
+	       0, d_encpot() + SYS_MAINMS);
+	sys_case_stop(&cs);
+	/* the wedge alone: the read-back finds the board silent after R,
+	 * the cycle after it acts (R + 3P, as relay writefail), plus mainms */
+	wedged("wedged relay alone", NULL, RE_F_ESTOP_LOST, -1,
+	       READBACK_MS + 3 * P() + SYS_MAINMS);
+	sys_case_stop(&cs);
+	check_fails("wedged relay");
+}
+
+/* ---- signals ------------------------------------------------------------ */
+
+static void quit_by(int sig, const char *logged)
+{
+	struct ph_opts o = {.calibration = "file"};
+	const char *ok = "roboelf: motors off: confirmed; motor power off "
+			 "(relay): confirmed; bye";
+	double t_sig = -1, t_relay, t_mo;
+	char by[3][48], st[2048];
+	int status;
+
+	if (ph_start(&cs, &o) < 0 || wait_ready(&cs, READY_MS) < 0 ||
+	    inject(&cs, "joy B rev") < 0 ||
+	    sys_wait_moving(&cs, 'B', 300, 5000) < 0 ||
+	    (t_sig = signal_at(&cs, sig, NULL)) < 0)
+		fail_msg("%s: %s", logged, cs.err);
+	if (proc_wait_exit(&cs.re, EXIT_WAIT_MS, &status) < 0)
+		fail_msg("%s: no exit within %d ms", logged, EXIT_WAIT_MS);
+	if (sys_wait_event(&cs, "relay off", t_sig, 2000, &t_relay) < 0)
+		fail_msg("%s: %s", logged, cs.err);
+	t_mo = wait_motors_off(&cs, t_sig, 2000);
+	if (t_mo < 0 || who_off(&cs, t_sig, by) < 0)
+		fail_msg("%s: not every motor was switched off", logged);
+	print_message("[ MEASURE  ] %s while jogging: exit %d, motors off %.0f"
+		      " ms (by %s), relay off %.0f ms after the signal\n",
+		      logged, proc_exit_code(&cs.re), t_mo - t_sig, by[0],
+		      t_relay - t_sig);
+	assert_int_equal(proc_exit_code(&cs.re), 0);
+	if (proc_find_line(&cs.re, PROC_STDOUT, ok, NULL, 0) < 0)
+		fail_msg("%s: no '%s' in:\n%s", logged, ok,
+			 tail(&cs.re, PROC_STDOUT, 600));
+	if (proc_find_line(&cs.re, PROC_STDOUT, "FAULT ", NULL, 0) == 0)
+		fail_msg("%s: a FAULT line on quit", logged);
+	/* the motors off on the supervisor's request (offreq: the program's
+	 * #OFF, or its own AB 1;MO ABC) before the relay opens - not by the
+	 * amplifier fault the power cut would cause - and no program fault */
+	for (int a = 0; a < 3; a++)
+		if (strncmp(by[a], "handle ", 7) && strncmp(by[a], "thread 0 ", 9))
+			fail_msg("%s: motor %c off by '%s', not on the "
+				 "supervisor's request",
+				 logged, 'A' + a, by[a]);
+	if (t_mo > t_relay)
+		fail_msg("%s: the relay opened before the motors were off",
+			 logged);
+	if (sys_check_safe(&cs, 0, HOLD_MS) < 0 ||
+	    sys_state(&cs, st, sizeof(st)) < 0 ||
+	    sys_log_find(&cs, "INFO stop: ", logged, NULL, 0) < 0)
+		fail_msg("%s: %s", logged, cs.err);
+	if (sys_state_num(st, "var.state") != 0 ||
+	    sys_state_num(st, "var.fcode") != 0)
+		fail_msg("%s: the program is not back in its safe state "
+			 "without a fault: %s",
+			 logged, st);
+	sys_case_stop(&cs);
+}
+
+static void test_signals_quit(void **state)
+{
+	(void)state;
+	need_env();
+	quit_by(SIGQUIT, "Ctrl-\\ (SIGQUIT)");
+	quit_by(SIGHUP, "SIGHUP (terminal lost)");
+	quit_by(SIGTERM, "SIGTERM");
+}
+
+/* Ctrl-Z is ignored: roboelf keeps writing its heartbeat every cycle (hbpc
+ * advances in every 100 ms window for 1 s), nothing trips, still armed. */
+static void test_signal_tstp_ignored(void **state)
+{
+	struct ph_opts o = {.calibration = "file"};
+	double hb0 = NAN, t0 = -1;
+	char st[2048];
+	int status;
+
+	(void)state;
+	need_env();
+	if (ph_start(&cs, &o) < 0 || wait_ready(&cs, READY_MS) < 0 ||
+	    (t0 = signal_at(&cs, SIGTSTP, NULL)) < 0)
+		fail_msg("%s", cs.err);
+	for (int k = 0; k <= 10; k++) {
+		double hb;
+
+		if (wait_sim_fine(&cs, t0 + k * 100.0, 2000) < 0 ||
+		    sys_state(&cs, st, sizeof(st)) < 0)
+			fail_msg("%s", cs.err);
+		hb = sys_state_num(st, "var.hbpc");
+		if (k > 0 && !(hb != hb0))
+			fail_msg("SIGTSTP: hbpc did not advance from %.0f "
+				 "within 100 ms (%d00 ms after): %s",
+				 hb0, k, st);
+		if (sys_state_num(st, "var.state") != 1)
+			fail_msg("SIGTSTP: the program left the armed state: "
+				 "%s",
+				 st);
+		hb0 = hb;
+	}
+	proc_pump(&cs.re, 0);
+	if (proc_find_line(&cs.re, PROC_STDOUT, "FAULT ", NULL, 0) == 0)
+		fail_msg("SIGTSTP: a FAULT line: %s",
+			 tail(&cs.re, PROC_STDOUT, 600));
+	print_message("[ MEASURE  ] SIGTSTP ignored: hbpc advanced in every "
+		      "100 ms over 1 s, still armed\n");
+	proc_signal(&cs.re, SIGTERM);
+	if (proc_wait_exit(&cs.re, EXIT_WAIT_MS, &status) < 0)
+		fail_msg("no exit within %d ms of SIGTERM", EXIT_WAIT_MS);
+	assert_int_equal(proc_exit_code(&cs.re), 0);
+}
+
+/* ---- centring, then armed ----------------------------------------------- */
+
+/*
+ * A calibration from the file with the robot off-centre: the move to the
+ * centre is the program's own service move; arming right after it must
+ * not be taken for motion nobody commanded. Whether it is depends on the
+ * order of two things within one mainms (the program releasing the axis
+ * in #MVSUP, roboelf's off request after it saw the move end), so the
+ * scenario runs CENTRING_RUNS times; each must arm and stay armed.
+ */
+#define CENTRING_RUNS 4
+
+static void test_centring_then_armed(void **state)
+{
+	struct ph_opts o = {.calibration = "file", .off_centre = 1};
+	int status;
+
+	(void)state;
+	need_env();
+	for (int k = 0; k < CENTRING_RUNS; k++) {
+		double t = -1;
+
+		if (ph_start(&cs, &o) < 0 || wait_ready(&cs, READY_MS) < 0 ||
+		    (t = sys_sim_time(&cs)) < 0 ||
+		    wait_sim_fine(&cs, t + 500, 3000) < 0)
+			fail_msg("run %d: %s", k + 1, cs.err);
+		proc_pump(&cs.re, 0);
+		if (proc_find_line(&cs.re, PROC_STDOUT, "FAULT ", NULL, 0) == 0)
+			fail_msg("run %d: armed after centring from (%.0f, "
+				 "%.0f, %.0f): %s",
+				 k + 1, off_centre[0], off_centre[1],
+				 off_centre[2], tail(&cs.re, PROC_STDOUT, 900));
+		proc_signal(&cs.re, SIGTERM);
+		if (proc_wait_exit(&cs.re, EXIT_WAIT_MS, &status) < 0)
+			fail_msg("no exit within %d ms of SIGTERM",
+				 EXIT_WAIT_MS);
+		assert_int_equal(proc_exit_code(&cs.re), 0);
+		sys_case_stop(&cs);
+	}
+}
+
 #define T(f) cmocka_unit_test_teardown(f, case_teardown)
 
 int main(void)
@@ -1549,6 +1929,11 @@ int main(void)
 	    T(test_freeze_anywhere),
 	    T(test_fault_in_calibration),
 	    T(test_fault_in_centring),
+	    T(test_link_loss_amp_model_off),
+	    T(test_wedged_relay),
+	    T(test_signals_quit),
+	    T(test_signal_tstp_ignored),
+	    T(test_centring_then_armed),
 	};
 	const char *filter = getenv("ROBOELF_SYS_FILTER");
 
