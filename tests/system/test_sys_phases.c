@@ -142,8 +142,10 @@ static void reset_fails(void)
 
 static void check_fails(const char *what)
 {
-	if (nfails)
-		fail_msg("%s: %zu failure(s):%s", what, nfails, fails);
+	if (!nfails)
+		return;
+	print_message("[  FAILS   ] %s:%s\n", what, fails);
+	fail_msg("%s: %zu failure(s), listed above", what, nfails);
 }
 
 /* ---- configuration, plant, rig ------------------------------------------ */
@@ -414,7 +416,8 @@ static int ph_start(struct sys_case *c, const struct ph_opts *o)
 	if (galil_load(c) < 0 ||
 	    (o->off_centre && preposition(c, o->power_output) < 0) ||
 	    sys_ctl(c, "watch state") < 0 || sys_ctl(c, "watch fcode") < 0 ||
-	    sys_ctl(c, "watch hbpc") < 0 || sys_events(c) < 0)
+	    sys_ctl(c, "watch hbpc") < 0 || sys_ctl(c, "watch armreq") < 0 ||
+	    sys_events(c) < 0)
 		return -1;
 	return start_roboelf(c, o->calibration);
 }
@@ -436,8 +439,16 @@ static int wait_ready(struct sys_case *c, int timeout_ms)
 		    c->re.out[PROC_STDOUT].fd < 0 || proc_now_ms() > deadline)
 			break;
 	}
-	seterr(c, "no 'RoboELF Ready for Use' within %d ms\n--- stdout:\n%s",
-	       timeout_ms, tail(&c->re, PROC_STDOUT, 1500));
+	{
+		char fault[1024] = "";
+
+		proc_find_line(&c->re, PROC_STDOUT, "FAULT ", fault,
+			       sizeof(fault));
+		seterr(c, "no 'RoboELF Ready for Use' within %d ms%s%s\n--- "
+			  "stdout:\n%s",
+		       timeout_ms, fault[0] ? ": " : "", fault,
+		       tail(&c->re, PROC_STDOUT, 500));
+	}
 	return -1;
 }
 
@@ -615,7 +626,8 @@ enum phase {
 	PH_SVCREQ,  /* the service state requested, not yet entered */
 	PH_CALIB,   /* full calibration (service state) */
 	PH_CENTRE,  /* calibration from the file: check and centring */
-	PH_ARMING,  /* back to safe after the service state, arm requested */
+	PH_OFF,	    /* back to safe after the service state */
+	PH_ARMREQ,  /* the armed state requested, not yet entered */
 	PH_ARMED,   /* armed, at rest */
 	PH_JOG,	    /* armed, axis A jogging */
 	PH_LATCHED, /* a fault latched */
@@ -624,8 +636,9 @@ enum phase {
 
 static const char *const ph_name[PH_COUNT] = {
     "start-up, relay open",  "start-up, relay closed", "service requested",
-    "full calibration",	     "centring (file)",	       "arming",
-    "armed at rest",	     "armed jogging",	       "latched",
+    "full calibration",	     "centring (file)",	       "back to safe",
+    "arm requested",	     "armed at rest",	       "armed jogging",
+    "latched",
 };
 
 /* One instant: a phase and where in it. @line: for PH_BOOT, the progress
@@ -704,10 +717,14 @@ static int reach(struct sys_case *c, const struct instant *in,
 			return -1;
 		*anchor = t;
 		return wait_sim_fine(c, t + in->at_ms, READY_MS);
-	case PH_ARMING:
-		return poll_var(c, "var.state", 3, 0, READY_MS) < 0 ||
-			       poll_var(c, "var.state", 0, 0, 2000) < 0
-			   ? -1
+	case PH_OFF:
+	case PH_ARMREQ:
+		if (poll_var(c, "var.state", 3, 0, READY_MS) < 0 ||
+		    poll_var(c, "var.state", 0, 0, 2000) < 0)
+			return -1;
+		/* the program takes armreq (back to 0) within mainms */
+		return in->ph == PH_ARMREQ
+			   ? poll_var(c, "var.armreq", 1, 0, 2000)
 			   : 0;
 	case PH_ARMED:
 	case PH_JOG:
@@ -755,7 +772,8 @@ static enum phase actual_phase(const struct sys_case *c, enum phase intent,
 	if (thr >= 0 && c->ev[thr].t_ms <= t_sig)
 		return intent == PH_JOG ? PH_JOG : PH_ARMED;
 	if (off >= 0 && c->ev[off].t_ms <= t_sig)
-		return PH_ARMING;
+		/* whether armreq was written: seen by reach() */
+		return intent == PH_ARMREQ ? PH_ARMREQ : PH_OFF;
 	return intent == PH_CENTRE ? PH_CENTRE : PH_CALIB;
 }
 
@@ -1031,8 +1049,10 @@ static size_t kill_plan(struct instant *plan, size_t cap, int full)
 	for (int k = 0; k < ncen && n < cap; k++)
 		plan[n++] = (struct instant){PH_CENTRE, NULL,
 					     ref.d_centre * (k + 0.5) / ncen};
-	if (n < cap)
-		plan[n++] = (struct instant){PH_ARMING, NULL, 0};
+	if (n + 1 < cap) {
+		plan[n++] = (struct instant){PH_OFF, NULL, 0};
+		plan[n++] = (struct instant){PH_ARMREQ, NULL, 0};
+	}
 	for (int k = 0; k < narm && n < cap; k++)
 		plan[n++] = (struct instant){PH_ARMED, NULL,
 					     100.0 + k * PERIOD_MS / narm};
@@ -1148,8 +1168,12 @@ static void freeze_one(const struct instant *in)
 				 what, line, first);
 	} else if (sys_wait_fault(&cs, 3000, line, sizeof(line)) < 0) {
 		add_fail("%s: no FAULT line within 3 s of SIGCONT; roboelf "
-			 "went on:\n%s",
-			 what, tail(&cs.re, PROC_STDOUT, 700));
+			 "went on%s",
+			 what,
+			 proc_find_line(&cs.re, PROC_STDOUT,
+					"RoboELF Ready for Use", NULL, 0) == 0
+			     ? " to 'RoboELF Ready for Use' and stayed armed"
+			     : "");
 	} else {
 		print_message("[ MEASURE  ] freeze in %s: after SIGCONT: %.160s"
 			      "...\n",
@@ -1172,8 +1196,10 @@ static void test_freeze_anywhere(void **state)
 {
 	const struct instant plan[] = {
 	    {PH_RELAY, NULL, 0},
+	    {PH_SVCREQ, NULL, 0},
 	    {PH_CALIB, NULL, ref.d_cal / 2},
 	    {PH_CENTRE, NULL, ref.d_centre / 2},
+	    {PH_ARMREQ, NULL, 0},
 	    {PH_ARMED, NULL, 100},
 	    {PH_JOG, NULL, 450},
 	    {PH_LATCHED, NULL, 100},
@@ -1599,8 +1625,19 @@ static void link_loss(const struct link_case *lc)
 	int status;
 
 	start_jogging_blind();
-	t_link = inject(&cs, lc->req);
-	if (t_link < 0 || (lc->transient && sys_ctl(&cs, "link ok") < 0) ||
+	if (lc->transient) {
+		/* both requests back to back (well under a millisecond) */
+		double t0 = sys_sim_time(&cs), t;
+
+		t_link = -1;
+		if (t0 >= 0 && sys_ctl(&cs, "%s", lc->req) == 0 &&
+		    sys_ctl(&cs, "link ok") == 0 &&
+		    sys_wait_event(&cs, "inject: link drop", t0, 2000, &t) == 0)
+			t_link = t;
+	} else {
+		t_link = inject(&cs, lc->req);
+	}
+	if (t_link < 0 ||
 	    sys_wait_fault(&cs, FAULT_WAIT_MS, line, sizeof(line)) < 0 ||
 	    sys_wait_event(&cs, "relay off", t_link, 3000, &t_relay) < 0)
 		fail_msg("%s: %s", lc->name, cs.err);
