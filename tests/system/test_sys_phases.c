@@ -81,8 +81,14 @@
  */
 #define D_CTRL_MS (WDTO_MS + SYS_MAINMS + SAMPLE_MS)
 
-#define SLACK_MS      25   /* scheduling allowance, as test_sys_faults */
-#define HOLD_MS	      200  /* no motion over this after the safe state */
+/* The program opens the power output (OP 0) in the same pass as MO ABC;
+ * galil-sim's plant reads the output at its next servo sample (the event
+ * "power output N cleared" is "seen at the next servo sample",
+ * docs/galil-sim.md): motor power is gone one sample after the motors. */
+#define D_POWER_MS (D_CTRL_MS + SAMPLE_MS)
+
+#define SLACK_MS      25  /* scheduling allowance, as test_sys_faults */
+#define HOLD_MS	      200 /* no motion over this after the safe state */
 #define START_MS      10000
 #define READY_MS      30000 /* --calibration file to Ready */
 #define CAL_READY_MS  90000 /* --calibration full to Ready */
@@ -115,7 +121,8 @@ static struct {
 static char fails[16384];
 static size_t nfails;
 
-static void add_fail(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static void add_fail(const char *fmt, ...)
+    __attribute__((format(printf, 1, 2)));
 
 static void add_fail(const char *fmt, ...)
 {
@@ -142,9 +149,18 @@ static void reset_fails(void)
 
 static void check_fails(const char *what)
 {
+	const char *p = fails;
+
 	if (!nfails)
 		return;
-	print_message("[  FAILS   ] %s:%s\n", what, fails);
+	/* line by line: cmocka's message buffers are short */
+	while (*p) {
+		size_t n = strcspn(p + 1, "\n") + 1;
+
+		print_message("[  FAILS   ] %s:%.*s\n", what, (int)n - 1,
+			      p + 1);
+		p += n;
+	}
 	fail_msg("%s: %zu failure(s), listed above", what, nfails);
 }
 
@@ -350,10 +366,18 @@ out:
 static int start_roboelf(struct sys_case *c, const char *calibration)
 {
 	char bin[SYS_PATH_MAX + 16], addr[32];
-	char *argv[] = {bin,	    (char *)"-c",	     c->cfg,
-			(char *)"--galil", addr,	     (char *)"--relay",
-			c->relay_link,	   (char *)"--calibration",
-			(char *)calibration, (char *)"--log", c->log, NULL};
+	char *argv[] = {bin,
+			(char *)"-c",
+			c->cfg,
+			(char *)"--galil",
+			addr,
+			(char *)"--relay",
+			c->relay_link,
+			(char *)"--calibration",
+			(char *)calibration,
+			(char *)"--log",
+			c->log,
+			NULL};
 
 	snprintf(bin, sizeof(bin), "%s/roboelf", env.bin);
 	snprintf(addr, sizeof(addr), "127.0.0.1:%d", c->sim.port);
@@ -444,8 +468,9 @@ static int wait_ready(struct sys_case *c, int timeout_ms)
 
 		proc_find_line(&c->re, PROC_STDOUT, "FAULT ", fault,
 			       sizeof(fault));
-		seterr(c, "no 'RoboELF Ready for Use' within %d ms%s%s\n--- "
-			  "stdout:\n%s",
+		seterr(c,
+		       "no 'RoboELF Ready for Use' within %d ms%s%s\n--- "
+		       "stdout:\n%s",
 		       timeout_ms, fault[0] ? ": " : "", fault,
 		       tail(&c->re, PROC_STDOUT, 500));
 	}
@@ -529,7 +554,8 @@ static int centring_time(void)
 	char err[512];
 	double d = 0;
 
-	if (!set || re_calfile_load(env.cal, NULL, set, err, sizeof(err)) != 0) {
+	if (!set ||
+	    re_calfile_load(env.cal, NULL, set, err, sizeof(err)) != 0) {
 		free(set);
 		return -1;
 	}
@@ -635,10 +661,11 @@ enum phase {
 };
 
 static const char *const ph_name[PH_COUNT] = {
-    "start-up, relay open",  "start-up, relay closed", "service requested",
-    "full calibration",	     "centring (file)",	       "back to safe",
-    "arm requested",	     "armed at rest",	       "armed jogging",
-    "latched",
+    "start-up, relay open", "start-up, relay closed",
+    "service requested",    "full calibration",
+    "centring (file)",	    "back to safe",
+    "arm requested",	    "armed at rest",
+    "armed jogging",	    "latched",
 };
 
 /* One instant: a phase and where in it. @line: for PH_BOOT, the progress
@@ -651,6 +678,7 @@ struct instant {
 };
 
 #define L_POWER_ON "roboelf: motor power on (relay closed)"
+#define L_ARMING   "roboelf: soft limits from the calibration; arming"
 #define SVC_ON	   "axis A motor on: SH (thread 0"
 
 static int wait_line(struct sys_case *c, const char *prefix, int timeout_ms)
@@ -663,8 +691,9 @@ static int wait_line(struct sys_case *c, const char *prefix, int timeout_ms)
 	return -1;
 }
 
-/* Poll the state line as fast as it answers until the watched variable
- * @var satisfies @want (1: non-zero ... see callers), at most @timeout_ms. */
+/* Poll the state line as fast as it answers (a window of start-up is a few
+ * ms wide) until the watched @var equals @value, or with @nonzero is not
+ * 0, at most @timeout_ms. */
 static int poll_var(struct sys_case *c, const char *var, double value,
 		    int nonzero, int timeout_ms)
 {
@@ -688,10 +717,45 @@ static int poll_var(struct sys_case *c, const char *var, double value,
 	}
 }
 
+/*
+ * The arm request sent, the armed state not entered: roboelf writes
+ * "hbpc=<n>;armreq=1" after L_ARMING (and the soft-limit writes behind
+ * it); the program takes armreq back to 0 within mainms and arms some
+ * 30 ms later (#PCHK). So: armreq seen at 1, or hbpc changed since the
+ * line, while the state is still 0.
+ */
+static int poll_arm_request(struct sys_case *c, int timeout_ms)
+{
+	long long deadline = proc_now_ms() + timeout_ms;
+	double hb0 = NAN;
+	char st[2048];
+
+	for (;;) {
+		double hb;
+
+		if (sys_state(c, st, sizeof(st)) < 0)
+			return -1;
+		hb = sys_state_num(st, "var.hbpc");
+		if (sys_state_num(st, "var.state") != 0) {
+			seterr(c, "the arm request was missed: %s", st);
+			return -1;
+		}
+		if (sys_state_num(st, "var.armreq") == 1 ||
+		    (!isnan(hb0) && hb != hb0))
+			return 0;
+		hb0 = isnan(hb0) ? hb : hb0;
+		if (proc_now_ms() > deadline) {
+			seterr(c, "no arm request within %d ms: %s", timeout_ms,
+			       st);
+			return -1;
+		}
+	}
+}
+
 /* Drive a fresh case to the instant @in. @anchor: [out] the simulated time
  * of the phase's anchor (-1 where none). Return: 0 or -1 (c->err). */
-static int reach(struct sys_case *c, const struct instant *in,
-		 int power_output, double *anchor)
+static int reach(struct sys_case *c, const struct instant *in, int power_output,
+		 double *anchor)
 {
 	struct ph_opts o = {.calibration = in->ph == PH_CALIB ? "full" : "file",
 			    .power_output = power_output,
@@ -718,13 +782,15 @@ static int reach(struct sys_case *c, const struct instant *in,
 		*anchor = t;
 		return wait_sim_fine(c, t + in->at_ms, READY_MS);
 	case PH_OFF:
+		return poll_var(c, "var.state", 3, 0, READY_MS) < 0 ||
+			       poll_var(c, "var.state", 0, 0, 2000) < 0
+			   ? -1
+			   : 0;
 	case PH_ARMREQ:
-		if (poll_var(c, "var.state", 3, 0, READY_MS) < 0 ||
-		    poll_var(c, "var.state", 0, 0, 2000) < 0)
-			return -1;
-		/* the program takes armreq (back to 0) within mainms */
-		return in->ph == PH_ARMREQ
-			   ? poll_var(c, "var.armreq", 1, 0, 2000)
+		return poll_var(c, "var.state", 3, 0, READY_MS) < 0 ||
+			       wait_line(c, L_ARMING, 2000) < 0 ||
+			       poll_arm_request(c, 2000) < 0
+			   ? -1
 			   : 0;
 	case PH_ARMED:
 	case PH_JOG:
@@ -780,13 +846,14 @@ static enum phase actual_phase(const struct sys_case *c, enum phase intent,
 /* ---- after a kill or a freeze: who switched the motors off, when -------- */
 
 struct off_result {
-	int on_at_sig;	/* some motor was on at the signal */
-	int on_after;	/* some motor was switched on after it */
-	double off_ms;	/* last motor off after the signal, ms; -1 none */
-	char by[64];	/* who switched that one off: "(thread 0 line 381)" */
-	double pout_ms; /* "power output N cleared" after the signal; -1 */
-	double fcode;	/* the program's latched fault at the end */
-	char st[2048];	/* the state line at the end */
+	int on_at_sig;	 /* some motor was on at the signal */
+	int on_after;	 /* some motor was switched on after it */
+	double off_ms;	 /* last motor off after the signal, ms; -1 none */
+	char by[64];	 /* who switched that one off: "(thread 0 line 381)" */
+	double pout_ms;	 /* "power output N cleared" after the signal; -1 */
+	double fcode;	 /* the program's latched fault at the end */
+	char st_d[2048]; /* the state line at D_POWER_MS (a few ms after) */
+	char st[2048];	 /* the state line at the end */
 };
 
 /* "... (thread 0 line 381)" -> "thread 0 line 381" */
@@ -828,8 +895,8 @@ static int axis_walk(const struct sys_case *c, int a, double t_sig,
 			}
 			on = 0;
 		}
-		if (e->t_ms <= t_sig && (i + 1 == c->nev ||
-					 c->ev[i + 1].t_ms > t_sig))
+		if (e->t_ms <= t_sig &&
+		    (i + 1 == c->nev || c->ev[i + 1].t_ms > t_sig))
 			r->on_at_sig |= on;
 	}
 	return on;
@@ -849,7 +916,9 @@ static int analyse_off(struct sys_case *c, double t_sig, int power_output,
 
 	memset(r, 0, sizeof(*r));
 	r->off_ms = r->pout_ms = -1;
-	if (wait_sim_fine(c, t_sig + D_CTRL_MS + 100, 5000) < 0 ||
+	if (wait_sim_fine(c, t_sig + D_POWER_MS, 5000) < 0 ||
+	    sys_state(c, r->st_d, sizeof(r->st_d)) < 0 ||
+	    wait_sim_fine(c, t_sig + D_CTRL_MS + 100, 5000) < 0 ||
 	    sys_events(c) < 0 || sys_state(c, r->st, sizeof(r->st)) < 0)
 		return -1;
 	if (sys_event_find(c, "events lost", 0) >= 0) {
@@ -861,8 +930,9 @@ static int analyse_off(struct sys_case *c, double t_sig, int power_output,
 		char by[64] = "";
 
 		if (axis_walk(c, a, t_sig, r, &t_off, by, sizeof(by))) {
-			seterr(c, "motor %c is still on %d ms after the "
-				  "signal: %s",
+			seterr(c,
+			       "motor %c is still on %d ms after the "
+			       "signal: %s",
 			       'A' + a, D_CTRL_MS + 100, r->st);
 			return -1;
 		}
@@ -879,13 +949,34 @@ static int analyse_off(struct sys_case *c, double t_sig, int power_output,
 	return 0;
 }
 
+/* No axis moved (true position X.act) from the state line @st0 to now. */
+static int still_since(struct sys_case *c, const char *st0)
+{
+	char st1[2048];
+
+	if (sys_state(c, st1, sizeof(st1)) < 0)
+		return -1;
+	for (int a = 0; a < 3; a++) {
+		char key[8];
+
+		snprintf(key, sizeof(key), "%c.act", 'A' + a);
+		if (sys_state_num(st0, key) != sys_state_num(st1, key)) {
+			seterr(c, "axis %c moved after the deadline:\n%s\n%s",
+			       'A' + a, st0, st1);
+			return -1;
+		}
+	}
+	return 0;
+}
+
 /*
  * The assertions after a kill or during a freeze (@what names it in the
  * messages): every motor that was on at the signal, or went on after it,
  * off within D_CTRL_MS, by the controller program (nobody else is left),
  * which latched WATCHDOG (2); with the power output wired, the output
- * cleared within the same deadline and motor power gone; then the robot
- * at rest (sys_check_safe; the relay may stay on: nobody opens it).
+ * cleared within the same deadline and motor power gone by then; then
+ * every motor off and no axis moving from the deadline to the end of a
+ * hold (sys_check_safe; the relay may stay on: nobody is left to open it).
  * Failures go to add_fail(). Return: 0 when all hold.
  */
 static int check_off(struct sys_case *c, const char *what, enum phase ph,
@@ -913,17 +1004,20 @@ static int check_off(struct sys_case *c, const char *what, enum phase ph,
 			add_fail("%s: the program latched fault %.0f, not "
 				 "WATCHDOG (2): %s",
 				 what, r->fcode, r->st);
-		if (power_output && (r->pout_ms < 0 || r->pout_ms > D_CTRL_MS))
+		if (power_output && (r->pout_ms < 0 || r->pout_ms > D_POWER_MS))
 			add_fail("%s: power output %d cleared %.0f ms after "
 				 "the signal (-1: never), deadline %d ms",
-				 what, power_output, r->pout_ms, D_CTRL_MS);
+				 what, power_output, r->pout_ms, D_POWER_MS);
 	} else if (r->on_after) {
 		add_fail("%s: a motor was switched on after the signal", what);
 	}
-	if (power_output && !strstr(r->st, " power=0 "))
-		add_fail("%s: motor power not cut (output %d wired): %s", what,
-			 power_output, r->st);
+	if (power_output && !strstr(r->st_d, " power=0 "))
+		add_fail("%s: motor power not cut at the deadline (output %d "
+			 "wired): %s",
+			 what, power_output, r->st_d);
 	if (sys_check_safe(c, 1, HOLD_MS) < 0)
+		add_fail("%s: %s", what, c->err);
+	else if (still_since(c, r->st_d) < 0)
 		add_fail("%s: %s", what, c->err);
 	return nfails == before ? 0 : -1;
 }
@@ -933,6 +1027,7 @@ static int check_off(struct sys_case *c, const char *what, enum phase ph,
 struct phase_stats {
 	int kills, off_before; /* off_before: the motors were off already */
 	double worst_ms;       /* worst time to motors off, -1 none */
+	double worst_pout_ms;  /* worst time to the power output cut, -1 */
 };
 
 static void stats_add(struct phase_stats *s, const struct off_result *r)
@@ -942,15 +1037,19 @@ static void stats_add(struct phase_stats *s, const struct off_result *r)
 		s->off_before++;
 	else if (r->off_ms > s->worst_ms)
 		s->worst_ms = r->off_ms;
+	if (r->pout_ms > s->worst_pout_ms)
+		s->worst_pout_ms = r->pout_ms;
 }
 
-static void print_table(const char *title, const struct phase_stats *s)
+static void print_table(const char *title, const struct phase_stats *s,
+			int power_output)
 {
-	print_message("[ MEASURE  ] %s: phase | kills | worst time to motors "
-		      "off | deadline\n",
-		      title);
+	print_message(
+	    "[ MEASURE  ] %s: phase | kills | worst time to motors "
+	    "off | deadline%s\n",
+	    title, power_output ? " | worst power output cut | deadline" : "");
 	for (int p = 0; p < PH_COUNT; p++) {
-		char worst[64];
+		char worst[64], pout[64] = "";
 
 		if (!s[p].kills)
 			continue;
@@ -960,26 +1059,34 @@ static void print_table(const char *title, const struct phase_stats *s)
 				 s[p].off_before ? " (some off already)" : "");
 		else
 			snprintf(worst, sizeof(worst), "off already");
-		print_message("[ MEASURE  ]   %-22s | %2d | %-24s | %d ms\n",
-			      ph_name[p], s[p].kills, worst, D_CTRL_MS);
+		if (power_output && s[p].worst_pout_ms >= 0)
+			snprintf(pout, sizeof(pout), " | %.0f ms | %d ms",
+				 s[p].worst_pout_ms, D_POWER_MS);
+		else if (power_output)
+			snprintf(pout, sizeof(pout), " | cut already | %d ms",
+				 D_POWER_MS);
+		print_message("[ MEASURE  ]   %-22s | %2d | %-24s | %d ms%s\n",
+			      ph_name[p], s[p].kills, worst, D_CTRL_MS, pout);
 	}
 }
 
 /* The [ MEASURE ] line of one signal. */
 static void measure_line(const char *sig, enum phase ph, double t_sig,
-			 double jitter, double anchor, const struct off_result *r)
+			 double jitter, double anchor,
+			 const struct off_result *r)
 {
 	char off[160], pout[48] = "";
 
 	if (r->on_at_sig || r->on_after)
-		snprintf(off, sizeof(off), "motors %s, all off %.0f ms after (%s)",
-			 r->on_at_sig ? "on" : "switched on AFTER it", r->off_ms,
-			 r->by);
+		snprintf(off, sizeof(off),
+			 "motors %s, all off %.0f ms after (%s)",
+			 r->on_at_sig ? "on" : "switched on AFTER it",
+			 r->off_ms, r->by);
 	else
 		snprintf(off, sizeof(off), "motors off already");
 	if (r->pout_ms >= 0)
-		snprintf(pout, sizeof(pout), "; power output cleared %.0f ms after",
-			 r->pout_ms);
+		snprintf(pout, sizeof(pout),
+			 "; power output cleared %.0f ms after", r->pout_ms);
 	print_message("[ MEASURE  ] %s in %-22s at %6.0f ms (+-%.0f), %6.0f ms "
 		      "into the phase: %s%s; program fault %.0f\n",
 		      sig, ph_name[ph], t_sig, jitter,
@@ -993,7 +1100,7 @@ static void kill_one(const struct instant *in, int power_output,
 	struct off_result r;
 	double anchor, t_sig, t0;
 	enum phase got;
-	char what[160];
+	char what[160], st[2048];
 
 	snprintf(what, sizeof(what), "kill in %s%s%s +%.0f ms%s",
 		 ph_name[in->ph], in->line ? " at '" : "",
@@ -1004,6 +1111,9 @@ static void kill_one(const struct instant *in, int power_output,
 		sys_case_stop(&cs);
 		return;
 	}
+	if (in->ph == PH_JOG && sys_state(&cs, st, sizeof(st)) == 0 &&
+	    !(fabs(sys_state_num(st, "A.vel")) > 0))
+		add_fail("%s: axis A is not moving: %s", what, st);
 	t_sig = signal_at(&cs, SIGKILL, &t0);
 	proc_wait_exit(&cs.re, EXIT_WAIT_MS, NULL);
 	if (t_sig < 0 || sys_events(&cs) < 0) {
@@ -1074,13 +1184,13 @@ static void kill_anywhere(int power_output)
 	need_env();
 	reset_fails();
 	for (int p = 0; p < PH_COUNT; p++)
-		stats[p] = (struct phase_stats){0, 0, -1};
+		stats[p] = (struct phase_stats){0, 0, -1, -1};
 	n = kill_plan(plan, sizeof(plan) / sizeof(plan[0]), !power_output);
 	for (size_t i = 0; i < n; i++)
 		kill_one(&plan[i], power_output, stats);
 	print_table(power_output ? "kill-anywhere, power output wired"
 				 : "kill-anywhere",
-		    stats);
+		    stats, power_output);
 	for (int p = 0; p < PH_COUNT; p++)
 		if (!stats[p].kills && p != PH_RELAY)
 			add_fail("no kill met the phase '%s'", ph_name[p]);
@@ -1277,32 +1387,54 @@ struct fclass {
 /* The matrix of test_sys_faults.c; the axis of a jam or a dead encoder is
  * one that moves (every axis moves in the service state). */
 static const struct fclass fclasses[FK_COUNT] = {
-    [FK_POT_OFFSET] = {"pot offset", "pot A offset 0.5", 0,
+    [FK_POT_OFFSET] = {"pot offset",
+		       "pot A offset 0.5",
+		       0,
 		       {RE_F_CAL_ABSOLUTE, RE_F_CTRL_POTRANGE, RE_F_CAL_RANGE,
 			RE_F_NONE},
 		       {RE_F_ENCPOT, RE_F_NONE}},
-    [FK_POT_OPEN] = {"pot open", "pot C open", 2,
+    [FK_POT_OPEN] = {"pot open",
+		     "pot C open",
+		     2,
 		     {RE_F_CTRL_POTRANGE, RE_F_CAL_ABSOLUTE, RE_F_NONE},
 		     {RE_F_CTRL_POTRANGE, RE_F_ENCPOT, RE_F_NONE}},
-    [FK_ENC_STUCK] = {"encoder stuck", "enc A stuck", 0,
+    [FK_ENC_STUCK] = {"encoder stuck",
+		      "enc A stuck",
+		      0,
 		      {RE_F_CTRL_POSERR, RE_F_CTRL_ENCODER, RE_F_MOTOR_OFF,
 		       RE_F_NONE},
 		      {RE_F_ENCPOT, RE_F_CTRL_POSERR, RE_F_CTRL_ENCODER,
 		       RE_F_MOTOR_OFF, RE_F_NONE}},
-    [FK_JAM] = {"jammed axis", "block B 1", 1,
+    [FK_JAM] = {"jammed axis",
+		"block B 1",
+		1,
 		{RE_F_CTRL_POSERR, RE_F_CTRL_ENCODER, RE_F_MOTOR_OFF,
 		 RE_F_NONE},
 		{RE_F_CTRL_POSERR, RE_F_CTRL_ENCODER, RE_F_MOTOR_OFF,
 		 RE_F_NONE}},
-    [FK_JOY] = {"joystick invalid held", "joy B fwd a", -1,
-		{RE_F_CTRL_INPUT, RE_F_NONE}, {RE_F_CTRL_INPUT, RE_F_NONE}},
-    [FK_STALL] = {"link stall", "link stall", -1,
-		  {RE_F_WDOG_REPLY, RE_F_NONE}, {RE_F_WDOG_REPLY, RE_F_NONE}},
-    [FK_DROP] = {"link drop", "link drop", -1, {RE_F_COMM, RE_F_NONE},
+    [FK_JOY] = {"joystick invalid held",
+		"joy B fwd a",
+		-1,
+		{RE_F_CTRL_INPUT, RE_F_NONE},
+		{RE_F_CTRL_INPUT, RE_F_NONE}},
+    [FK_STALL] = {"link stall",
+		  "link stall",
+		  -1,
+		  {RE_F_WDOG_REPLY, RE_F_NONE},
+		  {RE_F_WDOG_REPLY, RE_F_NONE}},
+    [FK_DROP] = {"link drop",
+		 "link drop",
+		 -1,
+		 {RE_F_COMM, RE_F_NONE},
 		 {RE_F_COMM, RE_F_NONE}},
-    [FK_UNPLUG] = {"relay unplug", "relayfault unplug", -1,
-		   {RE_F_ESTOP_LOST, RE_F_NONE}, {RE_F_ESTOP_LOST, RE_F_NONE}},
-    [FK_WRITEFAIL] = {"relay writefail", "relayfault writefail", -1,
+    [FK_UNPLUG] = {"relay unplug",
+		   "relayfault unplug",
+		   -1,
+		   {RE_F_ESTOP_LOST, RE_F_NONE},
+		   {RE_F_ESTOP_LOST, RE_F_NONE}},
+    [FK_WRITEFAIL] = {"relay writefail",
+		      "relayfault writefail",
+		      -1,
 		      {RE_F_ESTOP_LOST, RE_F_CTRL_POWER, RE_F_NONE},
 		      {RE_F_ESTOP_LOST, RE_F_CTRL_POWER, RE_F_NONE}},
 };
@@ -1334,7 +1466,8 @@ static struct fdeadline fault_deadlines(enum fkind k, enum phase ph)
 	switch (k) {
 	case FK_POT_OFFSET:
 		/* without tables only the ends of the travel and the
-		 * controller's range can tell: no deadline from the injection */
+		 * controller's range can tell: no deadline from the injection
+		 */
 		if (tables)
 			d = (struct fdeadline){d_encpot(),
 					       d_encpot() + SYS_MAINMS, -1};
@@ -1449,8 +1582,9 @@ static double pc_estop_ms(struct sys_case *c, double w0)
 {
 	double w1;
 
-	if (sys_log_time_ms(c, "FAULT ESTOP: the E-stop relay stopped "
-			       "answering",
+	if (sys_log_time_ms(c,
+			    "FAULT ESTOP: the E-stop relay stopped "
+			    "answering",
 			    &w1) < 0)
 		return -1;
 	return w1 - w0;
@@ -1472,8 +1606,8 @@ static void fault_one(enum fkind k, const struct instant *in)
 	}
 	w0 = sys_wall_ms();
 	t_inj = inject(&cs, fc->req);
-	if (t_inj < 0 || sys_wait_fault(&cs, FAULT_WAIT_MS, line,
-					sizeof(line)) < 0) {
+	if (t_inj < 0 ||
+	    sys_wait_fault(&cs, FAULT_WAIT_MS, line, sizeof(line)) < 0) {
 		add_fail("%s: %s", what, cs.err);
 		return;
 	}
@@ -1569,8 +1703,7 @@ static void test_fault_in_centring(void **state)
 
 /* The first "axis X motor off" of every axis after @after: the latest
  * time, and each source ("handle A", "thread 0 line 381"). */
-static double who_off(const struct sys_case *c, double after,
-		      char by[3][48])
+static double who_off(const struct sys_case *c, double after, char by[3][48])
 {
 	double last = -1;
 
@@ -1604,10 +1737,10 @@ static void start_jogging_blind(void)
 struct link_case {
 	const char *name;
 	const char *req;
-	int transient;	    /* "link ok" at once: only the sockets died */
-	int by_supervisor;  /* the supervisor's new connection stops */
+	int transient;	   /* "link ok" at once: only the sockets died */
+	int by_supervisor; /* the supervisor's new connection stops */
 	enum re_fault_id id;
-	double d_relay;	    /* the supervisor's deadline to relay off */
+	double d_relay; /* the supervisor's deadline to relay off */
 };
 
 /*
@@ -1728,8 +1861,8 @@ static void test_link_loss_amp_model_off(void **state)
  * board silent). The controller stop meets the fault's deadline, the FAULT
  * line says the relay open was not confirmed and asks for the hardware
  * E-stop, and roboelf still exits on SIGTERM at once with 4. */
-static void wedged(const char *name, const char *fault_req,
-		   enum re_fault_id id, int axis, double d_motors)
+static void wedged(const char *name, const char *fault_req, enum re_fault_id id,
+		   int axis, double d_motors)
 {
 	enum re_fault_id ids[2] = {id, RE_F_NONE};
 	struct ph_opts o = {.calibration = "file"};
@@ -1742,8 +1875,8 @@ static void wedged(const char *name, const char *fault_req,
 	    (t_w = inject(&cs, "relayfault wedge")) < 0)
 		fail_msg("%s: %s", name, cs.err);
 	t_f = fault_req ? inject(&cs, fault_req) : t_w;
-	if (t_f < 0 || sys_wait_fault(&cs, FAULT_WAIT_MS, line, sizeof(line)) <
-			   0)
+	if (t_f < 0 ||
+	    sys_wait_fault(&cs, FAULT_WAIT_MS, line, sizeof(line)) < 0)
 		fail_msg("%s: %s", name, cs.err);
 	t_mo = wait_motors_off(&cs, t_f, 3000);
 	if (t_mo < 0)
@@ -1844,7 +1977,8 @@ static void quit_by(int sig, const char *logged)
 	 * #OFF, or its own AB 1;MO ABC) before the relay opens - not by the
 	 * amplifier fault the power cut would cause - and no program fault */
 	for (int a = 0; a < 3; a++)
-		if (strncmp(by[a], "handle ", 7) && strncmp(by[a], "thread 0 ", 9))
+		if (strncmp(by[a], "handle ", 7) &&
+		    strncmp(by[a], "thread 0 ", 9))
 			fail_msg("%s: motor %c off by '%s', not on the "
 				 "supervisor's request",
 				 logged, 'A' + a, by[a]);
@@ -1961,16 +2095,11 @@ static void test_centring_then_armed(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	    T(test_kill_anywhere),
-	    T(test_kill_anywhere_power_output),
-	    T(test_freeze_anywhere),
-	    T(test_fault_in_calibration),
-	    T(test_fault_in_centring),
-	    T(test_link_loss_amp_model_off),
-	    T(test_wedged_relay),
-	    T(test_signals_quit),
-	    T(test_signal_tstp_ignored),
-	    T(test_centring_then_armed),
+	    T(test_kill_anywhere),	 T(test_kill_anywhere_power_output),
+	    T(test_freeze_anywhere),	 T(test_fault_in_calibration),
+	    T(test_fault_in_centring),	 T(test_link_loss_amp_model_off),
+	    T(test_wedged_relay),	 T(test_signals_quit),
+	    T(test_signal_tstp_ignored), T(test_centring_then_armed),
 	};
 	const char *filter = getenv("ROBOELF_SYS_FILTER");
 
