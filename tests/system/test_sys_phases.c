@@ -10,22 +10,27 @@
  * galil-sim. Times are galil-sim's simulated ms (its `events` and `time`
  * answers). The cases:
  *
- *  - kill-anywhere: SIGKILL at 32 instants spread over every phase
- *    (start-up before and after the relay closes, the service request,
- *    full calibration, centring after a calibration from a file, arming,
- *    armed at rest, armed jogging, latched), then one pass with the
- *    controller's motor-power output wired (power_output 3): every motor
- *    off and at rest within the controller's deadline, or off already;
- *    motor power cut by the controller's output as well;
+ *  - kill-anywhere: SIGKILL at 33 instants spread over every phase
+ *    (start-up with the relay open, with it closed, the service state
+ *    requested, full calibration, centring after a calibration from the
+ *    file, back to safe, the arm requested, armed at rest, armed jogging,
+ *    latched), then one instant per phase with the controller's motor-power
+ *    output wired (power_output 3): every motor off and at rest within the
+ *    controller's deadline, or off already; motor power cut as well;
  *  - freeze-anywhere: SIGSTOP for 2 s in each phase, then SIGCONT: the
  *    same deadline during the stop, then the FAULT line names the stall;
  *  - fault-anywhere: every class of the fault matrix (test_sys_faults.c)
  *    injected during a full calibration and during centring;
  *  - link loss with the amplifier model off (--no-amp-undervoltage): who
- *    stops the motors when motor power loss is invisible to the controller;
- *  - a wedged relay board and a fault: the stop, the FAULT line, the exit;
+ *    stops the motors when the controller cannot see motor power go;
+ *  - a wedged relay board, alone and with a fault: the stop, the FAULT
+ *    line, the exit;
  *  - signals: SIGQUIT, SIGHUP, SIGTERM end in the orderly power-off,
- *    SIGTSTP is ignored.
+ *    SIGTSTP is ignored;
+ *  - centring from off-centre, then armed: no fault.
+ *
+ * A case of many instants runs them all, prints a [ MEASURE ] line for
+ * each and a [  FAILS   ] line for each failed assertion, then fails.
  *
  * Environment: ROBOELF_BIN, ROBOELF_TOP (see sys_h.h), ROBOELF_KEEP=1
  * keeps the temporary directory (configurations, logs and the events of
@@ -979,8 +984,8 @@ static int still_since(struct sys_case *c, const char *st0)
  * hold (sys_check_safe; the relay may stay on: nobody is left to open it).
  * Failures go to add_fail(). Return: 0 when all hold.
  */
-static int check_off(struct sys_case *c, const char *what, enum phase ph,
-		     double t_sig, int power_output, struct off_result *r)
+static int check_off(struct sys_case *c, const char *what, double t_sig,
+		     int power_output, struct off_result *r)
 {
 	size_t before = nfails;
 
@@ -988,13 +993,13 @@ static int check_off(struct sys_case *c, const char *what, enum phase ph,
 		add_fail("%s: %s", what, c->err);
 		return -1;
 	}
-	if (ph != PH_LATCHED && (r->on_at_sig || r->on_after)) {
+	if (r->on_at_sig || r->on_after) {
 		if (r->off_ms < 0 || r->off_ms > D_CTRL_MS)
 			add_fail("%s: motors off %.0f ms after the signal, "
 				 "deadline %d ms%s",
 				 what, r->off_ms, D_CTRL_MS,
-				 r->on_after ? " (the motors went ON after "
-					       "the signal)"
+				 r->on_after ? " (the program switched them ON "
+					       "after the signal)"
 					     : "");
 		if (strncmp(r->by, "thread ", 7))
 			add_fail("%s: the last motor was switched off by '%s', "
@@ -1008,8 +1013,6 @@ static int check_off(struct sys_case *c, const char *what, enum phase ph,
 			add_fail("%s: power output %d cleared %.0f ms after "
 				 "the signal (-1: never), deadline %d ms",
 				 what, power_output, r->pout_ms, D_POWER_MS);
-	} else if (r->on_after) {
-		add_fail("%s: a motor was switched on after the signal", what);
 	}
 	if (power_output && !strstr(r->st_d, " power=0 "))
 		add_fail("%s: motor power not cut at the deadline (output %d "
@@ -1121,7 +1124,7 @@ static void kill_one(const struct instant *in, int power_output,
 		sys_case_stop(&cs);
 		return;
 	}
-	check_off(&cs, what, in->ph, t_sig, power_output, &r);
+	check_off(&cs, what, t_sig, power_output, &r);
 	got = actual_phase(&cs, in->ph, t_sig, sys_state_num(r.st, "var.hbpc"));
 	if (got != in->ph && !(in->ph == PH_RELAY && got == PH_SVCREQ))
 		add_fail("%s: the kill met '%s' instead", what, ph_name[got]);
@@ -1262,7 +1265,7 @@ static void freeze_one(const struct instant *in)
 		return;
 	}
 	/* while it is stopped: the controller's deadline, the safe state */
-	check_off(&cs, what, in->ph, t_sig, 0, &r);
+	check_off(&cs, what, t_sig, 0, &r);
 	measure_line("freeze", in->ph, t_sig, t_sig - t0, anchor, &r);
 	if (wait_sim_fine(&cs, t_sig + FREEZE_MS, FREEZE_MS + 3000) < 0 ||
 	    (t_cont = signal_at(&cs, SIGCONT, NULL)) < 0) {
