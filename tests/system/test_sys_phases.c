@@ -2072,6 +2072,7 @@ static void test_centring_then_armed(void **state)
 	(void)state;
 	need_env();
 	for (int k = 0; k < CENTRING_RUNS; k++) {
+		char line[1024];
 		double t = -1;
 
 		if (ph_start(&cs, &o) < 0 || wait_ready(&cs, READY_MS) < 0 ||
@@ -2079,11 +2080,12 @@ static void test_centring_then_armed(void **state)
 		    wait_sim_fine(&cs, t + 500, 3000) < 0)
 			fail_msg("run %d: %s", k + 1, cs.err);
 		proc_pump(&cs.re, 0);
-		if (proc_find_line(&cs.re, PROC_STDOUT, "FAULT ", NULL, 0) == 0)
+		if (proc_find_line(&cs.re, PROC_STDOUT, "FAULT ", line,
+				   sizeof(line)) == 0)
 			fail_msg("run %d: armed after centring from (%.0f, "
-				 "%.0f, %.0f): %s",
+				 "%.0f, %.0f), then: %s",
 				 k + 1, off_centre[0], off_centre[1],
-				 off_centre[2], tail(&cs.re, PROC_STDOUT, 900));
+				 off_centre[2], line);
 		proc_signal(&cs.re, SIGTERM);
 		if (proc_wait_exit(&cs.re, EXIT_WAIT_MS, &status) < 0)
 			fail_msg("no exit within %d ms of SIGTERM",
