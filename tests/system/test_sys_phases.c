@@ -2067,10 +2067,12 @@ static void test_signal_tstp_ignored(void **state)
  * centre is the program's own service move; arming right after it must
  * not be taken for motion nobody commanded. Whether it is depends on the
  * order of two things within one mainms (the program releasing the axis
- * in #MVSUP, roboelf's off request after it saw the move end), so the
- * scenario runs CENTRING_RUNS times; each must arm and stay armed.
+ * in #MVSUP, roboelf's off request after it saw the move end): the off
+ * request came first in 10 of 24 runs on the development machine, but not
+ * independently (runs of one binary tend to repeat the order). So the
+ * scenario runs up to CENTRING_RUNS times; each must arm and stay armed.
  */
-#define CENTRING_RUNS 4
+#define CENTRING_RUNS 8
 
 static void test_centring_then_armed(void **state)
 {
