@@ -659,6 +659,9 @@ int re_ctl_service(const struct re_io *io, long *hbpc, struct re_fault *fault,
 	char line[48];
 	int rc;
 
+	/* a new heartbeat with the request: the program judges the request
+	 * by the supervisor's last change (docs/dmc-interface.md, #GOON) */
+	*hbpc = (*hbpc + 1) % RE_HBPC_WRAP;
 	snprintf(line, sizeof(line), "hbpc=%ld;svcreq=1", *hbpc);
 	rc = cmd(io, line, err, errlen);
 	if (rc == GL_OK)
@@ -711,6 +714,7 @@ int re_ctl_arm(const struct re_io *io, const struct re_calset *cal,
 		rc = check_param(io, &p[k], err, errlen);
 	if (rc == GL_OK)
 		rc = wait_still(io, err, errlen);
+	*hbpc = (*hbpc + 1) % RE_HBPC_WRAP;
 	snprintf(line, sizeof(line), "hbpc=%ld;armreq=1", *hbpc);
 	if (rc == GL_OK)
 		rc = cmd(io, line, err, errlen);

@@ -62,6 +62,82 @@ static void test_heartbeat_stopped(void **state)
 	assert_true(dmc_h_var(h, "hbdmc") > det);
 }
 
+struct reqcase {
+	const char *req; /* svcreq or armreq */
+	double want;	 /* the state it asks for */
+	int stale;	 /* 0: request 20 ms after the last heartbeat
+			    change, 1: wdto after it */
+};
+
+/*
+ * The supervisor dies between its last heartbeat and its request (or just
+ * after both): the program judges the request by that last change, not by
+ * the request's own time (#GOON). A request wdto after the change latches
+ * fault 2 with no motor ever on; one 20 ms after it goes on, and every
+ * motor is off again within wdto + mainms (+1 sample) of the change.
+ */
+static void test_request_after_death(void **state)
+{
+	static const struct reqcase cases[] = {
+	    {"svcreq", 3, 0}, {"armreq", 1, 0}, {"svcreq", 3, 1},
+	    {"armreq", 1, 1},
+	};
+
+	(void)state;
+	for (size_t k = 0; k < sizeof(cases) / sizeof(cases[0]); k++) {
+		static struct dmc_h h;
+		const struct reqcase *c = &cases[k];
+		struct dmc_h_params p;
+		double wdto, mainms, t_last, t_on = -1, t, delay;
+		int on = 0;
+
+		dmc_h_params_default(&p);
+		DMC_H_CHECK(&h, dmc_h_open(&h));
+		DMC_H_CHECK(&h, dmc_h_start(&h));
+		DMC_H_CHECK(&h, dmc_h_configure(&h, &p));
+		wdto = dmc_h_var(&h, "wdto");
+		mainms = dmc_h_var(&h, "mainms");
+		h.hb_on = 0;
+		DMC_H_CHECK(&h, dmc_h_set(&h, "hbpc", (double)++h.hb));
+		t_last = dmc_h_now(&h);
+		delay = c->stale ? wdto : 20;
+		dmc_h_advance(&h, delay);
+		DMC_H_CHECK(&h, dmc_h_set(&h, c->req, 1));
+		while ((t = dmc_h_now(&h) - t_last) < delay + wdto &&
+		       dmc_h_var(&h, "state") != 2) {
+			dmc_h_advance(&h, 1);
+			if (!dmc_h_axis(&h, 0).motor_off && !on) {
+				on = 1;
+				t_on = dmc_h_now(&h) - t_last;
+			}
+			if (dmc_h_var(&h, "state") == c->want && t_on < 0)
+				t_on = dmc_h_now(&h) - t_last;
+		}
+		(void)dmc_h_wait_motor_off(&h, 7, 3 * mainms);
+		t = dmc_h_now(&h) - t_last;
+		print_message("measured: %s %.0f ms after the last heartbeat: "
+			      "motors %s, fault %g at %.0f ms\n",
+			      c->req, delay,
+			      on ? "went on" : "never on",
+			      dmc_h_var(&h, "fcode"), t);
+		assert_true(dmc_h_var(&h, "state") == 2);
+		assert_true(dmc_h_var(&h, "fcode") == 2);
+		if (c->stale) {
+			/* refused in the pass that takes the request, after
+			 * the parameter check (#PCHK, about 30 ms): nothing
+			 * was on meanwhile */
+			assert_int_equal(on, 0);
+			assert_true(t <= delay + mainms + 50);
+		} else {
+			assert_int_equal(on, 1);
+			assert_true(t <= wdto + mainms + 1);
+		}
+		for (int i = 0; i < DMC_H_AXES; i++)
+			assert_int_equal(dmc_h_axis(&h, i).motor_off, 1);
+		dmc_h_close(&h);
+	}
+}
+
 /* A heartbeat slower than the supervisor's but inside wdto - mainms never
  * trips (3 s). */
 static void test_heartbeat_slow_ok(void **state)
@@ -121,6 +197,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test_setup_teardown(test_heartbeat_stopped,
 					    dmc_h_fx_armed, dmc_h_fx_free),
+	    cmocka_unit_test(test_request_after_death),
 	    cmocka_unit_test_setup_teardown(test_heartbeat_slow_ok,
 					    dmc_h_fx_armed, dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_thread0_halted, dmc_h_fx_armed,
