@@ -24,20 +24,28 @@ static int real_record(void *ud, const char *prefix, struct gl_record *rec,
 		       int timeout_ms)
 {
 	struct re_io_real *r = ud;
+	int rc;
 
 	if (!r->link)
 		return GL_ERR_CLOSED;
-	return gl_link_record(r->link, prefix, rec, timeout_ms);
+	r->last_run_ns = re_io_now_ns();
+	rc = gl_link_record(r->link, prefix, rec, timeout_ms);
+	r->last_run_ns = re_io_now_ns();
+	return rc;
 }
 
 static int real_command(void *ud, const char *cmd, char *resp, size_t cap,
 			int timeout_ms)
 {
 	struct re_io_real *r = ud;
+	int rc;
 
 	if (!r->link)
 		return GL_ERR_CLOSED;
-	return gl_link_command(r->link, cmd, resp, cap, timeout_ms);
+	r->last_run_ns = re_io_now_ns();
+	rc = gl_link_command(r->link, cmd, resp, cap, timeout_ms);
+	r->last_run_ns = re_io_now_ns();
+	return rc;
 }
 
 static const char *real_ctrl_error(void *ud, int *code)
@@ -95,12 +103,34 @@ static int real_relay_off_finish(void *ud, int deadline_ms)
 			: GL_ERR_RELAY;
 }
 
+/* A new connection within @end_ns: refused or reset connections (the
+ * network coming back, the controller's listen queue) are tried again
+ * every RETRY_MS until then. */
+#define RETRY_MS 10
+static int open_until(struct re_io_real *r, int64_t end_ns, gl_link **l)
+{
+	char e[GL_ERRTEXT_LEN];
+	int rc;
+
+	for (;;) {
+		int64_t left_ms = (end_ns - re_io_now_ns()) / 1000000;
+		struct timespec pause = {0, RETRY_MS * 1000000L};
+
+		if (left_ms < 1)
+			return GL_ERR_TIMEOUT;
+		rc = gl_link_open(l, r->address, (int)left_ms, e);
+		if (rc == GL_OK || rc == GL_ERR_ARG ||
+		    re_io_now_ns() + RETRY_MS * 1000000LL >= end_ns)
+			return rc;
+		nanosleep(&pause, NULL);
+	}
+}
+
 /* A new connection, the command on it, and it replaces the old link. */
 static int real_stop_fresh(void *ud, const char *cmd, char *resp, size_t cap,
 			   int deadline_ms)
 {
 	struct re_io_real *r = ud;
-	char e[GL_ERRTEXT_LEN];
 	int64_t end = re_io_now_ns() + (int64_t)deadline_ms * 1000000;
 	int64_t left_ms;
 	gl_link *l;
@@ -108,7 +138,7 @@ static int real_stop_fresh(void *ud, const char *cmd, char *resp, size_t cap,
 
 	if (!r->address)
 		return GL_ERR_CLOSED;
-	rc = gl_link_open(&l, r->address, deadline_ms, e);
+	rc = open_until(r, end, &l);
 	if (rc != GL_OK)
 		return rc;
 	left_ms = (end - re_io_now_ns()) / 1000000;

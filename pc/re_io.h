@@ -58,8 +58,9 @@ struct re_io_ops {
 	int (*relay_off_finish)(void *ud, int deadline_ms);
 	/* Optional (NULL: not attempted). Deliver one command line over a new
 	 * connection to the controller (the old one is out of step or gone),
-	 * connect and reply within @deadline_ms in all; on success the new
-	 * connection replaces the command link. Return: as command(). */
+	 * connect and reply within @deadline_ms in all (a refused connect is
+	 * tried again every 10 ms within it); on success the new connection
+	 * replaces the command link. Return: as command(). */
 	int (*stop_fresh)(void *ud, const char *cmd, char *resp, size_t cap,
 			  int deadline_ms);
 	/* re_relay_state(): what was last confirmed written. */
@@ -84,6 +85,10 @@ struct re_io_real {
 	struct re_log *log;
 	const char *address; /* the controller, for stop_fresh; NULL: none */
 	int cmd_timeout_ms;  /* the command link's default reply deadline */
+	/* CLOCK_MONOTONIC ns at the start and the end of the last record or
+	 * command: a moment this process is known to have run (roboelf's
+	 * SIGCONT handler reads it to measure a stop) */
+	volatile int64_t last_run_ns;
 };
 
 /*

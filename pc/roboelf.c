@@ -94,6 +94,27 @@ static void on_signal(int sig)
 	quit_signal = sig;
 }
 
+/* A stop (SIGSTOP, a debugger) during start-up: the cycle measures its own
+ * gaps, but start-up is a sequence of waits and commands. SIGCONT says
+ * the process was stopped; the stop lasted from the last moment it is
+ * known to have run (a link call's start or end) to the SIGCONT. */
+static volatile sig_atomic_t continued;
+static volatile int64_t cont_stop_ms;
+static struct re_io_real *volatile cont_real;
+
+static void on_cont(int sig)
+{
+	struct timespec ts;
+	int64_t now, from;
+
+	(void)sig;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	now = (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+	from = cont_real ? cont_real->last_run_ns : now;
+	cont_stop_ms = (now - from) / 1000000;
+	continued = 1;
+}
+
 /* Every signal a terminal or a person can send ends in the orderly
  * shutdown (the safe state), never in a kill or a freeze with power on:
  * Ctrl-C, Ctrl-\, SIGTERM and a lost terminal (SIGHUP) quit; Ctrl-Z and
@@ -109,6 +130,10 @@ static void install_signals(void)
 	sigemptyset(&sa.sa_mask);
 	for (size_t i = 0; i < sizeof(quit) / sizeof(quit[0]); i++)
 		sigaction(quit[i], &sa, NULL);
+	sa.sa_handler = on_cont;
+	sa.sa_flags = SA_RESTART;
+	sigaction(SIGCONT, &sa, NULL);
+	sa.sa_flags = 0;
 	sa.sa_handler = SIG_IGN;
 	for (size_t i = 0; i < sizeof(ignore) / sizeof(ignore[0]); i++)
 		sigaction(ignore[i], &sa, NULL);
@@ -317,12 +342,28 @@ static void progress(struct app *a, const char *fmt, ...)
 	va_end(ap);
 	re_console_msg(&a->con, "roboelf: %s", text);
 	re_log_msg(&a->log, RE_LOG_INFO, "%s", text);
+	a->real.last_run_ns = re_io_now_ns();
 }
 
+static int64_t stalled_ms(const struct app *a);
+static int64_t stall_limit_ms(const struct app *a);
+
+/* The start refused with @what; a stop just before is named first. */
 static int fail(struct app *a, const char *what)
 {
-	re_console_msg(&a->con, "roboelf: error: %s", what);
-	re_log_msg(&a->log, RE_LOG_WARN, "start-up refused: %s", what);
+	int64_t ms = stalled_ms(a);
+
+	if (ms)
+		re_console_msg(&a->con,
+			       "roboelf: error: roboelf did not run for %lld ms "
+			       "(limit %lld ms: stopped, e.g. SIGSTOP or a "
+			       "debugger); then: %s",
+			       (long long)ms, (long long)stall_limit_ms(a),
+			       what);
+	else
+		re_console_msg(&a->con, "roboelf: error: %s", what);
+	re_log_msg(&a->log, RE_LOG_WARN, "start-up refused: %s%s", what,
+		   ms ? " (after a stop of roboelf itself)" : "");
 	return EXIT_CONNECT;
 }
 
@@ -461,11 +502,82 @@ static int init_super(struct app *a)
 	return 0;
 }
 
-static int latch(struct app *a, const struct re_fault *f)
+/* The critical reply-age limit, ms: a stop longer than this is a stall. */
+static int64_t stall_limit_ms(const struct app *a)
 {
-	if (f->id != RE_F_NONE && re_super_fault(a->sup, f) == RE_FAULT)
+	return a->sup ? a->sup->crit_ns / 1000000
+		      : (int64_t)(a->cfg.watchdog.critical_factor *
+				  a->cfg.period_ms);
+}
+
+/* The stop of a SIGCONT since the last look, when it outlasted the
+ * limit: its length in ms; else 0 (and forgotten). */
+static int64_t stalled_ms(const struct app *a)
+{
+	int64_t ms;
+
+	if (!continued)
+		return 0;
+	continued = 0;
+	ms = cont_stop_ms;
+	return ms > stall_limit_ms(a) ? ms : 0;
+}
+
+/* A stop during start-up is the cause of whatever failed after it (the
+ * controller's watchdog, a command timed out): the fault says so. */
+static void stall_first(struct app *a, struct re_fault *f)
+{
+	int64_t ms = stalled_ms(a);
+
+	if (!ms)
+		return;
+	if (f->id != RE_F_NONE) {
+		char what[512];
+
+		re_fault_format(f, a->names, what, sizeof(what));
+		re_log_msg(&a->log, RE_LOG_WARN,
+			   "start-up: after a stop of %lld ms: %s",
+			   (long long)ms, what);
+	}
+	re_fault_set(f, RE_F_STALL, -1);
+	f->i[0] = ms;
+	f->i[1] = stall_limit_ms(a);
+}
+
+static int latch(struct app *a, const struct re_fault *fault)
+{
+	struct re_fault f = *fault;
+
+	stall_first(a, &f);
+	if (f.id != RE_F_NONE && re_super_fault(a->sup, &f) == RE_FAULT)
 		re_console_fault(&a->con, re_super_fault_line(a->sup));
 	return EXIT_FAULT;
+}
+
+/* Between start-up steps: a stop is a fault once the supervisor exists
+ * (motor power may be on), else the start is refused. */
+static int check_stall(struct app *a)
+{
+	struct re_fault f;
+
+	if (!continued)
+		return 0;
+	if (!a->sup) {
+		int64_t ms = stalled_ms(a);
+
+		if (!ms)
+			return 0;
+		snprintf(a->err, sizeof(a->err),
+			 "roboelf did not run for %lld ms during start-up "
+			 "(limit %lld ms: stopped, e.g. SIGSTOP or a "
+			 "debugger); motor power was not switched on; start "
+			 "it again",
+			 (long long)ms, (long long)stall_limit_ms(a));
+		return fail(a, a->err);
+	}
+	re_fault_set(&f, RE_F_NONE, -1);
+	stall_first(a, &f);
+	return f.id == RE_F_NONE ? 0 : latch(a, &f);
 }
 
 /* A start-up step that failed with a message: a CONFIG fault. */
@@ -773,28 +885,27 @@ static int arm(struct app *a)
 	return 0;
 }
 
+typedef int (*startup_step)(struct app *a);
+
 static int startup(struct app *a)
 {
+	static const startup_step steps[] = {
+	    start_relay,   start_link, choose_calibration, prepare_controller,
+	    init_super,	   power_on,   enter_service,	   calibrate,
+	    arm,
+	};
 	int rc = take_locks(a);
 
-	if (!rc)
-		rc = start_relay(a);
-	if (!rc)
-		rc = start_link(a);
-	if (!rc && !quit_signal)
-		rc = choose_calibration(a);
-	if (!rc && !quit_signal)
-		rc = prepare_controller(a);
-	if (!rc && !quit_signal)
-		rc = init_super(a);
-	if (!rc && !quit_signal)
-		rc = power_on(a);
-	if (!rc && !quit_signal)
-		rc = enter_service(a);
-	if (!rc && !quit_signal)
-		rc = calibrate(a);
-	if (!rc && !quit_signal)
-		rc = arm(a);
+	cont_real = &a->real;
+	/* a stop while the operator chooses is no stall: nothing is on */
+	for (size_t i = 0; !rc && !quit_signal && i < sizeof(steps) /
+		 sizeof(steps[0]); i++) {
+		rc = steps[i](a);
+		if (steps[i] == choose_calibration)
+			continued = 0;
+		if (!rc)
+			rc = check_stall(a);
+	}
 	if (!rc && !quit_signal) {
 		re_console_msg(&a->con, "RoboELF Ready for Use");
 		re_log_msg(&a->log, RE_LOG_INFO, "RoboELF Ready for Use");
