@@ -1086,7 +1086,15 @@ static int check_clinical(struct pctx *c, const struct re_config *cfg)
 	return GL_OK;
 }
 
-/* The slow speed near a switch is not faster than the travel speed. */
+/* An open potentiometer wiper reads about 0 V: the lowest reading the
+ * controller accepts (potlo, docs/supervisor.md) must stay above this, so
+ * that an open wiper is a fault (16), not an axis at its end stop. */
+#define POT_OPEN_V 0.1
+
+/*
+ * The slow speed near a switch is not faster than the travel speed; the
+ * margin past a switch keeps an open potentiometer detectable.
+ */
 static int check_calibration(struct pctx *c, const struct re_config *cfg)
 {
 	const struct re_config_calibration *k = &cfg->calibration;
@@ -1096,6 +1104,28 @@ static int check_calibration(struct pctx *c, const struct re_config *cfg)
 			       "'seek_cps' (%d) must not exceed 'travel_cps' "
 			       "(%d): it is the slow speed near a switch",
 			       k->seek_cps, k->travel_cps);
+	for (int i = 0; i < RE_AXES; i++) {
+		const struct re_config_axis *a = &cfg->axes[i];
+		const struct re_config_analog *an = &a->analog;
+		double gain = (an->forward_v - an->reverse_v) /
+			      (double)a->travel_counts;
+		double room = an->reverse_v - an->absolute_tolerance_v -
+			      POT_OPEN_V;
+		double lo = room + POT_OPEN_V - k->near_margin_counts * gain;
+
+		if (an->reverse_v <= POT_OPEN_V || lo >= POT_OPEN_V)
+			continue;
+		return fail_at(
+		    c, later_mark(c, &k->near_margin_counts, &an->reverse_v),
+		    "axis '%s': the lowest potentiometer reading allowed "
+		    "('reverse_v' - 'absolute_tolerance_v' - "
+		    "'near_margin_counts' x %.3g V/count = %.3f V) is below "
+		    "%.1f V, so an open potentiometer (0 V) would look like "
+		    "the axis at its end stop: make 'near_margin_counts' at "
+		    "most %.0f",
+		    a->name, gain, lo, POT_OPEN_V,
+		    room > 0 ? floor(room / gain + 1e-9) : 0.0);
+	}
 	return GL_OK;
 }
 

@@ -94,7 +94,7 @@ static int write_config(struct rig *r, int port, const char *relay,
 		     "mode: development\nperiod_ms: 50\n"
 		     "controller: {address: \"127.0.0.1:%d\"}\n"
 		     "relay: {port_development: \"%s\", readback: true}\n"
-		     "calibration: {file: \"%s\"}\n"
+		     "calibration: {file: \"%s\", near_margin_counts: 500}\n"
 		     "log: {path: \"%s\"}\naxes:\n",
 		     port, relay, calfile, r->log);
 	n += snprintf(text + n, sizeof(text) - (size_t)n, axis_fmt, "A", 20000);

@@ -65,6 +65,7 @@
 #define VMAX_CPS    8000
 #define STEP_COUNTS 1000
 #define ER_COUNTS   800 /* below the step (the program's arm check 7) */
+#define NEAR_MARGIN 500 /* counts: potlo 0.125 V on C (open wiper outside) */
 #define PERSIST	    1	/* persistence_cycles */
 #define ALLOWED_ERR 0.5 /* allowed_error */
 #define READBACK_MS 500 /* relay.readback_timeout_ms */
@@ -210,10 +211,10 @@ static int write_config(const char *path, const char *log, int power_output)
 		     "watchdog: {noncritical_factor: %g, critical_factor: "
 		     "%g,\n  controller_timeout_ms: %d}\n"
 		     "joystick: {invalid_timeout_ms: %d}\n"
-		     "calibration: {file: \"%s\"}\n"
+		     "calibration: {file: \"%s\", near_margin_counts: %d}\n"
 		     "log: {path: \"%s\"}\naxes:\n",
 		     PERIOD_MS, power_output, READBACK_MS, NONCRIT_F, CRIT_F,
-		     WDTO_MS, JTO_MS, env.cal, log);
+		     WDTO_MS, JTO_MS, env.cal, NEAR_MARGIN, log);
 	for (int i = 0; i < 3; i++)
 		n += snprintf(text + n, sizeof(text) - (size_t)n, axis_fmt,
 			      names[i], travel[i], VMIN_CPS, VMAX_CPS,
@@ -1405,8 +1406,8 @@ static const struct fclass fclasses[FK_COUNT] = {
     [FK_POT_OPEN] = {"pot open",
 		     "pot C open",
 		     2,
-		     {RE_F_CTRL_POTRANGE, RE_F_CAL_ABSOLUTE, RE_F_NONE},
-		     {RE_F_CTRL_POTRANGE, RE_F_ENCPOT, RE_F_NONE}},
+		     {RE_F_CTRL_POTRANGE, RE_F_NONE},
+		     {RE_F_CTRL_POTRANGE, RE_F_NONE}},
     [FK_ENC_STUCK] = {"encoder stuck",
 		      "enc A stuck",
 		      0,
@@ -1444,19 +1445,23 @@ static const struct fclass fclasses[FK_COUNT] = {
     [FK_WRITEFAIL] = {"relay writefail",
 		      "relayfault writefail",
 		      -1,
-		      {RE_F_ESTOP_LOST, RE_F_CTRL_POWER, RE_F_NONE},
-		      {RE_F_ESTOP_LOST, RE_F_CTRL_POWER, RE_F_NONE}},
+		      {RE_F_ESTOP_LOST, RE_F_CTRL_POWER, RE_F_RELAY_POWER,
+		       RE_F_NONE},
+		      {RE_F_ESTOP_LOST, RE_F_CTRL_POWER, RE_F_RELAY_POWER,
+		       RE_F_NONE}},
 };
 
 /* The potentiometer's absolute range the program checks (fault 16):
  * potlo = reverse_v - absolute_tolerance_v - near_margin_counts x gain,
  * gain = (forward_v - reverse_v) / travel_counts (pc/re_plan.c), with the
- * defaults 0.5 V, 0.25 V, 2000 counts, 4.0 V. On the short robot (travel
- * 16000 counts for C) potlo is -0.25 V: an open wiper (0 V) is inside. */
+ * defaults 0.5 V, 0.25 V, 4.0 V and NEAR_MARGIN. roboelf refuses a
+ * configuration whose potlo is below 0.1 V (an open wiper must stay a
+ * fault): on the short robot potlo is 0.125 V for C, so an open wiper
+ * (0 V) is outside the range. */
 static int open_v_outside_range(int axis)
 {
 	static const double travel[3] = {20000, 20000, 16000};
-	double potlo = 0.5 - 0.25 - 2000 * 4.0 / travel[axis];
+	double potlo = 0.5 - 0.25 - NEAR_MARGIN * 4.0 / travel[axis];
 
 	return 0.0 < potlo;
 }

@@ -93,6 +93,12 @@ static const struct bad_case bad_cases[] = {
     {"bad_seek_fast.yaml", 4, 13,
      "'seek_cps' (9000) must not exceed 'travel_cps' (8000): it is the "
      "slow speed near a switch"},
+    {"bad_near_margin.yaml", 8, 23,
+     "axis 'A': the lowest potentiometer reading allowed ('reverse_v' - "
+     "'absolute_tolerance_v' - 'near_margin_counts' x 0.00025 V/count = "
+     "-0.250 V) is below 0.1 V, so an open potentiometer (0 V) would look "
+     "like the axis at its end stop: make 'near_margin_counts' at most "
+     "600"},
     {"bad_power_output.yaml", 3, 17,
      "'power_output' must be between 0 and 8, got 9"},
     {"bad_invalid_timeout.yaml", 3, 23,
