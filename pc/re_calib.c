@@ -60,6 +60,8 @@ struct re_calib {
 	struct re_encpot_state encpot[RE_AXES];
 	struct batch b;	  /* queued, not sent yet */
 	unsigned pending; /* sent, not taken yet (mvreq still 1) */
+	unsigned taken_now; /* taken after this sample's record was read:
+			       that record does not show the move yet */
 	int64_t sent_ns;
 	int64_t t0_ns;
 	int filled;
@@ -189,6 +191,7 @@ static int sample(struct re_calib *c, const struct re_calib_cfg *cfg,
 
 	if (cfg->stop && *cfg->stop)
 		return GL_ERR_AGAIN;
+	c->taken_now = 0; /* this record follows every acceptance so far */
 	rc = cfg->sampler.sample(cfg->sampler.ud, &c->rec);
 	if (rc == RE_FAULT)
 		re_fault_set(f, RE_F_NONE, -1);
@@ -293,6 +296,7 @@ static int taken(struct re_calib *c, const struct re_io *io,
 	if (rc < 0)
 		return comm_fault(f, "move request", rc);
 	if (req == 0) {
+		c->taken_now = c->pending;
 		c->pending = 0;
 		return GL_OK;
 	}
@@ -304,11 +308,12 @@ static int taken(struct re_calib *c, const struct re_io *io,
 	return GL_OK;
 }
 
-/* An axis with a move queued or not yet taken: its profiler does not
- * show that move yet, so its phase must not judge it. */
+/* An axis with a move queued, not yet taken, or taken only after the
+ * record in hand was read: that record does not show the move, so its
+ * phase must not judge it (it would see "stopped" before the start). */
 static int waiting(const struct re_calib *c, int i)
 {
-	return ((c->b.mask | c->pending) >> i) & 1;
+	return ((c->b.mask | c->pending | c->taken_now) >> i) & 1;
 }
 
 /* ---- the per-axis steps ----------------------------------------------------
@@ -719,7 +724,8 @@ static int to_centre(struct re_calib *c, const struct re_io *io,
 			rc = sample(c, cfg, f);
 		if (rc == GL_OK)
 			rc = taken(c, io, cfg, f);
-		if (rc == GL_OK && !c->pending && all_stopped(c, cfg->n_axes))
+		if (rc == GL_OK && !c->pending && !c->taken_now &&
+		    all_stopped(c, cfg->n_axes))
 			return GL_OK;
 	} while (rc == GL_OK && now_ns(io) < deadline);
 	if (rc != GL_OK)
@@ -742,7 +748,7 @@ static int sweep_all(struct re_calib *c, const struct re_io *io,
 		rc = sample(c, cfg, f);
 		if (rc == GL_OK)
 			rc = taken(c, io, cfg, f);
-		done = !c->pending && !c->b.mask;
+		done = !c->pending && !c->taken_now && !c->b.mask;
 		for (int i = 0; rc == GL_OK && i < cfg->n_axes; i++) {
 			rc = axis_step(c, io, cfg, i, f);
 			done &= c->ax[i].ph == PH_DONE;
@@ -778,6 +784,7 @@ int re_calib_full(struct re_calib *c, const struct re_io *io,
 	memset(set, 0, sizeof(*set));
 	memset(&c->b, 0, sizeof(c->b));
 	c->pending = 0;
+	c->taken_now = 0;
 	c->filled = 0;
 	for (int i = 0; i < RE_AXES; i++)
 		enter(c, io, i, PH_START);
@@ -849,6 +856,7 @@ int re_calib_check_robot(struct re_calib *c, const struct re_io *io,
 		return GL_ERR_ARG;
 	memset(&c->b, 0, sizeof(c->b));
 	c->pending = 0;
+	c->taken_now = 0;
 	c->t0_ns = now_ns(io);
 	rc = sample(c, cfg, fault);
 	if (rc == GL_OK)

@@ -867,6 +867,9 @@ static int arm(struct app *a)
 	struct re_fault f;
 	int rc;
 
+	/* the cycle wrote the heartbeat since the service began: go on
+	 * from its last value (a value behind it is out of sequence) */
+	a->hbpc = a->sup->hbpc;
 	if (re_ctl_off(&a->io, &a->hbpc, a->err, sizeof(a->err)) != GL_OK)
 		return latch_err(a);
 	re_super_start(a->sup, NULL, a->hbpc, 0);

@@ -90,7 +90,9 @@ static void test_neutral_stops(void **state)
 	DMC_H_CHECK(h, dmc_h_control(h, "joy B neutral"));
 	t = wait_still(h, 500);
 	assert_true(t >= 0);
-	assert_true(t <= loopms + 100 + 2);
+	print_message("measured: neutral -> still after %.0f ms\n", t);
+	/* + 5 samples: from the read of the inputs to the ST (test_dmc_ramp) */
+	assert_true(t <= loopms + 100 + 5);
 	assert_true(dmc_h_var(h, "state") == 1);
 }
 
