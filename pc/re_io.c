@@ -126,7 +126,9 @@ static int open_until(struct re_io_real *r, int64_t end_ns, gl_link **l)
 	}
 }
 
-/* A new connection, the command on it, and it replaces the old link. */
+/* A new connection, the command on it, and it replaces the old link. A
+ * connection that closes before the reply (the network just coming back)
+ * is tried again within the same deadline. */
 static int real_stop_fresh(void *ud, const char *cmd, char *resp, size_t cap,
 			   int deadline_ms)
 {
@@ -138,15 +140,22 @@ static int real_stop_fresh(void *ud, const char *cmd, char *resp, size_t cap,
 
 	if (!r->address)
 		return GL_ERR_CLOSED;
-	rc = open_until(r, end, &l);
-	if (rc != GL_OK)
-		return rc;
-	left_ms = (end - re_io_now_ns()) / 1000000;
-	rc = gl_link_command(l, cmd, resp, cap,
-			     left_ms > 1 ? (int)left_ms : 1);
-	if (rc < 0 && rc != GL_ERR_CTRL) {
+	for (;;) {
+		struct timespec pause = {0, RETRY_MS * 1000000L};
+
+		rc = open_until(r, end, &l);
+		if (rc != GL_OK)
+			return rc;
+		left_ms = (end - re_io_now_ns()) / 1000000;
+		rc = gl_link_command(l, cmd, resp, cap,
+				     left_ms > 1 ? (int)left_ms : 1);
+		if (rc >= 0 || rc == GL_ERR_CTRL)
+			break;
 		gl_link_close(l);
-		return rc;
+		if ((rc != GL_ERR_CLOSED && rc != GL_ERR_BROKEN) ||
+		    re_io_now_ns() + RETRY_MS * 1000000LL >= end)
+			return rc;
+		nanosleep(&pause, NULL);
 	}
 	gl_link_set_timeout(l, r->cmd_timeout_ms > 0 ? r->cmd_timeout_ms
 						     : deadline_ms);
