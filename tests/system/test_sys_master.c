@@ -1803,8 +1803,12 @@ static int ctl_line(int fd, char *line, size_t cap, int ms)
  * can be confirmed: the line must say NOT CONFIRMED and PRESS THE
  * HARDWARE E-STOP NOW. galil-sim cuts the power at the unplug; the
  * supervisor's reaction is measured on the wall clock to its FAULT entry,
- * deadline 2P (a lost link or relay is seen in the next cycle).
+ * deadline 2P + FRESH_STOP_MS: a lost link or relay is seen in the next
+ * cycle, the relay is told to open at once, and the stop then tries new
+ * connections to the controller for up to 2 x controller.timeout_ms
+ * before the FAULT entry is written (docs/safety.md D28).
  */
+#define FRESH_STOP_MS 200 /* 2 x controller.timeout_ms (default 100 ms) */
 static void test_link_and_relay_lost(void **state)
 {
 	static const char burst[] = "link drop\nrelayfault unplug\n";
@@ -1838,9 +1842,9 @@ static void test_link_and_relay_lost(void **state)
 		     "both injected at +%.0f / +%.0f ms; power cut %.0f ms "
 		     "and motors off %.0f ms (deadline M + s = %d) after "
 		     "the unplug; the FAULT entry %.0f ms after the burst "
-		     "(deadline 2P = %.0f, wall)",
+		     "(deadline 2P + fresh stop = %.0f, wall)",
 		     t_link - t0, t_relay - t0, t_off, t_mo, SYS_MAINMS + 1,
-		     w1 - w0, 2 * P());
+		     w1 - w0, 2 * P() + FRESH_STOP_MS);
 	if (sys_check_safe(&cs, 0, HOLD_MS) < 0)
 		fail_msg("%s", cs.err);
 	if (t_mo > SYS_MAINMS + 1 + SLACK_MS)
@@ -1859,7 +1863,7 @@ static void test_link_and_relay_lost(void **state)
 		 "power, then restart roboelf",
 		 cs.relay_link);
 	expect_text("the FAULT line", tpl, line, NULL, 0);
-	if (w1 - w0 > 2 * P() + SLACK_MS)
+	if (w1 - w0 > 2 * P() + FRESH_STOP_MS + SLACK_MS)
 		fail_msg("the FAULT entry came %.0f ms after the burst",
 			 w1 - w0);
 	row_pass(r, "NOT CONFIRMED, press the hardware E-stop");
