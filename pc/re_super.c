@@ -195,8 +195,11 @@ static int exchange(struct re_super *s, struct re_fault *f)
 	 * (stopped inside the wait), whatever the link did. */
 	over = now - t0 - (int64_t)tmo * NS_PER_MS;
 	if (over > s->crit_ns) {
+		/* Reported from t0, the last moment it is known to have
+		 * run: 'over' alone would leave out the part of the stop
+		 * that fell inside the wait (a 2 s SIGSTOP read 1924 ms). */
 		re_fault_set(f, RE_F_STALL, -1);
-		f->i[0] = over / NS_PER_MS;
+		f->i[0] = (now - t0) / NS_PER_MS;
 		f->i[1] = s->crit_ns / NS_PER_MS;
 		return RE_FAULT;
 	}
