@@ -10,17 +10,22 @@
 #   make install / uninstall   (PREFIX, DESTDIR)
 #
 # Source layout conventions (so that adding a file needs no Makefile edit):
-#   pc/gl_*.c            Galil link library          -> $(BUILD)/lib/libgl.a
-#   pc/re_*.c            supervisor modules          -> $(BUILD)/lib/libre.a
-#   pc/roboelf.c         supervisor main             -> $(BUILD)/bin/roboelf
-#   tools/galil-sim/*.c  simulator (main.c = main)   -> libsim.a + galil-sim
-#   tools/galil-load/*.c loader (main.c = main)      -> libload.a + galil-load
-#   tests/harness/*.c    test helpers                -> libharness.a
-#   tests/stub/*.c       the misbehaving socket stub -> $(BUILD)/bin/galil-stub
-#   tests/<dir>/test_*.c one cmocka binary each      -> $(BUILD)/tests/<dir>/test_*
-#     linked with: libload libsim libre libharness libgl (only what is used is
-#     pulled in), plus extra linker flags from an optional tests/<dir>/test_*.ldflags
-#     file (e.g. -Wl,--wrap=sp_open).
+#   pc/base/*.c          shared base: clock, files, YAML -> $(BUILD)/lib/libbase.a
+#   pc/galil/*.c         Galil link library (gl_*)       -> $(BUILD)/lib/libgl.a
+#   pc/dmc/*.c           the DMC language front end      -> $(BUILD)/lib/libdmc.a
+#   pc/re_*.c            supervisor modules              -> $(BUILD)/lib/libre.a
+#   pc/roboelf.c         supervisor main                 -> $(BUILD)/bin/roboelf
+#   tools/galil-sim/**.c simulator (main.c = main)       -> libsim.a + galil-sim
+#                        (ctrl/ the interpreter, plant/ the robot, net/ the ports)
+#   tools/galil-load/*.c loader (main.c = main)          -> libload.a + galil-load
+#   tests/harness/*.c    test helpers                    -> libharness.a
+#   tests/stub/*.c       the misbehaving socket stub     -> $(BUILD)/bin/galil-stub
+#   tests/<dir>/test_*.c one cmocka binary each          -> $(BUILD)/tests/<dir>/test_*
+#     linked with: libload libsim libre libdmc libgl libbase libharness (only
+#     what is used is pulled in), plus extra linker flags from an optional
+#     tests/<dir>/test_*.ldflags file (e.g. -Wl,--wrap=sp_open).
+# Layering (checked by tests/checks/layers.sh): base <- galil, dmc <- re <- roboelf;
+# base, galil, dmc <- galil-load and galil-sim; nothing includes upward.
 
 CC ?= cc
 CFLAGS ?= -O2 -g
@@ -44,25 +49,33 @@ SAN = -fsanitize=$(SANITIZE) -fno-sanitize-recover=$(SANITIZE) -fno-omit-frame-p
 endif
 
 ALL_CFLAGS = $(WARN) $(CFLAGS) $(SAN) -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE \
-             -Ipc -Itools/galil-sim -Itools/galil-load -Itests/harness -Itests/stub $(PKG_CFLAGS) -MMD -MP
+             $(addprefix -I,$(INC_DIRS)) $(PKG_CFLAGS) -MMD -MP
 ALL_LDFLAGS = $(LDFLAGS) $(SAN)
 LIBS = $(PKG_LIBS) -lpthread -lm
 
-GL_SRC := $(wildcard pc/gl_*.c)
+SIM_DIRS := tools/galil-sim $(wildcard tools/galil-sim/*/)
+INC_DIRS := pc $(wildcard pc/base pc/galil pc/dmc) $(patsubst %/,%,$(SIM_DIRS)) \
+            tools/galil-load tests/harness tests/stub
+
+BASE_SRC := $(wildcard pc/base/*.c)
+GL_SRC := $(wildcard pc/gl_*.c pc/galil/*.c)
+DMC_SRC := $(wildcard pc/dmc/*.c)
 RE_SRC := $(wildcard pc/re_*.c)
-SIM_SRC := $(filter-out tools/galil-sim/main.c,$(wildcard tools/galil-sim/*.c))
+SIM_SRC := $(filter-out tools/galil-sim/main.c,$(wildcard $(addsuffix /*.c,$(patsubst %/,%,$(SIM_DIRS)))))
 LOAD_SRC := $(filter-out tools/galil-load/main.c,$(wildcard tools/galil-load/*.c))
 HARN_SRC := $(wildcard tests/harness/*.c)
 STUB_SRC := $(wildcard tests/stub/*.c)
 TEST_SRC := $(wildcard tests/*/test_*.c)
 
 obj = $(patsubst %.c,$(BUILD)/obj/%.o,$(1))
+LIB_BASE := $(if $(BASE_SRC),$(BUILD)/lib/libbase.a)
 LIB_GL := $(BUILD)/lib/libgl.a
+LIB_DMC := $(if $(DMC_SRC),$(BUILD)/lib/libdmc.a)
 LIB_RE := $(BUILD)/lib/libre.a
 LIB_SIM := $(BUILD)/lib/libsim.a
 LIB_LOAD := $(BUILD)/lib/libload.a
 LIB_HARN := $(BUILD)/lib/libharness.a
-LINK_LIBS := $(LIB_HARN) $(LIB_LOAD) $(LIB_SIM) $(LIB_RE) $(LIB_GL)
+LINK_LIBS := $(LIB_HARN) $(LIB_LOAD) $(LIB_SIM) $(LIB_RE) $(LIB_DMC) $(LIB_GL) $(LIB_BASE)
 
 BINS := $(if $(wildcard pc/roboelf.c),$(BUILD)/bin/roboelf) \
         $(if $(wildcard tools/galil-load/main.c),$(BUILD)/bin/galil-load) \
@@ -88,22 +101,24 @@ $(1): $(call obj,$(2))
 	@rm -f $$@
 	$$(AR) rcs $$@ $$^
 endef
+$(if $(LIB_BASE),$(eval $(call mklib,$(LIB_BASE),$(BASE_SRC))))
 $(eval $(call mklib,$(LIB_GL),$(GL_SRC)))
+$(if $(LIB_DMC),$(eval $(call mklib,$(LIB_DMC),$(DMC_SRC))))
 $(eval $(call mklib,$(LIB_RE),$(RE_SRC)))
 $(eval $(call mklib,$(LIB_SIM),$(SIM_SRC)))
 $(eval $(call mklib,$(LIB_LOAD),$(LOAD_SRC)))
 $(eval $(call mklib,$(LIB_HARN),$(HARN_SRC)))
 
-$(BUILD)/bin/roboelf: $(call obj,pc/roboelf.c) $(LIB_RE) $(LIB_GL)
+$(BUILD)/bin/roboelf: $(call obj,pc/roboelf.c) $(LIB_RE) $(LIB_DMC) $(LIB_GL) $(LIB_BASE)
 	@mkdir -p $(@D)
 	$(CC) $(ALL_LDFLAGS) -o $@ $^ $(LIBS)
-$(BUILD)/bin/galil-load: $(call obj,tools/galil-load/main.c) $(LIB_LOAD) $(LIB_GL)
+$(BUILD)/bin/galil-load: $(call obj,tools/galil-load/main.c) $(LIB_LOAD) $(LIB_DMC) $(LIB_GL) $(LIB_BASE)
 	@mkdir -p $(@D)
 	$(CC) $(ALL_LDFLAGS) -o $@ $^ $(LIBS)
-$(BUILD)/bin/galil-sim: $(call obj,tools/galil-sim/main.c) $(LIB_SIM) $(LIB_RE) $(LIB_GL)
+$(BUILD)/bin/galil-sim: $(call obj,tools/galil-sim/main.c) $(LIB_SIM) $(LIB_RE) $(LIB_DMC) $(LIB_GL) $(LIB_BASE)
 	@mkdir -p $(@D)
 	$(CC) $(ALL_LDFLAGS) -o $@ $^ $(LIBS)
-$(BUILD)/bin/galil-stub: $(call obj,$(STUB_SRC)) $(LIB_GL)
+$(BUILD)/bin/galil-stub: $(call obj,$(STUB_SRC)) $(LIB_GL) $(LIB_BASE)
 	@mkdir -p $(@D)
 	$(CC) $(ALL_LDFLAGS) -o $@ $^ $(LIBS)
 
@@ -134,7 +149,7 @@ bench: deps
 lint:
 	clang-format --dry-run --Werror $(shell git ls-files '*.c' '*.h' 2>/dev/null)
 	cppcheck --quiet --error-exitcode=1 --std=c11 --enable=warning,portability \
-		--suppress=missingIncludeSystem -Ipc -Itools/galil-sim -Itools/galil-load \
+		--suppress=missingIncludeSystem $(addprefix -I,$(INC_DIRS)) \
 		pc tools tests
 
 # ---- dependencies ------------------------------------------------------------
