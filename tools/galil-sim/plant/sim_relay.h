@@ -3,9 +3,10 @@
  * pseudo-terminal that speaks one of the relay byte protocols of
  * relays-and-serial.md and switches the robot's motor power (relay 1).
  *
- * The relay starts OFF (motor power cut). The byte decoder is pure
- * (sim_relay_dec_*); struct sim_relay adds the pty, the optional symbolic
- * link, fault injection and state-change events. Nothing here prints.
+ * The relay starts OFF (motor power cut). The byte decoder is pure and
+ * lives in sim_relay_dec.h; struct sim_relay adds the pty, the optional
+ * symbolic link, fault injection and state-change events. Nothing here
+ * prints.
  */
 #ifndef SIM_RELAY_H
 #define SIM_RELAY_H
@@ -13,12 +14,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-enum sim_relay_proto {
-	SIM_RELAY_DEVANTECH, /* 0x65 on, 0x6F off, 0x5B read states */
-	SIM_RELAY_ICSTATION, /* 0x50 -> 0xAB, 0x51, then state masks */
-	SIM_RELAY_LCUS,	     /* A0 01 01 A2 on, A0 01 00 A1 off */
-	SIM_RELAY_KMTRONIC,  /* FF 01 01 on, FF 01 00 off, FF 01 03 read */
-};
+#include "sim_relay_dec.h"
 
 enum sim_relay_fault {
 	SIM_RELAY_OK,	     /* present and obeying */
@@ -27,36 +23,6 @@ enum sim_relay_fault {
 	SIM_RELAY_WEDGE,     /* device present, bytes left unread in the
 			      * pty, relay state kept as it was */
 };
-
-/* The protocol state of one relay board. */
-struct sim_relay_dec {
-	enum sim_relay_proto proto;
-	uint8_t states;	  /* bit n-1 = relay n energised */
-	int stage;	  /* icstation: 0 await 0x50, 1 await 0x51, 2 run;
-			   * devantech: 1 = next byte is a 0x5C mask */
-	uint8_t frame[4]; /* lcus / kmtronic frame being received */
-	int nframe;
-};
-
-/*
- * sim_relay_proto_parse() - "devantech", "icstation", "lcus", "kmtronic".
- * Return: 0 or GL_ERR_ARG.
- */
-int sim_relay_proto_parse(const char *name, enum sim_relay_proto *out);
-const char *sim_relay_proto_name(enum sim_relay_proto proto);
-
-/* sim_relay_dec_reset() - a board just powered up: every relay off. */
-void sim_relay_dec_reset(struct sim_relay_dec *d, enum sim_relay_proto proto);
-
-/*
- * sim_relay_dec_feed() - one byte from the host.
- * @reply: [out] bytes the board answers (at most 4); @cap >= 4.
- * @note: [out] optional, set to a short text when the byte was ignored
- *        (unknown command, bad checksum), else "".
- * Return: the number of reply bytes.
- */
-size_t sim_relay_dec_feed(struct sim_relay_dec *d, uint8_t b, uint8_t *reply,
-			  size_t cap, const char **note);
 
 struct sim_relay;
 

@@ -12,6 +12,10 @@
  * moves bytes. Commands are executed as they arrive, between samples, as
  * the controller's command interpreter does. Both ports bind 127.0.0.1
  * only. Nothing here prints.
+ *
+ * This is the loop and the server's life cycle only: the command port's
+ * connections and link faults are sim_cmdport.h, the control port's line
+ * framing sim_ctlport.h, the listener sim_sock.h.
  */
 #ifndef SIM_NET_H
 #define SIM_NET_H
@@ -21,8 +25,6 @@
 #include <stdint.h>
 
 #include "sim.h"
-
-#define SIM_NET_CONTROL_CLIENTS 4 /* simultaneous control connections */
 
 struct sim_net;
 
@@ -36,31 +38,42 @@ struct sim_net_stats {
 
 /*
  * sim_net_open() - bind the command port @port and the control port
- * @control_port on 127.0.0.1 (0 = any free port) and listen.
- * @s: the simulator served (not owned).
- * @err: [out] e.g. "cannot bind 127.0.0.1:23023: Address already in use".
+ * @control_port on 127.0.0.1 (0 = any free port) and listen; the server
+ * becomes @s's disconnect callback (sim_set_disconnect()).
+ * @out: [out] the server (owned by the caller: sim_net_free()), NULL on
+ *       failure.
+ * @s: the simulator served (not owned; it must outlive the server).
+ * @err: [out] e.g. "cannot listen on 127.0.0.1:23023: Address already in
+ *       use"; @errlen its size.
  * Return: 0, GL_ERR_SYS, GL_ERR_NOMEM.
  */
 int sim_net_open(struct sim_net **out, struct sim *s, int port,
 		 int control_port, char *err, size_t errlen);
 
-/* sim_net_free() - close every socket. NULL is a no-op. */
+/*
+ * sim_net_free() - close every socket and the timer, and stop being @n's
+ * simulator's disconnect callback. NULL is a no-op.
+ */
 void sim_net_free(struct sim_net *n);
 
-/* sim_net_port() / sim_net_control_port() - the bound port numbers. */
+/*
+ * sim_net_port() / sim_net_control_port() - the bound port numbers of the
+ * command port and of the control port (1..65535).
+ */
 int sim_net_port(const struct sim_net *n);
 int sim_net_control_port(const struct sim_net *n);
 
 /*
  * sim_net_run() - serve in real time until the "quit" request or until
- * *@stop becomes non-zero (set it from a signal handler).
- * @err: [out] the reason on failure.
+ * *@stop becomes non-zero (set it from a signal handler; NULL = never).
+ * What is queued is flushed once more before it returns (the "ok" of quit).
+ * @err: [out] the reason on failure; @errlen its size.
  * Return: 0, or GL_ERR_SYS (poll or the timer failed).
  */
 int sim_net_run(struct sim_net *n, volatile sig_atomic_t *stop, char *err,
 		size_t errlen);
 
-/* sim_net_stats() - loop figures since sim_net_open(). */
+/* sim_net_stats() - copy the loop figures since sim_net_open() to @out. */
 void sim_net_stats(const struct sim_net *n, struct sim_net_stats *out);
 
 #endif /* SIM_NET_H */

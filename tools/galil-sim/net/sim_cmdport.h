@@ -1,0 +1,119 @@
+/*
+ * sim_cmdport.h - galil-sim's Galil command port: the TCP connections that
+ * are the controller's Ethernet handles A..H (slot index = handle), the
+ * bytes between them and the controller (ctrl_input / ctrl_output), and
+ * the link faults of sim_link() applied on the way.
+ *
+ * Link faults: SIM_LINK_DROP closes every connection (through the
+ * disconnect callback, at once) and closes new ones as soon as they are
+ * accepted; SIM_LINK_STALL reads and discards what the hosts send and sends
+ * nothing (a half-open link: both directions lost), and leaves new
+ * connections in the listen backlog (the loop does not poll the listener);
+ * SIM_LINK_DELAY holds each reply back by the delay before it is written.
+ *
+ * IH closing: a handle the controller marks (ctrl_handle_close_wanted()) is
+ * closed after the reply of the IH command has gone to its sender. Opening
+ * and closing a connection are events ("handle A opened from ...",
+ * "handle A closed (peer)").
+ *
+ * It is not the event loop (sim_net.h polls the descriptors and calls in
+ * here), not the control port (sim_ctlport.h) and not the command language
+ * (the controller parses the bytes). Nothing here prints or allocates.
+ */
+#ifndef SIM_CMDPORT_H
+#define SIM_CMDPORT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sim.h"
+
+#define SIM_CMDPORT_OUT_CAP 65536 /* bytes queued per connection */
+#define SIM_CMDPORT_CHUNKS  512	  /* delayed reply chunks per connection */
+
+/* One reply chunk queued: it ends at @end in out[], may go at @due_us. */
+struct sim_cmdport_chunk {
+	size_t end;	/* offset in out[] where this chunk ends */
+	int64_t due_us; /* monotonic time it may be sent, us */
+};
+
+/* One command connection = one controller handle. */
+struct sim_cmdport_conn {
+	int fd; /* -1 = free; slot index = controller handle */
+	uint8_t out[SIM_CMDPORT_OUT_CAP];
+	size_t out_len;
+	struct sim_cmdport_chunk chunk[SIM_CMDPORT_CHUNKS];
+	int nchunk;
+};
+
+/* The command port; embed it (it is large) and use the functions below. */
+struct sim_cmdport {
+	struct sim *sim; /* served, not owned */
+	int lfd;	 /* listener, -1 = none */
+	int port;	 /* bound port number */
+	uint64_t refused; /* connections refused (all 8 busy, link dropped) */
+	struct sim_cmdport_conn conn[CTRL_HANDLES];
+};
+
+/*
+ * sim_cmdport_init() - an idle port serving @s (not owned): no listener, no
+ * connection. Call it before any other sim_cmdport_* call.
+ */
+void sim_cmdport_init(struct sim_cmdport *cp, struct sim *s);
+
+/*
+ * sim_cmdport_listen() - bind 127.0.0.1:@port (0 = any free port), listen.
+ * @err: [out] the reason on failure; @errlen its size.
+ * Return: 0 or GL_ERR_SYS.
+ */
+int sim_cmdport_listen(struct sim_cmdport *cp, int port, char *err,
+		       size_t errlen);
+
+/*
+ * sim_cmdport_shutdown() - close every connection (no event, the
+ * controller's handles closed) and the listener. The port may be
+ * listened on again.
+ */
+void sim_cmdport_shutdown(struct sim_cmdport *cp);
+
+/*
+ * sim_cmdport_disconnect_all() - the disconnect callback of
+ * sim_set_disconnect() (@ud = the struct sim_cmdport): close every
+ * connection with the event "handle X closed (link drop)" or
+ * "(power cycle)", after sim_link().
+ */
+void sim_cmdport_disconnect_all(void *ud);
+
+/*
+ * sim_cmdport_listen_fd() / sim_cmdport_fd() - the descriptors to poll for
+ * input: the listener (-1 while SIM_LINK_STALL: new connections wait in the
+ * backlog), and the connection of handle @h (0..CTRL_HANDLES-1; -1 when
+ * the handle has none).
+ */
+int sim_cmdport_listen_fd(const struct sim_cmdport *cp);
+int sim_cmdport_fd(const struct sim_cmdport *cp, int h);
+
+/*
+ * sim_cmdport_accept() - accept one waiting connection as the lowest free
+ * handle, or refuse it (all handles busy, SIM_LINK_DROP) with an event.
+ */
+void sim_cmdport_accept(struct sim_cmdport *cp);
+
+/*
+ * sim_cmdport_read() - read what handle @h's host sent (without blocking)
+ * and give it to the controller (dropped under SIM_LINK_STALL); a closed
+ * or failed connection is closed with its event. No-op without a
+ * connection.
+ */
+void sim_cmdport_read(struct sim_cmdport *cp, int h);
+
+/*
+ * sim_cmdport_flush() - take every handle's controller output into its
+ * queue (due at @now_us, or @now_us + the delay under SIM_LINK_DELAY;
+ * discarded under SIM_LINK_STALL), send what is due (without blocking),
+ * then close the handles IH wants closed whose IH reply has gone.
+ * @now_us: CLOCK_MONOTONIC time, microseconds.
+ */
+void sim_cmdport_flush(struct sim_cmdport *cp, int64_t now_us);
+
+#endif /* SIM_CMDPORT_H */
