@@ -39,22 +39,30 @@ enum sim_link {
 };
 
 /*
- * sim_new() - a simulator with the plant from @plant_file (YAML), or the
- * built-in default robot when @plant_file is NULL.
- * @err: [out] "FILE:LINE:COLUMN: message" on a bad plant file.
+ * sim_new() / sim_free() - a simulator with the plant from @plant_file
+ * (YAML), or the built-in default robot when @plant_file is NULL; the
+ * relay off, no pty; and its release (controller, plant, relay, pty and
+ * link; NULL is a no-op).
+ * @out: [out] the simulator, owned by the caller (sim_free()); NULL on
+ *       failure.
+ * @err: [out] "FILE:LINE:COLUMN: message" on a bad plant file; @errlen its
+ *       size.
  * Return: 0, GL_ERR_CONFIG, GL_ERR_NOMEM.
  */
 int sim_new(struct sim **out, const char *plant_file, char *err, size_t errlen);
 void sim_free(struct sim *s);
 
-/* sim_ctrl() - the controller inside, for ctrl_* calls. */
+/* sim_ctrl() - the controller inside, for ctrl_* calls (owned by @s). */
 struct ctrl *sim_ctrl(struct sim *s);
 
-/* sim_get_plant() / sim_get_relay() - the robot and the relay inside. */
+/*
+ * sim_get_plant() / sim_get_relay() - the robot and the relay inside, for
+ * sim_plant_* and sim_relay_* calls (owned by @s).
+ */
 struct sim_plant *sim_get_plant(struct sim *s);
 struct sim_relay *sim_get_relay(struct sim *s);
 
-/* sim_seed() - restart the potentiometer noise from @seed. */
+/* sim_seed() - restart the potentiometer noise generator from @seed. */
 void sim_seed(struct sim *s, unsigned long seed);
 
 /*
@@ -122,16 +130,20 @@ void sim_set_event_hook(struct sim *s,
 			void (*fn)(void *ud, double t_ms, const char *text),
 			void *ud);
 
-/* sim_link() - the injected link fault and its delay (ms). */
+/*
+ * sim_link() - the link fault injected now; @delay_ms: [out] optional
+ * (NULL), its reply delay in ms (SIM_LINK_DELAY).
+ */
 enum sim_link sim_link(const struct sim *s, double *delay_ms);
 
 /*
- * sim_set_disconnect() - @fn is called to close every command connection
- * (link drop, power cycle) before the controller state changes.
+ * sim_set_disconnect() - @fn(@ud) is called to close every command
+ * connection (link drop, power cycle) before the controller state changes.
+ * One callback at a time; NULL removes it. @ud is not owned.
  */
 void sim_set_disconnect(struct sim *s, void (*fn)(void *ud), void *ud);
 
-/* sim_quit_requested() - 1 after the "quit" request. */
+/* sim_quit_requested() - 1 after the "quit" request, else 0. */
 int sim_quit_requested(const struct sim *s);
 
 #endif /* SIM_H */

@@ -49,7 +49,11 @@ struct sim {
 	int prev_power, prev_pout;
 };
 
-/* sim_fmt_ms() - simulated time for messages: "1234" or "1234.5". */
+/*
+ * sim_fmt_ms() - simulated time @t_us (microseconds) as milliseconds for
+ * messages, "1234" or "1234.5", into @buf of @cap bytes (NUL-terminated,
+ * cut to fit).
+ */
 void sim_fmt_ms(char *buf, size_t cap, int64_t t_us);
 
 #endif /* SIM_INT_H */

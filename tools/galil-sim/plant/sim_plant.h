@@ -102,14 +102,19 @@ struct sim_plant_axis_state {
 
 struct sim_plant;
 
-/* sim_plant_cfg_default() - the built-in default robot (config/plant.yaml). */
+/*
+ * sim_plant_cfg_default() - fill @cfg (caller's storage) with the built-in
+ * default robot (the values of config/plant.yaml).
+ */
 void sim_plant_cfg_default(struct sim_plant_cfg *cfg);
 
 /*
  * sim_plant_cfg_parse() - override @cfg with the YAML plant text @buf.
  * @cfg: [in,out] usually the defaults; left untouched on error.
+ * @buf, @len: the YAML text and its length in bytes (not NUL-terminated
+ *        necessarily; not kept).
  * @name: file name used in messages.
- * @err: [out] "NAME:LINE:COLUMN: message" on error.
+ * @err: [out] "NAME:LINE:COLUMN: message" on error; @errlen its size.
  * Unknown keys, duplicate keys, an empty document, wrong types and values
  * out of range are errors. Return: 0 or GL_ERR_CONFIG.
  */
@@ -117,7 +122,9 @@ int sim_plant_cfg_parse(struct sim_plant_cfg *cfg, const char *buf, size_t len,
 			const char *name, char *err, size_t errlen);
 
 /*
- * sim_plant_cfg_load() - sim_plant_cfg_parse() on the contents of @path.
+ * sim_plant_cfg_load() - sim_plant_cfg_parse() on the contents of @path
+ * (the file name in messages is @path).
+ * @cfg: [in,out] as for sim_plant_cfg_parse(). @err: [out], @errlen.
  * Return: 0 or GL_ERR_CONFIG ("PATH:0:0: cannot read ..." when unreadable).
  */
 int sim_plant_cfg_load(struct sim_plant_cfg *cfg, const char *path, char *err,
@@ -125,20 +132,24 @@ int sim_plant_cfg_load(struct sim_plant_cfg *cfg, const char *path, char *err,
 
 /*
  * sim_plant_cfg_check() - range checks of a whole configuration.
- * @err: [out] a message naming the field. Return: 0 or GL_ERR_CONFIG.
+ * @err: [out] a message naming the field; @errlen its size.
+ * Return: 0 or GL_ERR_CONFIG.
  */
 int sim_plant_cfg_check(const struct sim_plant_cfg *cfg, char *err,
 			size_t errlen);
 
 /*
- * sim_plant_new() - a robot at its start positions, joysticks neutral, no
- * fault, encoders reading 0 at the centre of travel.
+ * sim_plant_new() / sim_plant_free() - a robot at its start positions,
+ * joysticks neutral, no fault, encoders reading 0 at the centre of travel;
+ * and its release (NULL is a no-op).
+ * @out: [out] the robot, owned by the caller (sim_plant_free()); NULL on
+ *       failure. @cfg: copied, not kept.
  * Return: 0, GL_ERR_CONFIG (cfg fails sim_plant_cfg_check), GL_ERR_NOMEM.
  */
 int sim_plant_new(struct sim_plant **out, const struct sim_plant_cfg *cfg);
 void sim_plant_free(struct sim_plant *p);
 
-/* sim_plant_cfg() - the configuration in use. */
+/* sim_plant_get_cfg() - the configuration in use (owned by @p). */
 const struct sim_plant_cfg *sim_plant_get_cfg(const struct sim_plant *p);
 
 /* sim_plant_seed() - restart the noise generator from @seed. */
@@ -190,8 +201,15 @@ double sim_plant_pot_volts(const struct sim_plant_axis_cfg *ax,
 			   double pos_counts);
 
 /*
- * Faults and operator inputs. @axis is 0..2; functions taking an index
- * return 0 or GL_ERR_ARG for an index or value out of range.
+ * Faults of one axis (@axis 0..2): sim_plant_set_pot_fault() with
+ * @offset_v the offset in volts (finite; used by SIM_PLANT_POT_OFFSET
+ * only; STUCK freezes the last reading); sim_plant_set_pot_noise() the
+ * noise bound @noise_v in volts (0..1); sim_plant_set_enc_fault() with
+ * @slip_counts the offset in counts (|slip| <= 1e8, rounded; used by
+ * SIM_PLANT_ENC_SLIP only; STUCK freezes the count); sim_plant_set_block()
+ * a jam (non-zero) or none (0).
+ * Return: 0, or GL_ERR_ARG for an axis, fault or value out of range
+ * (nothing changed).
  */
 int sim_plant_set_pot_fault(struct sim_plant *p, int axis,
 			    enum sim_plant_pot_fault f, double offset_v);
@@ -201,17 +219,27 @@ int sim_plant_set_enc_fault(struct sim_plant *p, int axis,
 int sim_plant_set_block(struct sim_plant *p, int axis, int blocked);
 
 /*
- * sim_plant_set_joy() - set the switches of @axis: @dir with channel mask
- * @chan (bit 0 = a, bit 1 = b; 3 = both) closed, every other switch of that
- * axis open. SIM_PLANT_NEUTRAL opens all four.
+ * sim_plant_set_joy() - set the switches of @axis (0..2): @dir with channel
+ * mask @chan (bit 0 = a, bit 1 = b; 3 = both) closed, every other switch of
+ * that axis open. SIM_PLANT_NEUTRAL opens all four.
+ * Return: 0, or GL_ERR_ARG for an axis, direction or mask out of range.
  */
 int sim_plant_set_joy(struct sim_plant *p, int axis, enum sim_plant_dir dir,
 		      unsigned chan);
 
-/* sim_plant_force_input() - digital input n (1..32) forced to @level. */
+/*
+ * sim_plant_force_input() / sim_plant_release_input() - digital input @n
+ * (1..32) forced to @level (0 or 1, overriding the joystick model), or
+ * given back to the model.
+ * Return: 0, or GL_ERR_ARG for @n or @level out of range.
+ */
 int sim_plant_force_input(struct sim_plant *p, int n, int level);
 int sim_plant_release_input(struct sim_plant *p, int n);
-/* sim_plant_force_analog() - analog input n (1..8) forced to @volts. */
+/*
+ * sim_plant_force_analog() / sim_plant_release_analog() - analog input @n
+ * (1..8) forced to @volts (-10..10), or given back to the model.
+ * Return: 0, or GL_ERR_ARG for @n or @volts out of range.
+ */
 int sim_plant_force_analog(struct sim_plant *p, int n, double volts);
 int sim_plant_release_analog(struct sim_plant *p, int n);
 
@@ -222,7 +250,10 @@ int sim_plant_release_analog(struct sim_plant *p, int n);
  */
 void sim_plant_zero_encoders(struct sim_plant *p);
 
-/* sim_plant_axis() - state of axis 0..2. Return 0 or GL_ERR_ARG. */
+/*
+ * sim_plant_axis() - copy the state of axis @axis (0..2) to @out.
+ * Return: 0, or GL_ERR_ARG for an axis out of range.
+ */
 int sim_plant_axis(const struct sim_plant *p, int axis,
 		   struct sim_plant_axis_state *out);
 

@@ -27,7 +27,8 @@ enum sim_relay_fault {
 struct sim_relay;
 
 /*
- * sim_relay_new() - a relay board (no pty yet), every relay off.
+ * sim_relay_new() - a relay board speaking @proto (no pty yet), every
+ * relay off. @out: [out] the board, owned by the caller (sim_relay_free()).
  * @event: optional callback for each state change ("relay on (0x65)",
  *         "relay off (0x6f)", "relay unplugged" ...); one line, no newline.
  * Return: 0 or GL_ERR_NOMEM.
@@ -35,7 +36,10 @@ struct sim_relay;
 int sim_relay_new(struct sim_relay **out, enum sim_relay_proto proto,
 		  void (*event)(void *ud, const char *line), void *ud);
 
-/* sim_relay_free() - close the pty and remove the link (if still ours). */
+/*
+ * sim_relay_free() - close the pty, remove the link (if it still points at
+ * our pty) and free @r. NULL is a no-op.
+ */
 void sim_relay_free(struct sim_relay *r);
 
 /*
@@ -49,7 +53,10 @@ void sim_relay_free(struct sim_relay *r);
 int sim_relay_attach(struct sim_relay *r, const char *link_path, char *err,
 		     size_t errlen);
 
-/* sim_relay_tty() - the slave path ("/dev/pts/N"), "" without a pty. */
+/*
+ * sim_relay_tty() - the slave path ("/dev/pts/N"), "" without a pty; owned
+ * by @r, valid until the next fault injection or sim_relay_free().
+ */
 const char *sim_relay_tty(const struct sim_relay *r);
 
 /*
@@ -100,6 +107,8 @@ int sim_relay_set(struct sim_relay *r, int on);
  */
 int sim_relay_set_fault(struct sim_relay *r, enum sim_relay_fault f, char *err,
 			size_t errlen);
+
+/* sim_relay_get_fault() - the fault injected now (SIM_RELAY_OK: none). */
 enum sim_relay_fault sim_relay_get_fault(const struct sim_relay *r);
 
 #endif /* SIM_RELAY_H */

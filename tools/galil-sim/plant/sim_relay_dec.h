@@ -30,21 +30,27 @@ struct sim_relay_dec {
 };
 
 /*
- * sim_relay_proto_parse() - "devantech", "icstation", "lcus", "kmtronic".
- * Return: 0 or GL_ERR_ARG.
+ * sim_relay_proto_parse() / sim_relay_proto_name() - a protocol from its
+ * name ("devantech", "icstation", "lcus", "kmtronic") into @out, and the
+ * name of @proto (a static string; "?" for a value out of range).
+ * Return (parse): 0, or GL_ERR_ARG for an unknown name (@out untouched).
  */
 int sim_relay_proto_parse(const char *name, enum sim_relay_proto *out);
 const char *sim_relay_proto_name(enum sim_relay_proto proto);
 
-/* sim_relay_dec_reset() - a board just powered up: every relay off. */
+/*
+ * sim_relay_dec_reset() - @d (caller's storage) becomes a board speaking
+ * @proto just powered up: every relay off, no frame begun.
+ */
 void sim_relay_dec_reset(struct sim_relay_dec *d, enum sim_relay_proto proto);
 
 /*
- * sim_relay_dec_feed() - one byte from the host.
+ * sim_relay_dec_feed() - one byte @b from the host; relay states change in
+ * @d as the protocol says.
  * @reply: [out] bytes the board answers (at most 4); @cap >= 4.
  * @note: [out] optional, set to a short text when the byte was ignored
  *        (unknown command, bad checksum), else "".
- * Return: the number of reply bytes.
+ * Return: the number of reply bytes (0 when @cap < 4: nothing decoded).
  */
 size_t sim_relay_dec_feed(struct sim_relay_dec *d, uint8_t b, uint8_t *reply,
 			  size_t cap, const char **note);
