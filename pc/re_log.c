@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "base_clock.h"
 #include "gl_err.h"
 
 static const char *const re_log_level_names[] = {"INFO", "WARN", "FAULT"};
@@ -250,11 +251,8 @@ int re_log_write_at(struct re_log *lg, enum re_log_level lvl,
 
 static void re_log_now(struct timespec *wall, int64_t *mono_ns)
 {
-	struct timespec m;
-
 	clock_gettime(CLOCK_REALTIME, wall);
-	clock_gettime(CLOCK_MONOTONIC, &m);
-	*mono_ns = (int64_t)m.tv_sec * 1000000000 + m.tv_nsec;
+	*mono_ns = base_now_ns();
 }
 
 static int re_log_vwrite(struct re_log *lg, enum re_log_level lvl,
