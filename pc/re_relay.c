@@ -58,6 +58,7 @@
 #include <unistd.h>
 
 #include "base_clock.h"
+#include "base_durable.h"
 #include "gl_err.h"
 #include "re_pathwatch.h"
 #include "re_relay_be.h"
@@ -601,23 +602,19 @@ static bool ics_recorded(const struct re_relay *r, const char *id)
 	return same;
 }
 
-/* Write the record atomically: temporary file, fsync, rename. */
+/* Write the record durably: temporary file, fsync, rename, fsync of the
+ * directory (base_durable_write). */
 static int ics_record(struct re_relay *r, const char *id, uint8_t model)
 {
-	char tmp[RE_RELAY_PATH_MAX + 8], text[256];
-	int fd, n, ok;
+	char text[256];
+	int n;
 
-	snprintf(tmp, sizeof(tmp), "%s.tmp", r->cfg.icstation_state);
 	n = snprintf(text, sizeof(text), "%s model=0x%02X\n", id, model);
-	fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-	if (fd < 0)
-		goto out_fail;
-	ok = write(fd, text, (size_t)n) == n && !fsync(fd);
-	ok = !close(fd) && ok;
-	if (ok && !rename(tmp, r->cfg.icstation_state))
+	if (n < 0 || (size_t)n >= sizeof(text))
+		n = (int)strlen(text);
+	if (base_durable_write(r->cfg.icstation_state, text, (size_t)n,
+			       0644) == 0)
 		return GL_OK;
-	unlink(tmp);
-out_fail:
 	return set_err(r, GL_ERR_RELAY,
 		       "cannot record the icstation "
 		       "handshake in '%s': %s",
