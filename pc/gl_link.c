@@ -66,6 +66,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "base_clock.h"
 #include "gl_err.h"
 #include "gl_link.h"
 #include "gl_proto.h"
@@ -108,17 +109,9 @@ struct xfer {
 
 /* ---- time ---------------------------------------------------------------- */
 
-static int64_t now_ms(void)
-{
-	struct timespec ts;
-
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (int64_t)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
-}
-
 static int left_ms(int64_t deadline)
 {
-	int64_t d = deadline - now_ms();
+	int64_t d = deadline - base_now_ms();
 
 	return d < 0 ? 0 : (int)d;
 }
@@ -239,7 +232,7 @@ static int link_connect(gl_link *l, const char *addr, int timeout_ms, char *err)
 {
 	char host[256], port[8];
 	struct addrinfo hints = {0}, *res, *ai;
-	int64_t deadline = now_ms() + timeout_ms;
+	int64_t deadline = base_now_ms() + timeout_ms;
 	int rc = GL_ERR_SYS, grc;
 
 	if (gl_link_addr_split(addr, host, sizeof(host), port, sizeof(port)) <
@@ -437,7 +430,7 @@ static int xfer_end(gl_link *l, struct gl_chan *ch, struct gl_reply *r,
 static int xfer(gl_link *l, struct gl_chan *ch, const struct xfer *x,
 		int timeout_ms, struct gl_reply *r)
 {
-	int64_t deadline = now_ms() + timeout_ms;
+	int64_t deadline = base_now_ms() + timeout_ms;
 	int rc;
 
 	rc = xfer_begin(l, ch, x, deadline);
@@ -711,7 +704,7 @@ static int dl_validate(const char *prog, size_t len, int *bad_line)
  */
 static int dl_early_reject(gl_link *l, struct gl_reply *r, bool *done)
 {
-	int64_t deadline = l->dl_pace_ms > 0 ? now_ms() + l->dl_pace_ms : -1;
+	int64_t deadline = l->dl_pace_ms > 0 ? base_now_ms() + l->dl_pace_ms : -1;
 	int rc, n_err = 0;
 
 	rc = chan_read(l, &l->cmd, deadline);
@@ -764,7 +757,7 @@ static int dl_run(gl_link *l, const char *prog, size_t len, int *bad,
 		  int timeout_ms, struct gl_reply *r)
 {
 	const struct xfer x = {.line = "DL", .len = 2, .n_term = 2};
-	int64_t deadline = now_ms() + timeout_ms;
+	int64_t deadline = base_now_ms() + timeout_ms;
 	bool done = false;
 	int rc;
 
@@ -872,7 +865,7 @@ int gl_link_open_messages(gl_link *l, int timeout_ms)
 	gl_proto_init(&l->msg.p);
 	l->msg.broken = false;
 	rc = sock_connect((struct sockaddr *)&l->addr, l->addr_len,
-			  now_ms() + t, &l->msg.fd);
+			  base_now_ms() + t, &l->msg.fd);
 	if (rc < 0)
 		return rc;
 	rc = msg_which_handle(l, t, &letter);

@@ -13,12 +13,14 @@
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
+#include "base_durable.h"
+#include "base_file.h"
 #include "gl_err.h"
 
 #define RE_CALFILE_MAGIC    "roboelf-calibration"
@@ -730,48 +732,6 @@ static void re_hook(int step)
 		re_calfile_save_hook(step);
 }
 
-static int re_write_all(int fd, const char *buf, size_t len)
-{
-	ssize_t n;
-
-	while (len > 0) {
-		n = write(fd, buf, len);
-		if (n < 0 && errno == EINTR)
-			continue;
-		if (n <= 0) {
-			if (n == 0)
-				errno = EIO;
-			return -1;
-		}
-		buf += n;
-		len -= (size_t)n;
-	}
-	return 0;
-}
-
-/* fsync the directory that holds @path. */
-static int re_sync_dir(const char *path)
-{
-	char dir[PATH_MAX];
-	const char *slash = strrchr(path, '/');
-	int fd, rc, e;
-
-	if (!slash)
-		snprintf(dir, sizeof(dir), ".");
-	else if (slash == path)
-		snprintf(dir, sizeof(dir), "/");
-	else
-		snprintf(dir, sizeof(dir), "%.*s", (int)(slash - path), path);
-	fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-	if (fd < 0)
-		return -1;
-	rc = fsync(fd);
-	e = errno;
-	close(fd);
-	errno = e;
-	return rc;
-}
-
 /* Write @buf to @tmp and fsync it. */
 static int re_write_tmp(const char *tmp, const char *buf, size_t len, char *err,
 			size_t errlen)
@@ -785,7 +745,7 @@ static int re_write_tmp(const char *tmp, const char *buf, size_t len, char *err,
 		errno = e;
 		return GL_ERR_SYS;
 	}
-	if (re_write_all(fd, buf, len) != 0 || fsync(fd) != 0) {
+	if (base_write_all(fd, buf, len) != 0 || fsync(fd) != 0) {
 		e = errno;
 		close(fd);
 		unlink(tmp);
@@ -877,7 +837,7 @@ static int re_save_text(const char *path, const char *text, size_t len,
 		goto remove_tmp;
 	}
 	re_hook(3);
-	if (re_sync_dir(path) != 0) {
+	if (base_fsync_dir(path) != 0) {
 		e = errno;
 		re_err(err, errlen, "cannot sync the directory of '%s': %s",
 		       path, strerror(e));
@@ -927,61 +887,36 @@ free_buf:
 	return rc;
 }
 
-/* Read the whole file into a new buffer. */
+/* Errors of base_file_read() that come from reading, not from opening. */
+static bool re_read_errno(int e)
+{
+	return e == EIO || e == EOVERFLOW;
+}
+
+/* Read the whole file into a new buffer (base_file_read), saying why not
+ * in @err as "cannot open", "not a calibration file" or "cannot read". */
 static int re_read_file(const char *path, char **out, size_t *len, char *err,
 			size_t errlen)
 {
-	struct stat st;
-	ssize_t n;
-	size_t got = 0;
-	int fd, e, rc = GL_ERR_SYS;
-	char *buf = NULL;
+	int rc = base_file_read(path, RE_CALFILE_MAX_BYTES, out, len);
 
-	fd = open(path, O_RDONLY | O_CLOEXEC);
-	if (fd < 0) {
-		e = errno;
-		re_err(err, errlen, "cannot open '%s': %s", path, strerror(e));
-		errno = e;
-		return e == ENOENT ? GL_ERR_NOENT : GL_ERR_SYS;
-	}
-	if (fstat(fd, &st) != 0)
-		goto fail_errno;
-	if (!S_ISREG(st.st_mode) || st.st_size > RE_CALFILE_MAX_BYTES) {
+	if (rc == 0)
+		return GL_OK;
+	if (rc == -EFBIG || rc == -EISDIR || rc == -EINVAL) {
 		re_err(err, errlen,
 		       "'%s' is not a calibration file (not a "
 		       "regular file or larger than %d bytes)",
 		       path, RE_CALFILE_MAX_BYTES);
-		rc = GL_ERR_FORMAT;
-		goto close_fd;
+		return GL_ERR_FORMAT;
 	}
-	buf = malloc((size_t)st.st_size + 1);
-	if (!buf) {
+	if (rc == -ENOMEM) {
 		re_err(err, errlen, "cannot read '%s': out of memory", path);
-		rc = GL_ERR_NOMEM;
-		goto close_fd;
+		return GL_ERR_NOMEM;
 	}
-	while (got < (size_t)st.st_size) {
-		n = read(fd, buf + got, (size_t)st.st_size - got);
-		if (n < 0 && errno == EINTR)
-			continue;
-		if (n < 0)
-			goto fail_errno;
-		if (n == 0)
-			break; /* shrank meanwhile: parse what is there */
-		got += (size_t)n;
-	}
-	close(fd);
-	*out = buf;
-	*len = got;
-	return GL_OK;
-fail_errno:
-	e = errno;
-	re_err(err, errlen, "cannot read '%s': %s", path, strerror(e));
-	errno = e;
-close_fd:
-	free(buf);
-	close(fd);
-	return rc;
+	re_err(err, errlen, "cannot %s '%s': %s",
+	       re_read_errno(-rc) ? "read" : "open", path, strerror(-rc));
+	errno = -rc;
+	return rc == -ENOENT ? GL_ERR_NOENT : GL_ERR_SYS;
 }
 
 int re_calfile_load(const char *path, const struct re_calfile_expect *exp,

@@ -1,6 +1,6 @@
 /*
  * re_io.c - the real binding of struct re_io: gl_link, re_relay, re_log and
- * CLOCK_MONOTONIC. See re_io.h.
+ * the monotonic clock (base_clock). See re_io.h.
  */
 #include "re_io.h"
 
@@ -10,14 +10,12 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "base_clock.h"
 #include "gl_err.h"
 
 int64_t re_io_now_ns(void)
 {
-	struct timespec ts;
-
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+	return base_now_ns();
 }
 
 static int real_record(void *ud, const char *prefix, struct gl_record *rec,
@@ -190,15 +188,8 @@ static int64_t real_now_ns(void *ud)
 
 static void real_sleep_until(void *ud, int64_t t_ns)
 {
-	struct timespec ts = {
-	    .tv_sec = (time_t)(t_ns / 1000000000),
-	    .tv_nsec = (long)(t_ns % 1000000000),
-	};
-
 	(void)ud;
-	while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) ==
-	       EINTR)
-		;
+	base_sleep_until_ns(t_ns);
 }
 
 static const struct re_io_ops real_ops = {

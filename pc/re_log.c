@@ -11,6 +11,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "base_clock.h"
+#include "base_durable.h"
 #include "gl_err.h"
 
 static const char *const re_log_level_names[] = {"INFO", "WARN", "FAULT"};
@@ -20,27 +22,6 @@ struct re_log_cfg re_log_cfg_default(void)
 	struct re_log_cfg c = {10u * 1024 * 1024, 5, 1000};
 
 	return c;
-}
-
-/* fsync the directory holding @path, so a new or renamed entry persists. */
-static int re_log_sync_dir(const char *path)
-{
-	char dir[RE_LOG_PATH_MAX];
-	const char *slash = strrchr(path, '/');
-	int fd, rc;
-
-	if (!slash)
-		snprintf(dir, sizeof(dir), ".");
-	else if (slash == path)
-		snprintf(dir, sizeof(dir), "/");
-	else
-		snprintf(dir, sizeof(dir), "%.*s", (int)(slash - path), path);
-	fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-	if (fd < 0)
-		return GL_ERR_SYS;
-	rc = fsync(fd);
-	close(fd);
-	return rc == 0 ? GL_OK : GL_ERR_SYS;
 }
 
 static int re_log_open_fd(struct re_log *lg)
@@ -60,7 +41,8 @@ static int re_log_open_fd(struct re_log *lg)
 		return GL_ERR_SYS;
 	}
 	lg->size = st.st_size;
-	return re_log_sync_dir(lg->path);
+	/* the directory too, so that a new entry persists (errno kept) */
+	return base_fsync_dir(lg->path) == 0 ? GL_OK : GL_ERR_SYS;
 }
 
 int re_log_open(struct re_log *lg, const char *path,
@@ -250,11 +232,8 @@ int re_log_write_at(struct re_log *lg, enum re_log_level lvl,
 
 static void re_log_now(struct timespec *wall, int64_t *mono_ns)
 {
-	struct timespec m;
-
 	clock_gettime(CLOCK_REALTIME, wall);
-	clock_gettime(CLOCK_MONOTONIC, &m);
-	*mono_ns = (int64_t)m.tv_sec * 1000000000 + m.tv_nsec;
+	*mono_ns = base_now_ns();
 }
 
 static int re_log_vwrite(struct re_log *lg, enum re_log_level lvl,

@@ -57,6 +57,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "base_clock.h"
+#include "base_durable.h"
 #include "gl_err.h"
 #include "re_pathwatch.h"
 #include "re_relay_be.h"
@@ -68,9 +70,8 @@
 #define ICS_REPLY_MS	500  /* deadline of the identification answer */
 #define PTY_MAJOR_MIN	136  /* Unix98 pty slaves: majors 136..143 */
 #define PTY_MAJOR_MAX	143
-#define NS_PER_MS	1000000LL
-#define NAP_NS		NS_PER_MS    /* longest sleep while waiting */
-#define FULL_CHECK_NS	1000000000LL /* stat() the port at least this often */
+#define NAP_NS		BASE_NS_PER_MS /* longest sleep while waiting */
+#define FULL_CHECK_NS	BASE_NS_PER_S  /* stat() the port at least this often */
 #define STALE_CHUNKS	4 /* x 16 bytes of stale input dropped per call */
 
 enum re_relay_op { OP_NONE = 0, OP_ON, OP_OFF };
@@ -97,7 +98,7 @@ struct re_relay {
 	bool reopen;		  /* "off" could not be written */
 	int rb_due;		  /* state queries sent, not answered */
 	bool rb_discard;	  /* the answers due predate a write */
-	struct timespec rb_sent;  /* the oldest query due was sent */
+	int64_t rb_sent_ns;	  /* the oldest query due was sent (base_now_ns) */
 	char err[RE_RELAY_ERR_MAX];
 };
 
@@ -168,15 +169,6 @@ static int set_err(struct re_relay *r, int rc, const char *fmt, ...)
 	return rc;
 }
 
-static long ms_since(const struct timespec *t)
-{
-	struct timespec now;
-
-	clock_gettime(CLOCK_MONOTONIC, &now);
-	return (now.tv_sec - t->tv_sec) * 1000L +
-	       (now.tv_nsec - t->tv_nsec) / 1000000L;
-}
-
 /* A pseudo-terminal, directly or through a symbolic link? */
 static bool is_pty(const char *path)
 {
@@ -212,32 +204,19 @@ static bool same_node(const struct re_relay *r, const struct stat *st)
 
 /* ---- time ---- */
 
-static int64_t now_ns(void)
-{
-	struct timespec t;
-
-	clock_gettime(CLOCK_MONOTONIC, &t);
-	return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
-}
-
 static int64_t deadline_in(int ms)
 {
-	return now_ns() + (int64_t)ms * NS_PER_MS;
+	return base_now_ns() + (int64_t)ms * BASE_NS_PER_MS;
 }
 
 /* Sleep NAP_NS at most, and never past @deadline. */
 static void nap(int64_t deadline)
 {
-	int64_t t = now_ns() + NAP_NS;
-	struct timespec ts;
+	int64_t t = base_now_ns() + NAP_NS;
 
 	if (t > deadline)
 		t = deadline;
-	ts.tv_sec = (time_t)(t / 1000000000LL);
-	ts.tv_nsec = (long)(t % 1000000000LL);
-	while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) ==
-	       EINTR)
-		;
+	base_sleep_until_ns(t);
 }
 
 /* ---- the port and its output ---- */
@@ -337,7 +316,7 @@ static int out_wait(struct re_relay *r, const char *what, int64_t deadline,
 			if (q <= 0)
 				return q < 0 ? GL_ERR_SYS : GL_OK;
 		}
-		if (now_ns() >= deadline)
+		if (base_now_ns() >= deadline)
 			break;
 		nap(deadline);
 	}
@@ -374,7 +353,7 @@ static int read_byte(struct re_relay *r, uint8_t *b, int ms)
 
 	for (;;) {
 		n = r->ops->read(&r->io, b, 1, r->err, sizeof(r->err));
-		if (n != 0 || now_ns() >= deadline)
+		if (n != 0 || base_now_ns() >= deadline)
 			return n;
 		nap(deadline);
 	}
@@ -384,7 +363,7 @@ static int read_byte(struct re_relay *r, uint8_t *b, int ms)
 static void rb_sent_one(struct re_relay *r)
 {
 	if (!r->rb_due++)
-		clock_gettime(CLOCK_MONOTONIC, &r->rb_sent);
+		r->rb_sent_ns = base_now_ns();
 }
 
 /* Does a state-query answer show the channel @on? */
@@ -455,7 +434,7 @@ static int readback_wait(struct re_relay *r, const char *what, bool on,
 				       what, r->cfg.channel, on ? "off" : "on");
 		if (n == 1)
 			continue;
-		if (now_ns() >= deadline)
+		if (base_now_ns() >= deadline)
 			break;
 		nap(deadline);
 	}
@@ -487,7 +466,7 @@ static int send_wait(struct re_relay *r, const uint8_t *msg, size_t len,
  * every call while it fails. */
 static int node_check(struct re_relay *r)
 {
-	int64_t now = now_ns();
+	int64_t now = base_now_ns();
 	struct stat st;
 
 	if (!re_pathwatch_changed(&r->pw) && !r->node_suspect &&
@@ -561,7 +540,8 @@ static int readback_step(struct re_relay *r)
 	if (n < 0)
 		return GL_ERR_RELAY;
 	if (n == 0) {
-		if (ms_since(&r->rb_sent) <= r->cfg.readback_timeout_ms)
+		if ((base_now_ns() - r->rb_sent_ns) / BASE_NS_PER_MS <=
+		    r->cfg.readback_timeout_ms)
 			return GL_OK;
 		return set_err(r, GL_ERR_RELAY,
 			       "no answer to the state query "
@@ -622,23 +602,19 @@ static bool ics_recorded(const struct re_relay *r, const char *id)
 	return same;
 }
 
-/* Write the record atomically: temporary file, fsync, rename. */
+/* Write the record durably: temporary file, fsync, rename, fsync of the
+ * directory (base_durable_write). */
 static int ics_record(struct re_relay *r, const char *id, uint8_t model)
 {
-	char tmp[RE_RELAY_PATH_MAX + 8], text[256];
-	int fd, n, ok;
+	char text[256];
+	int n;
 
-	snprintf(tmp, sizeof(tmp), "%s.tmp", r->cfg.icstation_state);
 	n = snprintf(text, sizeof(text), "%s model=0x%02X\n", id, model);
-	fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-	if (fd < 0)
-		goto out_fail;
-	ok = write(fd, text, (size_t)n) == n && !fsync(fd);
-	ok = !close(fd) && ok;
-	if (ok && !rename(tmp, r->cfg.icstation_state))
+	if (n < 0 || (size_t)n >= sizeof(text))
+		n = (int)strlen(text);
+	if (base_durable_write(r->cfg.icstation_state, text, (size_t)n,
+			       0644) == 0)
 		return GL_OK;
-	unlink(tmp);
-out_fail:
 	return set_err(r, GL_ERR_RELAY,
 		       "cannot record the icstation "
 		       "handshake in '%s': %s",

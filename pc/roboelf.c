@@ -34,6 +34,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "base_clock.h"
 #include "gl_err.h"
 #include "gl_link.h"
 #include "re_calfile.h"
@@ -104,12 +105,10 @@ static struct re_io_real *volatile cont_real;
 
 static void on_cont(int sig)
 {
-	struct timespec ts;
 	int64_t now, from;
 
 	(void)sig;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	now = (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+	now = base_now_ns();
 	from = cont_real ? cont_real->last_run_ns : now;
 	cont_stop_ms = (now - from) / 1000000;
 	continued = 1;
