@@ -1,5 +1,5 @@
 /*
- * test_sim_plant.c - galil-sim's robot model (tools/galil-sim/sim_plant.h):
+ * test_sim_plant.c - galil-sim's robot model (tools/galil-sim/plant/sim_plant.h):
  * potentiometer curve and noise, faults, motion, limit switches, joystick
  * inputs, and the YAML plant file (config/plant.yaml = built-in defaults).
  */

@@ -151,7 +151,8 @@ static void conn_fill(struct sim_cmdport *cp, int h, int64_t now)
 			;
 		return;
 	}
-	if (c->nchunk == SIM_CMDPORT_CHUNKS || c->out_len == SIM_CMDPORT_OUT_CAP)
+	if (c->nchunk == SIM_CMDPORT_CHUNKS ||
+	    c->out_len == SIM_CMDPORT_OUT_CAP)
 		return; /* the controller keeps it meanwhile */
 	got = ctrl_output(sim_ctrl(cp->sim), h, c->out + c->out_len,
 			  SIM_CMDPORT_OUT_CAP - c->out_len);

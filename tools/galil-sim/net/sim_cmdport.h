@@ -48,9 +48,9 @@ struct sim_cmdport_conn {
 
 /* The command port; embed it (it is large) and use the functions below. */
 struct sim_cmdport {
-	struct sim *sim; /* served, not owned */
-	int lfd;	 /* listener, -1 = none */
-	int port;	 /* bound port number */
+	struct sim *sim;  /* served, not owned */
+	int lfd;	  /* listener, -1 = none */
+	int port;	  /* bound port number */
 	uint64_t refused; /* connections refused (all 8 busy, link dropped) */
 	struct sim_cmdport_conn conn[CTRL_HANDLES];
 };

@@ -81,8 +81,8 @@ void sim_ctlport_accept(struct sim_ctlport *cp)
 	cp->client[i].fd = fd;
 }
 
-static void client_answer(struct sim_ctlport *cp,
-			  struct sim_ctlport_client *cl, char *line)
+static void client_answer(struct sim_ctlport *cp, struct sim_ctlport_client *cl,
+			  char *line)
 {
 	size_t len = strlen(line);
 

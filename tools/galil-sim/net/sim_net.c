@@ -16,6 +16,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "base_clock.h"
 #include "gl_err.h"
 #include "sim.h"
 #include "sim_cmdport.h"
@@ -35,14 +36,6 @@ struct sim_net {
 	struct sim_ctlport ctl;
 	struct sim_net_stats stats;
 };
-
-static int64_t now_us(void)
-{
-	struct timespec ts;
-
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
-}
 
 /* ---- life cycle ------------------------------------------------------- */
 
@@ -105,20 +98,15 @@ static int timer_arm(struct sim_net *n, char *err, size_t errlen)
 {
 	int64_t period = (int64_t)(ctrl_sample_ms(sim_ctrl(n->sim)) * 1000);
 	struct itimerspec it;
-	struct timespec now;
+	int64_t first_ns;
 
 	if (period < 100)
 		period = 100; /* a sane floor: 0.1 ms */
-	clock_gettime(CLOCK_MONOTONIC, &now);
+	first_ns = base_now_ns() + period * BASE_NS_PER_US;
 	it.it_interval.tv_sec = period / 1000000;
 	it.it_interval.tv_nsec = (long)(period % 1000000) * 1000;
-	it.it_value = now;
-	it.it_value.tv_nsec += it.it_interval.tv_nsec;
-	it.it_value.tv_sec += it.it_interval.tv_sec;
-	if (it.it_value.tv_nsec >= 1000000000L) {
-		it.it_value.tv_nsec -= 1000000000L;
-		it.it_value.tv_sec++;
-	}
+	it.it_value.tv_sec = (time_t)(first_ns / BASE_NS_PER_S);
+	it.it_value.tv_nsec = (long)(first_ns % BASE_NS_PER_S);
 	if (timerfd_settime(n->tfd, TFD_TIMER_ABSTIME, &it, NULL) < 0) {
 		snprintf(err, errlen, "cannot arm the sample timer: %s",
 			 strerror(errno));
@@ -217,7 +205,7 @@ static void dispatch(struct sim_net *n, int slot)
 
 static void flush_all(struct sim_net *n)
 {
-	sim_cmdport_flush(&n->cmd, now_us());
+	sim_cmdport_flush(&n->cmd, base_now_us());
 	sim_ctlport_flush(&n->ctl);
 }
 

@@ -1,20 +1,21 @@
 /*
  * sim_plant_cfg.c - the YAML plant file (config/plant.yaml) for sim_plant.
  *
- * libyaml loads the whole document; a table per mapping says which keys
- * exist and where their values go. Every key is optional (the defaults
- * stay), unknown and duplicate keys are rejected, and nothing is applied
- * unless the whole file is valid. Positions from libyaml are 0-based; the
- * messages say LINE:COLUMN 1-based.
+ * base_yaml loads the whole document (base_file reads the file); a table
+ * per mapping says which keys exist and where their values go. Every key is
+ * optional (the defaults stay), unknown and duplicate keys are rejected, and
+ * nothing is applied unless the whole file is valid. Positions from libyaml are
+ * 0-based; the messages say LINE:COLUMN 1-based.
  */
 #include <errno.h>
-#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <yaml.h>
 
+#include "base_file.h"
+#include "base_yaml.h"
 #include "gl_err.h"
 #include "sim_plant.h"
 
@@ -97,55 +98,39 @@ static int walk_map(struct ycx *cx, yaml_node_t *map, const struct field *table,
 static int yerr(struct ycx *cx, const yaml_node_t *n, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
+/* "NAME:LINE:COLUMN: message" at node @n (1:1 without a node). */
 static int yerr(struct ycx *cx, const yaml_node_t *n, const char *fmt, ...)
 {
-	char msg[200];
+	static const yaml_mark_t top = {0, 0, 0};
 	va_list ap;
 
 	va_start(ap, fmt);
-	vsnprintf(msg, sizeof(msg), fmt, ap);
+	base_yaml_vformat(cx->err, cx->errlen, cx->name,
+			  n ? &n->start_mark : &top, fmt, ap);
 	va_end(ap);
-	snprintf(cx->err, cx->errlen, "%s:%lu:%lu: %s", cx->name,
-		 n ? (unsigned long)n->start_mark.line + 1 : 1,
-		 n ? (unsigned long)n->start_mark.column + 1 : 1, msg);
 	return GL_ERR_CONFIG;
-}
-
-static const char *scalar(const yaml_node_t *n)
-{
-	return n && n->type == YAML_SCALAR_NODE
-		   ? (const char *)n->data.scalar.value
-		   : NULL;
 }
 
 static int get_double(struct ycx *cx, yaml_node_t *n, const char *key,
 		      double *out)
 {
-	const char *s = scalar(n);
-	char *end;
-	double v;
+	const char *s = base_yaml_scalar(n);
 
 	if (!s || !*s)
 		return yerr(cx, n, "'%s' must be a number", key);
-	errno = 0;
-	v = strtod(s, &end);
-	if (*end || errno || !isfinite(v))
+	if (base_yaml_double(n, out) < 0)
 		return yerr(cx, n, "'%s' must be a number, not '%s'", key, s);
-	*out = v;
 	return 0;
 }
 
 static int get_long(struct ycx *cx, yaml_node_t *n, const char *key, long *out)
 {
-	const char *s = scalar(n);
-	char *end;
+	const char *s = base_yaml_scalar(n);
 	long v;
 
 	if (!s || !*s)
 		return yerr(cx, n, "'%s' must be an integer", key);
-	errno = 0;
-	v = strtol(s, &end, 10);
-	if (*end || errno || v < -2147483647L || v > 2147483647L)
+	if (base_yaml_long(n, &v) < 0 || v < -2147483647L || v > 2147483647L)
 		return yerr(cx, n, "'%s' must be an integer, not '%s'", key, s);
 	*out = v;
 	return 0;
@@ -154,7 +139,7 @@ static int get_long(struct ycx *cx, yaml_node_t *n, const char *key, long *out)
 static int get_word(struct ycx *cx, yaml_node_t *n, const char *key,
 		    const char *a, const char *b, int *out)
 {
-	const char *s = scalar(n);
+	const char *s = base_yaml_scalar(n);
 
 	if (s && !strcmp(s, a))
 		*out = 0;
@@ -168,25 +153,21 @@ static int get_word(struct ycx *cx, yaml_node_t *n, const char *key,
 /* A mapping whose keys are all scalars and all different. */
 static int check_map(struct ycx *cx, yaml_node_t *map, const char *where)
 {
-	yaml_node_pair_t *p, *q;
+	yaml_node_pair_t *p;
+	yaml_node_t *k;
+	int rc;
 
 	if (!map || map->type != YAML_MAPPING_NODE)
 		return yerr(cx, map, "%s must be a mapping", where);
 	for (p = map->data.mapping.pairs.start; p < map->data.mapping.pairs.top;
 	     p++) {
-		yaml_node_t *k = yaml_document_get_node(cx->doc, p->key);
-
-		if (!scalar(k))
+		rc = base_yaml_key(cx->doc, map, p, &k);
+		if (rc == -EEXIST)
+			return yerr(cx, k, "duplicate key '%s' in %s",
+				    base_yaml_scalar(k), where);
+		if (rc < 0)
 			return yerr(cx, k, "keys of %s must be plain words",
 				    where);
-		for (q = map->data.mapping.pairs.start; q < p; q++) {
-			yaml_node_t *k2 =
-			    yaml_document_get_node(cx->doc, q->key);
-
-			if (!strcmp(scalar(k), scalar(k2)))
-				return yerr(cx, k, "duplicate key '%s' in %s",
-					    scalar(k), where);
-		}
 	}
 	return 0;
 }
@@ -230,15 +211,15 @@ static int walk_joy_inputs(struct ycx *cx, yaml_node_t *map, int *joy)
 		int cmd = -1;
 
 		for (int i = 0; i < 6; i++) {
-			if (!strcmp(scalar(k), joy_keys[i]))
+			if (!strcmp(base_yaml_scalar(k), joy_keys[i]))
 				cmd = i;
 		}
 		if (cmd < 0)
 			return yerr(cx, k,
 				    "unknown key '%s' in joystick.inputs"
 				    " (A_fwd A_rev B_fwd B_rev C_fwd C_rev)",
-				    scalar(k));
-		if (get_pair(cx, v, scalar(k), &joy[2 * cmd]) < 0)
+				    base_yaml_scalar(k));
+		if (get_pair(cx, v, base_yaml_scalar(k), &joy[2 * cmd]) < 0)
 			return GL_ERR_CONFIG;
 	}
 	return 0;
@@ -256,7 +237,7 @@ static int walk_axes(struct ycx *cx, yaml_node_t *map,
 	     p++) {
 		yaml_node_t *k = yaml_document_get_node(cx->doc, p->key);
 		yaml_node_t *v = yaml_document_get_node(cx->doc, p->value);
-		const char *s = scalar(k);
+		const char *s = base_yaml_scalar(k);
 
 		if (strlen(s) != 1 || s[0] < 'A' || s[0] > 'C')
 			return yerr(cx, k, "unknown axis '%s' (A, B or C)", s);
@@ -319,11 +300,12 @@ static int walk_map(struct ycx *cx, yaml_node_t *map, const struct field *table,
 		yaml_node_t *v = yaml_document_get_node(cx->doc, p->value);
 		const struct field *f = table;
 
-		while (f->key && strcmp(f->key, scalar(k)))
+		while (f->key && strcmp(f->key, base_yaml_scalar(k)))
 			f++;
 		if (!f->key)
-			return yerr(cx, k, "unknown key '%s'%s%s", scalar(k),
-				    *where ? " in " : "", where);
+			return yerr(cx, k, "unknown key '%s'%s%s",
+				    base_yaml_scalar(k), *where ? " in " : "",
+				    where);
 		if (set_field(cx, f, v, base, where) < 0)
 			return GL_ERR_CONFIG;
 	}
@@ -346,7 +328,8 @@ static yaml_node_t *section_node(struct ycx *cx, yaml_node_t *root,
 			 msg);
 	for (p = root->data.mapping.pairs.start;
 	     p < root->data.mapping.pairs.top; p++) {
-		if (!strcmp(scalar(yaml_document_get_node(cx->doc, p->key)),
+		if (!strcmp(base_yaml_scalar(
+				yaml_document_get_node(cx->doc, p->key)),
 			    sect))
 			return yaml_document_get_node(cx->doc, p->value);
 	}
@@ -372,58 +355,58 @@ static int parse_doc(struct ycx *cx, struct sim_plant_cfg *cfg)
 int sim_plant_cfg_parse(struct sim_plant_cfg *cfg, const char *buf, size_t len,
 			const char *name, char *err, size_t errlen)
 {
-	yaml_parser_t parser;
 	yaml_document_t doc;
+	struct base_yaml_error e;
 	struct ycx cx = {&doc, name, err, errlen};
-	int rc;
+	int rc = base_yaml_load(buf, len, 0, &doc, &e);
 
-	if (!yaml_parser_initialize(&parser))
+	if (rc == -ENOMEM && !e.problem)
 		return yerr(&cx, NULL, "out of memory");
-	yaml_parser_set_input_string(&parser, (const unsigned char *)buf, len);
-	if (!yaml_parser_load(&parser, &doc)) {
+	if (rc < 0) {
+		/* a reader error (bad encoding) has no line: 1:1, as before */
 		snprintf(err, errlen, "%s:%lu:%lu: %s", name,
-			 (unsigned long)parser.problem_mark.line + 1,
-			 (unsigned long)parser.problem_mark.column + 1,
-			 parser.problem ? parser.problem : "invalid YAML");
-		yaml_parser_delete(&parser);
+			 e.type == YAML_READER_ERROR
+			     ? 1UL
+			     : (unsigned long)e.mark.line + 1,
+			 e.type == YAML_READER_ERROR
+			     ? 1UL
+			     : (unsigned long)e.mark.column + 1,
+			 e.problem ? e.problem : "invalid YAML");
 		return GL_ERR_CONFIG;
 	}
 	rc = parse_doc(&cx, cfg);
 	yaml_document_delete(&doc);
-	yaml_parser_delete(&parser);
 	return rc;
 }
 
 int sim_plant_cfg_load(struct sim_plant_cfg *cfg, const char *path, char *err,
 		       size_t errlen)
 {
-	FILE *f = fopen(path, "rb");
 	char *buf;
 	size_t n;
-	int rc;
+	/* a file of PLANT_FILE_MAX bytes or more is refused */
+	int rc = base_file_read(path, PLANT_FILE_MAX - 1, &buf, &n);
 
-	if (!f) {
-		snprintf(err, errlen, "%s:0:0: cannot open plant file: %s",
-			 path, strerror(errno));
+	switch (rc) {
+	case 0: break;
+	case -EFBIG:
+		snprintf(err, errlen, "%s:0:0: plant file larger than 1 MiB",
+			 path);
 		return GL_ERR_CONFIG;
-	}
-	buf = malloc(PLANT_FILE_MAX);
-	if (!buf) {
-		fclose(f);
+	case -ENOMEM:
 		snprintf(err, errlen, "%s:0:0: out of memory", path);
 		return GL_ERR_CONFIG;
-	}
-	n = fread(buf, 1, PLANT_FILE_MAX, f);
-	if (ferror(f) || n == PLANT_FILE_MAX) {
-		snprintf(err, errlen, "%s:0:0: %s", path,
-			 ferror(f) ? "cannot read plant file"
-				   : "plant file larger than 1 MiB");
-		rc = GL_ERR_CONFIG;
-		goto out_free;
+	case -EISDIR:
+	case -EINVAL:
+	case -EIO:
+		snprintf(err, errlen, "%s:0:0: cannot read plant file", path);
+		return GL_ERR_CONFIG;
+	default:
+		snprintf(err, errlen, "%s:0:0: cannot open plant file: %s",
+			 path, strerror(-rc));
+		return GL_ERR_CONFIG;
 	}
 	rc = sim_plant_cfg_parse(cfg, buf, n, path, err, errlen);
-out_free:
 	free(buf);
-	fclose(f);
 	return rc;
 }

@@ -21,7 +21,7 @@
 #include "gl_err.h"
 #include "sim_relay.h"
 
-#define RELAY_READ_CHUNK 256  /* bytes per read() */
+#define RELAY_READ_CHUNK 256 /* bytes per read() */
 
 struct sim_relay {
 	struct sim_relay_dec dec;
