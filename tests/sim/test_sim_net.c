@@ -780,6 +780,188 @@ static void test_port_in_use(void **state)
 
 #define T(name) cmocka_unit_test_setup_teardown(name, setup, teardown)
 
+/* ---- line faults --------------------------------------------------------- */
+
+/* Read exactly @n bytes (deadline REPLY_MS); return the count read. */
+static size_t read_n(int fd, unsigned char *buf, size_t n)
+{
+	long long end = proc_now_ms() + REPLY_MS;
+	size_t got = 0;
+
+	while (got < n) {
+		struct pollfd p = {fd, POLLIN, 0};
+		long long left = end - proc_now_ms();
+		ssize_t r;
+
+		if (left <= 0 || poll(&p, 1, (int)left) <= 0)
+			break;
+		r = recv(fd, buf + got, n - got, 0);
+		if (r <= 0)
+			break;
+		got += (size_t)r;
+	}
+	return got;
+}
+
+/* Nothing arrives on @fd for QUIET_MS. */
+static void expect_quiet(int fd)
+{
+	struct pollfd p = {fd, POLLIN, 0};
+
+	assert_int_equal(poll(&p, 1, QUIET_MS), 0);
+}
+
+/* "link once": the next line only; each fault as docs/galil-sim.md says. */
+static void test_line_fault_replies(void **state)
+{
+	static const unsigned char garbage[] = "\x01\x02garbage\x00\x1f:";
+	struct fx *f = *state;
+	int fd = cmd_connect(f);
+	unsigned char buf[256];
+	long long t;
+
+	assert_string_equal(ctl(f, "link once qmark"), "ok");
+	send_cmd(fd, "MG 1;MG 2\r");
+	assert_int_equal(read_n(fd, buf, 11), 11);
+	assert_memory_equal(buf, "? 2.0000\r\n:", 11);
+	expect_reply(fd, "TC1", " 1 Unrecognized command\r\n:");
+	send_cmd(fd, "MG 1;MG 2\r");
+	assert_int_equal(read_n(fd, buf, 20), 20);
+	assert_memory_equal(buf, " 1.0000\r\n: 2.0000\r\n:", 20);
+	assert_string_equal(ctl(f, "link once garbage"), "ok");
+	send_cmd(fd, "MG 1\r");
+	assert_int_equal(read_n(fd, buf, sizeof(garbage) - 1),
+			 sizeof(garbage) - 1);
+	assert_memory_equal(buf, garbage, sizeof(garbage) - 1);
+	assert_string_equal(ctl(f, "link once unsol"), "ok");
+	send_cmd(fd, "MG 12345\r");
+	assert_int_equal(read_n(fd, buf, 14 + 16), 14 + 16);
+	assert_memory_equal(buf, " 12345.", 7);
+	assert_int_equal(buf[7], 'U' | 0x80);
+	assert_int_equal(buf[7 + 15], '\n' | 0x80);
+	assert_memory_equal(buf + 23, "0000\r\n:", 7);
+	assert_string_equal(ctl(f, "link once extra"), "ok");
+	send_cmd(fd, "MG 1\r");
+	assert_int_equal(read_n(fd, buf, 11), 11);
+	assert_memory_equal(buf, " 1.0000\r\n::", 11);
+	assert_string_equal(ctl(f, "link once extra 200"), "ok");
+	expect_reply(fd, "MG 1", " 1.0000\r\n:");
+	t = proc_now_ms();
+	assert_int_equal(read_n(fd, buf, 1), 1);
+	assert_int_equal(buf[0], ':');
+	assert_true(proc_now_ms() - t >= 150);
+	assert_string_equal(ctl(f, "link once split"), "ok");
+	t = proc_now_ms();
+	expect_reply(fd, "MG 1", " 1.0000\r\n:");
+	assert_true(proc_now_ms() - t >= 9); /* 10 bytes, 1 ms apart */
+	assert_string_equal(ctl(f, "link once chunks"), "ok");
+	expect_reply(fd, "MG 1", " 1.0000\r\n:");
+	assert_string_equal(ctl(f, "link once delay 300"), "ok");
+	t = proc_now_ms();
+	expect_reply(fd, "MG 1", " 1.0000\r\n:");
+	assert_true(proc_now_ms() - t >= 290);
+	expect_reply(fd, "MG 2", " 2.0000\r\n:");
+	assert_non_null(strstr(events(f), " handle A: line fault delay\n"));
+	close(fd);
+}
+
+/* unsolpre goes before a final QR's record; badhdr changes its header. */
+static void test_line_fault_records(void **state)
+{
+	struct fx *f = *state;
+	int fd = cmd_connect(f);
+	unsigned char buf[512];
+
+	assert_string_equal(ctl(f, "link once unsolpre"), "ok");
+	send_cmd(fd, "x=1;QR\r");
+	assert_int_equal(read_n(fd, buf, 1 + 16 + 190 + 1), 1 + 16 + 190 + 1);
+	assert_int_equal(buf[0], ':');
+	assert_int_equal(buf[1], 'U' | 0x80);
+	assert_int_equal(buf[17] & 0x80, 0x80); /* the record's header */
+	assert_int_equal(buf[19], 190);
+	assert_int_equal(buf[1 + 16 + 190], ':');
+	assert_string_equal(ctl(f, "link once badhdr"), "ok");
+	send_cmd(fd, "QR\r");
+	assert_int_equal(read_n(fd, buf, 191), 191);
+	assert_int_equal(buf[1], 0x0F);
+	send_cmd(fd, "QR\r");
+	assert_int_equal(read_n(fd, buf, 191), 191);
+	assert_int_not_equal(buf[1], 0x0F);
+	close(fd);
+}
+
+/* drop, silent; "link first" meets every new connection; "link ok" ends
+ * it; bad requests. */
+static void test_line_fault_connection(void **state)
+{
+	struct fx *f = *state;
+	int fd, i;
+
+	fd = cmd_connect(f);
+	assert_string_equal(ctl(f, "link once drop"), "ok");
+	send_cmd(fd, "MG 1\r");
+	expect_closed(fd);
+	close(fd);
+	fd = cmd_connect(f);
+	expect_mg1(fd);
+	assert_string_equal(ctl(f, "link once silent"), "ok");
+	send_cmd(fd, "MG 1\r");
+	expect_quiet(fd);
+	send_cmd(fd, "MG 1\r");
+	expect_quiet(fd);
+	close(fd);
+	assert_string_equal(ctl(f, "link first qmark"), "ok");
+	for (i = 0; i < 2; i++) {
+		fd = cmd_connect(f);
+		expect_reply(fd, "MG 1", "?");
+		expect_mg1(fd);
+		close(fd);
+	}
+	assert_string_equal(ctl(f, "link ok"), "ok");
+	fd = cmd_connect(f);
+	expect_mg1(fd);
+	close(fd);
+	assert_string_equal(ctl(f, "link once fly"),
+			    "error: line fault 'fly': unknown");
+	assert_string_equal(ctl(f, "link first delay"),
+			    "error: line fault 'delay': needs an argument");
+	assert_string_equal(ctl(f, "link once qmark 1"),
+			    "error: line fault 'qmark': takes no argument");
+	assert_string_equal(ctl(f, "link once dlreject 0"),
+			    "error: line fault 'dlreject': bad line number "
+			    "(1..4000)");
+	assert_memory_equal(ctl(f, "link once"),
+			    "error: usage: link <once|first> ", 32);
+}
+
+/* dlreject N: '?' as line N of the next download arrives, TC 60, the
+ * download refused; the lines before are not. */
+static void test_line_fault_dlreject(void **state)
+{
+	struct fx *f = *state;
+	int fd = cmd_connect(f);
+	unsigned char buf[64];
+
+	assert_string_equal(ctl(f, "link once dlreject 3"), "ok");
+	expect_mg1(fd);
+	send_cmd(fd, "DL\r#A\rx=1\r");
+	expect_quiet(fd);
+	send_cmd(fd, "x=2\r");
+	assert_int_equal(read_n(fd, buf, 1), 1);
+	assert_int_equal(buf[0], '?');
+	send_cmd(fd, "EN\r\\");
+	assert_int_equal(read_n(fd, buf, 2), 2);
+	assert_memory_equal(buf, ":?", 2);
+	expect_reply(fd, "TC1",
+		     " 60 Download error - line too long or too many "
+		     "lines\r\n:");
+	/* the next download is not touched */
+	send_cmd(fd, "DL\r#A\rx=1\rx=2\rEN\r\\");
+	assert_int_equal(read_n(fd, buf, 2), 2);
+	assert_memory_equal(buf, "::", 2);
+	close(fd);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -796,6 +978,10 @@ int main(void)
 	    T(test_relay_over_pty),
 	    T(test_relay_wedge),
 	    T(test_power_options),
+	    T(test_line_fault_replies),
+	    T(test_line_fault_records),
+	    T(test_line_fault_connection),
+	    T(test_line_fault_dlreject),
 	    T(test_quit),
 	    T(test_sigterm),
 	    cmocka_unit_test(test_bad_plant_file),

@@ -6,6 +6,7 @@
  * Time is counted in whole microseconds of simulated time (samples of
  * ctrl_sample_ms() each), so long runs do not drift.
  */
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -276,6 +277,76 @@ void sim_power_cycle(struct sim *s)
 int sim_power(const struct sim *s)
 {
 	return motor_power(s);
+}
+
+static const char *const line_fault_words[] = {
+    "none",	"delay", "qmark", "split",  "chunks",	"garbage", "unsol",
+    "unsolpre", "extra", "drop",  "silent", "dlreject", "badhdr",
+};
+
+const char *sim_line_fault_name(enum sim_line_kind kind)
+{
+	return kind >= SIM_LINE_NONE && kind <= SIM_LINE_BADHDR
+		   ? line_fault_words[kind]
+		   : "?";
+}
+
+/* The argument a line fault takes: 0 none, 1 optional ms, 2 required. */
+static int line_fault_arg(enum sim_line_kind k, const char *arg, int *out,
+			  const char **why)
+{
+	char *end;
+	long v;
+
+	*out = 0;
+	if (k != SIM_LINE_DELAY && k != SIM_LINE_EXTRA &&
+	    k != SIM_LINE_DLREJECT) {
+		*why = "takes no argument";
+		return arg ? GL_ERR_ARG : 0;
+	}
+	if (!arg) {
+		*why = "needs an argument";
+		return k == SIM_LINE_EXTRA ? 0 : GL_ERR_ARG;
+	}
+	errno = 0;
+	v = strtol(arg, &end, 10);
+	*why = k == SIM_LINE_DLREJECT ? "bad line number (1..4000)"
+				      : "bad delay (0..60000 ms)";
+	if (*end || end == arg || errno ||
+	    (k == SIM_LINE_DLREJECT ? v < 1 || v > 4000 : v < 0 || v > 60000))
+		return GL_ERR_ARG;
+	*out = (int)v;
+	return 0;
+}
+
+int sim_line_fault_parse(const char *word, const char *arg,
+			 struct sim_line_fault *out, const char **why)
+{
+	int a;
+
+	for (int k = SIM_LINE_DELAY; k <= SIM_LINE_BADHDR; k++) {
+		if (strcmp(word, line_fault_words[k]))
+			continue;
+		if (line_fault_arg((enum sim_line_kind)k, arg, &a, why) < 0)
+			return GL_ERR_ARG;
+		out->kind = (enum sim_line_kind)k;
+		out->arg = a;
+		return 0;
+	}
+	*why = "unknown";
+	return GL_ERR_ARG;
+}
+
+int sim_line_fault(const struct sim *s, int first, struct sim_line_fault *out)
+{
+	*out = first ? s->line_first : s->line_once;
+	return out->kind != SIM_LINE_NONE;
+}
+
+void sim_line_fault_used(struct sim *s)
+{
+	s->line_once.kind = SIM_LINE_NONE;
+	s->line_once.arg = 0;
 }
 
 enum sim_link sim_link(const struct sim *s, double *delay_ms)

@@ -39,6 +39,46 @@ enum sim_link {
 };
 
 /*
+ * Faults of one command line on the command port (net/ applies them; the
+ * control port's "link once" and "link first" inject them; the vocabulary
+ * is in docs/galil-sim.md, "Line faults"). @arg of struct sim_line_fault:
+ * ms for DELAY and EXTRA, the download line (1-based) for DLREJECT.
+ */
+enum sim_line_kind {
+	SIM_LINE_NONE,
+	SIM_LINE_DELAY,	   /* the line's reply held back arg ms */
+	SIM_LINE_QMARK,	   /* first command corrupted: '?', TC 1 */
+	SIM_LINE_SPLIT,	   /* reply sent byte by byte, 1 ms apart */
+	SIM_LINE_CHUNKS,   /* reply sent in 1..8-byte pieces, 0..2 ms apart */
+	SIM_LINE_GARBAGE,  /* reply replaced by control bytes and "garbage" */
+	SIM_LINE_UNSOL,	   /* an unsolicited line in the middle of the reply */
+	SIM_LINE_UNSOLPRE, /* an unsolicited line before a final QR's record */
+	SIM_LINE_EXTRA,	   /* one ':' more, arg ms later (0: same write) */
+	SIM_LINE_DROP,	   /* the connection closed, the line not run */
+	SIM_LINE_SILENT,   /* the connection answers nothing from then on */
+	SIM_LINE_DLREJECT, /* line arg of the next DL corrupted: '?', TC 60 */
+	SIM_LINE_BADHDR,   /* a QR record's header announces 4 axes */
+};
+
+struct sim_line_fault {
+	enum sim_line_kind kind;
+	int arg;
+};
+
+/*
+ * sim_line_fault_parse() / sim_line_fault_name() - a line fault from its
+ * control-port words (@word: "delay", "qmark", "split", "chunks",
+ * "garbage", "unsol", "unsolpre", "extra", "drop", "silent", "dlreject",
+ * "badhdr"; @arg: its argument or NULL) into @out, and the word of @kind
+ * (a static string; "?" out of range).
+ * Return (parse): 0, or GL_ERR_ARG with @why (static text) set to the
+ * reason (unknown word, missing, extra or bad argument); @out untouched.
+ */
+int sim_line_fault_parse(const char *word, const char *arg,
+			 struct sim_line_fault *out, const char **why);
+const char *sim_line_fault_name(enum sim_line_kind kind);
+
+/*
  * sim_new() / sim_free() - a simulator with the plant from @plant_file
  * (YAML), or the built-in default robot when @plant_file is NULL; the
  * relay off, no pty; and its release (controller, plant, relay, pty and
@@ -135,6 +175,18 @@ void sim_set_event_hook(struct sim *s,
  * (NULL), its reply delay in ms (SIM_LINK_DELAY).
  */
 enum sim_link sim_link(const struct sim *s, double *delay_ms);
+
+/*
+ * sim_line_fault() - a line fault injected and not yet used: @first 0 for
+ * "link once" (the next command line any host begins), 1 for "link first"
+ * (the first command line of every new connection).
+ * @out: [out] the fault; kind SIM_LINE_NONE when none.
+ * Return: 1 when one is armed, else 0.
+ */
+int sim_line_fault(const struct sim *s, int first, struct sim_line_fault *out);
+
+/* sim_line_fault_used() - the "link once" fault met its line: disarm it. */
+void sim_line_fault_used(struct sim *s);
 
 /*
  * sim_set_disconnect() - @fn(@ud) is called to close every command

@@ -257,11 +257,36 @@ static int req_block(struct sim *s, char **arg, int n, struct out *o)
 
 /* ---- link, relay, controller ------------------------------------------ */
 
+#define LINE_FAULT_USAGE                                                       \
+	"usage: link <once|first> <delay MS|qmark|split|chunks|garbage|"       \
+	"unsol|unsolpre|extra [MS]|drop|silent|dlreject N|badhdr>"
+
+/* "link once FAULT [ARG]" / "link first FAULT [ARG]": a line fault. */
+static int req_line_fault(struct sim *s, char **arg, int n, struct out *o)
+{
+	struct sim_line_fault f;
+	const char *why;
+
+	if (n < 2)
+		return fail(o, LINE_FAULT_USAGE);
+	if (sim_line_fault_parse(arg[1], n == 3 ? arg[2] : NULL, &f, &why) < 0)
+		return fail(o, "line fault '%s': %s", arg[1], why);
+	if (arg[0][0] == 'o')
+		s->line_once = f;
+	else
+		s->line_first = f;
+	sim_event(s, "inject: link %s %s%s%s", arg[0], arg[1],
+		  n == 3 ? " " : "", n == 3 ? arg[2] : "");
+	return ok(o);
+}
+
 static int req_link(struct sim *s, char **arg, int n, struct out *o)
 {
 	enum sim_link l;
 	double ms = 0;
 
+	if (!strcmp(arg[0], "once") || !strcmp(arg[0], "first"))
+		return req_line_fault(s, arg, n, o);
 	if (!strcmp(arg[0], "ok") && n == 1)
 		l = SIM_LINK_OK;
 	else if (!strcmp(arg[0], "drop") && n == 1)
@@ -276,6 +301,10 @@ static int req_link(struct sim *s, char **arg, int n, struct out *o)
 		return fail(o, "bad delay '%s' (0..60000 ms)", arg[1]);
 	s->link = l;
 	s->link_delay_ms = ms;
+	if (l == SIM_LINK_OK) { /* and no line fault either */
+		s->line_once.kind = s->line_first.kind = SIM_LINE_NONE;
+		s->line_once.arg = s->line_first.arg = 0;
+	}
 	sim_event(s, "inject: link %s%s%s", arg[0], n == 2 ? " " : "",
 		  n == 2 ? arg[1] : "");
 	if (l == SIM_LINK_DROP && s->disconnect)
@@ -504,7 +533,7 @@ static const struct request requests[] = {
     {"pot", 2, 3, req_pot, "pot <A|B|C> <ok|offset V|stuck|open|noise V>"},
     {"enc", 2, 3, req_enc, "enc <A|B|C> <ok|stuck|slip COUNTS>"},
     {"block", 2, 2, req_block, "block <A|B|C> <0|1>"},
-    {"link", 1, 2, req_link, "link <ok|drop|stall|delay MS>"},
+    {"link", 1, 3, req_link, "link <ok|drop|stall|delay MS>"},
     {"relay", 0, 1, req_relay, "relay [on|off]"},
     {"relayfault", 1, 1, req_relayfault,
      "relayfault <ok|unplug|writefail|wedge>"},

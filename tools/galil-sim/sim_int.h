@@ -39,6 +39,8 @@ struct sim {
 
 	enum sim_link link;
 	double link_delay_ms;
+	struct sim_line_fault line_once;  /* "link once": the next line */
+	struct sim_line_fault line_first; /* "link first": new connections */
 	void (*disconnect)(void *ud);
 	void *disconnect_ud;
 	int quit;

@@ -10,20 +10,26 @@
 #include <unistd.h>
 #include <arpa/inet.h>
 
+#include "base_clock.h"
 #include "gl_err.h"
 #include "sim.h"
 #include "sim_cmdport.h"
 #include "sim_sock.h"
+#include "sim_wire.h"
 
 #define CMDPORT_READ_CHUNK 4096 /* bytes per recv() */
+#define CMDPORT_DL_BAD_LEN 100	/* SIM_LINE_DLREJECT: an over-long line */
 
 void sim_cmdport_init(struct sim_cmdport *cp, struct sim *s)
 {
 	memset(cp, 0, sizeof(*cp));
 	cp->sim = s;
 	cp->lfd = -1;
-	for (int h = 0; h < CTRL_HANDLES; h++)
+	cp->rng = 1;
+	for (int h = 0; h < CTRL_HANDLES; h++) {
 		cp->conn[h].fd = -1;
+		cp->conn[h].dl_line = -1;
+	}
 }
 
 int sim_cmdport_listen(struct sim_cmdport *cp, int port, char *err,
@@ -110,12 +116,19 @@ void sim_cmdport_accept(struct sim_cmdport *cp)
 	cp->conn[h].fd = fd;
 	cp->conn[h].out_len = 0;
 	cp->conn[h].nchunk = 0;
+	sim_line_fault(cp->sim, 1, &cp->conn[h].pending);
+	cp->conn[h].silent = cp->conn[h].midline = cp->conn[h].dl_reject = 0;
+	cp->conn[h].dl_line = -1;
+	cp->conn[h].line_len = 0;
 	ctrl_handle_open(sim_ctrl(cp->sim), h);
 	ctrl_handle_peer(sim_ctrl(cp->sim), h, cp->port,
 			 ntohl(sa.sin_addr.s_addr), ntohs(sa.sin_port));
 	sim_event(cp->sim, "handle %c opened from %s:%d", 'A' + h, ip,
 		  ntohs(sa.sin_port));
 }
+
+static void conn_input(struct sim_cmdport *cp, int h, const uint8_t *buf,
+		       size_t len);
 
 void sim_cmdport_read(struct sim_cmdport *cp, int h)
 {
@@ -133,7 +146,22 @@ void sim_cmdport_read(struct sim_cmdport *cp, int h)
 	}
 	if (sim_link(cp->sim, NULL) == SIM_LINK_STALL)
 		return; /* lost on the wire */
-	ctrl_input(sim_ctrl(cp->sim), h, buf, (size_t)r);
+	conn_input(cp, h, buf, (size_t)r);
+}
+
+/* Queue @n bytes due at @due_us (the last chunk grows when all are used). */
+static void conn_queue(struct sim_cmdport_conn *c, const uint8_t *p, size_t n,
+		       int64_t due_us)
+{
+	if (!n || c->out_len + n > SIM_CMDPORT_OUT_CAP)
+		return;
+	memcpy(c->out + c->out_len, p, n);
+	c->out_len += n;
+	if (c->nchunk == SIM_CMDPORT_CHUNKS) {
+		c->chunk[c->nchunk - 1].end = c->out_len;
+		return;
+	}
+	c->chunk[c->nchunk++] = (struct sim_cmdport_chunk){c->out_len, due_us};
 }
 
 /* Take the controller's output for handle h into the queue. */
@@ -193,6 +221,177 @@ static void conn_flush(struct sim_cmdport *cp, int h, int64_t now)
 	c->nchunk -= k;
 	for (k = 0; k < c->nchunk; k++)
 		c->chunk[k].end -= (size_t)w;
+}
+
+/* ---- line faults ------------------------------------------------------ */
+
+/* Reshape the reply of the line just run under @f and queue its pieces. */
+static void conn_shape(struct sim_cmdport *cp, int h,
+		       const struct sim_line_fault *f)
+{
+	struct sim_cmdport_conn *c = &cp->conn[h];
+	struct sim_wire_piece piece[SIM_CMDPORT_CHUNKS];
+	int64_t now = base_now_us(), late = 0;
+	double delay_ms;
+	size_t got, room = SIM_CMDPORT_OUT_CAP - c->out_len, prev = 0;
+	int k;
+
+	if (room <= SIM_WIRE_GROWTH || c->nchunk > SIM_CMDPORT_CHUNKS - 2)
+		return; /* no room: conn_fill() sends it unshaped */
+	if (sim_link(cp->sim, &delay_ms) == SIM_LINK_DELAY)
+		late = (int64_t)(delay_ms * 1000);
+	got = ctrl_output(sim_ctrl(cp->sim), h, cp->reply,
+			  room - SIM_WIRE_GROWTH);
+	k = sim_wire_shape(f, cp->reply, got, cp->shaped, sizeof(cp->shaped),
+			   piece, SIM_CMDPORT_CHUNKS - c->nchunk, &cp->rng);
+	for (int i = 0; i < k; i++) {
+		conn_queue(c, cp->shaped + prev, piece[i].end - prev,
+			   now + late + piece[i].delay_us);
+		prev = piece[i].end;
+	}
+}
+
+/* Run the held line (@len bytes, its end included) under fault @f. */
+static void line_run(struct sim_cmdport *cp, int h,
+		     const struct sim_line_fault *f, size_t len)
+{
+	struct sim_cmdport_conn *c = &cp->conn[h];
+	struct ctrl *ctl = sim_ctrl(cp->sim);
+	char q[SIM_CMDPORT_LINE + 8];
+	size_t n;
+
+	switch (f->kind) {
+	case SIM_LINE_DROP: conn_close(cp, h, "line fault drop"); return;
+	case SIM_LINE_SILENT: c->silent = 1; return;
+	case SIM_LINE_NONE:
+	case SIM_LINE_DLREJECT:
+		ctrl_input(ctl, h, (const uint8_t *)c->line, len);
+		return;
+	case SIM_LINE_QMARK:
+		n = sim_wire_qmark(c->line, len - 1, q, sizeof(q) - 1);
+		q[n++] = '\r';
+		ctrl_input(ctl, h, (const uint8_t *)q, n);
+		return;
+	default:
+		conn_fill(cp, h, base_now_us()); /* what came before */
+		ctrl_input(ctl, h, (const uint8_t *)c->line, len);
+		conn_shape(cp, h, f);
+	}
+}
+
+/* Is the held line (@len bytes, CR included) a DL command? */
+static int is_dl(const char *line, size_t len)
+{
+	size_t i = 0;
+
+	while (i < len && line[i] == ' ')
+		i++;
+	return len - i >= 3 && line[i] == 'D' && line[i + 1] == 'L' &&
+	       strchr("\r #", line[i + 2]);
+}
+
+/* A held line of a watched download: line dl_reject is corrupted. */
+static void dl_line_end(struct sim_cmdport *cp, int h, size_t len)
+{
+	struct sim_cmdport_conn *c = &cp->conn[h];
+	char bad[CMDPORT_DL_BAD_LEN + 1];
+
+	if (c->line[len - 1] != '\r') { /* the download's end */
+		c->dl_line = -1;
+		c->dl_reject = 0;
+	} else if (++c->dl_line == c->dl_reject) {
+		sim_event(cp->sim, "handle %c: line fault dlreject at line %d",
+			  'A' + h, c->dl_line);
+		memset(bad, 'X', CMDPORT_DL_BAD_LEN);
+		bad[CMDPORT_DL_BAD_LEN] = '\r';
+		ctrl_input(sim_ctrl(cp->sim), h, (const uint8_t *)bad,
+			   sizeof(bad));
+		return;
+	}
+	ctrl_input(sim_ctrl(cp->sim), h, (const uint8_t *)c->line, len);
+}
+
+/* A held line has ended: the fault waiting for it meets it. */
+static void line_end(struct sim_cmdport *cp, int h)
+{
+	struct sim_cmdport_conn *c = &cp->conn[h];
+	struct sim_line_fault f = {SIM_LINE_NONE, 0};
+	size_t len = c->line_len;
+
+	c->line_len = 0;
+	c->midline = 0;
+	if (c->dl_line >= 0) {
+		dl_line_end(cp, h, len);
+		return;
+	}
+	if (c->pending.kind != SIM_LINE_NONE) {
+		f = c->pending;
+		c->pending.kind = SIM_LINE_NONE;
+	} else if (sim_line_fault(cp->sim, 0, &f)) {
+		sim_line_fault_used(cp->sim);
+	}
+	if (f.kind != SIM_LINE_NONE)
+		sim_event(cp->sim, "handle %c: line fault %s", 'A' + h,
+			  sim_line_fault_name(f.kind));
+	if (f.kind == SIM_LINE_DLREJECT)
+		c->dl_reject = f.arg;
+	if (c->dl_reject && is_dl(c->line, len))
+		c->dl_line = 0;
+	line_run(cp, h, &f, len);
+}
+
+/* Is a fault waiting for the next line this connection begins? */
+static int fault_waiting(const struct sim_cmdport *cp,
+			 const struct sim_cmdport_conn *c)
+{
+	struct sim_line_fault f;
+
+	return c->pending.kind != SIM_LINE_NONE || c->dl_reject ||
+	       sim_line_fault(cp->sim, 0, &f);
+}
+
+static int is_line_end(const struct sim_cmdport_conn *c, uint8_t b)
+{
+	return b == '\r' || (c->dl_line >= 0 && (b == '\\' || b == 0x1a ||
+						 b == 0x11 || b == 0x04));
+}
+
+/*
+ * Bytes from handle @h's host: to the controller as they come, except a
+ * line a fault waits for, held until its end (line_end()).
+ */
+static void conn_input(struct sim_cmdport *cp, int h, const uint8_t *buf,
+		       size_t len)
+{
+	struct sim_cmdport_conn *c = &cp->conn[h];
+	struct ctrl *ctl = sim_ctrl(cp->sim);
+	size_t n;
+	int end;
+
+	while (len && c->fd >= 0 && !c->silent) {
+		for (n = 0; n < len && !is_line_end(c, buf[n]); n++)
+			;
+		end = n < len;
+		n += (size_t)end;
+		if (c->line_len == 0 && (c->midline || !fault_waiting(cp, c))) {
+			ctrl_input(ctl, h, buf, n);
+			c->midline = !end;
+		} else if (c->line_len + n > sizeof(c->line)) {
+			/* too long to hold: the controller gets it as is */
+			ctrl_input(ctl, h, (const uint8_t *)c->line,
+				   c->line_len);
+			ctrl_input(ctl, h, buf, n);
+			c->line_len = 0;
+			c->midline = !end;
+		} else {
+			memcpy(c->line + c->line_len, buf, n);
+			c->line_len += n;
+			if (end)
+				line_end(cp, h);
+		}
+		buf += n;
+		len -= n;
+	}
 }
 
 /* Has everything the controller queued for handle @by been sent? A

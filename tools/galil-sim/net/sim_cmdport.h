@@ -11,6 +11,15 @@
  * connections in the listen backlog (the loop does not poll the listener);
  * SIM_LINK_DELAY holds each reply back by the delay before it is written.
  *
+ * Line faults (sim_line_fault(), docs/galil-sim.md): a connection that
+ * has one waiting (its own from "link first", or the port's "link once")
+ * holds the next line it begins until the line ends (CR), then the fault
+ * meets it: the line is corrupted (QMARK), dropped with the connection
+ * (DROP) or with everything after it (SILENT), or run and its reply
+ * reshaped (sim_wire.h). DLREJECT waits for the next DL instead and
+ * corrupts its line N. Lines that meet no fault go to the controller as
+ * the bytes arrive, as before.
+ *
  * IH closing: a handle the controller marks (ctrl_handle_close_wanted()) is
  * closed after the reply of the IH command has gone to its sender. Opening
  * and closing a connection are events ("handle A opened from ...",
@@ -30,6 +39,7 @@
 
 #define SIM_CMDPORT_OUT_CAP 65536 /* bytes queued per connection */
 #define SIM_CMDPORT_CHUNKS  512	  /* delayed reply chunks per connection */
+#define SIM_CMDPORT_LINE    256	  /* a line held for a line fault, bytes */
 
 /* One reply chunk queued: it ends at @end in out[], may go at @due_us. */
 struct sim_cmdport_chunk {
@@ -44,6 +54,16 @@ struct sim_cmdport_conn {
 	size_t out_len;
 	struct sim_cmdport_chunk chunk[SIM_CMDPORT_CHUNKS];
 	int nchunk;
+	/* line faults (sim.h): the one waiting for this connection's next
+	 * line ("link first"), the line held until its end to meet a fault,
+	 * whether the last byte given to the controller ended a line */
+	struct sim_line_fault pending;
+	int silent;    /* SIM_LINE_SILENT met: input read and dropped */
+	int midline;   /* the controller has part of a line */
+	int dl_reject; /* SIM_LINE_DLREJECT armed: this line of the next DL */
+	int dl_line;   /* in a DL being watched: lines so far, else -1 */
+	char line[SIM_CMDPORT_LINE];
+	size_t line_len;
 };
 
 /* The command port; embed it (it is large) and use the functions below. */
@@ -52,7 +72,10 @@ struct sim_cmdport {
 	int lfd;	  /* listener, -1 = none */
 	int port;	  /* bound port number */
 	uint64_t refused; /* connections refused (all 8 busy, link dropped) */
+	uint32_t rng;	  /* SIM_LINE_CHUNKS piece sizes */
 	struct sim_cmdport_conn conn[CTRL_HANDLES];
+	uint8_t reply[SIM_CMDPORT_OUT_CAP]; /* a reply being reshaped */
+	uint8_t shaped[SIM_CMDPORT_OUT_CAP];
 };
 
 /*
