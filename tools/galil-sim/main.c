@@ -32,9 +32,10 @@ struct opts {
 	const char *plant, *relay_link, *protocol;
 	unsigned long seed;
 	int have_seed, verbose;
-	double bench_s;	  /* > 0: run the speed bench instead */
-	int no_amp_uv;	  /* --no-amp-undervoltage */
-	int power_output; /* --power-output N, -1: the plant file's */
+	double bench_s;	      /* > 0: run the speed bench instead */
+	int no_amp_uv;	      /* --no-amp-undervoltage */
+	int power_output;     /* --power-output N, -1: the plant file's */
+	unsigned long serial; /* --serial N, 0: the default */
 };
 
 static volatile sig_atomic_t stop;
@@ -53,6 +54,7 @@ static void usage(FILE *f)
 	    "                 [--relay-link PATH | --no-relay-link]\n"
 	    "                 [--relay-protocol NAME] [--seed N] [--verbose]\n"
 	    "                 [--no-amp-undervoltage] [--power-output N]\n"
+	    "                 [--serial N]\n"
 	    "       galil-sim --bench [SECONDS]\n"
 	    "       galil-sim --help | --version\n"
 	    "  --port N            command port on 127.0.0.1 (default %d, 0 = "
@@ -72,6 +74,8 @@ static void usage(FILE *f)
 	    "the controller\n"
 	    "  --power-output N    motor power also needs controller output "
 	    "N (1..8; 0 = none)\n"
+	    "  --serial N          the controller's serial number, MG _BN "
+	    "(default 403001)\n"
 	    "  --bench [SECONDS]   measure virtual-time speed with 8 busy "
 	    "threads\n",
 	    DEFAULT_PORT, DEFAULT_CONTROL_PORT, DEFAULT_RELAY_LINK,
@@ -118,6 +122,16 @@ static int parse_opt(int c, const char *arg, struct opts *o)
 		}
 		o->power_output = (int)v;
 		return 0;
+	case 'S':
+		if (parse_ulong(arg, 999999999UL, &o->serial) < 0 ||
+		    o->serial == 0) {
+			fprintf(stderr,
+				"galil-sim: bad serial number '%s' "
+				"(1..999999999)\n",
+				arg);
+			return -1;
+		}
+		return 0;
 	case 's':
 		if (parse_ulong(arg, 0xFFFFFFFFUL, &o->seed) < 0) {
 			fprintf(stderr, "galil-sim: bad seed '%s'\n", arg);
@@ -151,6 +165,7 @@ static int parse_args(int argc, char **argv, struct opts *o)
 	    {"verbose", no_argument, NULL, 'v'},
 	    {"no-amp-undervoltage", no_argument, NULL, 'u'},
 	    {"power-output", required_argument, NULL, 'o'},
+	    {"serial", required_argument, NULL, 'S'},
 	    {"bench", optional_argument, NULL, 'b'},
 	    {"help", no_argument, NULL, 'h'},
 	    {"version", no_argument, NULL, 'V'},
@@ -268,7 +283,8 @@ int main(int argc, char **argv)
 			 0,
 			 0,
 			 0,
-			 -1};
+			 -1,
+			 0};
 	char err[ERR_LEN];
 	struct sim *s;
 	int rc = parse_args(argc, argv, &o);
@@ -278,7 +294,7 @@ int main(int argc, char **argv)
 	if (o.bench_s > 0)
 		return run_bench(o.bench_s);
 	set_signals();
-	if (sim_new(&s, o.plant, err, sizeof(err)) < 0) {
+	if (sim_new_serial(&s, o.plant, (long)o.serial, err, sizeof(err)) < 0) {
 		fprintf(stderr, "%s\n", err);
 		return 2;
 	}

@@ -64,11 +64,12 @@ void sim_set_event_hook(struct sim *s,
 
 /* ---- life cycle ------------------------------------------------------- */
 
-static int make_parts(struct sim *s, const struct sim_plant_cfg *pc)
+static int make_parts(struct sim *s, const struct sim_plant_cfg *pc,
+		      long serial)
 {
 	struct ctrl_cfg cc = {
 	    .model = SIM_MODEL,
-	    .serial = SIM_SERIAL,
+	    .serial = serial,
 	    .sample_us = SIM_SAMPLE_US,
 	    .event = event_cb,
 	    .event_ud = s,
@@ -86,6 +87,12 @@ static int make_parts(struct sim *s, const struct sim_plant_cfg *pc)
 
 int sim_new(struct sim **out, const char *plant_file, char *err, size_t errlen)
 {
+	return sim_new_serial(out, plant_file, 0, err, errlen);
+}
+
+int sim_new_serial(struct sim **out, const char *plant_file, long serial,
+		   char *err, size_t errlen)
+{
 	struct sim_plant_cfg pc;
 	struct sim *s;
 	int rc;
@@ -98,7 +105,8 @@ int sim_new(struct sim **out, const char *plant_file, char *err, size_t errlen)
 	if (!s)
 		return GL_ERR_NOMEM;
 	s->ev = calloc(SIM_EVENTS_MAX, sizeof(*s->ev));
-	rc = s->ev ? make_parts(s, &pc) : GL_ERR_NOMEM;
+	rc = s->ev ? make_parts(s, &pc, serial > 0 ? serial : SIM_SERIAL)
+		   : GL_ERR_NOMEM;
 	if (rc < 0) {
 		snprintf(err, errlen, "cannot create the simulator: %s",
 			 gl_strerror(rc));

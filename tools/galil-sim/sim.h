@@ -90,6 +90,12 @@ const char *sim_line_fault_name(enum sim_line_kind kind);
  * Return: 0, GL_ERR_CONFIG, GL_ERR_NOMEM.
  */
 int sim_new(struct sim **out, const char *plant_file, char *err, size_t errlen);
+/*
+ * sim_new_serial() - sim_new() with the controller's serial number (MG
+ * _BN) @serial instead of the default 403001 (@serial <= 0: the default).
+ */
+int sim_new_serial(struct sim **out, const char *plant_file, long serial,
+		   char *err, size_t errlen);
 void sim_free(struct sim *s);
 
 /* sim_ctrl() - the controller inside, for ctrl_* calls (owned by @s). */
