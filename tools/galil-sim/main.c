@@ -93,6 +93,17 @@ static int parse_ulong(const char *s, unsigned long max, unsigned long *out)
 	return *end || errno || *out > max ? -1 : 0;
 }
 
+static int parse_serial(const char *arg, struct opts *o)
+{
+	if (parse_ulong(arg, 999999999UL, &o->serial) < 0 || o->serial == 0) {
+		fprintf(stderr,
+			"galil-sim: bad serial number '%s' (1..999999999)\n",
+			arg);
+		return -1;
+	}
+	return 0;
+}
+
 static int parse_opt(int c, const char *arg, struct opts *o)
 {
 	unsigned long v;
@@ -122,16 +133,7 @@ static int parse_opt(int c, const char *arg, struct opts *o)
 		}
 		o->power_output = (int)v;
 		return 0;
-	case 'S':
-		if (parse_ulong(arg, 999999999UL, &o->serial) < 0 ||
-		    o->serial == 0) {
-			fprintf(stderr,
-				"galil-sim: bad serial number '%s' "
-				"(1..999999999)\n",
-				arg);
-			return -1;
-		}
-		return 0;
+	case 'S': return parse_serial(arg, o);
 	case 's':
 		if (parse_ulong(arg, 0xFFFFFFFFUL, &o->seed) < 0) {
 			fprintf(stderr, "galil-sim: bad seed '%s'\n", arg);
