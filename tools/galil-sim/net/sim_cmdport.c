@@ -287,7 +287,7 @@ static int is_dl(const char *line, size_t len)
 	while (i < len && line[i] == ' ')
 		i++;
 	return len - i >= 3 && line[i] == 'D' && line[i + 1] == 'L' &&
-	       strchr("\r #", line[i + 2]);
+	       line[i + 2] && strchr("\r #", line[i + 2]);
 }
 
 /* A held line of a watched download: line dl_reject is corrupted. */
