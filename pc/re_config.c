@@ -14,7 +14,6 @@
 #include "re_config.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <inttypes.h>
 #include <limits.h>
 #include <math.h>
@@ -22,10 +21,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 #include <yaml.h>
 
+#include "base_file.h"
+#include "base_yaml.h"
 #include "gl_err.h"
 #include "gl_hash.h"
 
@@ -94,18 +93,7 @@ static void vformat(struct pctx *c, const yaml_mark_t *m, const char *fmt,
 static void vformat(struct pctx *c, const yaml_mark_t *m, const char *fmt,
 		    va_list ap)
 {
-	int n = 0;
-
-	if (!c->err || !c->errlen)
-		return;
-	if (c->file && m)
-		n = snprintf(c->err, c->errlen, "%s:%zu:%zu: ", c->file,
-			     m->line + 1, m->column + 1);
-	else if (c->file)
-		n = snprintf(c->err, c->errlen, "%s: ", c->file);
-	if (n < 0 || (size_t)n >= c->errlen)
-		return;
-	vsnprintf(c->err + n, c->errlen - (size_t)n, fmt, ap);
+	base_yaml_vformat(c->err, c->errlen, c->file, m, fmt, ap);
 }
 
 /* fail_at() - message at mark @m (NULL: no position). Returns the code. */
@@ -186,6 +174,7 @@ static const char *node_kind(const yaml_node_t *v)
 	return "a value";
 }
 
+/* The text of @v, known to be a scalar. */
 static const char *scalar(const yaml_node_t *v)
 {
 	return (const char *)v->data.scalar.value;
@@ -276,6 +265,7 @@ static int get_integer(struct pctx *c, yaml_node_t *v, const char *key,
 		       long long *out)
 {
 	const char *s;
+	long l;
 
 	if (v->type != YAML_SCALAR_NODE || quoted(v))
 		return type_error(c, v, "an integer", key);
@@ -285,10 +275,9 @@ static int get_integer(struct pctx *c, yaml_node_t *v, const char *key,
 			return type_error(c, v, "an integer", key);
 		return type_error(c, v, "a number", key);
 	}
-	errno = 0;
-	*out = strtoll(s, NULL, 10);
-	if (errno == ERANGE || *out < lo || *out > hi)
+	if (base_yaml_long(v, &l) != 0 || l < lo || l > hi)
 		return range_error(c, &v->start_mark, key, min, max, s);
+	*out = l;
 	return GL_OK;
 }
 
@@ -300,9 +289,7 @@ static int get_double(struct pctx *c, yaml_node_t *v, const char *key,
 	if (v->type != YAML_SCALAR_NODE || quoted(v) || !is_num_text(scalar(v)))
 		return type_error(c, v, "a number", key);
 	s = scalar(v);
-	errno = 0;
-	*out = strtod(s, NULL);
-	if (errno == ERANGE || !isfinite(*out))
+	if (base_yaml_double(v, out) != 0)
 		return fail_at(c, &v->start_mark,
 			       "'%s' is out of range, got %.*s", key,
 			       TEXT_SHOWN, s);
@@ -311,16 +298,9 @@ static int get_double(struct pctx *c, yaml_node_t *v, const char *key,
 
 static int get_bool(struct pctx *c, yaml_node_t *v, const char *key, bool *out)
 {
-	if (v->type == YAML_SCALAR_NODE && !quoted(v)) {
-		if (!strcmp(scalar(v), "true")) {
-			*out = true;
-			return GL_OK;
-		}
-		if (!strcmp(scalar(v), "false")) {
-			*out = false;
-			return GL_OK;
-		}
-	}
+	if (v->type == YAML_SCALAR_NODE && !quoted(v) &&
+	    base_yaml_bool(v, out) == 0)
+		return GL_OK;
 	return type_error(c, v, "true or false", key);
 }
 
@@ -443,21 +423,16 @@ static const struct field *field_find(const struct field *tab, const char *k)
 static int map_key(struct pctx *c, yaml_node_t *map, yaml_node_pair_t *p,
 		   yaml_node_t **key)
 {
-	yaml_node_pair_t *q;
-	yaml_node_t *k = node_at(c, p->key), *o;
+	yaml_node_t *k;
+	int rc = base_yaml_key(c->doc, map, p, &k);
 
-	if (!k || k->type != YAML_SCALAR_NODE)
+	if (rc == -EINVAL)
 		return fail_at(c, k ? &k->start_mark : &map->start_mark,
 			       "expected a key name, got %s",
 			       k ? node_kind(k) : "nothing");
-	for (q = map->data.mapping.pairs.start; q < p; q++) {
-		o = node_at(c, q->key);
-		if (o && o->type == YAML_SCALAR_NODE &&
-		    !strcmp(scalar(o), scalar(k)))
-			return fail_at(c, &k->start_mark,
-				       "duplicate key '%.*s'", TEXT_SHOWN,
-				       scalar(k));
-	}
+	if (rc == -EEXIST)
+		return fail_at(c, &k->start_mark, "duplicate key '%.*s'",
+			       TEXT_SHOWN, scalar(k));
 	*key = k;
 	return GL_OK;
 }
@@ -1253,76 +1228,30 @@ void re_config_defaults(struct re_config *out)
 
 /* ---- parse ---- */
 
-/* Reader errors carry a byte offset only: turn it into line and column. */
-static yaml_mark_t offset_mark(const char *buf, size_t len, size_t off)
+/* Say why base_yaml_load() failed, at the place libyaml gives. */
+static int syntax_error(struct pctx *c, int rc, const struct base_yaml_error *e)
 {
-	yaml_mark_t m = {0, 0, 0};
-	size_t i;
-
-	for (i = 0; i < off && i < len; i++) {
-		if (buf[i] == '\n') {
-			m.line++;
-			m.column = 0;
-		} else {
-			m.column++;
-		}
-	}
-	m.index = off;
-	return m;
-}
-
-static int syntax_error(struct pctx *c, yaml_parser_t *p, const char *buf,
-			size_t len)
-{
-	yaml_mark_t m = p->problem_mark;
-
-	if (p->error == YAML_MEMORY_ERROR) {
+	if (rc == -ENOMEM) {
 		fail_at(c, NULL, "out of memory");
 		return GL_ERR_NOMEM;
 	}
-	if (p->error == YAML_READER_ERROR)
-		m = offset_mark(buf, len, p->problem_offset);
-	if (p->context)
-		return fail_at(c, &m, "%s (%s at line %zu column %zu)",
-			       p->problem ? p->problem : "syntax error",
-			       p->context, p->context_mark.line + 1,
-			       p->context_mark.column + 1);
-	return fail_at(c, &m, "%s", p->problem ? p->problem : "syntax error");
+	if (e->context)
+		return fail_at(c, &e->mark, "%s (%s at line %zu column %zu)",
+			       e->problem ? e->problem : "syntax error",
+			       e->context, e->context_mark.line + 1,
+			       e->context_mark.column + 1);
+	return fail_at(c, &e->mark, "%s",
+		       e->problem ? e->problem : "syntax error");
 }
 
 /* Load the one document of @buf into @doc; a second one is an error. */
 static int load_document(struct pctx *c, const char *buf, size_t len,
 			 yaml_document_t *doc)
 {
-	yaml_parser_t p;
-	yaml_document_t extra;
-	int rc = GL_OK;
+	struct base_yaml_error e;
+	int rc = base_yaml_load(buf, len, BASE_YAML_ONE_DOC, doc, &e);
 
-	if (!yaml_parser_initialize(&p)) {
-		fail_at(c, NULL, "out of memory");
-		return GL_ERR_NOMEM;
-	}
-	yaml_parser_set_input_string(&p, (const unsigned char *)buf, len);
-	if (!yaml_parser_load(&p, doc)) {
-		rc = syntax_error(c, &p, buf, len);
-		goto out_parser;
-	}
-	if (!yaml_document_get_root_node(doc))
-		goto out_parser; /* empty: the caller reports it */
-	if (!yaml_parser_load(&p, &extra)) {
-		rc = syntax_error(c, &p, buf, len);
-		goto out_doc;
-	}
-	if (yaml_document_get_root_node(&extra))
-		rc = fail_at(c, &extra.start_mark,
-			     "only one document is allowed");
-	yaml_document_delete(&extra);
-out_doc:
-	if (rc)
-		yaml_document_delete(doc);
-out_parser:
-	yaml_parser_delete(&p);
-	return rc;
+	return rc ? syntax_error(c, rc, &e) : GL_OK;
 }
 
 static void auto_defaults(struct pctx *c, struct re_config *cfg)
@@ -1394,43 +1323,22 @@ out_free_ctx:
 int re_config_load_file(const char *path, struct re_config *out, char *err,
 			size_t errlen)
 {
-	struct stat st;
 	char *buf = NULL;
-	ssize_t n;
 	size_t len = 0;
-	int fd, rc = GL_ERR_SYS, saved;
+	int rc, e;
 
-	fd = open(path, O_RDONLY | O_CLOEXEC);
-	if (fd < 0)
-		goto out_err;
-	if (fstat(fd, &st) < 0)
-		goto out_close;
-	if (!S_ISREG(st.st_mode) || st.st_size > CFG_FILE_MAX) {
-		errno = S_ISREG(st.st_mode) ? EFBIG : EINVAL;
-		goto out_close;
+	rc = base_file_read(path, CFG_FILE_MAX, &buf, &len);
+	if (rc != 0) {
+		/* a directory is "not a regular file" like any other */
+		e = rc == -EISDIR ? EINVAL : -rc;
+		if (err && errlen)
+			snprintf(err, errlen, "cannot read '%s': %s", path,
+				 strerror(e));
+		errno = e;
+		return GL_ERR_SYS;
 	}
-	buf = malloc((size_t)st.st_size + 1);
-	if (!buf)
-		goto out_close;
-	while ((n = read(fd, buf + len, (size_t)st.st_size + 1 - len)) > 0)
-		len += (size_t)n;
-	if (n < 0)
-		goto out_close;
-	close(fd);
 	rc = re_config_parse(buf, len, path, out, err, errlen);
 	free(buf);
-	return rc;
-out_close:
-	saved = errno;
-	close(fd);
-	free(buf);
-	errno = saved;
-out_err:
-	saved = errno;
-	if (err && errlen)
-		snprintf(err, errlen, "cannot read '%s': %s", path,
-			 strerror(saved));
-	errno = saved;
 	return rc;
 }
 

@@ -211,7 +211,7 @@ const char *re_config_relay_port(const struct re_config *cfg);
 void re_config_relay_cfg(const struct re_config *cfg, struct re_relay_cfg *out);
 
 /*
- * re_config_hash() - FNV-1a 64 (pc/gl_hash.h) over the fields a calibration
+ * re_config_hash() - FNV-1a 64 (pc/galil/gl_hash.h) over the fields a calibration
  * table depends on: per axis its name, step_counts, travel_counts,
  * travel_tolerance, analog input, expected_range_v, range_tolerance,
  * allowed_error and monotonic_margin_v. A calibration file whose hash

@@ -14,10 +14,10 @@
 #include <sys/random.h>
 #include <time.h>
 
+#include "base_clock.h"
 #include "gl_err.h"
 #include "gl_ident.h"
 
-#define NS_PER_MS	1000000LL
 #define LINE_MAX_CHARS	GL_LINE_MAX
 #define POLL_MS		10
 #define PROGRAM_WAIT_MS 1000 /* XQ #AUTO,0 -> state 0, heartbeat */
@@ -105,7 +105,7 @@ static int64_t now_ns(const struct re_io *io)
 
 static void pause_ms(const struct re_io *io, int ms)
 {
-	io->ops->sleep_until(io->ud, now_ns(io) + ms * NS_PER_MS);
+	io->ops->sleep_until(io->ud, now_ns(io) + ms * BASE_NS_PER_MS);
 }
 
 int re_ctl_stop(const struct re_io *io, int timeout_ms)
@@ -362,7 +362,7 @@ int re_ctl_halt(const struct re_io *io, char *err, size_t errlen)
 int re_ctl_amp_power(const struct re_io *io, int want_on, int timeout_ms,
 		     int *ta0, char *err, size_t errlen)
 {
-	int64_t deadline = now_ns(io) + (int64_t)timeout_ms * NS_PER_MS;
+	int64_t deadline = now_ns(io) + (int64_t)timeout_ms * BASE_NS_PER_MS;
 	double v = 0;
 	int rc, off;
 
@@ -547,7 +547,7 @@ static int check_param(const struct re_io *io, const struct param *p, char *err,
 static int wait_program(const struct re_io *io, struct re_ctl_info *info,
 			char *err, size_t errlen)
 {
-	int64_t deadline = now_ns(io) + PROGRAM_WAIT_MS * NS_PER_MS;
+	int64_t deadline = now_ns(io) + PROGRAM_WAIT_MS * BASE_NS_PER_MS;
 	double state = -1, hb0 = -1, hb = -1, mainms = 0;
 	int rc;
 
@@ -588,7 +588,7 @@ static int wait_state(const struct re_io *io, int want, int wait_ms,
 		      long *hbpc, struct re_fault *fault, char *err,
 		      size_t errlen)
 {
-	int64_t deadline = now_ns(io) + (int64_t)wait_ms * NS_PER_MS;
+	int64_t deadline = now_ns(io) + (int64_t)wait_ms * BASE_NS_PER_MS;
 	struct gl_record rec;
 	struct re_za za;
 	char prefix[32];
@@ -675,7 +675,7 @@ int re_ctl_service(const struct re_io *io, long *hbpc, struct re_fault *fault,
 static int wait_still(const struct re_io *io, char *err, size_t errlen)
 {
 	static const char *const tv[RE_AXES] = {"_TVA", "_TVB", "_TVC"};
-	int64_t deadline = now_ns(io) + ARM_WAIT_MS * NS_PER_MS;
+	int64_t deadline = now_ns(io) + ARM_WAIT_MS * BASE_NS_PER_MS;
 	double vstill = 0, v = 0;
 	int rc = read_err(io, "vstill", &vstill, err, errlen), i = 0;
 

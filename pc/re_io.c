@@ -111,14 +111,14 @@ static int open_until(struct re_io_real *r, int64_t end_ns, gl_link **l)
 	int rc;
 
 	for (;;) {
-		int64_t left_ms = (end_ns - re_io_now_ns()) / 1000000;
-		struct timespec pause = {0, RETRY_MS * 1000000L};
+		int64_t left_ms = (end_ns - re_io_now_ns()) / BASE_NS_PER_MS;
+		struct timespec pause = {0, RETRY_MS * BASE_NS_PER_MS};
 
 		if (left_ms < 1)
 			return GL_ERR_TIMEOUT;
 		rc = gl_link_open(l, r->address, (int)left_ms, e);
 		if (rc == GL_OK || rc == GL_ERR_ARG ||
-		    re_io_now_ns() + RETRY_MS * 1000000LL >= end_ns)
+		    re_io_now_ns() + RETRY_MS * BASE_NS_PER_MS >= end_ns)
 			return rc;
 		nanosleep(&pause, NULL);
 	}
@@ -131,7 +131,7 @@ static int real_stop_fresh(void *ud, const char *cmd, char *resp, size_t cap,
 			   int deadline_ms)
 {
 	struct re_io_real *r = ud;
-	int64_t end = re_io_now_ns() + (int64_t)deadline_ms * 1000000;
+	int64_t end = re_io_now_ns() + (int64_t)deadline_ms * BASE_NS_PER_MS;
 	int64_t left_ms;
 	gl_link *l;
 	int rc;
@@ -139,19 +139,19 @@ static int real_stop_fresh(void *ud, const char *cmd, char *resp, size_t cap,
 	if (!r->address)
 		return GL_ERR_CLOSED;
 	for (;;) {
-		struct timespec pause = {0, RETRY_MS * 1000000L};
+		struct timespec pause = {0, RETRY_MS * BASE_NS_PER_MS};
 
 		rc = open_until(r, end, &l);
 		if (rc != GL_OK)
 			return rc;
-		left_ms = (end - re_io_now_ns()) / 1000000;
+		left_ms = (end - re_io_now_ns()) / BASE_NS_PER_MS;
 		rc = gl_link_command(l, cmd, resp, cap,
 				     left_ms > 1 ? (int)left_ms : 1);
 		if (rc >= 0 || rc == GL_ERR_CTRL)
 			break;
 		gl_link_close(l);
 		if ((rc != GL_ERR_CLOSED && rc != GL_ERR_BROKEN) ||
-		    re_io_now_ns() + RETRY_MS * 1000000LL >= end)
+		    re_io_now_ns() + RETRY_MS * BASE_NS_PER_MS >= end)
 			return rc;
 		nanosleep(&pause, NULL);
 	}

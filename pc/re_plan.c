@@ -7,7 +7,8 @@
 #include <math.h>
 #include <string.h>
 
-#define NS_PER_MS     1000000LL
+#include "base_clock.h"
+
 #define MAINMS_DEFAULT 10  /* dmc/constants.dmc */
 #define ACFACT	       10  /* dmc/constants.dmc: AC = DC = 10 x speed */
 #define DECEL_MS       (1000 / ACFACT) /* full speed to rest, ms */
@@ -52,7 +53,7 @@ static void plan_axis(const struct re_config *cfg, int i,
 void re_plan_make(const struct re_config *cfg, int mainms,
 		  struct re_plan *out)
 {
-	int64_t p_ns = (int64_t)cfg->period_ms * NS_PER_MS;
+	int64_t p_ns = (int64_t)cfg->period_ms * BASE_NS_PER_MS;
 	int ms = mainms > 0 ? mainms : MAINMS_DEFAULT;
 	int fastest = cfg->period_ms < RE_PLAN_SAMPLE_MS ? cfg->period_ms
 							  : RE_PLAN_SAMPLE_MS;
@@ -71,17 +72,17 @@ void re_plan_make(const struct re_config *cfg, int mainms,
 	out->period_ns = p_ns;
 	/* never slower than the period: the watchdog limits are the
 	 * period's */
-	out->sample_ns = (int64_t)fastest * NS_PER_MS;
+	out->sample_ns = (int64_t)fastest * BASE_NS_PER_MS;
 	out->sample_limit_ns = (int64_t)(crit * (double)p_ns);
-	out->hb_limit_ns =
-	    (int64_t)(crit * (double)(ms * NS_PER_MS > p_ns ? ms * NS_PER_MS
-							    : p_ns));
+	out->hb_limit_ns = (int64_t)(crit * (double)(ms * BASE_NS_PER_MS > p_ns
+							 ? ms * BASE_NS_PER_MS
+							 : p_ns));
 	/* the program publishes a fault within one mainms of latching it */
 	out->settle_ms = 2 * ms + 5;
 	/* the program publishes its command up to mainms late, the record
 	 * is up to a period old, and a stopped axis still decelerates */
 	out->uncmd_grace_ns =
-	    (int64_t)(2 * ms + DECEL_MS + 50) * NS_PER_MS + 2 * p_ns;
+	    (int64_t)(2 * ms + DECEL_MS + 50) * BASE_NS_PER_MS + 2 * p_ns;
 	out->fresh_stop_ms = 2 * cfg->controller.timeout_ms;
 	out->relay_off_ms = cfg->relay.off_deadline_ms;
 }

@@ -11,10 +11,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base_clock.h"
 #include "gl_err.h"
 #include "re_super.h"
 
-#define NS_PER_MS 1000000LL
 /* The program told to latch, and the stop (re_io.h; the DMC's own #FAULT
  * uses the same two commands), in one line: pcflt first, so that the
  * program's next pass latches 12 rather than finding our motor-off. */
@@ -129,7 +129,7 @@ static int program_fault(struct re_super *s, struct re_za *za, double *det)
 static void program_verdict(struct re_super *s, struct re_fault *f)
 {
 	int64_t t0 = now_ns(s);
-	int64_t end = t0 + (int64_t)s->cfg.settle_ms * NS_PER_MS;
+	int64_t end = t0 + (int64_t)s->cfg.settle_ms * BASE_NS_PER_MS;
 	struct re_za za;
 	double det;
 	int rc;
@@ -149,7 +149,8 @@ static void program_verdict(struct re_super *s, struct re_fault *f)
 			re_ctrl_fault(&za, (long long)det, f);
 			return;
 		}
-		s->io.ops->sleep_until(s->io.ud, now_ns(s) + 2 * NS_PER_MS);
+		s->io.ops->sleep_until(s->io.ud,
+				       now_ns(s) + 2 * BASE_NS_PER_MS);
 	} while (now_ns(s) < end);
 	snprintf(s->verdict, sizeof(s->verdict),
 		 "no program fault within %d ms", s->cfg.settle_ms);
@@ -451,7 +452,8 @@ int re_super_shutdown(struct re_super *s, char *what, size_t cap)
 				   sizeof(s->resp),
 				   s->cfg.fault_cmd_timeout_ms);
 	if (off_rc >= 0)
-		s->io.ops->sleep_until(s->io.ud, now_ns(s) + 25 * NS_PER_MS);
+		s->io.ops->sleep_until(s->io.ud,
+				       now_ns(s) + 25 * BASE_NS_PER_MS);
 	stop_rc = send_stop(s, RE_STOP_ALL);
 	mo_rc = stop_rc >= 0 ? motors_off(s) : stop_rc;
 	relay_rc = relay_finish(s, relay_start(s));

@@ -28,7 +28,7 @@
  * re_relay_off() is both with relay.off_deadline_ms; the same pairs exist
  * for "on" (deadline relay.write_timeout_ms) and for closing.
  *
- * Errors: functions return GL_OK or a negative gl_err code (pc/gl_err.h);
+ * Errors: functions return GL_OK or a negative gl_err code (pc/galil/gl_err.h);
  * the handle keeps a message such as
  *   "relay '/tmp/roboelf-relay': write failed: Input/output error"
  *   "relay '/dev/ttyUSB0': off not confirmed: 1 byte still queued after

@@ -66,8 +66,7 @@ int base_fsync_dir(const char *path)
 }
 
 /* Create @tmp, write @len bytes, fsync, close; remove it on error. */
-static int write_tmp(const char *tmp, const void *data, size_t len,
-		     mode_t mode)
+static int write_tmp(const char *tmp, const void *data, size_t len, mode_t mode)
 {
 	int fd, rc;
 

@@ -77,8 +77,7 @@ fail_errno:
 	return (int)-n;
 }
 
-int base_file_read(const char *path, size_t max_bytes, char **buf,
-		   size_t *len)
+int base_file_read(const char *path, size_t max_bytes, char **buf, size_t *len)
 {
 	struct stat st;
 	int fd, rc;

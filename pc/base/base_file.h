@@ -26,7 +26,6 @@
  *         otherwise the negated errno of open(), fstat() or read() (e.g.
  *         -ENOENT, -EACCES, -EIO). errno is also set to the positive code.
  */
-int base_file_read(const char *path, size_t max_bytes, char **buf,
-		   size_t *len);
+int base_file_read(const char *path, size_t max_bytes, char **buf, size_t *len);
 
 #endif /* BASE_FILE_H */

@@ -61,8 +61,8 @@ static int no_second(yaml_parser_t *p, const char *buf, size_t len,
 	return rc;
 }
 
-int base_yaml_load(const char *buf, size_t len, int flags,
-		   yaml_document_t *doc, struct base_yaml_error *e)
+int base_yaml_load(const char *buf, size_t len, int flags, yaml_document_t *doc,
+		   struct base_yaml_error *e)
 {
 	yaml_parser_t p;
 	int rc = 0;

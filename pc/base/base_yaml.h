@@ -48,8 +48,8 @@ struct base_yaml_error {
  *         out of memory), -EBADMSG (syntax or encoding error),
  *         BASE_YAML_EMORE.
  */
-int base_yaml_load(const char *buf, size_t len, int flags,
-		   yaml_document_t *doc, struct base_yaml_error *e);
+int base_yaml_load(const char *buf, size_t len, int flags, yaml_document_t *doc,
+		   struct base_yaml_error *e);
 
 /*
  * base_yaml_vformat() - write "@file:LINE:COLUMN: " (1-based, from the

@@ -20,14 +20,13 @@
 
 #include <arpa/inet.h>
 
+#include "base_clock.h"
+
 #define PROC_BUF_INIT 4096
 
 long long proc_now_ms(void)
 {
-	struct timespec ts;
-
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (long long)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+	return (long long)base_now_ms();
 }
 
 static int remaining_ms(long long deadline_ms)

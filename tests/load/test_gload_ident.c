@@ -1,5 +1,5 @@
 /*
- * test_gload_ident.c - the program identity stamp (pc/gl_ident.c) that
+ * test_gload_ident.c - the program identity stamp (pc/galil/gl_ident.c) that
  * galil-load appends and roboelf checks at start-up, the normal form of a
  * program text, and galil-load's read-back comparison (gload_dl_compare),
  * which uses that normal form.

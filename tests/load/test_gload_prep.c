@@ -20,7 +20,7 @@
 
 #define GOOD "tests/data/dmc_good/"
 
-/* FNV-1a 64, written out here independently of pc/gl_hash.c. */
+/* FNV-1a 64, written out here independently of pc/galil/gl_hash.c. */
 static uint64_t fnv(const char *s, size_t n)
 {
 	uint64_t h = 14695981039346656037ULL;

@@ -48,6 +48,7 @@
 #include <arpa/inet.h>
 #include <fcntl.h>
 
+#include "base_clock.h"
 #include "gl_record.h"
 #include "stub_scenarios.h"
 
@@ -138,14 +139,6 @@ static volatile sig_atomic_t stop;
 static struct reply rb; /* one reply at a time */
 
 /* ---- helpers ------------------------------------------------------------- */
-
-static int64_t now_ms(void)
-{
-	struct timespec ts;
-
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (int64_t)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
-}
 
 static uint32_t rnd(void)
 {
@@ -259,7 +252,7 @@ static void queue(struct client *c, const uint8_t *p, size_t n, int64_t due)
 static void schedule(struct client *c, const struct reply *r, enum mode m,
 		     int delay_ms)
 {
-	int64_t t = now_ms() + (m == M_DELAY ? delay_ms : 0);
+	int64_t t = base_now_ms() + (m == M_DELAY ? delay_ms : 0);
 	size_t off = 0, n;
 	int i;
 
@@ -343,7 +336,7 @@ static void send_message(const char *text)
 	memcpy(buf + n, "\r\n", 2);
 	if (st.cw1)
 		high_bits(buf, n + 2);
-	queue(to, buf, n + 2, now_ms());
+	queue(to, buf, n + 2, base_now_ms());
 }
 
 static const struct {
@@ -653,7 +646,7 @@ static void handle_line(struct client *c, char *line)
 		puts_r(&rb, ":");
 	schedule(c, &rb, m, arg);
 	if (m == M_EXTRA && arg > 0)
-		queue(c, (const uint8_t *)":", 1, now_ms() + arg);
+		queue(c, (const uint8_t *)":", 1, base_now_ms() + arg);
 }
 
 /* ---- download ------------------------------------------------------------ */
@@ -680,7 +673,7 @@ static void dl_line_done(struct client *c)
 		c->dl_rejected = true;
 		st.tc_code = STUB_TC_DL;
 		st.tc_text = STUB_TC_DL_TEXT;
-		queue(c, (const uint8_t *)"?", 1, now_ms());
+		queue(c, (const uint8_t *)"?", 1, base_now_ms());
 	}
 	if (c->dl_len + c->dl_cur_len + 1 <= sizeof(c->dl_prog)) {
 		memcpy(c->dl_prog + c->dl_len, c->dl_cur, c->dl_cur_len);
@@ -820,7 +813,7 @@ static void serve(int lfd)
 			    .fd = st.c[i].fd,
 			    .events = POLLIN | (st.c[i].seg_n ? POLLOUT : 0)};
 		}
-		if (poll(pfd, (nfds_t)n, poll_timeout(now_ms())) < 0) {
+		if (poll(pfd, (nfds_t)n, poll_timeout(base_now_ms())) < 0) {
 			if (errno == EINTR)
 				continue;
 			perror("galil-stub: poll");
@@ -833,7 +826,7 @@ static void serve(int lfd)
 
 			if (c->fd >= 0 && (pfd[i].revents & (POLLIN | POLLHUP)))
 				client_read(c);
-			if (c->fd >= 0 && !flush_due(c, now_ms()))
+			if (c->fd >= 0 && !flush_due(c, base_now_ms()))
 				client_close(c);
 		}
 	}

@@ -116,8 +116,7 @@ static void test_write_long_name(void **state)
 	(void)state;
 	memset(name, 'a', sizeof(name) - 1);
 	name[sizeof(name) - 1] = '\0';
-	assert_int_equal(base_durable_write(name, "x", 1, 0644),
-			 -ENAMETOOLONG);
+	assert_int_equal(base_durable_write(name, "x", 1, 0644), -ENAMETOOLONG);
 	assert_int_equal(base_fsync_dir(name), 0); /* a bare name: "." */
 }
 
@@ -168,8 +167,7 @@ int main(void)
 	static const struct CMUnitTest tests[] = {
 	    cmocka_unit_test_setup_teardown(test_write_new_and_replace, setup,
 					    teardown),
-	    cmocka_unit_test_setup_teardown(test_write_errors, setup,
-					    teardown),
+	    cmocka_unit_test_setup_teardown(test_write_errors, setup, teardown),
 	    cmocka_unit_test(test_write_long_name),
 	    cmocka_unit_test_setup_teardown(test_fsync_dir, setup, teardown),
 	    cmocka_unit_test(test_write_all),

@@ -2,7 +2,7 @@
  * gload_prep.h - galil-load's preprocessor: read the DMC source files (or a
  * directory's MANIFEST), strip what the controller does not need, keep the
  * source file and line of every remaining line, and stamp the result with
- * its identity (pc/gl_ident.h).
+ * its identity (pc/galil/gl_ident.h).
  *
  * Rules (docs/galil-load.md, "Preprocessing"), applied to each source line:
  *  1. a line whose first word is REM is dropped;

@@ -1,6 +1,6 @@
 /*
  * ctrl_rec.c - the QR data record of a DMC-4030 (galil-notes.md 2.2-2.3),
- * encoded with gl_record_encode() from pc/gl_record.h.
+ * encoded with gl_record_encode() from pc/galil/gl_record.h.
  *
  * Amplifier status (bytes 52-55) follows GalilSup's reading: byte 55 is
  * _TA0 (bit 3 = under-voltage A-D, set while motor power is off), byte 52

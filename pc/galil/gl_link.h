@@ -51,7 +51,10 @@ int gl_link_open(gl_link **out, const char *addr, int timeout_ms,
 int gl_link_addr_split(const char *addr, char *host, size_t hcap, char *port,
 		       size_t pcap);
 
-/* gl_link_close() - close both handles and free. NULL is a no-op. */
+/*
+ * gl_link_close() - close both handles and free @l (the caller's pointer is
+ * then invalid). NULL is a no-op. No return value.
+ */
 void gl_link_close(gl_link *l);
 
 /*
@@ -174,7 +177,10 @@ int gl_link_open_messages(gl_link *l, int timeout_ms);
 int gl_link_message(gl_link *l, char *line, size_t cap);
 
 /*
- * gl_link_stats() - bytes sent and received and round trips, since open.
+ * gl_link_stats() - traffic since gl_link_open().
+ * @tx_bytes: [out] optional, bytes sent; @rx_bytes: [out] optional, bytes
+ * received; @round_trips: [out] optional, command-handle replies completed.
+ * A NULL @l gives zeros. No return value; cannot fail.
  */
 void gl_link_stats(const gl_link *l, uint64_t *tx_bytes, uint64_t *rx_bytes,
 		   uint64_t *round_trips);

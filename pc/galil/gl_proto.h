@@ -86,7 +86,10 @@ struct gl_proto {
 	uint64_t unsol_dropped; /* characters lost because the queue was full */
 };
 
-/* gl_proto_init() - initialise @p (empty, no reply awaited). */
+/*
+ * gl_proto_init() - initialise @p, owned by the caller (empty, no reply
+ * awaited, nothing allocated). No return value.
+ */
 void gl_proto_init(struct gl_proto *p);
 
 /*
@@ -118,7 +121,10 @@ int gl_proto_expect(struct gl_proto *p, int n_terminators, size_t binary_len);
  */
 int gl_proto_expect_upload(struct gl_proto *p, char *buf, size_t cap);
 
-/* gl_proto_space() - how many bytes gl_proto_feed() accepts now. */
+/*
+ * gl_proto_space() - room in @p's input buffer.
+ * Return: how many bytes gl_proto_feed() accepts now (0 when full).
+ */
 size_t gl_proto_space(const struct gl_proto *p);
 
 /*
@@ -148,7 +154,11 @@ int gl_proto_next(struct gl_proto *p, struct gl_reply *reply);
  */
 int gl_proto_progress(const struct gl_proto *p, int *n_err);
 
-/* gl_proto_awaiting() - number of announced replies not yet returned. */
+/*
+ * gl_proto_awaiting() - replies announced with gl_proto_expect*() that
+ * gl_proto_next() has not returned yet.
+ * Return: that number (>= 0).
+ */
 int gl_proto_awaiting(const struct gl_proto *p);
 
 /*
