@@ -244,6 +244,10 @@ static void conn_shape(struct sim_cmdport *cp, int h,
 			  room - SIM_WIRE_GROWTH);
 	k = sim_wire_shape(f, cp->reply, got, cp->shaped, sizeof(cp->shaped),
 			   piece, SIM_CMDPORT_CHUNKS - c->nchunk, &cp->rng);
+	if (k == 0) { /* cannot happen with the room checked: never lose it */
+		conn_queue(c, cp->reply, got, now + late);
+		return;
+	}
 	for (int i = 0; i < k; i++) {
 		conn_queue(c, cp->shaped + prev, piece[i].end - prev,
 			   now + late + piece[i].delay_us);
