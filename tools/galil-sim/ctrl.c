@@ -2,7 +2,6 @@
  * ctrl.c - the simulated DMC-4030: life cycle, one servo sample, burning
  * (BP/BN/BV) and the simulated power cycle, and the small public getters.
  */
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,19 +10,6 @@
 #include "gl_err.h"
 
 #define DEFAULT_MODEL "DMC4030 Rev 1.2h-sim"
-
-void ctrl_event(struct ctrl *c, const char *fmt, ...)
-{
-	char line[200];
-	va_list ap;
-
-	if (!c->cfg.event)
-		return;
-	va_start(ap, fmt);
-	vsnprintf(line, sizeof(line), fmt, ap);
-	va_end(ap);
-	c->cfg.event(c->cfg.event_ud, line);
-}
 
 /* ctrl_axis_defaults() - factory settings (DMC-40x0 command reference). */
 void ctrl_axis_defaults(struct ctrl_axis_par *p)

@@ -5,6 +5,7 @@
  * Layout of the controller:
  *   ctrl_num.c    32.16 fixed-point numbers, Galil number formats
  *   ctrl_buf.c    growable byte buffers (replies, unsolicited output)
+ *   ctrl_out.c    events, host output queues, unsolicited routing (CF/CW)
  *   ctrl_var.c    variables and arrays
  *   ctrl_expr.c   expression evaluator (strictly left to right) and operands
  *   ctrl_prog.c   program memory: download checks, statements, labels
@@ -419,11 +420,31 @@ int ctrl_num_list(struct ctrl_xc *x, const char *a, double *v, int max,
 #define CTRL_NUM_GAIN 3 /* 4 decimals */
 int ctrl_put_num(struct ctrl_xc *x, double v, int how);
 
-/* ---- output (ctrl_proto.c) -------------------------------------------- */
+/* ---- output (ctrl_out.c) ---------------------------------------------- */
 
-int ctrl_unsol_send(struct ctrl *c, int route, const uint8_t *p, size_t n);
+/*
+ * ctrl_event() - format one event line (printf style, no CR LF, cut to 199
+ * characters) and hand it to cfg.event; nothing when cfg.event is NULL.
+ */
 void ctrl_event(struct ctrl *c, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
+/*
+ * ctrl_out_put() - queue @n bytes of @p for host handle @h (0..8, not
+ * checked). Past CTRL_OUT_MAX bytes pending the bytes are dropped, with an
+ * event. The bytes are copied; @p stays the caller's.
+ */
+void ctrl_out_put(struct ctrl *c, int h, const void *p, size_t n);
+/*
+ * ctrl_unsol_send() - unsolicited bytes to @route (a handle 0..7,
+ * CTRL_SERIAL, or CTRL_ROUTE_DEFAULT: the CF handle); high bit set under
+ * CW 1; a closed handle drops them. @p is copied.
+ * Return: 0 (sent or dropped), -1 when the FIFO is full and CW ,0 asks the
+ * thread to wait.
+ */
+int ctrl_unsol_send(struct ctrl *c, int route, const uint8_t *p, size_t n);
+
+/* ---- host protocol (ctrl_proto.c) -------------------------------------- */
+
 void ctrl_proto_reset(struct ctrl *c);
 int ctrl_proto_host(struct ctrl *c, int h, const char *line);
 

@@ -104,48 +104,6 @@ void ctrl_handle_peer(struct ctrl *c, int h, int local_port, uint32_t peer_ip,
 	c->h[h].peer_port = peer_port;
 }
 
-static void put_out(struct ctrl *c, int h, const void *p, size_t n)
-{
-	struct ctrl_handle *hd = &c->h[h];
-
-	if (ctrl_buf_pending(&hd->out) + n > CTRL_OUT_MAX) {
-		ctrl_event(c, "handle %c output overflow, %zu bytes dropped",
-			   'A' + h, n);
-		return;
-	}
-	ctrl_buf_put(&hd->out, p, n);
-}
-
-/*
- * ctrl_unsol_send() - unsolicited bytes to @route (CTRL_ROUTE_DEFAULT: CF).
- * Return: 0 (sent or dropped), -1 when the FIFO is full and CW ,0 asks the
- * thread to wait.
- */
-int ctrl_unsol_send(struct ctrl *c, int route, const uint8_t *p, size_t n)
-{
-	int h = route == CTRL_ROUTE_DEFAULT ? c->cf : route;
-	uint8_t tmp[256];
-	size_t k, i;
-
-	if (h == CTRL_SERIAL || h < 0) {
-		if (ctrl_buf_pending(&c->serial) + n > CTRL_SERIAL_MAX)
-			ctrl_buf_clear(&c->serial);
-		ctrl_buf_put(&c->serial, p, n);
-		return 0;
-	}
-	if (!c->h[h].open)
-		return 0; /* nobody there: dropped */
-	if (ctrl_buf_pending(&c->h[h].out) + n > CTRL_UNSOL_FIFO)
-		return c->cw_drop ? 0 : -1;
-	for (k = 0; k < n; k += i) {
-		for (i = 0; i < sizeof(tmp) && k + i < n; i++)
-			tmp[i] =
-			    c->cw_hibit ? (uint8_t)(p[k + i] | 0x80) : p[k + i];
-		put_out(c, h, tmp, i);
-	}
-	return 0;
-}
-
 /* ---- commands from a host ---------------------------------------------- */
 
 /* One command from a host. Return 1 when DL switched to download mode. */
@@ -159,7 +117,7 @@ static int host_cmd(struct ctrl *c, int h, const char *s, int *errors)
 	if (rc > 0 || rc == CTRL_RETRY) {
 		c->tc = rc > 0 ? rc : 1;
 		(*errors)++;
-		put_out(c, h, "?", 1);
+		ctrl_out_put(c, h, "?", 1);
 		return 0;
 	}
 	if (x.dl) {
@@ -174,9 +132,9 @@ static int host_cmd(struct ctrl *c, int h, const char *s, int *errors)
 		ctrl_unsol_send(c, x.route, c->tmp.p + c->tmp.start,
 				ctrl_buf_pending(&c->tmp));
 	else
-		put_out(c, h, c->tmp.p + c->tmp.start,
+		ctrl_out_put(c, h, c->tmp.p + c->tmp.start,
 			ctrl_buf_pending(&c->tmp));
-	put_out(c, h, ":", 1);
+	ctrl_out_put(c, h, ":", 1);
 	return 0;
 }
 
@@ -213,17 +171,17 @@ int ctrl_proto_host(struct ctrl *c, int h, const char *text)
 		hd->overflow = 0;
 		c->tc = 5;
 		for (i = 0; i <= hd->semis; i++)
-			put_out(c, h, "?", 1);
+			ctrl_out_put(c, h, "?", 1);
 		return hd->semis + 1;
 	}
 	if (text[0] == 0x12) {
 		if (text[1] != 0x16 || text[2] != '\0') {
 			c->tc = 1;
-			put_out(c, h, "?", 1);
+			ctrl_out_put(c, h, "?", 1);
 			return 1;
 		}
 		n = snprintf(line, sizeof(line), "%s\r\n:", c->model);
-		put_out(c, h, line, (size_t)n);
+		ctrl_out_put(c, h, line, (size_t)n);
 		return 0;
 	}
 	snprintf(line, sizeof(line), "%s", text);
@@ -239,7 +197,7 @@ static void dl_bad_line(struct ctrl *c, int h, int tc)
 	if (!hd->dl_err)
 		hd->dl_err = tc;
 	c->tc = tc;
-	put_out(c, h, "?", 1);
+	ctrl_out_put(c, h, "?", 1);
 }
 
 static void dl_end_line(struct ctrl *c, int h)
@@ -263,17 +221,17 @@ static void dl_finish(struct ctrl *c, int h)
 	if (hd->dl_linelen > 0)
 		dl_end_line(c, h);
 	hd->mode = CTRL_H_CMD;
-	put_out(c, h, ":", 1);
+	ctrl_out_put(c, h, ":", 1);
 	if (hd->dl_err) {
 		rc = ctrl_load_program(c, "", 0, &bad_line);
 		ctrl_event(c, "download refused: TC %d (program erased)",
 			   hd->dl_err);
 		c->tc = hd->dl_err;
-		put_out(c, h, "?", 1);
+		ctrl_out_put(c, h, "?", 1);
 	} else {
 		rc = ctrl_load_program(c, (const char *)hd->dl.p + hd->dl.start,
 				       ctrl_buf_pending(&hd->dl), &bad_line);
-		put_out(c, h, rc ? "?" : ":", 1);
+		ctrl_out_put(c, h, rc ? "?" : ":", 1);
 	}
 	ctrl_buf_clear(&hd->dl);
 }
