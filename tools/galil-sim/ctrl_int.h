@@ -9,7 +9,8 @@
  *   ctrl_var.c    variables and arrays
  *   ctrl_expr.c   expression evaluator (strictly left to right) and operands
  *   ctrl_prog.c   program memory: download checks, statements, labels
- *   ctrl_exec.c   statement dispatch, threads, errors, automatic subroutines
+ *   ctrl_thread.c threads as state, automatic subroutines, TC texts
+ *   ctrl_exec.c   statement dispatch, run-time errors, the line scheduler
  *   ctrl_flow.c   IF/ELSE/ENDIF JP JS EN RE ZS XQ HX and the trippoints
  *   ctrl_cmd.c    command table and the general commands
  *   ctrl_axcmd.c  axis commands (SP AC ... PA PR BG ST SH MO TP ...)
@@ -362,9 +363,13 @@ struct ctrl_xc {
 
 #define CTRL_ROUTE_DEFAULT (-2)
 
-/* "handle B", "thread 0 line 57" or "private port": who ran a statement,
- * as the events name it. */
 #define CTRL_WHO_LEN 32
+/*
+ * ctrl_xc_who() - who runs the statement of @x, as events name it: "handle
+ * B" (a host), "thread 0 line 57" (a program thread, 0-based line) or
+ * "private port" (ctrl_command()). @buf gets at most @cap bytes
+ * (CTRL_WHO_LEN is enough), NUL-terminated. In ctrl_thread.c.
+ */
 void ctrl_xc_who(const struct ctrl_xc *x, char *buf, size_t cap);
 
 /* ---- expressions (ctrl_expr.c) ---------------------------------------- */
@@ -377,21 +382,46 @@ double *ctrl_param_ptr(struct ctrl_xc *x, int i);
 int ctrl_axis_letter(char ch);
 int ctrl_axis_desig(struct ctrl_xc *x, const char **p, int *axis);
 
-/* ---- statements and threads (ctrl_exec.c, ctrl_flow.c) ---------------- */
+/* ---- threads and automatic subroutines (ctrl_thread.c) ----------------- */
+
+/* ctrl_tc_text() - the TC1 text of code @tc (static), or "" if unknown. */
+const char *ctrl_tc_text(int tc);
+/* ctrl_any_running() - 1 when any of the 8 threads runs, else 0. */
+int ctrl_any_running(const struct ctrl *c);
+/*
+ * ctrl_thread_start() - (re)start thread @t (0..7) at statement @pc: its
+ * stack, trippoint and parameters are cleared, the AT reference is now.
+ */
+void ctrl_thread_start(struct ctrl *c, int t, int pc);
+/*
+ * ctrl_thread_halt() - stop thread @t (0..7) if it runs, with the event
+ * "thread t stopped: @why"; ctrl_threads_halt_all() does it for all 8.
+ */
+void ctrl_thread_halt(struct ctrl *c, int t, const char *why);
+void ctrl_threads_halt_all(struct ctrl *c, const char *why);
+/* ctrl_thread_line() - _XQn: 0-based line of thread @t, or -1 if stopped. */
+int ctrl_thread_line(const struct ctrl *c, int t);
+/* ctrl_thread_waiting() - 1 when thread @t runs and waits at a trippoint. */
+int ctrl_thread_waiting(const struct ctrl *c, int t);
+/*
+ * ctrl_autosub_raise() - mark automatic subroutine @which (enum
+ * ctrl_autosub) pending; ctrl_autosubs_dispatch() enters pending ones in
+ * thread 0 (by priority, #CMDERR may interrupt the others) and drops those
+ * the program lacks.
+ */
+void ctrl_autosub_raise(struct ctrl *c, int which);
+void ctrl_autosubs_dispatch(struct ctrl *c);
+/* ctrl_autosub_label() - first line of #CMDERR etc. in RAM, or -1. */
+int ctrl_autosub_label(const struct ctrl *c, int which);
+/* ctrl_autosub_active() - 1 when thread 0 is inside @which (-1: any). */
+int ctrl_autosub_active(const struct ctrl *c, int which);
+
+/* ---- statements (ctrl_exec.c, ctrl_flow.c) ---------------------------- */
 
 int ctrl_exec(struct ctrl_xc *x, const char *s);
 void ctrl_threads_run(struct ctrl *c);
-void ctrl_thread_start(struct ctrl *c, int t, int pc);
-void ctrl_thread_halt(struct ctrl *c, int t, const char *why);
-void ctrl_threads_halt_all(struct ctrl *c, const char *why);
-int ctrl_thread_line(const struct ctrl *c, int t);
-int ctrl_thread_waiting(const struct ctrl *c, int t);
-void ctrl_autosub_raise(struct ctrl *c, int which);
-int ctrl_autosub_label(const struct ctrl *c, int which);
 int ctrl_wait_done(struct ctrl *c, struct ctrl_thread *t);
 int ctrl_goto_line(struct ctrl_xc *x, double line);
-int ctrl_any_running(const struct ctrl *c);
-const char *ctrl_tc_text(int tc);
 
 /* command handlers shared through the table in ctrl_cmd.c */
 typedef int (*ctrl_cmd_fn)(struct ctrl_xc *x, const char *name, const char *a);
