@@ -7,6 +7,7 @@
  *   ctrl_buf.c    growable byte buffers (replies, unsolicited output)
  *   ctrl_out.c    events, host output queues, unsolicited routing (CF/CW)
  *   ctrl_var.c    variables and arrays
+ *   ctrl_axis.c   axis letters and designators
  *   ctrl_expr.c   expression evaluator (strictly left to right) and operands
  *   ctrl_prog.c   program memory: download checks, statements, labels
  *   ctrl_thread.c threads as state, automatic subroutines, TC texts
@@ -372,6 +373,17 @@ struct ctrl_xc {
  */
 void ctrl_xc_who(const struct ctrl_xc *x, char *buf, size_t cap);
 
+/* ---- axis names and operands (ctrl_axis.c) ---------------------------- */
+
+/* ctrl_axis_letter() - axis index of A..H (X Y Z W = A B C D), or -1. */
+int ctrl_axis_letter(char ch);
+/*
+ * ctrl_axis_desig() - one axis at *p: a letter or ~a..~h; *p moves past it
+ * and @axis gets 0..CTRL_AXES-1.
+ * Return: 0, TC 1 (not an axis), TC 6 (axis not on a DMC-4030).
+ */
+int ctrl_axis_desig(struct ctrl_xc *x, const char **p, int *axis);
+
 /* ---- expressions (ctrl_expr.c) ---------------------------------------- */
 
 int ctrl_expr(struct ctrl_xc *x, const char **p, double *out);
@@ -379,8 +391,6 @@ int ctrl_operand(struct ctrl_xc *x, const char **p, double *out);
 int ctrl_expr_end(struct ctrl_xc *x, const char *s, double *out);
 const char *ctrl_skip(const char *s);
 double *ctrl_param_ptr(struct ctrl_xc *x, int i);
-int ctrl_axis_letter(char ch);
-int ctrl_axis_desig(struct ctrl_xc *x, const char **p, int *axis);
 
 /* ---- threads and automatic subroutines (ctrl_thread.c) ----------------- */
 
