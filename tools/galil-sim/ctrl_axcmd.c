@@ -1,7 +1,8 @@
 /*
  * ctrl_axcmd.c - axis commands: the parameters (SP AC DC SD KP KI KD TL IL
  * OF OV ER OE OA OT LD FL BL TW), motion (PA PR JG PT DP ZA BG ST AB SH MO)
- * and the reports (TP TE TD RP TV TT TS SC), with their _operands.
+ * and the reports (TP TE TD RP TV TT TS SC). The parameter table and the
+ * _operands that read an axis are in ctrl_axis.c.
  *
  * Ranges and resolutions are those of the DMC-40x0 command reference; a
  * value out of range is TC 6 and nothing is changed.
@@ -12,97 +13,6 @@
 #include <string.h>
 
 #include "ctrl_int.h"
-
-struct par_desc {
-	char name[3];
-	double lo, hi;
-	double step;   /* resolution: values are cut to it (to zero) */
-	int fmt;       /* CTRL_NUM_* for queries */
-	int in_motion; /* may change while the axis profiles */
-};
-
-static const struct par_desc par_table[] = {
-    {"AC", 1024, 1073740800, 1024, CTRL_NUM_INT, 1},
-    {"BL", -2147483648.0, 2147483647, 1, CTRL_NUM_PF, 1},
-    {"DC", 1024, 1073740800, 1024, CTRL_NUM_INT, 0},
-    {"ER", -1, 2147483647, 1, CTRL_NUM_INT, 1},
-    {"FL", -2147483648.0, 2147483647, 1, CTRL_NUM_PF, 1},
-    {"IL", -9.9982, 9.9982, 0, CTRL_NUM_GAIN, 1},
-    {"KD", 0, 4095.875, 0.125, CTRL_NUM_GAIN, 1},
-    {"KI", 0, 255.999, 0, CTRL_NUM_GAIN, 1},
-    {"KP", 0, 1023.875, 0.125, CTRL_NUM_GAIN, 1},
-    {"OF", -9.9982, 9.9982, 0, CTRL_NUM_GAIN, 1},
-    {"OV", 0, 9.9982, 0, CTRL_NUM_GAIN, 1},
-    {"SD", 1024, 1073740800, 1024, CTRL_NUM_INT, 1},
-    {"SP", 0, 15000000, 2, CTRL_NUM_INT, 1},
-    {"TL", 0, 9.9982, 0, CTRL_NUM_GAIN, 1},
-    {"TW", -1, 32767, 1, CTRL_NUM_INT, 1},
-};
-
-/* Integer parameters kept as int in struct ctrl_axis_par. */
-struct ipar_desc {
-	char name[3];
-	int lo, hi;
-};
-
-static const struct ipar_desc ipar_table[] = {
-    {"LD", 0, 3},
-    {"OA", 0, 1},
-    {"OE", 0, 3},
-    {"OT", 1, 32000},
-};
-
-static const struct par_desc *par_find(const char *name)
-{
-	size_t i;
-
-	for (i = 0; i < sizeof(par_table) / sizeof(par_table[0]); i++)
-		if (!strcmp(par_table[i].name, name))
-			return &par_table[i];
-	return NULL;
-}
-
-static const struct ipar_desc *ipar_find(const char *name)
-{
-	size_t i;
-
-	for (i = 0; i < sizeof(ipar_table) / sizeof(ipar_table[0]); i++)
-		if (!strcmp(ipar_table[i].name, name))
-			return &ipar_table[i];
-	return NULL;
-}
-
-/* The parameter of @d in @p (every table entry has a case). */
-static double *par_ptr(struct ctrl_axis_par *p, const struct par_desc *d)
-{
-	switch (d->name[0] << 8 | d->name[1]) {
-	case 'A' << 8 | 'C': return &p->ac;
-	case 'B' << 8 | 'L': return &p->bl;
-	case 'D' << 8 | 'C': return &p->dc;
-	case 'E' << 8 | 'R': return &p->er;
-	case 'F' << 8 | 'L': return &p->fl;
-	case 'I' << 8 | 'L': return &p->il;
-	case 'K' << 8 | 'D': return &p->kd;
-	case 'K' << 8 | 'I': return &p->ki;
-	case 'K' << 8 | 'P': return &p->kp;
-	case 'O' << 8 | 'F': return &p->of;
-	case 'O' << 8 | 'V': return &p->ov;
-	case 'S' << 8 | 'D': return &p->sd;
-	case 'S' << 8 | 'P': return &p->sp;
-	case 'T' << 8 | 'L': return &p->tl;
-	default: return &p->tw;
-	}
-}
-
-static int *ipar_ptr(struct ctrl_axis_par *p, const struct ipar_desc *d)
-{
-	switch (d->name[0] << 8 | d->name[1]) {
-	case 'L' << 8 | 'D': return &p->ld;
-	case 'O' << 8 | 'A': return &p->oa;
-	case 'O' << 8 | 'E': return &p->oe;
-	default: return &p->ot;
-	}
-}
 
 /* Print the queried fields: " 1, 2\r\n". */
 static void put_queries(struct ctrl_xc *x, const struct ctrl_args *a,
@@ -154,10 +64,10 @@ axis_values(struct ctrl_xc *x, const char *a, double lo, double hi, double step,
 
 static double *par_slot(struct ctrl *c, int axis, const void *ud)
 {
-	return par_ptr(&c->ax[axis].p, ud);
+	return ctrl_par_ptr(&c->ax[axis].p, ud);
 }
 
-static int cmd_par(struct ctrl_xc *x, const struct par_desc *d, const char *a)
+static int cmd_par(struct ctrl_xc *x, const struct ctrl_par_desc *d, const char *a)
 {
 	struct ctrl_args args;
 	int i, rc;
@@ -183,7 +93,7 @@ static int cmd_par(struct ctrl_xc *x, const struct par_desc *d, const char *a)
 	return axis_values(x, a, d->lo, d->hi, d->step, d->fmt, par_slot, d);
 }
 
-static int cmd_ipar(struct ctrl_xc *x, const struct ipar_desc *d, const char *a)
+static int cmd_ipar(struct ctrl_xc *x, const struct ctrl_ipar_desc *d, const char *a)
 {
 	struct ctrl_args args;
 	double cur[CTRL_AXES];
@@ -192,7 +102,7 @@ static int cmd_ipar(struct ctrl_xc *x, const struct ipar_desc *d, const char *a)
 	if (rc)
 		return rc;
 	for (i = 0; i < CTRL_AXES; i++) {
-		cur[i] = *ipar_ptr(&x->c->ax[i].p, d);
+		cur[i] = *ctrl_ipar_ptr(&x->c->ax[i].p, d);
 		if (args.set[i] == 1 &&
 		    (args.v[i] != (int)args.v[i] || args.v[i] < d->lo ||
 		     args.v[i] > d->hi))
@@ -200,7 +110,7 @@ static int cmd_ipar(struct ctrl_xc *x, const struct ipar_desc *d, const char *a)
 	}
 	for (i = 0; i < CTRL_AXES; i++)
 		if (args.set[i] == 1)
-			*ipar_ptr(&x->c->ax[i].p, d) = (int)args.v[i];
+			*ctrl_ipar_ptr(&x->c->ax[i].p, d) = (int)args.v[i];
 	put_queries(x, &args, cur, CTRL_NUM_INT);
 	return 0;
 }
@@ -503,82 +413,6 @@ static int cmd_shmo(struct ctrl_xc *x, const char *a, int on)
 
 /* ---- reports and operands ------------------------------------------------ */
 
-static int switches(const struct ctrl *c, int i, int ts)
-{
-	const struct ctrl_axis *ax = &c->ax[i];
-	double te = round(ax->ref) - round(ax->enc);
-	int v = 0x02; /* home input: not wired, reads 1 */
-
-	if (!ax->lim_f)
-		v |= 0x08;
-	if (!ax->lim_r)
-		v |= 0x04;
-	if (ts) {
-		if (ax->profiling)
-			v |= 0x80;
-		if (ax->p.er >= 0 && fabs(te) > ax->p.er)
-			v |= 0x40;
-		if (ax->p.motor_off)
-			v |= 0x20;
-	}
-	return v;
-}
-
-/*
- * ctrl_axis_operand() - _XXa: state (TP RP TE TD TV TT TS SC MO BG LF LR
- * HM PA PR JG PT DP ZA) or a parameter. Return 0 or TC 1.
- */
-int ctrl_axis_operand(struct ctrl *c, const char *n, int i, double *v)
-{
-	const struct ctrl_axis *ax = &c->ax[i];
-	const struct par_desc *d = par_find(n);
-	const struct ipar_desc *id = ipar_find(n);
-
-	if (d)
-		*v = *par_ptr((struct ctrl_axis_par *)&ax->p, d);
-	else if (id)
-		*v = *ipar_ptr((struct ctrl_axis_par *)&ax->p, id);
-	else if (!strcmp(n, "TP") || !strcmp(n, "DP"))
-		*v = round(ax->enc);
-	else if (!strcmp(n, "RP"))
-		*v = round(ax->ref);
-	else if (!strcmp(n, "TE"))
-		*v = round(ax->ref) - round(ax->enc);
-	else if (!strcmp(n, "TD"))
-		*v = 0;
-	else if (!strcmp(n, "TV"))
-		*v = round(ctrl_axis_tv(ax, ctrl_dt(c)));
-	else if (!strcmp(n, "TT"))
-		*v = ax->torque;
-	else if (!strcmp(n, "TS"))
-		*v = switches(c, i, 1);
-	else if (!strcmp(n, "SC"))
-		*v = ax->stop_code;
-	else if (!strcmp(n, "MO"))
-		*v = ax->p.motor_off;
-	else if (!strcmp(n, "BG"))
-		*v = ax->profiling;
-	else if (!strcmp(n, "LF"))
-		*v = !ax->lim_f;
-	else if (!strcmp(n, "LR"))
-		*v = !ax->lim_r;
-	else if (!strcmp(n, "HM"))
-		*v = 1;
-	else if (!strcmp(n, "PA"))
-		*v = ax->pa_last;
-	else if (!strcmp(n, "PR"))
-		*v = ax->pr;
-	else if (!strcmp(n, "JG"))
-		*v = fabs(ax->jg);
-	else if (!strcmp(n, "PT"))
-		*v = ax->pt;
-	else if (!strcmp(n, "ZA"))
-		*v = ax->za;
-	else
-		return 1;
-	return 0;
-}
-
 /* TP TE TD RP TV TT TS SC [mask] */
 static int cmd_report(struct ctrl_xc *x, const char *name, const char *a)
 {
@@ -607,8 +441,8 @@ static int cmd_report(struct ctrl_xc *x, const char *name, const char *a)
 /* ctrl_axis_cmd() - the axis commands of the command table. */
 int ctrl_axis_cmd(struct ctrl_xc *x, const char *name, const char *a)
 {
-	const struct par_desc *d = par_find(name);
-	const struct ipar_desc *id = ipar_find(name);
+	const struct ctrl_par_desc *d = ctrl_par_find(name);
+	const struct ctrl_ipar_desc *id = ctrl_ipar_find(name);
 
 	if (d)
 		return cmd_par(x, d, a);

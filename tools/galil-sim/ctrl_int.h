@@ -7,7 +7,7 @@
  *   ctrl_buf.c    growable byte buffers (replies, unsolicited output)
  *   ctrl_out.c    events, host output queues, unsolicited routing (CF/CW)
  *   ctrl_var.c    variables and arrays
- *   ctrl_axis.c   axis letters and designators
+ *   ctrl_axis.c   axis letters, designators, parameter table, _XXa operands
  *   ctrl_expr.c   expression evaluator (strictly left to right) and operands
  *   ctrl_prog.c   program memory: download checks, statements, labels
  *   ctrl_thread.c threads as state, automatic subroutines, TC texts
@@ -384,6 +384,41 @@ int ctrl_axis_letter(char ch);
  */
 int ctrl_axis_desig(struct ctrl_xc *x, const char **p, int *axis);
 
+/* One real-valued axis parameter (SP AC DC SD KP KI KD TL IL OF OV ER FL
+ * BL TW): its range and resolution. */
+struct ctrl_par_desc {
+	char name[3];
+	double lo, hi;
+	double step;   /* resolution: values are cut to it (to zero) */
+	int fmt;       /* CTRL_NUM_* for queries */
+	int in_motion; /* may change while the axis profiles */
+};
+
+/* One integer axis parameter (LD OA OE OT): its range. */
+struct ctrl_ipar_desc {
+	char name[3];
+	int lo, hi;
+};
+
+/*
+ * ctrl_par_find() / ctrl_ipar_find() - the table entry of parameter @name
+ * ("SP", "OE" ...), static; NULL when @name is not one.
+ */
+const struct ctrl_par_desc *ctrl_par_find(const char *name);
+const struct ctrl_ipar_desc *ctrl_ipar_find(const char *name);
+/*
+ * ctrl_par_ptr() / ctrl_ipar_ptr() - where parameter @d is kept in @p
+ * (units of struct ctrl_axis_par); never NULL for a table entry.
+ */
+double *ctrl_par_ptr(struct ctrl_axis_par *p, const struct ctrl_par_desc *d);
+int *ctrl_ipar_ptr(struct ctrl_axis_par *p, const struct ctrl_ipar_desc *d);
+/*
+ * ctrl_axis_operand() - _XXa of axis @axis (0..CTRL_AXES-1): state (TP RP
+ * TE TD TV TT TS SC MO BG LF LR HM PA PR JG PT DP ZA; counts, counts/s,
+ * volts) or a parameter, into @v. Return: 0, or TC 1 (no such operand).
+ */
+int ctrl_axis_operand(struct ctrl *c, const char *name, int axis, double *v);
+
 /* ---- expressions (ctrl_expr.c) ---------------------------------------- */
 
 int ctrl_expr(struct ctrl_xc *x, const char **p, double *out);
@@ -440,7 +475,6 @@ int ctrl_cmd_assignable(const char *name);
 
 int ctrl_flow_cmd(struct ctrl_xc *x, const char *name, const char *a);
 int ctrl_axis_cmd(struct ctrl_xc *x, const char *name, const char *a);
-int ctrl_axis_operand(struct ctrl *c, const char *name, int axis, double *v);
 int ctrl_mg(struct ctrl_xc *x, const char *a);
 
 /* arguments: "n,n,n" with '?' queries and "X=n" single axis forms */
