@@ -35,36 +35,6 @@ int ctrl_goto_line(struct ctrl_xc *x, double line)
 	return 0;
 }
 
-/*
- * Up to @max comma-separated numbers; absent fields keep their value.
- * @present: [out] optional, bit i set when field i was given.
- */
-int ctrl_num_list(struct ctrl_xc *x, const char *a, double *v, int max,
-		  unsigned *present)
-{
-	unsigned got = 0;
-	int i = 0, rc;
-
-	a = ctrl_skip(a);
-	while (*a && i < max) {
-		if (*a != ',') {
-			rc = ctrl_expr(x, &a, &v[i]);
-			if (rc)
-				return rc;
-			got |= 1u << i;
-			a = ctrl_skip(a);
-		}
-		i++;
-		if (*a == ',')
-			a = ctrl_skip(a + 1);
-		else if (*a)
-			return 1;
-	}
-	if (present)
-		*present = got;
-	return *a ? 4 : 0;
-}
-
 /* ---- IF / ELSE / ENDIF ------------------------------------------------ */
 
 static int cmd_if(struct ctrl_xc *x, const char *a)

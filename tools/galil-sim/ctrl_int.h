@@ -13,6 +13,7 @@
  *   ctrl_thread.c threads as state, automatic subroutines, TC texts
  *   ctrl_exec.c   statement dispatch, run-time errors, the line scheduler
  *   ctrl_flow.c   IF/ELSE/ENDIF JP JS EN RE ZS XQ HX and the trippoints
+ *   ctrl_args.c   command arguments: axis fields, masks, number lists
  *   ctrl_cmd.c    command table and the general commands
  *   ctrl_axcmd.c  axis commands (SP AC ... PA PR BG ST SH MO TP ...)
  *   ctrl_motion.c profiler, servo and protection, once per sample
@@ -468,6 +469,47 @@ void ctrl_threads_run(struct ctrl *c);
 int ctrl_wait_done(struct ctrl *c, struct ctrl_thread *t);
 int ctrl_goto_line(struct ctrl_xc *x, double line);
 
+/* ---- command arguments (ctrl_args.c) ---------------------------------- */
+
+/* Arguments "n,n,n" with '?' queries and the "X=n" single axis forms. */
+struct ctrl_args {
+	int n;		    /* fields present (0..CTRL_AXES) */
+	int set[CTRL_AXES]; /* 1 value, 2 query, 0 empty */
+	double v[CTRL_AXES];
+};
+/*
+ * ctrl_parse_axis_args() - @a as "n,n,n" (expressions; empty fields skip
+ * an axis, '?' asks) or "A=n", "~a=n", "*=n", "A=?" into @out.
+ * Return: 0, or a TC code (6: more fields than axes, 1: syntax, or the
+ * expression's).
+ */
+int ctrl_parse_axis_args(struct ctrl_xc *x, const char *a,
+			 struct ctrl_args *out);
+/*
+ * ctrl_parse_mask() - @a as axes "ABC", "B", "~a~b", or "" (all axes) into
+ * @mask, bit i = axis i. Return: 0 or the TC code of ctrl_axis_desig().
+ */
+int ctrl_parse_mask(struct ctrl_xc *x, const char *a, unsigned *mask);
+/*
+ * ctrl_num_list() - up to @max comma-separated expressions of @a into
+ * @v[]; absent fields keep their value. @present: [out] optional, bit i
+ * set when field i was given. Return: 0, TC 4 (more than @max fields),
+ * TC 1 (syntax) or the expression's TC.
+ */
+int ctrl_num_list(struct ctrl_xc *x, const char *a, double *v, int max,
+		  unsigned *present);
+#define CTRL_NUM_VF   0 /* variable format (VF, LZ) */
+#define CTRL_NUM_PF   1 /* position format (PF) */
+#define CTRL_NUM_INT  2 /* integer */
+#define CTRL_NUM_GAIN 3 /* 4 decimals */
+/*
+ * ctrl_put_num() - @v appended to the statement's output (c->tmp) in format
+ * @how (CTRL_NUM_*). Return: 0, or 1 when it cannot be formatted or stored.
+ */
+int ctrl_put_num(struct ctrl_xc *x, double v, int how);
+
+/* ---- commands (ctrl_cmd.c, ctrl_flow.c, ctrl_axcmd.c, ctrl_mg.c) ------ */
+
 /* command handlers shared through the table in ctrl_cmd.c */
 typedef int (*ctrl_cmd_fn)(struct ctrl_xc *x, const char *name, const char *a);
 int ctrl_cmd_dispatch(struct ctrl_xc *x, const char *name, const char *a);
@@ -477,22 +519,6 @@ int ctrl_flow_cmd(struct ctrl_xc *x, const char *name, const char *a);
 int ctrl_axis_cmd(struct ctrl_xc *x, const char *name, const char *a);
 int ctrl_mg(struct ctrl_xc *x, const char *a);
 
-/* arguments: "n,n,n" with '?' queries and "X=n" single axis forms */
-struct ctrl_args {
-	int n;		    /* fields present (0..CTRL_AXES) */
-	int set[CTRL_AXES]; /* 1 value, 2 query, 0 empty */
-	double v[CTRL_AXES];
-};
-int ctrl_parse_axis_args(struct ctrl_xc *x, const char *a,
-			 struct ctrl_args *out);
-int ctrl_parse_mask(struct ctrl_xc *x, const char *a, unsigned *mask);
-int ctrl_num_list(struct ctrl_xc *x, const char *a, double *v, int max,
-		  unsigned *present);
-#define CTRL_NUM_VF   0 /* variable format (VF, LZ) */
-#define CTRL_NUM_PF   1 /* position format (PF) */
-#define CTRL_NUM_INT  2 /* integer */
-#define CTRL_NUM_GAIN 3 /* 4 decimals */
-int ctrl_put_num(struct ctrl_xc *x, double v, int how);
 
 /* ---- output (ctrl_out.c) ---------------------------------------------- */
 
