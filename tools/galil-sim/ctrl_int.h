@@ -20,7 +20,8 @@
  *   ctrl_mg.c     MG and its formatters
  *   ctrl_proto.c  host handles: framing, DL/UL, unsolicited routing
  *   ctrl_rec.c    the QR data record
- *   ctrl.c        life cycle, ctrl_step(), burn and power cycle
+ *   ctrl_store.c  DL into program memory; BP BN BV into flash
+ *   ctrl.c        life cycle, ctrl_step(), power cycle
  */
 #ifndef SIM_CTRL_INT_H
 #define SIM_CTRL_INT_H
@@ -468,6 +469,9 @@ int ctrl_exec(struct ctrl_xc *x, const char *s);
 void ctrl_threads_run(struct ctrl *c);
 int ctrl_wait_done(struct ctrl *c, struct ctrl_thread *t);
 int ctrl_goto_line(struct ctrl_xc *x, double line);
+/* ctrl_samples() - servo samples in @ms milliseconds at the current TM,
+ * rounded to nearest. In ctrl_flow.c. */
+int ctrl_samples(const struct ctrl *c, double ms);
 
 /* ---- command arguments (ctrl_args.c) ---------------------------------- */
 
@@ -562,18 +566,33 @@ double ctrl_axis_tv(const struct ctrl_axis *a, double dt);
 double ctrl_dt(const struct ctrl *c);
 int ctrl_blocked_dir(const struct ctrl_axis *a, int dir);
 
+/* ---- program memory and flash (ctrl_store.c) ------------------------- */
+
+/*
+ * ctrl_burn_program() / ctrl_burn_vars() - BP / BV: copy the program /
+ * the variables and arrays in RAM to flash, with an event.
+ * Return: 0, or -1 when out of memory (flash keeps what it had).
+ */
+int ctrl_burn_program(struct ctrl *c);
+int ctrl_burn_vars(struct ctrl *c);
+/* ctrl_burn_params() - BN: axis parameters and settings to flash. */
+void ctrl_burn_params(struct ctrl *c);
+/*
+ * ctrl_load_program() - replace program memory with @len bytes of @text
+ * (copied); on a refused text the memory is left empty, TC set, and
+ * @bad_line gets the 1-based line refused. Events either way.
+ * Return: 0 or the TC code (60 61 62 63 ...).
+ */
+int ctrl_load_program(struct ctrl *c, const char *text, size_t len,
+		      int *bad_line);
+
 /* ---- data record (ctrl_rec.c) ----------------------------------------- */
 
 int ctrl_record(struct ctrl *c, uint8_t *buf, size_t cap);
 
 /* ---- life cycle helpers (ctrl.c) -------------------------------------- */
 
+/* ctrl_axis_defaults() - @p set to the factory settings of an axis. */
 void ctrl_axis_defaults(struct ctrl_axis_par *p);
-int ctrl_burn_program(struct ctrl *c);
-void ctrl_burn_params(struct ctrl *c);
-int ctrl_burn_vars(struct ctrl *c);
-int ctrl_samples(const struct ctrl *c, double ms);
-int ctrl_load_program(struct ctrl *c, const char *text, size_t len,
-		      int *bad_line);
 
 #endif /* SIM_CTRL_INT_H */
