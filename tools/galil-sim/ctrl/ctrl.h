@@ -60,6 +60,8 @@ struct ctrl_axis_info {
 
 /*
  * ctrl_new() - a controller in its power-up state (no program, motors off).
+ * @cfg is copied (NULL: defaults). The caller owns the result and frees it
+ * with ctrl_free() (NULL is ignored).
  * Return: NULL on allocation failure.
  */
 struct ctrl *ctrl_new(const struct ctrl_cfg *cfg);

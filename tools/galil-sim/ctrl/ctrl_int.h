@@ -2,25 +2,28 @@
  * ctrl_int.h - internals of the simulated DMC-4030 (ctrl.h), shared by the
  * ctrl_*.c files only. Nothing here is part of the public API.
  *
- * Layout of the controller:
+ * Layout of the controller (tools/galil-sim/ctrl/), in layers: a file
+ * calls only files listed above it, never below, so there is no import
+ * cycle:
  *   ctrl_num.c    32.16 fixed-point numbers, Galil number formats
  *   ctrl_buf.c    growable byte buffers (replies, unsolicited output)
- *   ctrl_out.c    events, host output queues, unsolicited routing (CF/CW)
  *   ctrl_var.c    variables and arrays
- *   ctrl_axis.c   axis letters, designators, parameter table, _XXa operands
- *   ctrl_expr.c   expression evaluator (strictly left to right) and operands
  *   ctrl_prog.c   program memory: download checks, statements, labels
+ *   ctrl_out.c    events, host output queues, unsolicited routing (CF/CW)
  *   ctrl_thread.c threads as state, automatic subroutines, TC texts
- *   ctrl_exec.c   statement dispatch, run-time errors, the line scheduler
- *   ctrl_flow.c   IF/ELSE/ENDIF JP JS EN RE ZS XQ HX and the trippoints
- *   ctrl_args.c   command arguments: axis fields, masks, number lists
- *   ctrl_cmd.c    command table and the general commands
- *   ctrl_axcmd.c  axis commands (SP AC ... PA PR BG ST SH MO TP ...)
  *   ctrl_motion.c profiler, servo and protection, once per sample
+ *   ctrl_axis.c   axis letters, designators, parameter table, _XXa operands
+ *   ctrl_oper.c   _operands
+ *   ctrl_expr.c   expression evaluator (strictly left to right)
+ *   ctrl_args.c   command arguments: axis fields, masks, number lists
+ *   ctrl_flow.c   IF/ELSE/ENDIF JP JS EN RE ZS XQ HX and the trippoints
  *   ctrl_mg.c     MG and its formatters
- *   ctrl_proto.c  host handles: framing, DL/UL, unsolicited routing
+ *   ctrl_axcmd.c  axis commands (SP AC ... PA PR BG ST SH MO TP ...)
  *   ctrl_rec.c    the QR data record
  *   ctrl_store.c  DL into program memory; BP BN BV into flash
+ *   ctrl_cmd.c    command table and the general commands
+ *   ctrl_exec.c   statement dispatch, run-time errors, the line scheduler
+ *   ctrl_proto.c  host handles: framing, DL/UL
  *   ctrl.c        life cycle, ctrl_step(), power cycle
  */
 #ifndef SIM_CTRL_INT_H
@@ -68,13 +71,26 @@ struct ctrl_buf {
 	size_t cap;
 };
 
+/*
+ * ctrl_buf_put() / ctrl_buf_puts() / ctrl_buf_printf() - append @n bytes
+ * of @data, the string @s, or printf output (cut to 255 bytes) to @b,
+ * growing it; the bytes are copied. A zeroed struct is an empty buffer.
+ * Return: 0, or -1 when out of memory (or a format error): nothing added.
+ */
 int ctrl_buf_put(struct ctrl_buf *b, const void *data, size_t n);
 int ctrl_buf_puts(struct ctrl_buf *b, const char *s);
 int ctrl_buf_printf(struct ctrl_buf *b, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
+/* ctrl_buf_pending() - bytes of @b not yet taken. */
 size_t ctrl_buf_pending(const struct ctrl_buf *b);
+/*
+ * ctrl_buf_take() - move up to @cap unread bytes of @b into @out (FIFO).
+ * Return: the number of bytes copied.
+ */
 size_t ctrl_buf_take(struct ctrl_buf *b, uint8_t *out, size_t cap);
+/* ctrl_buf_clear() - drop the contents of @b, keeping its memory. */
 void ctrl_buf_clear(struct ctrl_buf *b);
+/* ctrl_buf_free() - release the memory of @b; it is empty and usable. */
 void ctrl_buf_free(struct ctrl_buf *b);
 
 /* ---- numbers (ctrl_num.c) ------------------------------------------- */
@@ -89,10 +105,26 @@ struct ctrl_fmt {
 	int n;	   /* digits right of the point */
 };
 
+/*
+ * ctrl_fx() - @v on the 32.16 fixed-point grid (1/65536, rounded to
+ * nearest), wrapped like a 48-bit register; NaN gives 0.
+ * ctrl_fx_raw() - the same as the raw signed 48-bit value (v * 65536);
+ * ctrl_fx_from_raw() - a raw value back to a double.
+ */
 double ctrl_fx(double v);
 int64_t ctrl_fx_raw(double v);
 double ctrl_fx_from_raw(int64_t raw);
+/*
+ * ctrl_fmt_num() - print @v in format @f ('F'/'Z': m 0..10, n 0..4; '$':
+ * m 1..8, n 0..4; 'S': m 1..6 characters, @cap >= 8) into @out (@cap
+ * bytes, NUL-terminated). Return: characters written (snprintf style),
+ * or -1 for a bad format.
+ */
 int ctrl_fmt_num(char *out, size_t cap, double v, const struct ctrl_fmt *f);
+/*
+ * ctrl_str_value() - the value of a "string": its first 6 of @n
+ * characters packed into 48 bits, the first in the top byte.
+ */
 double ctrl_str_value(const char *s, size_t n);
 
 /* ---- names, variables and arrays (ctrl_var.c) ------------------------ */
@@ -115,16 +147,44 @@ struct ctrl_vars {
 	int arr_used; /* elements allocated in total */
 };
 
+/* ctrl_ident_len() - length of the run of letters and digits at @s. */
 size_t ctrl_ident_len(const char *s);
+/*
+ * ctrl_name_key() - the key of a variable/array/label name: the @n
+ * characters of @s (a letter, then letters or digits, 1..CTRL_NAME_MAX)
+ * packed one byte each, first in the low byte, into @key.
+ * Return: 0, or TC 9 (variable error) for a bad or too long name.
+ * ctrl_key_name() - the name of @key back into @out, NUL-terminated.
+ */
 int ctrl_name_key(const char *s, size_t n, uint64_t *key);
 void ctrl_key_name(uint64_t key, char out[CTRL_NAME_MAX + 1]);
+/* ctrl_var_find() - the slot of variable @key in @vs->slot[], or -1. */
 int ctrl_var_find(const struct ctrl_vars *vs, uint64_t key);
+/*
+ * ctrl_var_set() - assign @v to variable @key, creating it if needed.
+ * @slot: [out] optional, the variable's slot.
+ * Return: 0, or TC 67 when all CTRL_VARS variables are used.
+ */
 int ctrl_var_set(struct ctrl_vars *vs, uint64_t key, double v, int *slot);
+/* ctrl_array_find() - array @key of @vs (owned by @vs), or NULL. */
 struct ctrl_array *ctrl_array_find(struct ctrl_vars *vs, uint64_t key);
+/*
+ * ctrl_array_dim() - DM name[@n]: a new array of @n zeros. An existing
+ * array is never re-dimensioned (docs/galil-sim-controller.md).
+ * Return: 0, TC 6 (size), TC 57 (exists), TC 66 (array space full or out
+ * of memory), TC 67 (too many arrays).
+ */
 int ctrl_array_dim(struct ctrl_vars *vs, uint64_t key, int n);
+/* ctrl_array_free() - DA of array @key. Return: 0, or TC 57 (none). */
 int ctrl_array_free(struct ctrl_vars *vs, uint64_t key);
+/* ctrl_arrays_free() - how many more arrays may be dimensioned (_DA). */
 int ctrl_arrays_free(const struct ctrl_vars *vs);
+/* ctrl_vars_clear() - free all arrays and forget all variables of @vs. */
 void ctrl_vars_clear(struct ctrl_vars *vs);
+/*
+ * ctrl_vars_copy() - deep copy of @src into @dst (BV and power-up); @dst
+ * is cleared first. Return: 0, or -1 when out of memory (@dst then empty).
+ */
 int ctrl_vars_copy(struct ctrl_vars *dst, const struct ctrl_vars *src);
 
 /* ---- program memory (ctrl_prog.c) ----------------------------------- */
@@ -161,13 +221,32 @@ struct ctrl_prog {
 	size_t pool_len, pool_cap;
 };
 
+/*
+ * ctrl_prog_load() - check the program text @text (@len bytes, copied) and
+ * load it into @p, which must be empty (zeroed or freed).
+ * @bad_line: [out] 1-based line of the first error, 0 if none.
+ * @tc: [out] its TC code (60, 61, 62 ...).
+ * Return: 0, a TC code (p is then empty), or -1 when out of memory.
+ */
 int ctrl_prog_load(struct ctrl_prog *p, const char *text, size_t len,
 		   int *bad_line, int *tc);
+/* ctrl_prog_free() - release @p's memory; @p is then empty. */
 void ctrl_prog_free(struct ctrl_prog *p);
+/*
+ * ctrl_prog_copy() - deep copy of @src over @dst (BP, power-up).
+ * Return: 0, or -1 when out of memory (@dst unchanged).
+ */
 int ctrl_prog_copy(struct ctrl_prog *dst, const struct ctrl_prog *src);
+/* ctrl_prog_label() - 0-based line of label @key in @p, or -1. */
 int ctrl_prog_label(const struct ctrl_prog *p, uint64_t key);
+/*
+ * ctrl_prog_stmt_text() - statement @i as written in its line, into @out
+ * (@cap > CTRL_LINE_MAX). Return: 0, or -1 (bad index or small @cap).
+ */
 int ctrl_prog_stmt_text(const struct ctrl_prog *p, int i, char *out,
 			size_t cap);
+/* ctrl_prog_stmt() - the text of statement @i (0 <= i < nstmts), owned by
+ * @p. */
 const char *ctrl_prog_stmt(const struct ctrl_prog *p, int i);
 
 /* ---- threads and automatic subroutines ------------------------------ */
@@ -423,11 +502,36 @@ int ctrl_axis_operand(struct ctrl *c, const char *name, int axis, double *v);
 
 /* ---- expressions (ctrl_expr.c) ---------------------------------------- */
 
+/*
+ * ctrl_expr() - evaluate the expression at *p into @out, strictly left to
+ * right; stops at the first character that is not an operator (',', ')',
+ * ']', '{', end ...). Return: 0 or a TC code; *p is advanced only on
+ * success.
+ */
 int ctrl_expr(struct ctrl_xc *x, const char **p, double *out);
-int ctrl_operand(struct ctrl_xc *x, const char **p, double *out);
+/*
+ * ctrl_expr_end() - the whole of @s is one expression, into @out.
+ * Return: 0, TC 59 (a ')' too many), TC 1 (text after it) or the TC of
+ * ctrl_expr().
+ */
 int ctrl_expr_end(struct ctrl_xc *x, const char *s, double *out);
+/* ctrl_skip() - @s past spaces and tabs. */
 const char *ctrl_skip(const char *s);
+/*
+ * ctrl_param_ptr() - where ^a..^h (@i 0..7) of the running thread is kept
+ * (its frame, or the variable passed by &ref), owned by the controller;
+ * NULL from a host or for a bad @i.
+ */
 double *ctrl_param_ptr(struct ctrl_xc *x, int i);
+
+/* ---- _operands (ctrl_oper.c) ------------------------------------------ */
+
+/*
+ * ctrl_operand() - the _operand at *p ('_' included) into @out, on the
+ * 32.16 grid. Return: 0 or a TC code (1: unknown); *p is advanced only on
+ * success.
+ */
+int ctrl_operand(struct ctrl_xc *x, const char **p, double *out);
 
 /* ---- threads and automatic subroutines (ctrl_thread.c) ----------------- */
 
@@ -463,15 +567,6 @@ int ctrl_autosub_label(const struct ctrl *c, int which);
 /* ctrl_autosub_active() - 1 when thread 0 is inside @which (-1: any). */
 int ctrl_autosub_active(const struct ctrl *c, int which);
 
-/* ---- statements (ctrl_exec.c, ctrl_flow.c) ---------------------------- */
-
-int ctrl_exec(struct ctrl_xc *x, const char *s);
-void ctrl_threads_run(struct ctrl *c);
-int ctrl_wait_done(struct ctrl *c, struct ctrl_thread *t);
-int ctrl_goto_line(struct ctrl_xc *x, double line);
-/* ctrl_samples() - servo samples in @ms milliseconds at the current TM,
- * rounded to nearest. In ctrl_flow.c. */
-int ctrl_samples(const struct ctrl *c, double ms);
 
 /* ---- command arguments (ctrl_args.c) ---------------------------------- */
 
@@ -514,14 +609,72 @@ int ctrl_put_num(struct ctrl_xc *x, double v, int how);
 
 /* ---- commands (ctrl_cmd.c, ctrl_flow.c, ctrl_axcmd.c, ctrl_mg.c) ------ */
 
-/* command handlers shared through the table in ctrl_cmd.c */
+/* A command handler: @name the two letters, @a the argument text. */
 typedef int (*ctrl_cmd_fn)(struct ctrl_xc *x, const char *name, const char *a);
+
+/*
+ * ctrl_flow_cmd() - the flow and trippoint commands @name (IF ELSE ENDIF
+ * JP JS EN RE RI ZS XQ HX WT AT AM MC MF MR AI) with argument text @a.
+ * Return: 0 or a TC code.
+ */
+int ctrl_flow_cmd(struct ctrl_xc *x, const char *name, const char *a);
+/*
+ * ctrl_wait_done() - 1 when the trippoint of thread @t is satisfied (and
+ * then cleared), else 0; an MC past its TW sets stop code 99 and raises
+ * #MCTIME.
+ */
+int ctrl_wait_done(struct ctrl *c, struct ctrl_thread *t);
+/*
+ * ctrl_goto_line() - continue the running thread at program line @line
+ * (0-based). Return: 0, or TC 11 (not a line of the program).
+ */
+int ctrl_goto_line(struct ctrl_xc *x, double line);
+/* ctrl_samples() - servo samples in @ms milliseconds at the current TM,
+ * rounded to nearest. */
+int ctrl_samples(const struct ctrl *c, double ms);
+/*
+ * ctrl_axis_cmd() - the axis commands @name (parameters, PA PR JG PT DP ZA
+ * BG ST AB SH MO, reports TP TE TD RP TV TT TS SC) with argument text @a;
+ * replies go to the statement output. Return: 0 or a TC code.
+ */
+int ctrl_axis_cmd(struct ctrl_xc *x, const char *name, const char *a);
+/*
+ * ctrl_mg() - MG with argument text @a: the message formatted into the
+ * statement output. Return: 0 or a TC code.
+ */
+int ctrl_mg(struct ctrl_xc *x, const char *a);
+/*
+ * ctrl_record() - the QR data record of @c encoded into @buf (@cap bytes).
+ * Return: its length, or a negative gl_err (GL_ERR_OVERFLOW: @cap too
+ * small).
+ */
+int ctrl_record(struct ctrl *c, uint8_t *buf, size_t cap);
+
+/* ---- the command table (ctrl_cmd.c) ----------------------------------- */
+
+/*
+ * ctrl_cmd_dispatch() - run command @name (two letters) with argument text
+ * @a through the command table. Return: 0 or a TC code (1: unknown
+ * command, 2: program only, 3: not valid in a program).
+ */
 int ctrl_cmd_dispatch(struct ctrl_xc *x, const char *name, const char *a);
+/* ctrl_cmd_assignable() - 1 when command @name takes the single-axis
+ * "XXa=n" form, else 0. */
 int ctrl_cmd_assignable(const char *name);
 
-int ctrl_flow_cmd(struct ctrl_xc *x, const char *name, const char *a);
-int ctrl_axis_cmd(struct ctrl_xc *x, const char *name, const char *a);
-int ctrl_mg(struct ctrl_xc *x, const char *a);
+/* ---- statements (ctrl_exec.c) ----------------------------------------- */
+
+/*
+ * ctrl_exec() - run one statement @s (no ';') in the context @x; output
+ * goes to c->tmp. Return: 0, a TC code, CTRL_RETRY or CTRL_STOP.
+ */
+int ctrl_exec(struct ctrl_xc *x, const char *s);
+/*
+ * ctrl_threads_run() - the program part of one servo sample: the running
+ * threads get program lines round robin, c->lines_per_sample in all;
+ * automatic subroutines are entered, run-time errors handled.
+ */
+void ctrl_threads_run(struct ctrl *c);
 
 
 /* ---- output (ctrl_out.c) ---------------------------------------------- */
@@ -549,21 +702,62 @@ int ctrl_unsol_send(struct ctrl *c, int route, const uint8_t *p, size_t n);
 
 /* ---- host protocol (ctrl_proto.c) -------------------------------------- */
 
+/*
+ * ctrl_proto_reset() - power cycle: every open host handle is to be
+ * closed, all host and serial output and downloads are dropped.
+ */
 void ctrl_proto_reset(struct ctrl *c);
+/*
+ * ctrl_proto_host() - a complete command line @line (no CR) from handle
+ * @h (0..8): run its commands and queue their replies.
+ * Return: the number of commands that answered '?'.
+ */
 int ctrl_proto_host(struct ctrl *c, int h, const char *line);
 
 /* ---- motion (ctrl_motion.c) ------------------------------------------- */
 
-void ctrl_motion_sample(struct ctrl *c);
+/*
+ * ctrl_motion_sense() - take the plant's sample @in (encoders, switches,
+ * inputs, motor power); ctrl_motion_sample() - protection, profiler and
+ * servo of one sample; ctrl_motion_drive() - what goes to the plant, in
+ * plant coordinates, into @out.
+ */
 void ctrl_motion_sense(struct ctrl *c, const struct ctrl_sense *in);
+void ctrl_motion_sample(struct ctrl *c);
 void ctrl_motion_drive(struct ctrl *c, struct ctrl_drive *out);
+/*
+ * ctrl_motion_begin() - BG of axis @axis (0..2) with its staged mode.
+ * @dry_run: only check. Return: 0, TC 20 (motor off), 21 (already
+ * moving), 22 (a limit in the way), 7 (position tracking).
+ */
 int ctrl_motion_begin(struct ctrl *c, int axis, int dry_run);
+/*
+ * ctrl_motion_stop() - decelerate axis @axis at @dec counts/s^2, stop code
+ * @code (ST: 4, which also leaves position tracking).
+ */
 void ctrl_motion_stop(struct ctrl *c, int axis, int code, double dec);
+/*
+ * ctrl_motion_abort() - AB of axis @axis: the reference stops at once
+ * (event "axis A abort: AB (@who)"); with OE set the motor goes off.
+ */
 void ctrl_motion_abort(struct ctrl *c, int axis, const char *who);
+/*
+ * ctrl_motion_off() - motor off for axis @axis; @code: stop code to set
+ * (-1: keep), @why: for the event.
+ */
 void ctrl_motion_off(struct ctrl *c, int axis, int code, const char *why);
+/*
+ * ctrl_motion_pt_target() - PA in position tracking: retarget axis @axis
+ * to @target counts on the fly. Return: 0.
+ */
 int ctrl_motion_pt_target(struct ctrl *c, int axis, double target);
+/* ctrl_axis_tv() - _TV of @a, counts/s, over the last CTRL_TV_SAMPLES
+ * samples of @dt seconds. */
 double ctrl_axis_tv(const struct ctrl_axis *a, double dt);
+/* ctrl_dt() - the servo sample period in seconds (TM). */
 double ctrl_dt(const struct ctrl *c);
+/* ctrl_blocked_dir() - 1 when motion of @a in direction @dir (-1, 0, 1)
+ * is refused by a limit switch or a soft limit (FL/BL), else 0. */
 int ctrl_blocked_dir(const struct ctrl_axis *a, int dir);
 
 /* ---- program memory and flash (ctrl_store.c) ------------------------- */
@@ -585,10 +779,6 @@ void ctrl_burn_params(struct ctrl *c);
  */
 int ctrl_load_program(struct ctrl *c, const char *text, size_t len,
 		      int *bad_line);
-
-/* ---- data record (ctrl_rec.c) ----------------------------------------- */
-
-int ctrl_record(struct ctrl *c, uint8_t *buf, size_t cap);
 
 /* ---- life cycle helpers (ctrl.c) -------------------------------------- */
 
