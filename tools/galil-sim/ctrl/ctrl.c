@@ -7,13 +7,22 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_buf.h"
+#include "ctrl_exec.h"
+#include "ctrl_motion.h"
+#include "ctrl_num.h"
+#include "ctrl_out.h"
+#include "ctrl_prog.h"
+#include "ctrl_proto.h"
+#include "ctrl_store.h"
+#include "ctrl_thread.h"
+#include "ctrl_var.h"
 #include "gl_err.h"
 
 #define DEFAULT_MODEL "DMC4030 Rev 1.2h-sim"
 
 /* ctrl_axis_defaults() - factory settings (DMC-40x0 command reference). */
-void ctrl_axis_defaults(struct ctrl_axis_par *p)
+static void ctrl_axis_defaults(struct ctrl_axis_par *p)
 {
 	memset(p, 0, sizeof(*p));
 	p->sp = 25000;

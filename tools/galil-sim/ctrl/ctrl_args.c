@@ -9,7 +9,11 @@
  */
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_args.h"
+#include "ctrl_axis.h"
+#include "ctrl_buf.h"
+#include "ctrl_expr.h"
+#include "ctrl_num.h"
 
 /* ctrl_put_num() - one number into the output, CTRL_NUM_* format. */
 int ctrl_put_num(struct ctrl_xc *x, double v, int how)

@@ -12,7 +12,14 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_axcmd.h"
+#include "ctrl_args.h"
+#include "ctrl_axis.h"
+#include "ctrl_buf.h"
+#include "ctrl_expr.h"
+#include "ctrl_motion.h"
+#include "ctrl_out.h"
+#include "ctrl_thread.h"
 
 /* Print the queried fields: " 1, 2\r\n". */
 static void put_queries(struct ctrl_xc *x, const struct ctrl_args *a,

@@ -10,7 +10,8 @@
 #include <math.h>
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_axis.h"
+#include "ctrl_motion.h"
 
 /* ctrl_axis_letter() - axis index of A..H (X Y Z W = A B C D), or -1. */
 int ctrl_axis_letter(char ch)

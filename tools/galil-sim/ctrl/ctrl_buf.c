@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_buf.h"
 
 /* Make room for n more bytes; moves unread data to the front first. */
 static int buf_reserve(struct ctrl_buf *b, size_t n)

@@ -10,7 +10,18 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_cmd.h"
+#include "ctrl_args.h"
+#include "ctrl_axcmd.h"
+#include "ctrl_buf.h"
+#include "ctrl_expr.h"
+#include "ctrl_flow.h"
+#include "ctrl_mg.h"
+#include "ctrl_prog.h"
+#include "ctrl_rec.h"
+#include "ctrl_store.h"
+#include "ctrl_thread.h"
+#include "ctrl_var.h"
 #include "gl_record.h"
 
 #define F_PROG	 1u /* program only: TC 2 from a host */

@@ -22,7 +22,17 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_exec.h"
+#include "ctrl_axis.h"
+#include "ctrl_buf.h"
+#include "ctrl_cmd.h"
+#include "ctrl_expr.h"
+#include "ctrl_flow.h"
+#include "ctrl_num.h"
+#include "ctrl_out.h"
+#include "ctrl_prog.h"
+#include "ctrl_thread.h"
+#include "ctrl_var.h"
 
 /* ---- statements ------------------------------------------------------ */
 

@@ -17,7 +17,11 @@
 #include <math.h>
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_expr.h"
+#include "ctrl_num.h"
+#include "ctrl_oper.h"
+#include "ctrl_prog.h"
+#include "ctrl_var.h"
 
 #define EXPR_DEPTH 40 /* nested parentheses / unary signs */
 #define DEG	   (M_PI / 180.0)

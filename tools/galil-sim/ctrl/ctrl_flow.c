@@ -11,7 +11,12 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_flow.h"
+#include "ctrl_args.h"
+#include "ctrl_expr.h"
+#include "ctrl_out.h"
+#include "ctrl_thread.h"
+#include "ctrl_var.h"
 
 static struct ctrl_thread *cur(struct ctrl_xc *x)
 {

@@ -13,7 +13,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_mg.h"
+#include "ctrl_buf.h"
+#include "ctrl_expr.h"
+#include "ctrl_num.h"
 
 /* A number format "F5.2" etc. at s (after '{'); *p past the '}'. */
 static int num_fmt(const char *s, const char **p, struct ctrl_fmt *f)

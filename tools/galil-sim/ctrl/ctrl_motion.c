@@ -19,7 +19,9 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_motion.h"
+#include "ctrl_out.h"
+#include "ctrl_thread.h"
 
 #define DAC_V_PER_COUNT (10.0 / 32768.0)
 #define CTRL_KI_LEAK	100.0 /* integrator leak time constant, samples */

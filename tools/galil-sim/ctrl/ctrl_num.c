@@ -11,7 +11,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_num.h"
 
 #define FX_BITS 48
 #define FX_MOD	281474976710656.0 /* 2^48 */

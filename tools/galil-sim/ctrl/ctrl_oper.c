@@ -7,7 +7,11 @@
 #include <ctype.h>
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_oper.h"
+#include "ctrl_axis.h"
+#include "ctrl_num.h"
+#include "ctrl_thread.h"
+#include "ctrl_var.h"
 
 static unsigned thread_mask(const struct ctrl *c)
 {

@@ -9,7 +9,8 @@
 #include <stdarg.h>
 #include <stdio.h>
 
-#include "ctrl_int.h"
+#include "ctrl_out.h"
+#include "ctrl_buf.h"
 
 void ctrl_event(struct ctrl *c, const char *fmt, ...)
 {

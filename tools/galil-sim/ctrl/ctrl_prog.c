@@ -14,7 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_prog.h"
+#include "ctrl_var.h"
 
 struct split {
 	const char *s;

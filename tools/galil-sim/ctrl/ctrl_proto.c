@@ -22,7 +22,12 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_proto.h"
+#include "ctrl_buf.h"
+#include "ctrl_exec.h"
+#include "ctrl_out.h"
+#include "ctrl_store.h"
+#include "ctrl_thread.h"
 #include "gl_err.h"
 
 static int valid_handle(int h)

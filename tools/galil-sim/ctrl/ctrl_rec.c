@@ -9,7 +9,8 @@
 #include <math.h>
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_rec.h"
+#include "ctrl_motion.h"
 #include "gl_record.h"
 
 static int32_t clamp32(double v)

@@ -8,7 +8,11 @@
  */
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_store.h"
+#include "ctrl_out.h"
+#include "ctrl_prog.h"
+#include "ctrl_thread.h"
+#include "ctrl_var.h"
 
 /* ---- burning --------------------------------------------------------- */
 

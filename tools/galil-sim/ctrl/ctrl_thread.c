@@ -10,7 +10,10 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_thread.h"
+#include "ctrl_out.h"
+#include "ctrl_prog.h"
+#include "ctrl_var.h"
 
 static const struct {
 	int tc;

@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "ctrl_int.h"
+#include "ctrl_var.h"
 
 /* ctrl_ident_len() - length of the run of letters and digits at @s. */
 size_t ctrl_ident_len(const char *s)
