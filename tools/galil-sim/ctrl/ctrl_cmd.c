@@ -1,7 +1,7 @@
 /*
- * ctrl_cmd.c - the command table, argument parsing shared by the command
- * families, and the general commands (TC TH WH QZ QR CF CW SB CB OB OP TI
- * TA TB DM DA LV LA LL LS UL DL BP BN BV NO TM VF PF LZ IH CN EO).
+ * ctrl_cmd.c - the command table and the general commands (TC TH WH QZ QR
+ * CF CW SB CB OB OP TI TA TB DM DA LV LA LL LS UL DL BP BN BV NO TM VF PF
+ * LZ IH CN EO). The argument parsers are in ctrl_args.c.
  *
  * A command not in the table answers TC 1: nothing is accepted silently.
  */

@@ -1,8 +1,8 @@
 /*
  * ctrl_oper.c - _operands in expressions: _XXa reads what command XX holds
- * for axis a (_TPA, _SPB, _ZAC ...; see ctrl_axis_operand()), plus the
- * controller-wide ones (_TC, _ED, _XQn, _NO, _BN ...). Operands cannot be
- * assigned. An unknown operand is TC 1.
+ * for axis a (_TPA, _SPB, _ZAC ...; ctrl_axis_operand() in ctrl_axis.c),
+ * plus the controller-wide ones (_TC, _ED, _XQn, _NO, _BN ...). Operands
+ * cannot be assigned. An unknown operand is TC 1.
  */
 #include <ctype.h>
 #include <string.h>
