@@ -12,7 +12,7 @@
 #include <string.h>
 
 #include "gl_err.h"
-#include "re_super.h"
+#include "re_pot.h"
 
 #define NS_PER_MS 1000000LL
 #define AXES	  "ABC"

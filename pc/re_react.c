@@ -13,6 +13,7 @@
 
 #include "base_clock.h"
 #include "gl_err.h"
+#include "re_pot.h"
 #include "re_super.h"
 
 /* The program told to latch, and the stop (re_io.h; the DMC's own #FAULT

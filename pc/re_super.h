@@ -37,13 +37,11 @@
 #include "gl_record.h"
 #include "re_check.h"
 #include "re_io.h"
+#include "re_pot.h"
 
 #define RE_SUPER_AXES 3
 #define RE_SUPER_LINE 768 /* FAULT line, bytes incl. NUL */
 #define RE_SUPER_MSGS 8	  /* unsolicited lines drained per cycle */
-
-/* AQ2 (default): analog inputs read +-10 V as +-32768 counts. */
-#define RE_AN_COUNTS_PER_V 3276.8
 
 struct re_super_cfg {
 	int n_axes;		   /* 1..RE_SUPER_AXES */
@@ -293,16 +291,6 @@ void re_super_status(const struct re_super *s, struct re_status *st);
  * Return: GL_OK when everything was confirmed, else the first error.
  */
 int re_super_shutdown(struct re_super *s, char *what, size_t cap);
-
-/* re_pot_volts() - analog input counts (AQ2) to volts. */
-double re_pot_volts(int32_t analog_in);
-
-/*
- * re_pot_of() - the potentiometer of axis @axis in @rec, volts: analog
- * input @input (1..n_axes: its axis block), or the axis's own block when
- * @input is out of that range.
- */
-double re_pot_of(const struct gl_record *rec, int axis, int input);
 
 /*
  * re_super_late_ms() - wake-up lateness percentile over every cycle so far.
