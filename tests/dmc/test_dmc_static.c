@@ -21,6 +21,7 @@
 #include <cmocka.h>
 
 #include "dmc_h.h"
+#include "dmc_text.h"
 
 #define LINE_MAX_CH 80
 #define PROG_LINES  4000
@@ -251,18 +252,22 @@ static void test_statements(void **state)
 
 	(void)state;
 	for (int i = 0; prog_line(i, line, sizeof(line)) >= 0; i++) {
-		char *save = NULL;
+		size_t pos = 0, at, len;
+		char stmt[256];
 
 		if (line[0] == '#')
 			continue;
 		if (strchr(line, '\''))
 			fail_msg("line %d: comment left: %s", i + 1, line);
-		if (strchr(line, '"') && strchr(line, ';'))
-			continue; /* no string with ';' in this program */
-		for (char *st = strtok_r(line, ";", &save); st;
-		     st = strtok_r(NULL, ";", &save)) {
+		/* the one splitter: ';' inside a "string" does not split */
+		while (dmc_stmt_next(line, strlen(line), &pos, &at, &len)) {
+			char *st = stmt;
 			int n;
 
+			if (!len)
+				continue;
+			memcpy(stmt, line + at, len);
+			stmt[len] = '\0';
 			while (*st == ' ')
 				st++;
 			if (islower((unsigned char)st[0])) {

@@ -26,7 +26,7 @@ static char *check_path(const char *path, const char *model, int *problems)
 {
 	struct gload_prog p = {0};
 	struct gload_diags d = {0};
-	const struct gload_model *m = gload_model_find(model);
+	const struct dmc_model *m = dmc_model_find(model);
 	size_t len = 0;
 	char *out;
 	int i;
@@ -60,7 +60,7 @@ static char *check_text(const char *text, int *problems)
 	int i;
 
 	gload_prep_buffer(&p, "mem.dmc", text, strlen(text), &d);
-	gload_check(&p, gload_model_default(), &d, NULL);
+	gload_check(&p, dmc_model_default(), &d, NULL);
 	gload_diags_sort(&d);
 	for (i = 0; i < d.n; i++)
 		len += strlen(d.v[i].text) + 1;
@@ -288,21 +288,21 @@ static void test_label_case_and_length(void **state)
 /* The model table and its aliases. */
 static void test_models(void **state)
 {
-	const struct gload_model *m;
+	const struct dmc_model *m;
 
 	(void)state;
-	m = gload_model_default();
+	m = dmc_model_default();
 	assert_string_equal(m->name, "40x0");
 	assert_int_equal(m->max_lines, 4000);
 	assert_int_equal(m->max_vars, 510);
 	assert_int_equal(m->max_labels, 510);
 	assert_int_equal(m->line_chars, 80);
-	assert_ptr_equal(gload_model_find("DMC-4030"), m);
-	assert_ptr_equal(gload_model_find("dmc4040"), m);
-	assert_string_equal(gload_model_find("4143")->name, "41x3");
-	assert_int_equal(gload_model_find("30010")->threads, 6);
-	assert_int_equal(gload_model_find("21x3")->max_lines, 1000);
-	assert_null(gload_model_find("1806"));
+	assert_ptr_equal(dmc_model_find("DMC-4030"), m);
+	assert_ptr_equal(dmc_model_find("dmc4040"), m);
+	assert_string_equal(dmc_model_find("4143")->name, "41x3");
+	assert_int_equal(dmc_model_find("30010")->threads, 6);
+	assert_int_equal(dmc_model_find("21x3")->max_lines, 1000);
+	assert_null(dmc_model_find("1806"));
 }
 
 /* Random text made of DMC's special characters never crashes the
@@ -328,7 +328,7 @@ static void test_random_input(void **state)
 			    alphabet[(seed >> 16) % (sizeof(alphabet) - 1)];
 		}
 		gload_prep_buffer(&p, "r.dmc", buf, (size_t)n, &d);
-		assert_true(gload_check(&p, gload_model_default(), &d, NULL) >=
+		assert_true(gload_check(&p, dmc_model_default(), &d, NULL) >=
 			    0);
 		assert_int_equal(gload_prog_finish(&p), 0);
 		gload_diags_free(&d);

@@ -7,6 +7,8 @@
 #include <string.h>
 
 #include "gl_err.h"
+#include "dmc_cmd.h"
+#include "dmc_text.h"
 #include "gload_check.h"
 
 /*
@@ -15,24 +17,7 @@
  * quoted 2000 lines / 254 variables; DMC-2x00 manual: 254 variables), so the
  * smaller commonly quoted values are used. Threads [3.4].
  */
-static const struct gload_model models[] = {
-    {"40x0", "DMC-40x0", 80, 4000, 510, 510, 8, 1},
-    {"41x3", "DMC-41x3", 80, 2000, 254, 254, 8, 0},
-    {"21x3", "DMC-21x3", 80, 1000, 254, 254, 8, 0},
-    {"30010", "DMC-30010", 80, 2000, 254, 254, 6, 0},
-};
 
-/* Two-letter commands (the kForth DMC grammar list plus EN IN NO RE RI). */
-static const char commands[] =
-    "AB AC AD AF AG AI AL AM AO AP AQ AR AS AT AU AV AZ BA BC BD BG BI BK "
-    "BL BM BN BP BR BT BV BW BX BZ CA CB CC CD CE CF CI CM CN CR CS CW DA "
-    "DC DE DH DL DM DP DR DT DV EA EB EC ED EG EI EM EN EO EP EQ ER ES ET "
-    "EW EY FA FE FI FL FV GA GD GM GP GR HM HS HV HX IA ID IH II IK IL IN "
-    "IP IT JG JP JS KD KI KP KS LA LC LD LE LF LI LL LM LR LS LV LZ MB MC "
-    "ME MF MG MO MR MT MU MW NB NF NO NZ OA OB OC OE OF OP OT OV PA PF PL "
-    "PR PT PV PW QD QH QQ QR QS QU QZ RA RC RD RE RI RL RP RS SA SB SC SD "
-    "SH SL SM SP ST TA TB TC TD TE TH TI TK TL TM TN TP TR TS TT TV TW TZ "
-    "UI UL US VA VD VE VF VM VP VR VS VV WH WT XQ YA YB YC YR YS ZA ZS";
 
 /* Axis letters after a command ("KPA=10"). */
 static const char axis_letters[] = "ABCDEFGHSTWXYZ";
@@ -55,7 +40,7 @@ struct symtab {
 
 struct chk {
 	const struct gload_prog *p;
-	const struct gload_model *m;
+	const struct dmc_model *m;
 	struct gload_diags *d;
 	struct symtab labels, refs, vars;
 	int *ifs; /* line index of each open IF */
@@ -63,11 +48,6 @@ struct chk {
 	int problems;
 	int nomem;
 };
-
-static int is_word(char c)
-{
-	return isalnum((unsigned char)c) || c == '_';
-}
 
 static int is_upper(char c)
 {
@@ -78,7 +58,7 @@ static size_t word_len(const char *s, size_t n)
 {
 	size_t i = 0;
 
-	while (i < n && is_word(s[i]))
+	while (i < n && dmc_is_name_char(s[i]))
 		i++;
 	return i;
 }
@@ -127,16 +107,16 @@ static struct sym *sym_add(struct chk *c, struct symtab *t, const char *s,
 	return e;
 }
 
+/* An upper-case two-letter command of the one table (dmc_cmd); the
+ * keyword IF is checked apart. */
 static int is_command(const char *s)
 {
-	const char *p;
+	const struct dmc_cmd *e;
 
 	if (!is_upper(s[0]) || !is_upper(s[1]))
 		return 0;
-	for (p = commands; p[0] && p[1]; p += p[2] ? 3 : 2)
-		if (p[0] == s[0] && p[1] == s[1])
-			return 1;
-	return 0;
+	e = dmc_cmd_find(s);
+	return e && !(e->flags & DMC_CMD_KEYWORD);
 }
 
 /* "IF", "ELSE", "ENDIF": the keyword a word is, in any case, or NULL. */
@@ -161,9 +141,9 @@ static void check_label_def(struct chk *c, int idx, const char *s, size_t n)
 		       "invalid label '%.*s' (a letter, then letters, digits "
 		       "or '_')",
 		       (int)n, s);
-	else if (wl > GLOAD_LABEL_MAX)
+	else if (wl > DMC_LABEL_MAX)
 		report(c, idx, "label '%.*s' is longer than %d characters",
-		       (int)n, s, GLOAD_LABEL_MAX);
+		       (int)n, s, DMC_LABEL_MAX);
 	sym_add(c, &c->labels, s + 1, n - 1, idx);
 }
 
@@ -186,11 +166,11 @@ static void check_expr(struct chk *c, int idx, const char *s, size_t n)
 			i += word_len(s + i, n - i);
 		} else if (isalpha((unsigned char)ch)) {
 			wl = word_len(s + i, n - i);
-			if (wl > GLOAD_VAR_MAX)
+			if (wl > DMC_NAME_MAX)
 				report(c, idx,
 				       "variable name '%.*s' is longer "
 				       "than %d characters",
-				       (int)wl, s + i, GLOAD_VAR_MAX);
+				       (int)wl, s + i, DMC_NAME_MAX);
 			i += wl;
 		} else {
 			i++;
@@ -213,11 +193,11 @@ static int check_var_name(struct chk *c, int idx, const char *w, size_t n)
 		       (int)n, w);
 		return 0;
 	}
-	if (n > GLOAD_VAR_MAX) {
+	if (n > DMC_NAME_MAX) {
 		report(c, idx,
 		       "variable name '%.*s' is longer than %d "
 		       "characters",
-		       (int)n, w, GLOAD_VAR_MAX);
+		       (int)n, w, DMC_NAME_MAX);
 		return 0;
 	}
 	for (i = 0; i < sizeof(reserved) / sizeof(reserved[0]); i++)
@@ -425,7 +405,7 @@ static void check_statements(struct chk *c, int idx)
 			s++;
 		st = s;
 		no = end - s >= 2 && s[0] == 'N' && s[1] == 'O' &&
-		     (end - s == 2 || !is_word(s[2]));
+		     (end - s == 2 || !dmc_is_name_char(s[2]));
 		for (in_str = 0; s < end && (in_str || *s != ';'); s++)
 			if (*s == '"' && !no)
 				in_str = !in_str;
@@ -544,7 +524,7 @@ static void check_vars(struct chk *c)
 
 static void check_end(struct chk *c)
 {
-	const struct gload_model *m = c->m;
+	const struct dmc_model *m = c->m;
 	int total = c->p->nlines + 1; /* with the identity line */
 	int i;
 
@@ -561,7 +541,7 @@ static void check_end(struct chk *c)
 	check_vars(c);
 }
 
-int gload_check(const struct gload_prog *p, const struct gload_model *m,
+int gload_check(const struct gload_prog *p, const struct dmc_model *m,
 		struct gload_diags *d, struct gload_stats *st)
 {
 	struct chk c = {.p = p, .m = m, .d = d};
@@ -590,33 +570,4 @@ int gload_check(const struct gload_prog *p, const struct gload_model *m,
 	free(c.vars.v);
 	free(c.ifs);
 	return c.nomem ? GL_ERR_NOMEM : c.problems;
-}
-
-const struct gload_model *gload_model_default(void)
-{
-	return &models[0];
-}
-
-const struct gload_model *gload_model_find(const char *name)
-{
-	static const char *const alias[][2] = {
-	    {"4020", "40x0"}, {"4030", "40x0"},	  {"4040", "40x0"},
-	    {"4050", "40x0"}, {"4060", "40x0"},	  {"4070", "40x0"},
-	    {"4080", "40x0"}, {"4103", "41x3"},	  {"4123", "41x3"},
-	    {"4133", "41x3"}, {"4143", "41x3"},	  {"4163", "41x3"},
-	    {"4183", "41x3"}, {"2103", "21x3"},	  {"2123", "21x3"},
-	    {"2133", "21x3"}, {"2143", "21x3"},	  {"2163", "21x3"},
-	    {"2183", "21x3"}, {"31010", "30010"},
-	};
-	size_t i;
-
-	if (!strncasecmp(name, "DMC", 3))
-		name += name[3] == '-' ? 4 : 3;
-	for (i = 0; i < sizeof(alias) / sizeof(alias[0]); i++)
-		if (!strcasecmp(name, alias[i][0]))
-			name = alias[i][1];
-	for (i = 0; i < sizeof(models) / sizeof(models[0]); i++)
-		if (!strcasecmp(name, models[i].name))
-			return &models[i];
-	return NULL;
 }

@@ -27,34 +27,9 @@
 #ifndef GLOAD_CHECK_H
 #define GLOAD_CHECK_H
 
+#include "dmc_model.h"
 #include "gload_diag.h"
 #include "gload_prep.h"
-
-#define GLOAD_LABEL_MAX 7 /* characters after '#' [galil-notes 3.4] */
-#define GLOAD_VAR_MAX	8 /* characters in a variable name [3.4] */
-
-/* A controller family and its program limits (docs/galil-load.md). */
-struct gload_model {
-	const char *name;  /* --model value: "40x0" */
-	const char *title; /* in messages: "DMC-40x0" */
-	int line_chars;	   /* characters per program line */
-	int max_lines;	   /* program lines */
-	int max_labels;
-	int max_vars;  /* scalar variables */
-	int threads;   /* program threads 0..threads-1 */
-	int confirmed; /* 0: limits not confirmed from a primary
-			* source; conservative values */
-};
-
-/*
- * gload_model_find() - the model called @name ("40x0", "41x3", "21x3",
- * "30010"; also "4030" style numbers and a "DMC-"/"DMC" prefix).
- * Return: the model, or NULL when unknown.
- */
-const struct gload_model *gload_model_find(const char *name);
-
-/* gload_model_default() - the DMC-40x0 (the RoboELF DMC-4030). */
-const struct gload_model *gload_model_default(void);
 
 /* What the checker counted, for the summary line. */
 struct gload_stats {
@@ -71,7 +46,7 @@ struct gload_stats {
  * @st: [out] optional counts.
  * Return: the number of problems found (>= 0; 0 = clean), or GL_ERR_NOMEM.
  */
-int gload_check(const struct gload_prog *p, const struct gload_model *m,
+int gload_check(const struct gload_prog *p, const struct dmc_model *m,
 		struct gload_diags *d, struct gload_stats *st);
 
 #endif /* GLOAD_CHECK_H */

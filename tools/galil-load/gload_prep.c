@@ -5,6 +5,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "dmc_text.h"
 #include "gl_err.h"
 #include "gload_prep.h"
 
@@ -13,29 +14,12 @@ static int is_blank(char c)
 	return c == ' ' || c == '\t';
 }
 
-static int is_word(char c)
-{
-	return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') ||
-	       (c >= '0' && c <= '9') || c == '_';
-}
-
-/* "REM" as the first word of the line. */
-static int is_rem_line(const char *s, size_t n)
-{
-	size_t i = 0;
-
-	while (i < n && is_blank(s[i]))
-		i++;
-	return n - i >= 3 && memcmp(s + i, "REM", 3) == 0 &&
-	       (n - i == 3 || is_blank(s[i + 3]));
-}
-
 /* A statement starting at @s is a NO comment: "NO" not followed by a name
  * character (NOx=1 is an assignment to the variable NOx). */
 static int is_no_stmt(const char *s, size_t n)
 {
 	return n >= 2 && s[0] == 'N' && s[1] == 'O' &&
-	       (n == 2 || !is_word(s[2]));
+	       (n == 2 || !dmc_is_name_char(s[2]));
 }
 
 static size_t trim_end(const char *out, size_t o)
@@ -176,7 +160,7 @@ int gload_prep_buffer(struct gload_prog *p, const char *path, const char *buf,
 	p->src_bytes += len;
 	while (next_src_line(buf, len, &pos, &s, &n)) {
 		line++;
-		if (is_rem_line(s, n))
+		if (dmc_is_rem(s, n))
 			continue;
 		olen = strip_line(s, n, out, &open_quote);
 		if (open_quote)

@@ -30,13 +30,13 @@
 
 struct opts {
 	const char *addr;
-	const struct gload_model *model;
+	const struct dmc_model *model;
 	int check_only;
 	int burn;
 	int start;
 	int force;
 	int timeout_ms;
-	char start_label[GLOAD_LABEL_MAX + 1];
+	char start_label[DMC_LABEL_MAX + 1];
 	const char *output;
 	const char *cmds[MAX_COMMANDS];
 	int ncmds;
@@ -108,7 +108,7 @@ static int set_start_label(struct opts *o, const char *arg)
 	if (arg[0] == '#')
 		arg++;
 	n = strlen(arg);
-	if (n == 0 || n > GLOAD_LABEL_MAX ||
+	if (n == 0 || n > DMC_LABEL_MAX ||
 	    !((arg[0] >= 'A' && arg[0] <= 'Z') ||
 	      (arg[0] >= 'a' && arg[0] <= 'z')))
 		return -1;
@@ -175,7 +175,7 @@ static int parse_opt(struct opts *o, int ch, const char *arg)
 	case 'c': return add_command(o, arg);
 	case 'h': return -1;
 	case 'm':
-		o->model = gload_model_find(arg);
+		o->model = dmc_model_find(arg);
 		return o->model ? 0
 				: usage_error("unknown model '%s' (40x0, "
 					      "41x3, 21x3, 30010)",
@@ -222,7 +222,7 @@ static int parse_args(int argc, char **argv, struct opts *o)
 	int ch, rc;
 
 	memset(o, 0, sizeof(*o));
-	o->model = gload_model_default();
+	o->model = dmc_model_default();
 	o->timeout_ms = DEFAULT_TIMEOUT_MS;
 	opterr = 0;
 	while ((ch = getopt_long(argc, argv, ":a:m:o:fc:t:h", long_opts,

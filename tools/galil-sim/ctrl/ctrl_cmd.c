@@ -149,6 +149,12 @@ static const struct cmd_ent *cmd_find(const char *name)
 		       sizeof(cmd_table[0]), ent_cmp);
 }
 
+const char *ctrl_cmd_name_at(size_t i)
+{
+	return i < sizeof(cmd_table) / sizeof(cmd_table[0]) ? cmd_table[i].name
+							     : NULL;
+}
+
 int ctrl_cmd_assignable(const char *name)
 {
 	const struct cmd_ent *e = cmd_find(name);

@@ -22,4 +22,11 @@ int ctrl_cmd_dispatch(struct ctrl_xc *x, const char *name, const char *a);
  * "XXa=n" form, else 0. */
 int ctrl_cmd_assignable(const char *name);
 
+/*
+ * ctrl_cmd_name_at() - the name of the @i-th command galil-sim runs
+ * (0 <= i, alphabetical), or NULL past the end: the dispatch table, for
+ * the test that holds it to the one command table (pc/dmc/dmc_cmd.h).
+ */
+const char *ctrl_cmd_name_at(size_t i);
+
 #endif /* SIM_CTRL_CMD_H */

@@ -33,6 +33,7 @@
 #include "ctrl_prog.h"
 #include "ctrl_thread.h"
 #include "ctrl_var.h"
+#include "dmc_text.h"
 
 /* ---- statements ------------------------------------------------------ */
 
@@ -179,8 +180,8 @@ static int word_stmt(struct ctrl_xc *x, const char *s)
 	if ((n == 4 && !strncmp(s, "ELSE", 4)) ||
 	    (n == 5 && !strncmp(s, "ENDIF", 5)))
 		return ctrl_flow_cmd(x, n == 4 ? "ELSE" : "ENDIF", after);
-	if (n >= 3 && !strncmp(s, "REM", 3))
-		return 0;
+	if (dmc_is_rem(s, n))
+		return 0; /* the one REM rule (dmc_text.h) */
 	if ((*after == '=' || *after == '[') && !is_axis_assign(s, n) &&
 	    !(n == 2 && isupper((unsigned char)s[0]) &&
 	      isupper((unsigned char)s[1])))

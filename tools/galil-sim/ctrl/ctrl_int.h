@@ -37,18 +37,19 @@
 #include <stddef.h>
 
 #include "ctrl.h"
+#include "dmc_model.h"
 
-/* Limits of a DMC-40x0 (galil-notes.md 3.4; DMC command reference). */
-#define CTRL_LINE_MAX	 80    /* characters per line (host and program) */
-#define CTRL_PROG_LINES	 4000  /* program lines */
-#define CTRL_LABELS	 510   /* labels */
-#define CTRL_VARS	 510   /* variables */
+/* Limits of a DMC-40x0: from the one model table (pc/dmc/dmc_model.h). */
+#define CTRL_LINE_MAX	 DMC_LINE_MAX	  /* characters per line */
+#define CTRL_PROG_LINES	 DMC_40X0_LINES	  /* program lines */
+#define CTRL_LABELS	 DMC_40X0_LABELS /* labels */
+#define CTRL_VARS	 DMC_40X0_VARS	  /* variables */
 #define CTRL_VAR_SLOTS	 1024  /* hash slots, power of two > 2 * CTRL_VARS */
 #define CTRL_ARRAYS	 30    /* arrays */
 #define CTRL_ARRAY_SPACE 24000 /* array elements in total */
 #define CTRL_STACK_DEPTH 16    /* JS nesting (TC 12) */
-#define CTRL_NAME_MAX	 8     /* variable / array name characters */
-#define CTRL_LABEL_MAX	 7     /* label characters after '#' */
+#define CTRL_NAME_MAX	 DMC_NAME_MAX  /* variable / array name characters */
+#define CTRL_LABEL_MAX	 DMC_LABEL_MAX /* label characters after '#' */
 #define CTRL_NPARAM	 8     /* ^a .. ^h */
 
 /* Model choices (documented in docs/galil-sim-controller.md). */

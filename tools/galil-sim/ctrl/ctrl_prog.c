@@ -16,6 +16,7 @@
 
 #include "ctrl_prog.h"
 #include "ctrl_var.h"
+#include "dmc_text.h"
 
 struct split {
 	const char *s;
@@ -94,15 +95,6 @@ static int stmt_flow(const char *s, size_t n)
 	return CTRL_FLOW_NONE;
 }
 
-static int is_rem(const char *s, size_t n)
-{
-	while (n && *s == ' ') {
-		s++;
-		n--;
-	}
-	return n >= 3 && !strncmp(s, "REM", 3);
-}
-
 /* Split line @ln into statements, appending to p->stmt. */
 static void split_line(struct ctrl_prog *p, int ln)
 {
@@ -116,7 +108,7 @@ static void split_line(struct ctrl_prog *p, int ln)
 			quote = !quote;
 		if (i < n && (quote || s[i] != ';'))
 			continue;
-		if (i < n && is_rem(s + start, i - start))
+		if (i < n && dmc_is_rem(s + start, i - start))
 			continue; /* REM runs to the end of the line */
 		p->stmt[p->nstmts].line = ln;
 		p->stmt[p->nstmts].off = (uint8_t)start;
