@@ -5,6 +5,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "base_clock.h"
 #include "gl_err.h"
 #include "gl_ident.h"
 #include "gload_dl.h"
@@ -46,22 +47,6 @@ static int send_simple(gl_link *l, const char *cmd, int timeout_ms)
 	return rc < 0 ? rc : GL_OK;
 }
 
-/* ms on the monotonic clock. */
-static long long mono_ms(void)
-{
-	struct timespec ts;
-
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (long long)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
-}
-
-static void sleep_ms(int ms)
-{
-	struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
-
-	while (nanosleep(&ts, &ts) == -1 && errno == EINTR)
-		;
-}
 
 int gload_dl_busy(gl_link *l, int watch_ms, int *state, int timeout_ms)
 {
@@ -76,7 +61,7 @@ int gload_dl_busy(gl_link *l, int watch_ms, int *state, int timeout_ms)
 		return 0;
 	if (gload_query_number(l, "MG hbpc", &hb0, timeout_ms) != GL_OK)
 		return 0;
-	sleep_ms(watch_ms);
+	base_sleep_ms(watch_ms);
 	if (gload_query_number(l, "MG hbpc", &hb1, timeout_ms) != GL_OK ||
 	    hb1 == hb0)
 		return 0;
@@ -88,7 +73,7 @@ int gload_dl_busy(gl_link *l, int watch_ms, int *state, int timeout_ms)
 static int wait_stopped(gl_link *l, int axes, int stop_ms,
 			char failed[GLOAD_CMD_LEN], int timeout_ms)
 {
-	long long end = mono_ms() + stop_ms;
+	long long end = base_now_ms() + stop_ms;
 	double bg;
 	int i, rc, moving;
 
@@ -102,8 +87,8 @@ static int wait_stopped(gl_link *l, int axes, int stop_ms,
 			moving |= bg != 0;
 		}
 		if (moving)
-			sleep_ms(10);
-	} while (moving && mono_ms() < end);
+			base_sleep_ms(10);
+	} while (moving && base_now_ms() < end);
 	return moving ? GL_ERR_TIMEOUT : GL_OK;
 }
 

@@ -5,6 +5,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "base_file.h"
 #include "dmc_text.h"
 #include "gl_err.h"
 #include "gload_prep.h"
@@ -177,51 +178,14 @@ out_free:
 }
 
 /* Read a whole file into a malloc'd buffer (NUL-terminated). */
+/* The whole file (pc/base), NUL-terminated; *err the errno on failure
+ * (EFBIG above GLOAD_FILE_MAX). */
 static int read_file(const char *path, char **buf, size_t *len, int *err)
 {
-	FILE *f = fopen(path, "rb");
-	size_t cap = 4096, n = 0, got;
-	char *b = NULL, *nb;
+	int rc = base_file_read(path, (size_t)GLOAD_FILE_MAX, buf, len);
 
-	*err = 0;
-	if (!f)
-		goto out_errno;
-	b = malloc(cap);
-	if (!b)
-		goto out_nomem;
-	while ((got = fread(b + n, 1, cap - n - 1, f)) > 0) {
-		n += got;
-		if (n > (size_t)GLOAD_FILE_MAX)
-			goto out_too_big;
-		if (n + 1 < cap)
-			continue;
-		cap *= 2;
-		nb = realloc(b, cap);
-		if (!nb)
-			goto out_nomem;
-		b = nb;
-	}
-	if (ferror(f))
-		goto out_errno;
-	fclose(f);
-	b[n] = '\0';
-	*buf = b;
-	*len = n;
-	return GL_OK;
-
-out_too_big:
-	*err = EFBIG;
-	goto out_close;
-out_nomem:
-	*err = ENOMEM;
-	goto out_close;
-out_errno:
-	*err = errno;
-out_close:
-	if (f)
-		fclose(f);
-	free(b);
-	return GL_ERR_NOENT;
+	*err = rc < 0 ? -rc : 0;
+	return rc < 0 ? GL_ERR_NOENT : GL_OK;
 }
 
 static int prep_file(struct gload_prog *p, const char *path, int mline,
