@@ -23,7 +23,7 @@
 #include <stdint.h>
 #include <time.h>
 
-#include "re_check.h"
+#include "re_calcheck.h"
 
 #define RE_CALFILE_VERSION   1
 #define RE_CAL_NAME_MAX	     16 /* axis name incl. NUL: [A-Za-z0-9_-]{1,15} */

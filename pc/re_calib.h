@@ -29,7 +29,7 @@
  *      stall shorter than the controller watchdog loses at most one step at
  *      vmax) is fitted from the samples of both neighbours, and logged;
  *   4. back off the forward switch: the forward soft limit.
- * Then the table checks of re_check.h (monotonic with the noise margin,
+ * Then the table checks of re_calcheck.h (monotonic with the noise margin,
  * range, number of points, encoder advance, and both end values against
  * the potentiometer's expected absolute values), and every axis to the
  * centre at the travel speed, checking the potentiometer against the new
@@ -45,7 +45,7 @@
 #include <stdint.h>
 
 #include "re_calfile.h"
-#include "re_check.h"
+#include "re_calcheck.h"
 #include "re_config.h"
 #include "re_io.h"
 #include "re_plan.h"

@@ -7,7 +7,7 @@
 #   sh tests/checks/docs.sh --list [ROOT]  print what was extracted, check nothing
 #
 # What must be documented:
-#   (a) every FAULT line: each entry of re_fault_table in pc/re_check.c, as the
+#   (a) every FAULT line: each entry of re_fault_table in pc/re_fault.c, as the
 #       operator sees it ("FAULT <CLASS>: <what>. Recovery: <recovery>", with
 #       the {a} {s} {i0} ... placeholders as written in the table), verbatim on
 #       one line of docs/operator.md; and every other "FAULT <CLASS>: ..."
@@ -124,7 +124,7 @@ tokens() {
 # fault_table: "ID<TAB>CLASS<TAB>what<TAB>recovery" per re_fault_table entry;
 # the class is the name re_fclass_names gives it.
 fault_table() {
-	tokens pc/re_check.c | awk -F '\t' '
+	tokens pc/re_fault.c | awk -F '\t' '
 	# re_fclass_names: [ RE_FC_X ] = "NAME"
 	$1 == "P" && $2 == "[" { st = 1; next }
 	st == 1 && $1 == "W" && $2 ~ /^RE_FC_/ { fc = $2; st = 2; next }
@@ -162,11 +162,11 @@ other_faults() {
 
 check_faults() {
 	doc=docs/operator.md
-	need_file pc/re_check.c || return
+	need_file pc/re_fault.c || return
 	fault_table >"$TMPD/faults"
 	other_faults >"$TMPD/other"
 	if [ ! -s "$TMPD/faults" ]; then
-		fail "no FAULT templates found in re_fault_table of pc/re_check.c (the extraction no longer matches the code)"
+		fail "no FAULT templates found in re_fault_table of pc/re_fault.c (the extraction no longer matches the code)"
 		return
 	fi
 	if [ "$LIST" = 1 ]; then
@@ -185,7 +185,7 @@ check_faults() {
 		for (j = 1; j <= nl && !found; j++)
 			if (index(line[j], want)) found = 1
 		if (!found)
-			printf "docs.sh: FAULT message %s (\"%s\") is in pc/re_check.c but not in %s\n", $1, want, doc
+			printf "docs.sh: FAULT message %s (\"%s\") is in pc/re_fault.c but not in %s\n", $1, want, doc
 		next
 	}
 	{	# a printf-style literal: pieces between conversions, in order

@@ -46,7 +46,7 @@ drop() {
 # ---- 1. synthetic tree ---------------------------------------------------------
 S=$TMP/syn
 mkdir -p "$S/pc" "$S/tools/galil-load" "$S/tools/galil-sim" "$S/docs"
-cat >"$S/pc/re_check.c" <<'EOF'
+cat >"$S/pc/re_fault.c" <<'EOF'
 /* "FAULT FAKE: in a comment. Recovery: never counted" */
 static const char *const re_fclass_names[RE_FC_COUNT] = {
     [RE_FC_NONE] = "NONE",
@@ -155,10 +155,10 @@ fi
 gap() { rm -rf "$TMP/g"; cp -R "$S" "$TMP/g"; }
 gap; drop "$TMP/g/docs/operator.md" 'FAULT MOTION: axis'
 expect_fail "synthetic: FAULT line removed" "$TMP/g" \
-	'docs.sh: FAULT message RE_F_ONE ("FAULT MOTION: axis {a}: it moved {i0} counts ("quoted"). Recovery: keep the E-stop pressed, then restart roboelf") is in pc/re_check.c but not in docs/operator.md'
+	'docs.sh: FAULT message RE_F_ONE ("FAULT MOTION: axis {a}: it moved {i0} counts ("quoted"). Recovery: keep the E-stop pressed, then restart roboelf") is in pc/re_fault.c but not in docs/operator.md'
 gap; sed 's/then restart roboelf/then restart/' "$S/docs/operator.md" >"$TMP/g/docs/operator.md"
 expect_fail "synthetic: recovery text changed in the doc" "$TMP/g" \
-	'docs.sh: FAULT message RE_F_ONE ("FAULT MOTION: axis {a}: it moved {i0} counts ("quoted"). Recovery: keep the E-stop pressed, then restart roboelf") is in pc/re_check.c but not in docs/operator.md'
+	'docs.sh: FAULT message RE_F_ONE ("FAULT MOTION: axis {a}: it moved {i0} counts ("quoted"). Recovery: keep the E-stop pressed, then restart roboelf") is in pc/re_fault.c but not in docs/operator.md'
 gap; drop "$TMP/g/docs/operator.md" 'unknown fault'
 expect_fail "synthetic: printf FAULT line removed" "$TMP/g" \
 	'docs.sh: FAULT message "FAULT PROGRAM: unknown fault %d. Recovery: quit, note the log" is in pc/re_super.c but not in docs/operator.md'
@@ -204,14 +204,14 @@ first=$(awk -F '\t' '$1 == "fault" { print $2 "\t" $3; exit }' "$TMP/rlist")
 fid=${first%%	*}; fline=${first#*	}
 real; drop "$TMP/r2/docs/operator.md" "$fline"
 expect_fail "real: FAULT line $fid removed from operator.md" "$TMP/r2" \
-	"docs.sh: FAULT message $fid (\"$fline\") is in pc/re_check.c but not in docs/operator.md"
+	"docs.sh: FAULT message $fid (\"$fline\") is in pc/re_fault.c but not in docs/operator.md"
 
 # a FAULT template added to the code
 real; awk '{ print } /re_fault_table\[\] = \{/ {
 	print "\t{RE_F_SELFTEST, RE_FC_MOTION, \"a new message\", \"a new recovery\"}," }' \
-	"$R/pc/re_check.c" >"$TMP/r2/pc/re_check.c"
-expect_fail "real: FAULT template added to re_check.c" "$TMP/r2" \
-	'docs.sh: FAULT message RE_F_SELFTEST ("FAULT MOTION: a new message. Recovery: a new recovery") is in pc/re_check.c but not in docs/operator.md'
+	"$R/pc/re_fault.c" >"$TMP/r2/pc/re_fault.c"
+expect_fail "real: FAULT template added to re_fault.c" "$TMP/r2" \
+	'docs.sh: FAULT message RE_F_SELFTEST ("FAULT MOTION: a new message. Recovery: a new recovery") is in pc/re_fault.c but not in docs/operator.md'
 
 # a FAULT printf line added elsewhere in pc/
 real; printf 'static const char *x = "FAULT COMM: lost %%s. Recovery: "\n\t"check it";\n' \

@@ -19,6 +19,7 @@
 #include <cmocka.h>
 
 #include "gl_err.h"
+#include "re_calcheck.h"
 #include "re_check.h"
 
 #define MS 1000000LL /* ns */

@@ -1,0 +1,93 @@
+/*
+ * re_dmcif.h - the DMC contract, the PC's side: the program's ZA record
+ * fields (state, fault code, axis), its fault codes and details, and the
+ * controller's stop codes, turned into the supervisor's faults. The DMC
+ * side is the dmc/ programs (docs/dmc-interface.md, "Fault codes");
+ * tests/unit/test_re_dmcif.c holds the two to each other.
+ *
+ * Not the cycle's checks (re_check). Pure: no I/O, no printing.
+ */
+#ifndef RE_DMCIF_H
+#define RE_DMCIF_H
+
+#include <stdint.h>
+
+#include "re_fault.h"
+
+/* ---- data record: the program's ZA fields and the axes ------------------- */
+
+enum re_dmc_state {
+	RE_DMC_UNARMED = 0, /* safe: motors off */
+	RE_DMC_ARMED = 1,
+	RE_DMC_FAULT = 2,
+	RE_DMC_SERVICE = 3, /* supervised automatic moves (calibration) */
+};
+
+/* Controller fault codes (docs/dmc-interface.md "Fault codes"). */
+enum re_dmc_fcode {
+	RE_DMC_F_NONE = 0,
+	RE_DMC_F_PARAM = 1,
+	RE_DMC_F_WATCHDOG = 2,
+	RE_DMC_F_INPUT = 3,
+	RE_DMC_F_POSERR = 4,
+	RE_DMC_F_LIMIT = 5,
+	RE_DMC_F_CMDERR = 6,
+	RE_DMC_F_TCPERR = 7,
+	RE_DMC_F_AMPERR = 8,
+	RE_DMC_F_ENCODER = 9,
+	RE_DMC_F_MOTOROFF = 10,
+	RE_DMC_F_THREAD = 11,
+	RE_DMC_F_SUPERVISOR = 12,
+	RE_DMC_F_UNCMD = 13,	/* motion the program did not command */
+	RE_DMC_F_FOREIGN = 14,	/* heartbeat out of sequence, settings */
+	RE_DMC_F_SVCMOVE = 15,	/* a service move out of its bounds */
+	RE_DMC_F_POTRANGE = 16, /* potentiometer outside its range */
+	RE_DMC_F_MAX = 16,
+};
+
+struct re_za {
+	int32_t hbdmc; /* ZAA */
+	int state;     /* ZAB % 10 */
+	int fcode;     /* (ZAB / 10) % 100 */
+	int faxis;     /* ZAB / 1000: 1..3 = A..C, 0 none */
+	int jraw;      /* ZAC % 4096 */
+	int jcmd;      /* (ZAC / 4096) % 8 - 1: -1 invalid, 0, 1..6 */
+	int mcmd;      /* ZAC / 32768: 0..6 */
+};
+
+/*
+ * re_za_decode() - decode ZAA, ZAB, ZAC (axes A, B, C's user fields).
+ * @out: [out] filled only on success.
+ * Return: GL_OK; GL_ERR_RANGE when a field is negative or a decoded value is
+ *         outside its range (state > 3, fcode > 16, faxis > 3, jcmd > 6,
+ *         mcmd > 6, hbdmc > 999999); GL_ERR_ARG on NULL.
+ */
+int re_za_decode(int32_t zaa, int32_t zab, int32_t zac, struct re_za *out);
+
+/*
+ * re_stop_reason() - text for a stop code: 8 "position error above the
+ * limit", 12 "encoder failure", 15 "amplifier fault", 2 "forward limit", 3
+ * "reverse limit", 4 "stop command", 7 "abort command", 6 "abort input", ...
+ * Return: a static string, never NULL ("unexpected stop" for others).
+ */
+const char *re_stop_reason(int stop_code);
+
+/*
+ * re_fault_is_ctrl() - @id is a fault the controller program latched (one
+ * that re_ctrl_fault() produces).
+ * Return: 1 or 0.
+ */
+int re_fault_is_ctrl(enum re_fault_id id);
+
+/*
+ * re_ctrl_fault() - turn a latched controller fault (state 2) into a fault.
+ * @za: [in] decoded fields; fcode, faxis used.
+ * @fdet: the detail (MG fdet), or RE_VAL_UNKNOWN when not read.
+ * @fault: [out] the matching RE_F_CTRL_* (RE_F_CTRL_UNKNOWN for code 0 or an
+ *         unknown code); axis = faxis - 1.
+ * Return: GL_OK, GL_ERR_ARG on NULL.
+ */
+int re_ctrl_fault(const struct re_za *za, long long fdet,
+		  struct re_fault *fault);
+
+#endif /* RE_DMCIF_H */

@@ -1,0 +1,112 @@
+/*
+ * test_re_dmcif.c - the DMC contract holds on both sides: the program's
+ * fault codes as dmc/roboelf.dmc raises them (#FAULT(n,...)), as the
+ * supervisor names them (enum re_dmc_fcode, pc/re_dmcif.h), and as
+ * docs/dmc-interface.md lists them ("| n | NAME |") are the same set with
+ * the same names. Sources are read from ROBOELF_TOP (default ".").
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "base_file.h"
+#include "re_dmcif.h"
+
+/* The supervisor's names of the codes, in the enum's words. */
+static const struct {
+	enum re_dmc_fcode code;
+	const char *name;
+} names[] = {
+    {RE_DMC_F_PARAM, "PARAM"},	       {RE_DMC_F_WATCHDOG, "WATCHDOG"},
+    {RE_DMC_F_INPUT, "INPUT"},	       {RE_DMC_F_POSERR, "POSERR"},
+    {RE_DMC_F_LIMIT, "LIMIT"},	       {RE_DMC_F_CMDERR, "CMDERR"},
+    {RE_DMC_F_TCPERR, "TCPERR"},       {RE_DMC_F_AMPERR, "AMPERR"},
+    {RE_DMC_F_ENCODER, "ENCODER"},     {RE_DMC_F_MOTOROFF, "MOTOROFF"},
+    {RE_DMC_F_THREAD, "THREAD"},       {RE_DMC_F_SUPERVISOR, "SUPERVISOR"},
+    {RE_DMC_F_UNCMD, "UNCMD"},	       {RE_DMC_F_FOREIGN, "FOREIGN"},
+    {RE_DMC_F_SVCMOVE, "SVCMOVE"},     {RE_DMC_F_POTRANGE, "POTRANGE"},
+};
+#define N_NAMES (sizeof(names) / sizeof(names[0]))
+
+static char *slurp(const char *rel)
+{
+	const char *top = getenv("ROBOELF_TOP");
+	char path[1024], *buf = NULL;
+	size_t len;
+
+	snprintf(path, sizeof(path), "%s/%s", top ? top : ".", rel);
+	if (base_file_read(path, 4u << 20, &buf, &len) != 0)
+		fail_msg("cannot read %s", path);
+	return buf;
+}
+
+/* Every code 1..RE_DMC_F_MAX is named once, in order. */
+static void test_enum_complete(void **state)
+{
+	(void)state;
+	assert_int_equal(N_NAMES, RE_DMC_F_MAX);
+	for (size_t i = 0; i < N_NAMES; i++)
+		assert_int_equal(names[i].code, (int)i + 1);
+}
+
+/* The program raises exactly the codes the supervisor knows. */
+static void test_dmc_raises_known_codes(void **state)
+{
+	char *src = slurp("dmc/roboelf.dmc");
+	int seen[RE_DMC_F_MAX + 1] = {0};
+
+	(void)state;
+	for (const char *p = src; (p = strstr(p, "#FAULT(")); p++) {
+		char *end;
+		long n = strtol(p + 7, &end, 10);
+
+		if (end == p + 7)
+			continue; /* a code in a variable: #FAULT(mflt,...) */
+		if (n < 1 || n > RE_DMC_F_MAX)
+			fail_msg("dmc raises fault code %ld, unknown to the "
+				 "supervisor",
+				 n);
+		seen[n]++;
+	}
+	for (int c = 1; c <= RE_DMC_F_MAX; c++)
+		if (!seen[c])
+			fail_msg("the supervisor knows fault code %d (%s), "
+				 "dmc never raises it",
+				 c, names[c - 1].name);
+	free(src);
+}
+
+/* docs/dmc-interface.md lists each code with the same name. */
+static void test_docs_agree(void **state)
+{
+	char *doc = slurp("docs/dmc-interface.md");
+
+	(void)state;
+	for (size_t i = 0; i < N_NAMES; i++) {
+		char row[64];
+
+		snprintf(row, sizeof(row), "\n| %d | %s |", (int)names[i].code,
+			 names[i].name);
+		if (!strstr(doc, row))
+			fail_msg("docs/dmc-interface.md has no row '%s'",
+				 row + 1);
+	}
+	free(doc);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	    cmocka_unit_test(test_enum_complete),
+	    cmocka_unit_test(test_dmc_raises_known_codes),
+	    cmocka_unit_test(test_docs_agree),
+	};
+
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
