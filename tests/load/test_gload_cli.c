@@ -23,6 +23,7 @@
 
 #include <cmocka.h>
 
+#include "load_h.h"
 #include "proc.h"
 
 #define BAD		"tests/data/dmc_bad/"
@@ -53,20 +54,13 @@ static int setup(void **state)
 /* Run galil-load with @args (NULL-terminated); return its exit code. */
 static int run(struct proc *p, const char *const *args)
 {
-	char *argv[32];
-	int i, status;
+	int rc = load_h_run(p, bin, NULL, args, RUN_DEADLINE_MS);
 
-	argv[0] = bin;
-	for (i = 0; i < 30 && args[i]; i++)
-		argv[i + 1] = (char *)args[i];
-	argv[i + 1] = NULL;
-	assert_int_equal(proc_spawn(p, argv, NULL), 0);
-	if (proc_wait_exit(p, RUN_DEADLINE_MS, &status) != 0) {
-		proc_kill(p);
+	if (rc == -2)
 		fail_msg("galil-load did not exit within %d ms",
 			 RUN_DEADLINE_MS);
-	}
-	return proc_exit_code(p);
+	assert_true(rc >= 0);
+	return rc;
 }
 
 /* A listening socket on 127.0.0.1 that never answers; returns its port. */

@@ -37,6 +37,7 @@
 
 #include <cmocka.h>
 
+#include "load_h.h"
 #include "proc.h"
 
 #define GOOD		"tests/data/dmc_good/"
@@ -364,23 +365,16 @@ static int setup_group(void **state)
 /* Run galil-load -a <fake> @args...; return the exit code. */
 static int run(struct proc *p, const char *const *args)
 {
-	char addr[32], *argv[32];
-	int i, status;
+	char addr[32];
 
 	snprintf(addr, sizeof(addr), "127.0.0.1:%d", fk.port);
-	argv[0] = bin;
-	argv[1] = (char *)"-a";
-	argv[2] = addr;
-	for (i = 0; i < 28 && args[i]; i++)
-		argv[i + 3] = (char *)args[i];
-	argv[i + 3] = NULL;
-	assert_int_equal(proc_spawn(p, argv, NULL), 0);
-	if (proc_wait_exit(p, RUN_DEADLINE_MS, &status) != 0) {
-		proc_kill(p);
+	int rc = load_h_run(p, bin, addr, args, RUN_DEADLINE_MS);
+
+	if (rc == -2)
 		fail_msg("galil-load did not exit within %d ms",
 			 RUN_DEADLINE_MS);
-	}
-	return proc_exit_code(p);
+	assert_true(rc >= 0);
+	return rc;
 }
 
 static char *clean_program(void)

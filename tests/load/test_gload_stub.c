@@ -34,6 +34,7 @@
 #include "gl_err.h"
 #include "gl_ident.h"
 #include "gl_link.h"
+#include "load_h.h"
 #include "proc.h"
 
 #define GOOD		"tests/data/dmc_good/"
@@ -124,22 +125,13 @@ static void galil_stub_start(struct stub *s, const char *const *scenario)
 
 static int run(struct proc *p, const struct stub *s, const char *const *args)
 {
-	char *argv[32];
-	int i, status;
+	int rc = load_h_run(p, load_bin, s->addr, args, RUN_DEADLINE_MS);
 
-	argv[0] = load_bin;
-	argv[1] = (char *)"-a";
-	argv[2] = (char *)s->addr;
-	for (i = 0; i < 28 && args[i]; i++)
-		argv[i + 3] = (char *)args[i];
-	argv[i + 3] = NULL;
-	assert_int_equal(proc_spawn(p, argv, NULL), 0);
-	if (proc_wait_exit(p, RUN_DEADLINE_MS, &status) != 0) {
-		proc_kill(p);
+	if (rc == -2)
 		fail_msg("galil-load did not exit within %d ms",
 			 RUN_DEADLINE_MS);
-	}
-	return proc_exit_code(p);
+	assert_true(rc >= 0);
+	return rc;
 }
 
 /* -c: an assignment and its value read back, in order. */
