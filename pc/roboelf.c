@@ -1,7 +1,7 @@
 /*
  * roboelf.c - the RoboELF operator's console supervisor (robotTask and its
- * GUI, rebuilt): options, the life cycle Configure -> Startup -> Run every
- * period -> Cleanup, signals and exit codes.
+ * GUI, rebuilt): options, the life cycle Configure -> Startup (re_start.c)
+ * -> Run every period -> Cleanup, signals and exit codes.
  *
  *   roboelf [-c FILE] [--galil HOST[:PORT]] [--relay PORT]
  *           [--calibration full|file] [--period MS] [--log FILE]
@@ -49,69 +49,27 @@
 #include "re_log.h"
 #include "re_plan.h"
 #include "re_relay.h"
+#include "re_start.h"
 #include "re_super.h"
-
-#define EXIT_USAGE     2
-#define EXIT_CONNECT   3
-#define EXIT_FAULT     4
-#define DEFAULT_CONFIG "config/roboelf.yaml"
-
-struct opts {
-	const char *config;
-	const char *galil;
-	const char *relay;
-	const char *log;
-	const char *show_cal;
-	int period_ms; /* 0: from the configuration */
-	enum re_calib_choice calib;
-};
-
-struct app {
-	struct opts o;
-	struct re_config cfg;
-	struct re_log log;
-	struct re_console con;
-	re_relay *relay;
-	struct re_lock lock_ctl, lock_relay; /* one supervisor per each */
-	struct re_io_real real; /* real.link: the command link */
-	struct re_io io;
-	struct re_ctl_info info;
-	struct re_plan plan;
-	struct re_calset *cal;
-	struct re_super *sup;
-	const char *names[RE_AXES];
-	long hbpc;
-	int calib;   /* the operator's choice: RE_CALIB_FULL / _FILE */
-	int powered; /* the relay was switched on at some point */
-	unsigned foreign_shown; /* other programs' handles already shown */
-	int ctl_ours; /* the controller was taken over: ours to stop */
-	char err[RE_CONFIG_ERR_MAX];
-};
-
-static volatile sig_atomic_t quit_signal;
 
 static void on_signal(int sig)
 {
-	quit_signal = sig;
+	re_sig.quit = sig;
 }
 
 /* A stop (SIGSTOP, a debugger) during start-up: the cycle measures its own
  * gaps, but start-up is a sequence of waits and commands. SIGCONT says
  * the process was stopped; the stop lasted from the last moment it is
  * known to have run (a link call's start or end) to the SIGCONT. */
-static volatile sig_atomic_t continued;
-static volatile int64_t cont_stop_ms;
-static struct re_io_real *volatile cont_real;
-
 static void on_cont(int sig)
 {
 	int64_t now, from;
 
 	(void)sig;
 	now = base_now_ns();
-	from = cont_real ? cont_real->last_run_ns : now;
-	cont_stop_ms = (now - from) / 1000000;
-	continued = 1;
+	from = re_sig.cont_real ? re_sig.cont_real->last_run_ns : now;
+	re_sig.cont_stop_ms = (now - from) / 1000000;
+	re_sig.continued = 1;
 }
 
 /* Every signal a terminal or a person can send ends in the orderly
@@ -326,595 +284,6 @@ static int open_log(struct app *a)
 	return 0;
 }
 
-/* ---- start-up ------------------------------------------------------------ */
-
-static void progress(struct app *a, const char *fmt, ...)
-    __attribute__((format(printf, 2, 3)));
-
-static void progress(struct app *a, const char *fmt, ...)
-{
-	char text[512];
-	va_list ap;
-
-	va_start(ap, fmt);
-	vsnprintf(text, sizeof(text), fmt, ap);
-	va_end(ap);
-	re_console_msg(&a->con, "roboelf: %s", text);
-	re_log_msg(&a->log, RE_LOG_INFO, "%s", text);
-	a->real.last_run_ns = re_io_now_ns();
-}
-
-static int64_t stalled_ms(const struct app *a);
-static int64_t stall_limit_ms(const struct app *a);
-
-/* The start refused with @what; a stop just before is named first. */
-static int fail(struct app *a, const char *what)
-{
-	int64_t ms = stalled_ms(a);
-
-	if (ms)
-		re_console_msg(&a->con,
-			       "roboelf: error: roboelf did not run for %lld ms "
-			       "(limit %lld ms: stopped, e.g. SIGSTOP or a "
-			       "debugger); then: %s",
-			       (long long)ms, (long long)stall_limit_ms(a),
-			       what);
-	else
-		re_console_msg(&a->con, "roboelf: error: %s", what);
-	re_log_msg(&a->log, RE_LOG_WARN, "start-up refused: %s%s", what,
-		   ms ? " (after a stop of roboelf itself)" : "");
-	return EXIT_CONNECT;
-}
-
-/* One supervisor per controller and per relay: both locks before the
- * relay is opened (opening switches it off: a second roboelf must not cut
- * the first one's motor power) and before the controller is touched. */
-static int take_locks(struct app *a)
-{
-	char key[RE_LOCK_PATH_MAX];
-	const char *port = re_config_relay_port(&a->cfg);
-
-	if (re_lock_controller_key(a->cfg.controller.address, key,
-				   sizeof(key)) != GL_OK) {
-		snprintf(a->err, sizeof(a->err),
-			 "bad controller address '%s'",
-			 a->cfg.controller.address);
-		return fail(a, a->err);
-	}
-	if (re_lock_acquire(&a->lock_ctl, "controller", key, a->err,
-			    sizeof(a->err)) != GL_OK)
-		return fail(a, a->err);
-	if (re_lock_relay_key(port, key, sizeof(key)) != GL_OK) {
-		snprintf(a->err, sizeof(a->err),
-			 "cannot open the E-stop relay '%s': %s (is galil-sim "
-			 "running, or the relay plugged in?)",
-			 port, strerror(errno));
-		return fail(a, a->err);
-	}
-	if (re_lock_acquire(&a->lock_relay, "relay", key, a->err,
-			    sizeof(a->err)) != GL_OK)
-		return fail(a, a->err);
-	return 0;
-}
-
-/* The relay opened (which switches it off) and kept off. */
-static int start_relay(struct app *a)
-{
-	struct re_relay_cfg rc;
-
-	re_config_relay_cfg(&a->cfg, &rc);
-	progress(a, "opening the E-stop relay '%s' (motor power stays off)",
-		 rc.port);
-	if (re_relay_open(&a->relay, &rc, a->err, sizeof(a->err)) != GL_OK)
-		return fail(a, a->err);
-	a->real.relay = a->relay;
-	return 0;
-}
-
-/* Connect, identify, refuse a controller another supervisor runs, close
- * the other connections, check the program's identity. */
-static int start_link(struct app *a)
-{
-	char e[GL_ERRTEXT_LEN];
-	char id[256];
-	gl_link *l;
-
-	progress(a, "connecting to the controller at %s",
-		 a->cfg.controller.address);
-	if (gl_link_open(&l, a->cfg.controller.address,
-			 a->cfg.controller.connect_timeout_ms, e) != GL_OK)
-		return fail(a, e);
-	gl_link_set_timeout(l, a->cfg.controller.timeout_ms);
-	a->real.link = l;
-	a->real.address = a->cfg.controller.address;
-	a->real.cmd_timeout_ms = a->cfg.controller.timeout_ms;
-	if (re_ctl_identify(l, &a->cfg, &a->info, a->err, sizeof(a->err)) ||
-	    re_ctl_check_busy(&a->io, a->cfg.watchdog.controller_timeout_ms,
-			      a->err, sizeof(a->err)) ||
-	    re_ctl_take_over(l, &a->info, a->err, sizeof(a->err)))
-		return fail(a, a->err);
-	a->ctl_ours = 1;
-	snprintf(id, sizeof(id), "%s, serial %ld, program id %016llX",
-		 a->info.model, a->info.serial,
-		 (unsigned long long)a->info.program_id);
-	progress(a, "controller %s", id);
-	return 0;
-}
-
-/* In development mode (the simulator, a bench) an amplifier check that
- * fails is logged; in clinical mode it refuses the start. */
-static int amp_check(struct app *a, int want_on, int timeout_ms)
-{
-	int ta0 = 0;
-
-	if (re_ctl_amp_power(&a->io, want_on, timeout_ms, &ta0, a->err,
-			     sizeof(a->err)) == GL_OK)
-		return 0;
-	if (a->cfg.mode == RE_MODE_CLINICAL)
-		return fail(a, a->err);
-	re_console_msg(&a->con, "roboelf: warning: %s (development mode: "
-				"continuing)", a->err);
-	re_log_msg(&a->log, RE_LOG_WARN, "%s (development mode)", a->err);
-	return 0;
-}
-
-/* Halted and read back off, configured, no motor power seen, program
- * started: the controller is known safe before the relay closes. */
-static int prepare_controller(struct app *a)
-{
-	re_plan_make(&a->cfg, 0, &a->plan);
-	progress(a, "halting the controller program; every motor off");
-	if (re_ctl_halt(&a->io, a->err, sizeof(a->err)) ||
-	    re_ctl_configure(&a->io, &a->cfg, &a->plan, a->err,
-			     sizeof(a->err)))
-		return fail(a, a->err);
-	progress(a, "controller configured and read back");
-	if (amp_check(a, 0, 200))
-		return EXIT_CONNECT;
-	if (re_ctl_start_program(&a->io, &a->info, a->err, sizeof(a->err)))
-		return fail(a, a->err);
-	re_plan_make(&a->cfg, a->info.mainms, &a->plan);
-	return 0;
-}
-
-static int power_on(struct app *a)
-{
-	if (re_relay_on(a->relay) != GL_OK) {
-		snprintf(a->err, sizeof(a->err),
-			 "cannot switch motor power on: %s",
-			 re_relay_errmsg(a->relay));
-		return fail(a, a->err);
-	}
-	a->powered = 1;
-	progress(a, "motor power on (relay closed); the motors are off");
-	return amp_check(a, 1, 500);
-}
-
-static int init_super(struct app *a)
-{
-	struct re_super_cfg sc;
-
-	re_plan_super_cfg(&a->plan, &a->cfg, a->names, &sc);
-	a->sup = calloc(1, sizeof(*a->sup));
-	if (!a->sup || re_super_init(a->sup, &a->io, &sc, NULL, 0) != GL_OK)
-		return fail(a, "cannot set up the supervisor");
-	return 0;
-}
-
-/* The critical reply-age limit, ms: a stop longer than this is a stall. */
-static int64_t stall_limit_ms(const struct app *a)
-{
-	return a->sup ? a->sup->crit_ns / 1000000
-		      : (int64_t)(a->cfg.watchdog.critical_factor *
-				  a->cfg.period_ms);
-}
-
-/* The stop of a SIGCONT since the last look, when it outlasted the
- * limit: its length in ms; else 0 (and forgotten). */
-static int64_t stalled_ms(const struct app *a)
-{
-	int64_t ms;
-
-	if (!continued)
-		return 0;
-	continued = 0;
-	ms = cont_stop_ms;
-	return ms > stall_limit_ms(a) ? ms : 0;
-}
-
-/* A stop during start-up is the cause of whatever failed after it (the
- * controller's watchdog, a command timed out): the fault says so. */
-static void stall_first(struct app *a, struct re_fault *f)
-{
-	int64_t ms = stalled_ms(a);
-
-	if (!ms)
-		return;
-	if (f->id != RE_F_NONE) {
-		char what[512];
-
-		re_fault_format(f, a->names, what, sizeof(what));
-		re_log_msg(&a->log, RE_LOG_WARN,
-			   "start-up: after a stop of %lld ms: %s",
-			   (long long)ms, what);
-	}
-	re_fault_set(f, RE_F_STALL, -1);
-	f->i[0] = ms;
-	f->i[1] = stall_limit_ms(a);
-}
-
-static int latch(struct app *a, const struct re_fault *fault)
-{
-	struct re_fault f = *fault;
-
-	stall_first(a, &f);
-	if (f.id != RE_F_NONE && re_super_fault(a->sup, &f) == RE_FAULT)
-		re_console_fault(&a->con, re_super_fault_line(a->sup));
-	return EXIT_FAULT;
-}
-
-/* Between start-up steps: a stop is a fault once the supervisor exists
- * (motor power may be on), else the start is refused. */
-static int check_stall(struct app *a)
-{
-	struct re_fault f;
-
-	if (!continued)
-		return 0;
-	if (!a->sup) {
-		int64_t ms = stalled_ms(a);
-
-		if (!ms)
-			return 0;
-		snprintf(a->err, sizeof(a->err),
-			 "roboelf did not run for %lld ms during start-up "
-			 "(limit %lld ms: stopped, e.g. SIGSTOP or a "
-			 "debugger); motor power was not switched on; start "
-			 "it again",
-			 (long long)ms, (long long)stall_limit_ms(a));
-		return fail(a, a->err);
-	}
-	re_fault_set(&f, RE_F_NONE, -1);
-	stall_first(a, &f);
-	return f.id == RE_F_NONE ? 0 : latch(a, &f);
-}
-
-/* A start-up step that failed with a message: a CONFIG fault. */
-static int latch_err(struct app *a)
-{
-	struct re_fault f;
-
-	re_fault_set(&f, RE_F_CONFIG, -1);
-	snprintf(f.s, sizeof(f.s), "%.*s", (int)sizeof(f.s) - 1, a->err);
-	return latch(a, &f);
-}
-
-/* Parameters, then the service state: from here every move is supervised
- * by the program and by the cycle. */
-static int enter_service(struct app *a)
-{
-	struct re_fault f;
-	int rc;
-
-	if (re_ctl_write_params(&a->io, &a->cfg, &a->plan, NULL, a->err,
-				sizeof(a->err)))
-		return latch_err(a);
-	a->hbpc = re_ctl_session();
-	rc = re_ctl_service(&a->io, &a->hbpc, &f, a->err, sizeof(a->err));
-	if (rc == RE_FAULT)
-		return latch(a, &f);
-	if (rc != GL_OK)
-		return latch_err(a);
-	re_super_start(a->sup, NULL, a->hbpc, RE_DMC_SERVICE);
-	re_super_set_period(a->sup, a->plan.sample_ns);
-	return 0;
-}
-
-/* ---- calibration --------------------------------------------------------- */
-
-static void log_calibration(struct app *a, const char *how, double secs,
-			    int filled)
-{
-	for (int i = 0; i < a->cal->n_axes; i++) {
-		const struct re_caltable *t = &a->cal->axis[i];
-
-		re_log_msg(&a->log, RE_LOG_INFO,
-			   "calibration (%s) axis %s: "
-			   "%d points, start %.0f, step %.0f counts, soft "
-			   "limits %.0f..%.0f, pot %.3f..%.3f V",
-			   how, a->names[i], t->n, t->start_counts,
-			   t->step_counts, t->soft_rev, t->soft_fwd,
-			   t->pot_v[0], t->pot_v[t->n - 1]);
-	}
-	if (filled)
-		re_log_msg(&a->log, RE_LOG_WARN,
-			   "calibration: %d table point(s) had no sample of "
-			   "their own (the PC was late) and were fitted from "
-			   "their neighbours",
-			   filled);
-	re_log_msg(&a->log, RE_LOG_INFO, "calibration (%s) done in %.1f s", how,
-		   secs);
-	re_console_msg(&a->con, "roboelf: calibration (%s) done in %.1f s", how,
-		       secs);
-}
-
-static void stamp_calset(struct app *a)
-{
-	snprintf(a->cal->serial, sizeof(a->cal->serial), "%ld", a->info.serial);
-	a->cal->config_hash = re_config_hash(&a->cfg);
-	re_calfile_date(time(NULL), a->cal->date, sizeof(a->cal->date));
-}
-
-/* calibration.backup false: the save kept the previous table as FILE.bak
- * (re_calfile_save always does, atomically); remove it afterwards. */
-static void drop_backup(struct app *a)
-{
-	char bak[RE_PATH_MAX + 8];
-
-	if (a->cfg.calibration.backup)
-		return;
-	snprintf(bak, sizeof(bak), "%s.bak", a->cfg.calibration.file);
-	if (unlink(bak) != 0 && errno != ENOENT)
-		re_log_msg(&a->log, RE_LOG_WARN, "cannot remove '%s': %s", bak,
-			   strerror(errno));
-}
-
-/* Another program connected to the controller: not a fault (it may only
- * look), but the operator is told once per handle. */
-static void show_foreign(struct app *a, unsigned mask)
-{
-	unsigned fresh = mask & ~a->foreign_shown;
-	char hs[9];
-	int n = 0;
-
-	if (!fresh)
-		return;
-	a->foreign_shown |= fresh;
-	for (int h = 0; h < 8; h++)
-		if (fresh >> h & 1)
-			hs[n++] = (char)('A' + h);
-	hs[n] = '\0';
-	re_console_msg(&a->con,
-		       "roboelf: WARNING: another program connected to the "
-		       "controller (handle %s). roboelf still supervises; if "
-		       "nobody should be there, press q and find it.",
-		       hs);
-}
-
-/* The calibration's sampler: one supervised cycle per sample. */
-static int sample_cb(void *ud, const struct gl_record **rec)
-{
-	struct app *a = ud;
-	struct re_status st;
-	int v;
-
-	if (quit_signal)
-		return GL_ERR_AGAIN;
-	re_super_wait(a->sup);
-	v = re_super_cycle(a->sup);
-	re_super_status(a->sup, &st);
-	show_foreign(a, st.foreign);
-	re_console_status(&a->con, &st, re_io_now_ns(), 0);
-	if (v == RE_FAULT) {
-		re_console_fault(&a->con, re_super_fault_line(a->sup));
-		return RE_FAULT;
-	}
-	*rec = &a->sup->rec;
-	return GL_OK;
-}
-
-static void own_cb(void *ud, unsigned mask)
-{
-	struct app *a = ud;
-
-	re_super_own(a->sup, mask);
-}
-
-static void tables_cb(void *ud, const struct re_calset *set)
-{
-	const struct re_caltable *t[RE_AXES];
-	struct app *a = ud;
-
-	for (int i = 0; i < RE_AXES; i++)
-		t[i] = &set->axis[i];
-	re_super_tables(a->sup, t);
-}
-
-static void fill_expect(struct app *a, const struct re_calib_cfg *cc,
-			struct re_calfile_expect *e, char *serial)
-{
-	memset(e, 0, sizeof(*e));
-	snprintf(serial, 32, "%ld", a->info.serial);
-	e->serial = serial;
-	e->n_axes = RE_AXES;
-	e->config_hash = re_config_hash(&a->cfg);
-	for (int i = 0; i < RE_AXES; i++) {
-		snprintf(e->name[i], sizeof(e->name[i]), "%s", a->names[i]);
-		e->step_counts[i] = a->cfg.axes[i].step_counts;
-		e->check[i] = cc->axis[i].check;
-	}
-}
-
-/* Load the tables (before anything is powered); on failure offer a full
- * calibration (terminal only). Return: 0 loaded, 1 full calibration
- * instead, EXIT_USAGE. */
-static int calib_load(struct app *a)
-{
-	struct re_calfile_expect e;
-	struct re_calib_cfg cc;
-	char serial[32];
-
-	re_calib_cfg_from(&a->cfg, &a->plan, a->names, &cc);
-	progress(a, "loading calibration '%s'", a->cfg.calibration.file);
-	fill_expect(a, &cc, &e, serial);
-	if (re_calfile_load(a->cfg.calibration.file, &e, a->cal, a->err,
-			    sizeof(a->err)) == GL_OK)
-		return 0;
-	re_console_msg(&a->con, "roboelf: error: %s", a->err);
-	re_log_msg(&a->log, RE_LOG_WARN, "calibration file refused: %s",
-		   a->err);
-	if (re_console_ask_yes(&a->con, "Run a full calibration instead? "
-					"Every axis will move to both of its "
-					"limit switches, then to the centre."))
-		return 1;
-	re_console_msg(&a->con, "roboelf: run again with --calibration full");
-	return EXIT_USAGE;
-}
-
-/* What will move and where, said before anything moves; the choice is the
- * operator's (the prompt) or the command line's. Return: 0, EXIT_USAGE. */
-static int choose_calibration(struct app *a)
-{
-	int how = a->o.calib, rc;
-
-	if (how == RE_CALIB_ASK)
-		how = re_console_ask_calibration(&a->con);
-	if (how != RE_CALIB_FULL && how != RE_CALIB_FILE)
-		return quit_signal ? 0 : EXIT_USAGE;
-	a->cal = calloc(1, sizeof(*a->cal));
-	if (!a->cal)
-		return fail(a, "out of memory");
-	if (how == RE_CALIB_FILE) {
-		rc = calib_load(a);
-		if (rc > 1)
-			return rc;
-		how = rc == 1 ? RE_CALIB_FULL : how;
-	}
-	a->calib = how;
-	if (how == RE_CALIB_FULL)
-		progress(a, "full calibration chosen: every axis will move to "
-			    "its reverse and forward limit switches, then to "
-			    "the centre of its travel");
-	else
-		progress(a, "calibration from the file: every axis will move "
-			    "to the centre of its calibrated travel (A %.0f, "
-			    "B %.0f, C %.0f counts)",
-			 (a->cal->axis[0].soft_rev + a->cal->axis[0].soft_fwd) / 2,
-			 (a->cal->axis[1].soft_rev + a->cal->axis[1].soft_fwd) / 2,
-			 (a->cal->axis[2].soft_rev + a->cal->axis[2].soft_fwd) / 2);
-	return 0;
-}
-
-static void save_calibration(struct app *a)
-{
-	stamp_calset(a);
-	if (re_calfile_save(a->cfg.calibration.file, a->cal, a->err,
-			    sizeof(a->err)) != GL_OK) {
-		re_console_msg(&a->con, "roboelf: warning: %s", a->err);
-		re_log_msg(&a->log, RE_LOG_WARN, "calibration not saved: %s",
-			   a->err);
-		return;
-	}
-	progress(a, "calibration saved to '%s'", a->cfg.calibration.file);
-	drop_backup(a);
-}
-
-/* The chosen procedure in the service state. Return: 0, EXIT_FAULT, or
- * 0 with quit_signal set (interrupted). */
-static int run_calibration(struct app *a, struct re_calib *c,
-			   struct re_calib_cfg *cc)
-{
-	struct re_fault f;
-	double secs = 0;
-	int rc, filled = 0;
-
-	if (a->calib == RE_CALIB_FULL) {
-		progress(a, "full calibration: every axis end to end");
-		rc = re_calib_full(c, &a->io, cc, a->cal, &f, &secs, &filled);
-	} else {
-		progress(a, "checking the robot against the file, moving to "
-			    "the centre");
-		rc = re_calib_check_robot(c, &a->io, cc, a->cal, &f);
-	}
-	if (rc == RE_FAULT)
-		return latch(a, &f);
-	if (rc == GL_ERR_AGAIN) {
-		progress(a, "calibration interrupted: '%s' was not changed",
-			 a->cfg.calibration.file);
-		return 0;
-	}
-	if (rc != GL_OK) {
-		snprintf(a->err, sizeof(a->err), "calibration failed: %s",
-			 gl_strerror(rc));
-		return latch_err(a);
-	}
-	log_calibration(a, a->calib == RE_CALIB_FULL ? "full" : "file", secs,
-			filled);
-	return 0;
-}
-
-static int calibrate(struct app *a)
-{
-	struct re_calib_cfg cc;
-	struct re_calib *c;
-	int rc;
-
-	if (re_calib_new(&c) != GL_OK)
-		return fail(a, "out of memory");
-	re_calib_cfg_from(&a->cfg, &a->plan, a->names, &cc);
-	cc.stop = &quit_signal;
-	cc.sampler = (struct re_calib_sampler){sample_cb, own_cb, tables_cb, a};
-	rc = run_calibration(a, c, &cc);
-	re_calib_free(c);
-	return rc;
-}
-
-/* Back to the safe state (motors off) for the slow file I/O, then armed. */
-static int arm(struct app *a)
-{
-	const struct re_caltable *t[RE_AXES];
-	struct re_fault f;
-	int rc;
-
-	/* the cycle wrote the heartbeat since the service began: go on
-	 * from its last value (a value behind it is out of sequence) */
-	a->hbpc = a->sup->hbpc;
-	if (re_ctl_off(&a->io, &a->hbpc, a->err, sizeof(a->err)) != GL_OK)
-		return latch_err(a);
-	re_super_start(a->sup, NULL, a->hbpc, 0);
-	if (a->calib == RE_CALIB_FULL)
-		save_calibration(a);
-	progress(a, "soft limits from the calibration; arming");
-	rc = re_ctl_arm(&a->io, a->cal, &a->hbpc, &f, a->err, sizeof(a->err));
-	if (rc == RE_FAULT)
-		return latch(a, &f);
-	if (rc != GL_OK)
-		return latch_err(a);
-	for (int i = 0; i < RE_AXES; i++)
-		t[i] = &a->cal->axis[i];
-	re_super_set_period(a->sup, 0);
-	re_super_start(a->sup, t, a->hbpc, RE_DMC_ARMED);
-	return 0;
-}
-
-typedef int (*startup_step)(struct app *a);
-
-static int startup(struct app *a)
-{
-	static const startup_step steps[] = {
-	    start_relay,   start_link, choose_calibration, prepare_controller,
-	    init_super,	   power_on,   enter_service,	   calibrate,
-	    arm,
-	};
-	int rc = take_locks(a);
-
-	cont_real = &a->real;
-	/* a stop while the operator chooses is no stall: nothing is on */
-	for (size_t i = 0; !rc && !quit_signal && i < sizeof(steps) /
-		 sizeof(steps[0]); i++) {
-		rc = steps[i](a);
-		if (steps[i] == choose_calibration)
-			continued = 0;
-		if (!rc)
-			rc = check_stall(a);
-	}
-	if (!rc && !quit_signal) {
-		re_console_msg(&a->con, "RoboELF Ready for Use");
-		re_log_msg(&a->log, RE_LOG_INFO, "RoboELF Ready for Use");
-	}
-	return rc;
-}
-
 /* ---- run and cleanup ------------------------------------------------------
  */
 
@@ -922,7 +291,7 @@ static const char *quit_reason(int key)
 {
 	if (key)
 		return "operator pressed q";
-	switch (quit_signal) {
+	switch (re_sig.quit) {
 	case SIGINT: return "Ctrl-C (SIGINT)";
 	case SIGTERM: return "SIGTERM";
 	case SIGHUP: return "SIGHUP (terminal lost)";
@@ -964,12 +333,12 @@ static void run(struct app *a)
 	int key = 0;
 
 	re_console_raw(&a->con);
-	while (!quit_signal) {
+	while (!re_sig.quit) {
 		re_super_wait(a->sup);
 		if (re_super_cycle(a->sup) == RE_FAULT)
 			re_console_fault(&a->con, re_super_fault_line(a->sup));
 		re_super_status(a->sup, &st);
-		show_foreign(a, st.foreign);
+		re_start_show_foreign(a, st.foreign);
 		re_console_status(&a->con, &st, re_io_now_ns(), 0);
 		retry_log(a, &next_retry);
 		key = re_console_key(&a->con);
@@ -1063,7 +432,7 @@ static int supervise(struct app *a)
 	re_lock_init(&a->lock_relay);
 	re_io_bind(&a->io, &a->real);
 	install_signals();
-	rc = startup(a);
+	rc = re_start(a);
 	if ((rc == 0 || rc == EXIT_FAULT) && a->sup)
 		run(a);
 	if (cleanup(a))

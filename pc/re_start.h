@@ -1,0 +1,104 @@
+/*
+ * re_start.h - roboelf's start-up, from the locks to "RoboELF Ready for
+ * Use": the power-on order (docs/supervisor.md), the calibration or the
+ * check of the calibration file, the move to the centre and arming, each
+ * step supervised, and a stop of roboelf itself (SIGSTOP) during it named.
+ * Also the application state the start-up, the run loop and the shutdown
+ * share (struct app), and what the signal handlers tell them (re_sig).
+ *
+ * Not the options, the signal handlers, the run loop or the shutdown
+ * (pc/roboelf.c), nor the supervisor's cycle (re_super).
+ */
+#ifndef RE_START_H
+#define RE_START_H
+
+#include <signal.h>
+#include <stdint.h>
+
+#include "re_calfile.h"
+#include "re_calib.h"
+#include "re_config.h"
+#include "re_console.h"
+#include "re_ctl.h"
+#include "re_io.h"
+#include "re_lock.h"
+#include "re_log.h"
+#include "re_plan.h"
+#include "re_relay.h"
+#include "re_super.h"
+
+/* roboelf's exit codes (roboelf.1). */
+#define EXIT_USAGE     2
+#define EXIT_CONNECT   3
+#define EXIT_FAULT     4
+#define DEFAULT_CONFIG "config/roboelf.yaml"
+
+struct opts {
+	const char *config;
+	const char *galil;
+	const char *relay;
+	const char *log;
+	const char *show_cal;
+	int period_ms; /* 0: from the configuration */
+	enum re_calib_choice calib;
+};
+
+struct app {
+	struct opts o;
+	struct re_config cfg;
+	struct re_log log;
+	struct re_console con;
+	re_relay *relay;
+	struct re_lock lock_ctl, lock_relay; /* one supervisor per each */
+	struct re_io_real real; /* real.link: the command link */
+	struct re_io io;
+	struct re_ctl_info info;
+	struct re_plan plan;
+	struct re_calset *cal;
+	struct re_super *sup;
+	const char *names[RE_AXES];
+	long hbpc;
+	int calib;   /* the operator's choice: RE_CALIB_FULL / _FILE */
+	int powered; /* the relay was switched on at some point */
+	unsigned foreign_shown; /* other programs' handles already shown */
+	int ctl_ours; /* the controller was taken over: ours to stop */
+	char err[RE_CONFIG_ERR_MAX];
+};
+
+/* What the signal handlers (pc/roboelf.c) tell the start-up and the run
+ * loop: @quit the signal that asks to quit (0: none); @continued a SIGCONT
+ * came, after a stop of @cont_stop_ms ms measured from
+ * @cont_real->last_run_ns (the last moment roboelf is known to have run). */
+struct re_signals {
+	volatile sig_atomic_t quit;
+	volatile sig_atomic_t continued;
+	volatile int64_t cont_stop_ms;
+	struct re_io_real *volatile cont_real;
+};
+extern struct re_signals re_sig;
+
+/*
+ * re_start() - the whole start-up of @a (configuration and log already
+ * loaded and open): locks, relay, controller, calibration, arming. Every
+ * step is refused (exit 3, message on the console and in the log) or
+ * latches a fault (exit 4) when it fails; a quit signal ends it early.
+ * Return: 0 when armed ("RoboELF Ready for Use" shown) or on a quit
+ * signal; EXIT_CONNECT, EXIT_USAGE or EXIT_FAULT otherwise.
+ */
+int re_start(struct app *a);
+
+/*
+ * re_start_stall_limit_ms() - the critical reply-age limit, ms: a stop of
+ * roboelf longer than this is a stall (from the supervisor once it
+ * exists, else from the configuration).
+ */
+int64_t re_start_stall_limit_ms(const struct app *a);
+
+/*
+ * re_start_show_foreign() - another program connected to the controller
+ * (@mask: its handles, bit n = handle n): not a fault (it may only look),
+ * but the operator is told once per handle, on the console and in the log.
+ */
+void re_start_show_foreign(struct app *a, unsigned mask);
+
+#endif /* RE_START_H */
