@@ -21,7 +21,9 @@ make --no-print-directory BUILD="$BUILD" "$BUILD/obj/tests/bench/bench_sys.o"
 mkdir -p "$BUILD/bench"
 # shellcheck disable=SC2046
 $CC -o "$BUILD/bench/bench_sys" "$BUILD/obj/tests/bench/bench_sys.o" \
-	"$BUILD/lib/libharness.a" "$BUILD/lib/libre.a" "$BUILD/lib/libgl.a" \
+	"$BUILD/lib/libharness.a" "$BUILD/lib/libre.a" \
+	$(ls "$BUILD/lib/libdmc.a" 2>/dev/null) "$BUILD/lib/libgl.a" \
+	$(ls "$BUILD/lib/libbase.a" 2>/dev/null) \
 	$(pkg-config --libs libserialport yaml-0.1) -lpthread -lm
 $CC -O2 -Wall -Wextra -shared -fPIC -o "$BUILD/bench/alloc_count.so" \
 	tests/bench/alloc_count.c -ldl
