@@ -21,6 +21,7 @@
 
 #include <cmocka.h>
 
+#include "base_clock.h"
 #include "gl_err.h"
 #include "sim_relay.h"
 
@@ -45,10 +46,7 @@ static void on_event(void *ud, const char *line)
 
 static long long now_ms(void)
 {
-	struct timespec ts;
-
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return ts.tv_sec * 1000LL + ts.tv_nsec / 1000000;
+	return (long long)base_now_ms();
 }
 
 static int open_host(const char *path)

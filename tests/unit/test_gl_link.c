@@ -28,6 +28,7 @@
 #include <unistd.h>
 #include <cmocka.h>
 
+#include "base_clock.h"
 #include "gl_err.h"
 #include "gl_link.h"
 #include "gl_proto.h"
@@ -44,10 +45,7 @@ static int stub_ok; /* 2 when both group setup and teardown succeeded */
 
 static int64_t now_ms(void)
 {
-	struct timespec ts;
-
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (int64_t)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+	return base_now_ms();
 }
 
 /* Read the stub's ready line from @fd within START_MS. */

@@ -18,14 +18,12 @@
 
 #include <cmocka.h>
 
+#include "base_clock.h"
 #include "re_console.h"
 
 static int64_t mono_ns(void)
 {
-	struct timespec t;
-
-	clock_gettime(CLOCK_MONOTONIC, &t);
-	return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+	return base_now_ns();
 }
 
 /* Fill the pipe until the kernel refuses more; return the bytes written. */

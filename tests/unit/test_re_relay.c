@@ -29,6 +29,7 @@
 
 #include <cmocka.h>
 
+#include "base_clock.h"
 #include "gl_err.h"
 #include "re_relay.h"
 
@@ -401,10 +402,7 @@ static const uint8_t OFF1[] = {0x6F}, ON1[] = {0x65};
 
 static int64_t mono_ns(void)
 {
-	struct timespec t;
-
-	clock_gettime(CLOCK_MONOTONIC, &t);
-	return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+	return base_now_ns();
 }
 
 #define LATE_MS 15 /* a timeout may come this much after its deadline */
