@@ -22,9 +22,9 @@ struct re_calcheck_cfg {
 	double step_tol_counts;	 /* allowed |advance - step|, counts, >= 0 */
 	/* the end values against the potentiometer's expected absolute
 	 * readings there (0 tolerance: not checked) */
-	double abs_first_v;   /* expected pot at point 0, V */
-	double abs_last_v;    /* expected pot at point n-1, V */
-	double abs_tol_v;     /* allowed |pot - expected| there, V */
+	double abs_first_v; /* expected pot at point 0, V */
+	double abs_last_v;  /* expected pot at point n-1, V */
+	double abs_tol_v;   /* allowed |pot - expected| there, V */
 };
 
 /*

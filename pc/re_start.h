@@ -50,7 +50,7 @@ struct app {
 	struct re_console con;
 	re_relay *relay;
 	struct re_lock lock_ctl, lock_relay; /* one supervisor per each */
-	struct re_io_real real; /* real.link: the command link */
+	struct re_io_real real;		     /* real.link: the command link */
 	struct re_io io;
 	struct re_ctl_info info;
 	struct re_plan plan;

@@ -34,8 +34,8 @@ static void test_table_sorted(void **state)
 	(void)state;
 	assert_int_equal(dmc_cmd_count(), 208);
 	for (size_t i = 1; i < dmc_cmd_count(); i++)
-		assert_true(strcmp(dmc_cmd_at(i - 1)->name,
-				   dmc_cmd_at(i)->name) < 0);
+		assert_true(
+		    strcmp(dmc_cmd_at(i - 1)->name, dmc_cmd_at(i)->name) < 0);
 	assert_null(dmc_cmd_at(dmc_cmd_count()));
 	assert_string_equal(dmc_cmd_find("KPA=10")->name, "KP");
 	assert_null(dmc_cmd_find("XX"));
@@ -53,7 +53,8 @@ static void test_sim_commands_in_table(void **state)
 
 		if (!e || !(e->flags & DMC_CMD_SIM))
 			fail_msg("galil-sim runs %s, the table says it does "
-				 "not", n);
+				 "not",
+				 n);
 	}
 	assert_int_equal(i, 89);
 }
@@ -82,7 +83,8 @@ static void test_table_commands_in_sim(void **state)
 			 "%s%s", missing++ ? " " : "", e->name);
 	}
 	print_message("[ MEASURE  ] %d commands galil-load accepts that "
-		      "galil-sim does not run: %s\n", missing, list);
+		      "galil-sim does not run: %s\n",
+		      missing, list);
 	assert_int_equal(missing, 208 - 89);
 	tp_free(&p);
 }

@@ -23,14 +23,14 @@ static const struct {
 	enum re_dmc_fcode code;
 	const char *name;
 } names[] = {
-    {RE_DMC_F_PARAM, "PARAM"},	       {RE_DMC_F_WATCHDOG, "WATCHDOG"},
-    {RE_DMC_F_INPUT, "INPUT"},	       {RE_DMC_F_POSERR, "POSERR"},
-    {RE_DMC_F_LIMIT, "LIMIT"},	       {RE_DMC_F_CMDERR, "CMDERR"},
-    {RE_DMC_F_TCPERR, "TCPERR"},       {RE_DMC_F_AMPERR, "AMPERR"},
-    {RE_DMC_F_ENCODER, "ENCODER"},     {RE_DMC_F_MOTOROFF, "MOTOROFF"},
-    {RE_DMC_F_THREAD, "THREAD"},       {RE_DMC_F_SUPERVISOR, "SUPERVISOR"},
-    {RE_DMC_F_UNCMD, "UNCMD"},	       {RE_DMC_F_FOREIGN, "FOREIGN"},
-    {RE_DMC_F_SVCMOVE, "SVCMOVE"},     {RE_DMC_F_POTRANGE, "POTRANGE"},
+    {RE_DMC_F_PARAM, "PARAM"},	   {RE_DMC_F_WATCHDOG, "WATCHDOG"},
+    {RE_DMC_F_INPUT, "INPUT"},	   {RE_DMC_F_POSERR, "POSERR"},
+    {RE_DMC_F_LIMIT, "LIMIT"},	   {RE_DMC_F_CMDERR, "CMDERR"},
+    {RE_DMC_F_TCPERR, "TCPERR"},   {RE_DMC_F_AMPERR, "AMPERR"},
+    {RE_DMC_F_ENCODER, "ENCODER"}, {RE_DMC_F_MOTOROFF, "MOTOROFF"},
+    {RE_DMC_F_THREAD, "THREAD"},   {RE_DMC_F_SUPERVISOR, "SUPERVISOR"},
+    {RE_DMC_F_UNCMD, "UNCMD"},	   {RE_DMC_F_FOREIGN, "FOREIGN"},
+    {RE_DMC_F_SVCMOVE, "SVCMOVE"}, {RE_DMC_F_POTRANGE, "POTRANGE"},
 };
 #define N_NAMES (sizeof(names) / sizeof(names[0]))
 
