@@ -179,6 +179,15 @@ static int send(struct re_calib *c, const struct re_io *io,
 			 c->line, io->ops->ctrl_error(io->ud, NULL));
 		return RE_FAULT;
 	}
+	if (rc == GL_ERR_TIMEOUT) {
+		/* no reply within the command's deadline: the same cause as a
+		 * record without reply in the cycle (a stalled link), named
+		 * the same way */
+		re_fault_set(f, RE_F_WDOG_REPLY, -1);
+		f->i[0] = cfg->cmd_timeout_ms;
+		f->i[1] = cfg->cmd_timeout_ms;
+		return RE_FAULT;
+	}
 	return rc < 0 ? comm_fault(f, "command failed", rc) : GL_OK;
 }
 
