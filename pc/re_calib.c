@@ -11,10 +11,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base_clock.h"
 #include "gl_err.h"
 #include "re_pot.h"
 
-#define NS_PER_MS 1000000LL
 #define AXES	  "ABC"
 #define ACFACT	  10	/* dmc/constants.dmc: DC = 10 x speed */
 #define GUARD_CNT 200	/* extra counts before a slow zone */
@@ -309,7 +309,7 @@ static int taken(struct re_calib *c, const struct re_io *io,
 		c->pending = 0;
 		return GL_OK;
 	}
-	if (now_ns(io) - c->sent_ns > (int64_t)cfg->accept_ms * NS_PER_MS)
+	if (now_ns(io) - c->sent_ns > (int64_t)cfg->accept_ms * BASE_NS_PER_MS)
 		return abort_axis(f, -1,
 				  "the controller program did not take a move "
 				  "request within %d ms",
@@ -585,7 +585,7 @@ static int axis_step(struct re_calib *c, const struct re_io *io,
 	int64_t age = now_ns(io) - c->ax[i].t_phase_ns;
 
 	if (c->ax[i].ph != PH_START && c->ax[i].ph != PH_DONE &&
-	    age > (int64_t)cfg->move_timeout_ms * NS_PER_MS)
+	    age > (int64_t)cfg->move_timeout_ms * BASE_NS_PER_MS)
 		return abort_axis(f, i,
 				  "a calibration move did not end "
 				  "within %d ms (encoder %.0f)",
@@ -721,7 +721,7 @@ static int to_centre(struct re_calib *c, const struct re_io *io,
 		     const struct re_calib_cfg *cfg,
 		     const struct re_calset *set, struct re_fault *f)
 {
-	int64_t deadline = now_ns(io) + cfg->move_timeout_ms * NS_PER_MS;
+	int64_t deadline = now_ns(io) + cfg->move_timeout_ms * BASE_NS_PER_MS;
 	int rc;
 
 	for (int i = 0; i < RE_AXES; i++)

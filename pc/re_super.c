@@ -10,9 +10,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base_clock.h"
 #include "gl_err.h"
 
-#define NS_PER_MS 1000000LL
 
 static int64_t now_ns(const struct re_super *s)
 {
@@ -134,9 +134,9 @@ static int reply_timeout_ms(const struct re_super *s)
 {
 	int64_t left = s->last_good_ns + s->crit_ns - now_ns(s);
 
-	if (left < NS_PER_MS)
+	if (left < BASE_NS_PER_MS)
 		return 1;
-	return (int)((left + NS_PER_MS - 1) / NS_PER_MS);
+	return (int)((left + BASE_NS_PER_MS - 1) / BASE_NS_PER_MS);
 }
 
 static int comm_fault(int rc, struct re_fault *f)
@@ -161,8 +161,8 @@ static int check_stall(struct re_super *s, struct re_fault *f)
 	if (gap <= s->crit_ns)
 		return RE_OK;
 	re_fault_set(f, RE_F_STALL, -1);
-	f->i[0] = gap / NS_PER_MS;
-	f->i[1] = s->crit_ns / NS_PER_MS;
+	f->i[0] = gap / BASE_NS_PER_MS;
+	f->i[1] = s->crit_ns / BASE_NS_PER_MS;
 	return RE_FAULT;
 }
 
@@ -180,14 +180,14 @@ static int exchange(struct re_super *s, struct re_fault *f)
 	/* The round trip waits at most tmo: a return later than that by more
 	 * than the critical limit means this process did not run meanwhile
 	 * (stopped inside the wait), whatever the link did. */
-	over = now - t0 - (int64_t)tmo * NS_PER_MS;
+	over = now - t0 - (int64_t)tmo * BASE_NS_PER_MS;
 	if (over > s->crit_ns) {
 		/* Reported from t0, the last moment it is known to have
 		 * run: 'over' alone would leave out the part of the stop
 		 * that fell inside the wait (a 2 s SIGSTOP read 1924 ms). */
 		re_fault_set(f, RE_F_STALL, -1);
-		f->i[0] = (now - t0) / NS_PER_MS;
-		f->i[1] = s->crit_ns / NS_PER_MS;
+		f->i[0] = (now - t0) / BASE_NS_PER_MS;
+		f->i[1] = s->crit_ns / BASE_NS_PER_MS;
 		return RE_FAULT;
 	}
 	if (rc != GL_OK && rc != GL_ERR_TIMEOUT)
@@ -196,14 +196,14 @@ static int exchange(struct re_super *s, struct re_fault *f)
 	if (v < 0) {
 		re_fault_set(f, RE_F_WDOG_REPLY, -1);
 		f->i[0] = RE_VAL_UNKNOWN;
-		f->i[1] = s->crit_ns / NS_PER_MS;
+		f->i[1] = s->crit_ns / BASE_NS_PER_MS;
 		v = RE_FAULT;
 	}
 	if (rc == GL_ERR_TIMEOUT && v != RE_FAULT) {
 		/* the deadline was the critical limit: rounding aside, late */
 		re_fault_set(f, RE_F_WDOG_REPLY, -1);
-		f->i[0] = age / NS_PER_MS;
-		f->i[1] = s->crit_ns / NS_PER_MS;
+		f->i[0] = age / BASE_NS_PER_MS;
+		f->i[1] = s->crit_ns / BASE_NS_PER_MS;
 		v = RE_FAULT;
 	}
 	if (rc == GL_OK) {
@@ -379,7 +379,7 @@ static int check_record(struct re_super *s, struct re_fault *f)
 static int latched_cycle(struct re_super *s)
 {
 	int rc = s->io.ops->record(s->io.ud, NULL, &s->rec,
-				   (int)(s->period_ns / NS_PER_MS) + 1);
+				   (int)(s->period_ns / BASE_NS_PER_MS) + 1);
 	struct re_fault scratch;
 
 	memset(&scratch, 0, sizeof(scratch));

@@ -28,7 +28,8 @@ int dmc_stmt_next(const char *s, size_t n, size_t *pos, size_t *start,
 	size_t i = *pos;
 	int quote = 0;
 
-	if (i > n || (i == n && (n == 0 || s[n - 1] != ';' || i == 0)))
+	/* at the end: one more (empty) statement only after a final ';' */
+	if (i > n || (i == n && (i == 0 || s[i - 1] != ';')))
 		return 0;
 	*start = i;
 	for (; i < n && (quote || s[i] != ';'); i++)
