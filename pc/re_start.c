@@ -602,3 +602,50 @@ int re_start(struct app *a)
 	}
 	return rc;
 }
+
+/* The controller for the commissioning run: connected, identified, not
+ * run by another supervisor; halted, every motor read back off,
+ * configured and read back; the relay open and off. Its program is not
+ * checked (commissioning may come before the first galil-load). */
+static int commission_link(struct app *a)
+{
+	char e[GL_ERRTEXT_LEN];
+	gl_link *l;
+
+	progress(a, "connecting to the controller at %s",
+		 a->cfg.controller.address);
+	if (gl_link_open(&l, a->cfg.controller.address,
+			 a->cfg.controller.connect_timeout_ms, e) != GL_OK)
+		return fail(a, e);
+	gl_link_set_timeout(l, a->cfg.controller.timeout_ms);
+	a->real.link = l;
+	a->real.address = a->cfg.controller.address;
+	a->real.cmd_timeout_ms = a->cfg.controller.timeout_ms;
+	if (re_ctl_identify(l, &a->cfg, &a->info, a->err, sizeof(a->err)) ||
+	    re_ctl_check_busy(&a->io, a->cfg.watchdog.controller_timeout_ms,
+			      a->err, sizeof(a->err)))
+		return fail(a, a->err);
+	a->ctl_ours = 1;
+	progress(a, "controller %s, serial %ld", a->info.model,
+		 a->info.serial);
+	re_plan_make(&a->cfg, 0, &a->plan);
+	progress(a, "halting the controller program; every motor off");
+	if (re_ctl_halt(&a->io, a->err, sizeof(a->err)) ||
+	    re_ctl_configure(&a->io, &a->cfg, &a->plan, a->err,
+			     sizeof(a->err)))
+		return fail(a, a->err);
+	progress(a, "controller configured and read back; motor power off");
+	return 0;
+}
+
+int re_start_commission(struct app *a)
+{
+	int rc = take_locks(a);
+
+	re_sig.cont_real = &a->real;
+	if (!rc)
+		rc = start_relay(a);
+	if (!rc)
+		rc = commission_link(a);
+	return rc;
+}

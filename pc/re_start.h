@@ -31,6 +31,7 @@
 #define EXIT_USAGE     2
 #define EXIT_CONNECT   3
 #define EXIT_FAULT     4
+#define EXIT_COMMISSION 5 /* the commissioning run found a fault */
 #define DEFAULT_CONFIG "config/roboelf.yaml"
 
 struct opts {
@@ -39,6 +40,8 @@ struct opts {
 	const char *relay;
 	const char *log;
 	const char *show_cal;
+	const char *commission; /* report directory */
+	int wait_s;		/* commissioning: each wait for the technician */
 	int period_ms; /* 0: from the configuration */
 	enum re_calib_choice calib;
 };
@@ -86,6 +89,16 @@ extern struct re_signals re_sig;
  * signal; EXIT_CONNECT, EXIT_USAGE or EXIT_FAULT otherwise.
  */
 int re_start(struct app *a);
+
+/*
+ * re_start_commission() - what the commissioning run (roboelf --commission)
+ * needs before its first step: the locks, the relay opened and off, the
+ * controller connected, identified (the configured model), not run by
+ * another supervisor, halted with every motor read back off, configured
+ * and read back. Its program is not checked. Refusals as re_start().
+ * Return: 0, EXIT_CONNECT.
+ */
+int re_start_commission(struct app *a);
 
 /*
  * re_start_stall_limit_ms() - the critical reply-age limit, ms: a stop of

@@ -41,6 +41,8 @@
 #include "re_calib.h"
 #include "re_calshow.h"
 #include "re_check.h"
+#include "re_comm.h"
+#include "re_comm_report.h"
 #include "re_config.h"
 #include "re_console.h"
 #include "re_ctl.h"
@@ -106,6 +108,8 @@ static void usage(FILE *f)
 	    "               [--calibration full|file] [--period MS] "
 	    "[--log FILE]\n"
 	    "       roboelf --show-calibration FILE\n"
+	    "       roboelf --commission DIR [-c FILE] [--galil ...] "
+	    "[--wait S]\n"
 	    "\n"
 	    "  -c, --config FILE        configuration (default %s)\n"
 	    "      --galil HOST[:PORT]  controller address (overrides the "
@@ -117,10 +121,14 @@ static void usage(FILE *f)
 	    "      --log FILE           failure log\n"
 	    "      --show-calibration FILE  print a calibration file (and "
 	    "plot it)\n"
+	    "      --commission DIR     the commissioning run; report "
+	    "in DIR\n"
+	    "      --wait S             commissioning: each wait for the "
+	    "technician (60 s)\n"
 	    "  -h, --help               this text\n"
 	    "\n"
 	    "exit: 0 quit, 2 usage/config, 3 no relay/controller, "
-	    "4 fault latched\n",
+	    "4 fault latched, 5 commissioning found a fault\n",
 	    DEFAULT_CONFIG);
 }
 
@@ -156,6 +164,16 @@ static int opt_value(struct opts *o, int c, const char *arg)
 	case 'r': o->relay = arg; return 0;
 	case 'l': o->log = arg; return 0;
 	case 's': o->show_cal = arg; return 0;
+	case 'M': o->commission = arg; return 0;
+	case 'W':
+		o->wait_s = atoi(arg);
+		if (o->wait_s >= 1 && o->wait_s <= 3600)
+			return 0;
+		fprintf(stderr,
+			"roboelf: error: invalid wait '%s': must be 1..3600 "
+			"s\n",
+			arg);
+		return -1;
 	case 'p':
 		if (parse_period(arg, &o->period_ms) == 0)
 			return 0;
@@ -187,6 +205,8 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 	    {"period", required_argument, NULL, 'p'},
 	    {"log", required_argument, NULL, 'l'},
 	    {"show-calibration", required_argument, NULL, 's'},
+	    {"commission", required_argument, NULL, 'M'},
+	    {"wait", required_argument, NULL, 'W'},
 	    {"help", no_argument, NULL, 'h'},
 	    {NULL, 0, NULL, 0},
 	};
@@ -457,6 +477,94 @@ static int show_calibration(struct app *a)
 		   : EXIT_USAGE;
 }
 
+/* ---- the commissioning run ------------------------------------------- */
+
+static void comm_say(void *ud, const char *line)
+{
+	struct app *a = ud;
+
+	re_console_msg(&a->con, "%s", line);
+	re_log_msg(&a->log, RE_LOG_INFO, "%s", line);
+}
+
+/* A yes/no question on the terminal (or a line on stdin): only "y" or
+ * "yes" is a yes; end of input is a no. */
+static int comm_confirm(void *ud, const char *question)
+{
+	struct app *a = ud;
+	char line[32];
+	int yes;
+
+	re_console_msg(&a->con, "commission: %s [y/N]", question);
+	yes = fgets(line, sizeof(line), stdin) &&
+	      (!strcmp(line, "y\n") || !strcmp(line, "yes\n"));
+	re_log_msg(&a->log, RE_LOG_INFO, "commission: %s -> %s", question,
+		   yes ? "yes" : "no");
+	return yes;
+}
+
+static void comm_date(char *buf, size_t cap)
+{
+	time_t t = time(NULL);
+	struct tm tm;
+
+	gmtime_r(&t, &tm);
+	strftime(buf, cap, "%Y-%m-%d %H:%M:%S UTC", &tm);
+}
+
+/* After re_start_commission(): the steps, the report, the summary. */
+static int comm_steps(struct app *a)
+{
+	static struct re_comm c;
+	char date[32], line[1024], err[256];
+	struct re_comm_where w = {a->cfg.controller.address, a->o.config, date};
+	int rc, plots = 0;
+
+	re_comm_init(&c);
+	c.io = &a->io;
+	c.link = a->real.link;
+	c.relay = a->relay;
+	c.cfg = &a->cfg;
+	c.ui = (struct re_comm_ui){a, comm_say, comm_confirm};
+	c.quit = &re_sig.quit;
+	if (a->o.wait_s)
+		c.wait_ms = a->o.wait_s * 1000;
+	snprintf(c.model, sizeof(c.model), "%s", a->info.model);
+	c.serial = a->info.serial;
+	rc = re_comm_run(&c);
+	a->powered = c.power_on_seen;
+	comm_date(date, sizeof(date));
+	re_comm_summary(&c, line, sizeof(line));
+	re_console_msg(&a->con, "commission: %s", line);
+	re_log_msg(&a->log, rc ? RE_LOG_WARN : RE_LOG_INFO, "commission: %s",
+		   line);
+	if (re_comm_report(&c, &w, a->o.commission, &plots, err,
+			   sizeof(err)) != GL_OK) {
+		re_console_msg(&a->con, "roboelf: error: %s", err);
+		return EXIT_CONNECT;
+	}
+	re_console_msg(&a->con, "commission: report %s/%s, %d plot(s)",
+		       a->o.commission, RE_COMM_REPORT_NAME, plots);
+	return rc == GL_OK ? 0 : EXIT_COMMISSION;
+}
+
+static int commission(struct app *a)
+{
+	int rc;
+
+	re_console_open(&a->con, stdout, STDIN_FILENO);
+	a->real.log = &a->log;
+	re_lock_init(&a->lock_ctl);
+	re_lock_init(&a->lock_relay);
+	re_io_bind(&a->io, &a->real);
+	install_signals();
+	rc = re_start_commission(a);
+	if (!rc)
+		rc = comm_steps(a);
+	cleanup(a);
+	return rc;
+}
+
 int main(int argc, char **argv)
 {
 	static struct app a;
@@ -468,5 +576,7 @@ int main(int argc, char **argv)
 		return show_calibration(&a);
 	if (load_config(&a) < 0 || open_log(&a) < 0)
 		return EXIT_USAGE;
+	if (a.o.commission)
+		return commission(&a);
 	return supervise(&a);
 }

@@ -1,0 +1,75 @@
+/*
+ * re_comm_int.h - what the commissioning run's modules share (re_comm.c,
+ * re_comm_fw.c, re_comm_wire.c, re_comm_move.c): the steps and the small
+ * controller helpers. Not for use outside the re_comm modules.
+ */
+#ifndef RE_COMM_INT_H
+#define RE_COMM_INT_H
+
+#include "re_comm.h"
+
+/* Technician-facing prompts start with this (tests wait for it). */
+#define RC_PROMPT "commission: "
+
+/*
+ * rc_say() - one line to the technician (printf-style), prefixed with
+ * RC_PROMPT. No return value.
+ */
+void rc_say(struct re_comm *c, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+
+/*
+ * rc_cmd() - one command line through c->io; @resp may be NULL.
+ * Return: the reply length (>= 0) or the link's error (GL_ERR_CTRL: the
+ *         controller answered '?', rc_tc() has its TC1).
+ */
+int rc_cmd(struct re_comm *c, const char *cmd, char *resp, size_t cap);
+
+/*
+ * rc_tc() - the controller's TC1 text after GL_ERR_CTRL (never NULL) and
+ * its code in @code (may be NULL).
+ */
+const char *rc_tc(struct re_comm *c, int *code);
+
+/*
+ * rc_num() - the one number "MG @expr" answers. Return: as re_io_read().
+ */
+int rc_num(struct re_comm *c, const char *expr, double *v);
+
+/* rc_quit() - the run was asked to stop (c->quit set): waits return
+ * GL_ERR_AGAIN, which re_comm_run() reports as an interruption. */
+int rc_quit(const struct re_comm *c);
+
+/* rc_sleep_ms() - wait @ms through the io's clock. */
+void rc_sleep_ms(struct re_comm *c, int ms);
+
+/* rc_now_ms() - the io's monotonic clock, ms. */
+double rc_now_ms(struct re_comm *c);
+
+/*
+ * rc_link_fail() - record a FAIL item for a link or controller error @rc
+ * met in @step while doing @what. Return: @rc.
+ */
+int rc_link_fail(struct re_comm *c, const char *step, const char *what,
+		 int rc);
+
+/*
+ * rc_safe() - stop every axis and switch the motors off (AB 1;MO ABC), then
+ * the relay off (confirmed within its deadline). Best effort on every
+ * path. Return: GL_OK when both were confirmed, else the first error.
+ */
+int rc_safe(struct re_comm *c);
+
+/*
+ * The steps (re_comm.h). Each returns GL_OK when it passed (notes allowed),
+ * GL_ERR_MISMATCH after recording its FAIL item, or a link error.
+ */
+int rc_step_identity(struct re_comm *c);
+int rc_step_firmware(struct re_comm *c);
+int rc_step_joystick(struct re_comm *c);
+int rc_step_pots(struct re_comm *c);
+int rc_step_limits(struct re_comm *c);
+int rc_step_relay(struct re_comm *c);
+int rc_step_motion(struct re_comm *c);
+
+#endif /* RE_COMM_INT_H */
