@@ -62,7 +62,7 @@ static void test_left_to_right(void **state)
 	expect_reply(p, "MG (1<2)+(2<=2)+(3>=4)+(1<>1)+(5=5)", " 3.0000\r\n");
 	expect_reply(p, "MG 7%3", " 1.0000\r\n");
 	expect_reply(p, "MG -3+5", " 2.0000\r\n");
-	expect_reply(p, "MG 2*-3", "-6.0000\r\n");
+	expect_reply(p, "MG 2*-3", " -6.0000\r\n");
 }
 
 /* 32.16 fixed point: 1/3 is $0.5555; decimal output rounds to 4 places. */
@@ -72,10 +72,10 @@ static void test_fixed_point(void **state)
 
 	expect_reply(p, "MG (1/3){$1.4}", "$0.5555\r\n");
 	expect_reply(p, "MG 2/3", " 0.6667\r\n");
-	expect_reply(p, "MG -1/3", "-0.3333\r\n");
+	expect_reply(p, "MG -1/3", " -0.3333\r\n");
 	expect_reply(p, "MG @ABS[-2147483647]", " 2147483647.0000\r\n");
 	expect_reply(p, "MG $7FFFFFFF.FFFF{$8.4}", "$7FFFFFFF.FFFF\r\n");
-	expect_reply(p, "MG $FFFFFFFF", "-1.0000\r\n");
+	expect_reply(p, "MG $FFFFFFFF", " -1.0000\r\n");
 	expect_error(p, "MG 1/0", 6);
 }
 
@@ -83,12 +83,12 @@ static void test_functions(void **state)
 {
 	struct tplant *p = *state;
 
-	expect_reply(p, "MG @INT[1.2],@INT[-2.4]", " 1.0000-2.0000\r\n");
-	expect_reply(p, "MG @FRAC[1.2],@FRAC[-2.4]", " 0.2000-0.4000\r\n");
+	expect_reply(p, "MG @INT[1.2],@INT[-2.4]", " 1.0000 -2.0000\r\n");
+	expect_reply(p, "MG @FRAC[1.2],@FRAC[-2.4]", " 0.2000 -0.4000\r\n");
 	expect_reply(p, "MG @RND[5.5],@RND[-5.5],@RND[-5.7]",
-		     " 6.0000-5.0000-6.0000\r\n");
+		     " 6.0000 -5.0000 -6.0000\r\n");
 	expect_reply(p, "MG @SQR[2],@SQR[-2]", " 1.4142 1.4142\r\n");
-	expect_reply(p, "MG @SIN[90],@COS[180]", " 1.0000-1.0000\r\n");
+	expect_reply(p, "MG @SIN[90],@COS[180]", " 1.0000 -1.0000\r\n");
 	expect_reply(p, "MG @ATAN[10]", " 84.2894\r\n");
 	expect_reply(p, "MG {$8.0} @COM[0]", "$FFFFFFFF\r\n");
 	expect_reply(p, "MG @FLOT[2.5] {$8.0}", "$40200000\r\n");
@@ -598,7 +598,7 @@ static void test_misc_commands(void **state)
 	expect_reply(p, "MG _BV,_TM,_QZ1,_QZ3",
 		     " 3.0000 1000.0000 52.0000 "
 		     "36.0000\r\n");
-	expect_reply(p, "VF 3.1;MG 2.25,-1234", ": 2.3-999.9\r\n");
+	expect_reply(p, "VF 3.1;MG 2.25,-1234", ": 2.3 -999.9\r\n");
 	expect_reply(p, "LZ 0;MG 2.25;x=7;x=?", ": 002.3\r\n:: 007.0\r\n");
 	expect_reply(p, "VF 10.4;LZ 1;PF 5.2;DP 7;TP A", ":::: 7.00\r\n");
 	expect_reply(p, "VF ?", "10.4\r\n");

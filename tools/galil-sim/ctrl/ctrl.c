@@ -51,6 +51,8 @@ static void settings_defaults(struct ctrl *c)
 	c->cw_hibit = f->have_par ? f->cw_hibit : 0;
 	c->cw_drop = f->have_par ? f->cw_drop : 0;
 	c->cn0 = f->have_par ? f->cn0 : -1;
+	for (i = 0; i < 4; i++) /* CN defaults: -1, -1, 0, 0 */
+		c->cn[i] = f->have_par ? f->cn[i] : i < 2 ? -1 : 0;
 	c->sample_us = f->have_par	      ? f->sample_us
 		       : c->cfg.sample_us > 0 ? c->cfg.sample_us
 					      : 1000;
@@ -331,4 +333,9 @@ unsigned ctrl_threads(const struct ctrl *c)
 		if (c->th[t].running)
 			m |= 1u << t;
 	return m;
+}
+
+void ctrl_set_deviate(struct ctrl *c, unsigned dev_bits)
+{
+	c->cfg.deviate = dev_bits;
 }

@@ -31,13 +31,24 @@ struct ctrl_cfg {
 	 * stopped, program error ...): one line, no CR LF. May be NULL. */
 	void (*event)(void *ud, const char *line);
 	void *event_ud;
+	/* CTRL_DEV_* bits: answer differently from the command reference on
+	 * purpose (galil-sim --deviate, docs/galil-sim.md); 0 = faithful */
+	unsigned deviate;
 };
+
+/* Deliberate deviations from the reference (struct ctrl_cfg.deviate). */
+#define CTRL_DEV_MG_JOIN   0x01u /* MG of several values: '-1.0000-2.0000' */
+#define CTRL_DEV_DM_EXISTS 0x02u /* DM of an existing array re-dimensions */
+#define CTRL_DEV_QR_HEADER 0x04u /* QR header byte 1 reads 0x03, not 0x07 */
+#define CTRL_DEV_UL_TRIM   0x08u /* UL drops trailing spaces of each line */
+#define CTRL_DEV_MO_MOVING 0x10u /* MO accepted while an axis profiles */
 
 /* What the plant reports to the controller each sample. */
 struct ctrl_sense {
 	double enc[CTRL_AXES];	  /* main encoder, counts */
 	int fwd_limit[CTRL_AXES]; /* 1 = forward limit switch active */
 	int rev_limit[CTRL_AXES]; /* 1 = reverse limit switch active */
+	int home[CTRL_AXES];	  /* 1 = home input grounded (active) */
 	double an_v[CTRL_ANALOG]; /* analog inputs 1..8, volts */
 	uint32_t inputs; /* digital inputs, bit n-1 = input n, 1 = high */
 	int amp_power;	 /* 1 = motor power present (E-stop relay on) */
@@ -178,5 +189,12 @@ size_t ctrl_serial_output(struct ctrl *c, uint8_t *buf, size_t cap);
  * servo sample (default 16; see docs/galil-sim-controller.md).
  */
 void ctrl_set_line_budget(struct ctrl *c, int lines_per_sample);
+
+/*
+ * ctrl_set_deviate() - replace the deliberate deviations from the command
+ * reference (CTRL_DEV_* bits, as struct ctrl_cfg.deviate); 0 = faithful.
+ * Unknown bits are ignored.
+ */
+void ctrl_set_deviate(struct ctrl *c, unsigned dev_bits);
 
 #endif /* SIM_CTRL_H */

@@ -389,8 +389,9 @@ static int cmd_shmo(struct ctrl_xc *x, const char *a, int on)
 	if (rc)
 		return rc;
 	for (i = 0; i < CTRL_AXES; i++)
-		if ((mask & (1u << i)) && c->ax[i].profiling)
-			return 7;
+		if ((mask & (1u << i)) && c->ax[i].profiling &&
+		    (on || !(c->cfg.deviate & CTRL_DEV_MO_MOVING)))
+			return 7; /* deviation mo-moving: MO accepted */
 	ctrl_xc_who(x, who, sizeof(who));
 	snprintf(why, sizeof(why), "MO (%s)", who);
 	for (i = 0; i < CTRL_AXES; i++) {

@@ -132,11 +132,26 @@ int *ctrl_ipar_ptr(struct ctrl_axis_par *p, const struct ctrl_ipar_desc *d)
 
 /* ---- operands ------------------------------------------------------------ */
 
+/*
+ * _HMa (command reference HM, CN): with CN n1 = -1 (default) 1 while the
+ * home input is pulled up (not active), 0 while grounded; CN n1 = 1
+ * inverts it.
+ */
+int ctrl_axis_home(const struct ctrl *c, int i)
+{
+	int grounded = c->in.home[i] != 0;
+
+	return c->cn[0] == 1 ? grounded : !grounded;
+}
+
 static int switches(const struct ctrl *c, int i, int ts)
 {
 	const struct ctrl_axis *ax = &c->ax[i];
 	double te = round(ax->ref) - round(ax->enc);
-	int v = 0x02; /* home input: not wired, reads 1 */
+	int v = ctrl_axis_home(c, i) ? 0x02 : 0;
+
+	if (ts)
+		v |= 0x01; /* TS: latch not armed (no latch simulated) */
 
 	if (!ax->lim_f)
 		v |= 0x08;
@@ -192,7 +207,9 @@ int ctrl_axis_operand(struct ctrl *c, const char *n, int i, double *v)
 	else if (!strcmp(n, "LR"))
 		*v = !ax->lim_r;
 	else if (!strcmp(n, "HM"))
-		*v = 1;
+		*v = ctrl_axis_home(c, i);
+	else if (!strcmp(n, "MT"))
+		*v = 1; /* servo motor; MT is not settable */
 	else if (!strcmp(n, "PA"))
 		*v = ax->pa_last;
 	else if (!strcmp(n, "PR"))

@@ -47,8 +47,13 @@ const struct ctrl_ipar_desc *ctrl_ipar_find(const char *name);
 double *ctrl_par_ptr(struct ctrl_axis_par *p, const struct ctrl_par_desc *d);
 int *ctrl_ipar_ptr(struct ctrl_axis_par *p, const struct ctrl_ipar_desc *d);
 /*
+ * ctrl_axis_home() - _HM of axis @i (0..CTRL_AXES-1): the home input of the
+ * last sample read through CN n1 (-1: 1 = pulled up, 0 = grounded).
+ */
+int ctrl_axis_home(const struct ctrl *c, int i);
+/*
  * ctrl_axis_operand() - _XXa of axis @axis (0..CTRL_AXES-1): state (TP RP
- * TE TD TV TT TS SC MO BG LF LR HM PA PR JG PT DP ZA; counts, counts/s,
+ * TE TD TV TT TS SC MO BG LF LR HM MT PA PR JG PT DP ZA; counts, counts/s,
  * volts) or a parameter, into @v. Return: 0, or TC 1 (no such operand).
  */
 int ctrl_axis_operand(struct ctrl *c, const char *name, int axis, double *v);

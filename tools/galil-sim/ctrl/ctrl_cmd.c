@@ -1,7 +1,7 @@
 /*
  * ctrl_cmd.c - the command table and the general commands (TC TH WH QZ QR
  * CF CW SB CB OB OP TI TA TB DM DA LV LA LL LS UL DL BP BN BV NO TM VF PF
- * LZ IH CN EO). The argument parsers are in ctrl_args.c.
+ * LZ IH CN EO ID MT). The argument parsers are in ctrl_args.c.
  *
  * A command not in the table answers TC 1: nothing is accepted silently.
  */
@@ -13,6 +13,7 @@
 #include "ctrl_cmd.h"
 #include "ctrl_args.h"
 #include "ctrl_axcmd.h"
+#include "ctrl_axis.h"
 #include "ctrl_buf.h"
 #include "ctrl_expr.h"
 #include "ctrl_flow.h"
@@ -67,6 +68,7 @@ static const struct cmd_ent cmd_table[] = {
     {"ER", AX, F_ASSIGN},
     {"FL", AX, F_ASSIGN},
     {"HX", FL, 0},
+    {"ID", GE, 0},
     {"IF", FL, F_PROG},
     {"IH", GE, F_ASSIGN},
     {"IL", AX, F_ASSIGN},
@@ -87,6 +89,7 @@ static const struct cmd_ent cmd_table[] = {
     {"MG", cmd_mg, 0},
     {"MO", AX, 0},
     {"MR", FL, F_PROG | F_ASSIGN},
+    {"MT", GE, F_ASSIGN},
     {"NO", GE, 0},
     {"OA", AX, F_ASSIGN},
     {"OB", GE, 0},
@@ -448,6 +451,10 @@ static int cmd_dm(struct ctrl_xc *x, const char *a)
 			return 55;
 		if (n != (int)n)
 			return 6;
+		if ((x->c->cfg.deviate & CTRL_DEV_DM_EXISTS) && n >= 1 &&
+		    n <= CTRL_ARRAY_SPACE &&
+		    ctrl_array_find(&x->c->vars, key))
+			ctrl_array_free(&x->c->vars, key); /* re-dimension */
 		rc = ctrl_array_dim(&x->c->vars, key, (int)n);
 		if (rc)
 			return rc;
@@ -608,9 +615,15 @@ static int cmd_ls_ul(struct ctrl_xc *x, const char *a, int ul)
 	if (*ctrl_skip(a))
 		return ul ? 1 : 1; /* LS n0,n1 / UL n: not simulated */
 	for (i = 0; i < c->prog.nlines; i++) {
+		const char *t = c->prog.line[i];
+		size_t len = strlen(t);
+
 		if (!ul)
 			ctrl_buf_printf(&c->tmp, "%d ", i);
-		ctrl_buf_puts(&c->tmp, c->prog.line[i]);
+		else if (c->cfg.deviate & CTRL_DEV_UL_TRIM)
+			while (len && t[len - 1] == ' ')
+				len--; /* deviation ul-trim */
+		ctrl_buf_put(&c->tmp, t, len);
 		ctrl_buf_puts(&c->tmp, "\r\n");
 	}
 	if (ul)
@@ -709,10 +722,49 @@ static int cmd_tm(struct ctrl_xc *x, const char *a)
 	return 0;
 }
 
+/*
+ * CN n0,n1,n2,n3,n4 (command reference CN): n0 limit switch polarity, n1
+ * home input polarity (_HM), both -1 or 1; n2 latch polarity (-1, 1), n3
+ * selective abort and n4 abort program end (0, 1) are stored and reported
+ * only. Fields left out keep their value. CN ? answers the five.
+ */
+static int cmd_cn(struct ctrl_xc *x, const char *a)
+{
+	struct ctrl *c = x->c;
+	double v[5] = {0, 0, 0, 0, 0};
+	unsigned got = 0;
+	int i, rc;
+
+	if (*ctrl_skip(a) == '?') {
+		ctrl_buf_printf(&c->tmp, " %d, %d, %d, %d, %d\r\n", c->cn0,
+				c->cn[0], c->cn[1], c->cn[2], c->cn[3]);
+		return 0;
+	}
+	rc = ctrl_num_list(x, a, v, 5, &got);
+	if (rc)
+		return rc;
+	if (!got)
+		return 50;
+	for (i = 0; i < 5; i++) {
+		if (!(got & (1u << i)))
+			continue;
+		if (i < 3 ? (v[i] != -1 && v[i] != 1) : (v[i] != 0 && v[i] != 1))
+			return 6;
+	}
+	for (i = 0; i < 5; i++) {
+		if (!(got & (1u << i)))
+			continue;
+		if (i == 0)
+			c->cn0 = (int)v[0];
+		else
+			c->cn[i - 1] = (int)v[i];
+	}
+	return 0;
+}
+
 static int cmd_settings(struct ctrl_xc *x, const char *name, const char *a)
 {
 	struct ctrl *c = x->c;
-	double v[5] = {-1, 0, 0, 0, 0};
 	int n, rc;
 
 	if (!strcmp(name, "LZ")) {
@@ -723,13 +775,55 @@ static int cmd_settings(struct ctrl_xc *x, const char *name, const char *a)
 	}
 	if (!strcmp(name, "EO"))
 		return int_arg(x, a, 0, 1, -1, &n); /* no echo on TCP */
-	/* CN n0,...: only the limit switch polarity n0 is simulated */
-	rc = ctrl_num_list(x, a, v, 5, NULL);
-	if (rc)
-		return rc;
-	if (v[0] != -1 && v[0] != 1)
-		return 6;
-	c->cn0 = (int)v[0];
+	return cmd_cn(x, a);
+}
+
+/*
+ * MT (command reference MT): every simulated axis is a servo, type 1.
+ * Only queries are simulated: "MT ?,?", "MTA=?"; setting a type is TC 1.
+ */
+static int cmd_mt(struct ctrl_xc *x, const char *a)
+{
+	struct ctrl *c = x->c;
+	int n = 0;
+
+	a = ctrl_skip(a);
+	if (ctrl_axis_letter(a[0]) >= 0 && *ctrl_skip(a + 1) == '=') {
+		if (ctrl_axis_letter(a[0]) >= CTRL_AXES)
+			return 6;
+		if (strcmp(ctrl_skip(ctrl_skip(a + 1) + 1), "?"))
+			return 1;
+		ctrl_buf_puts(&c->tmp, " 1\r\n");
+		return 0;
+	}
+	for (;;) {
+		if (*a == '?')
+			ctrl_buf_puts(&c->tmp, n++ ? ", 1" : " 1");
+		else if (*a != ',' && *a != '\0')
+			return 1; /* MT n: not simulated */
+		a = ctrl_skip(*a == '?' ? a + 1 : a);
+		if (*a == '\0')
+			break;
+		if (*a++ != ',')
+			return 1;
+		a = ctrl_skip(a);
+	}
+	if (!n)
+		return 1;
+	ctrl_buf_puts(&c->tmp, "\r\n");
+	return 0;
+}
+
+/*
+ * ID (command reference ID: "FW, firmware revision" then one line per
+ * board): the ^R^V text, the 4-axis DMC board and the AMP-43040 amplifier
+ * the under-voltage status (_TA0 bit 3) belongs to. Rev numbers: choice.
+ */
+static int cmd_id(struct ctrl_xc *x)
+{
+	ctrl_buf_printf(&x->c->tmp,
+			"FW, %s\r\nDMC, 4030, Rev 1\r\nAMP1, 43040, Rev 1\r\n",
+			x->c->model);
 	return 0;
 }
 
@@ -798,6 +892,8 @@ static int cmd_general(struct ctrl_xc *x, const char *name, const char *a)
 	case 'L' << 8 | 'Z':
 	case 'E' << 8 | 'O':
 	case 'C' << 8 | 'N': return cmd_settings(x, name, a);
+	case 'M' << 8 | 'T': return cmd_mt(x, a);
+	case 'I' << 8 | 'D': return *ctrl_skip(a) ? 1 : cmd_id(x);
 	}
 	return cmd_misc(x, name, a);
 }

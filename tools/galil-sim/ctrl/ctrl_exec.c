@@ -33,6 +33,7 @@
 #include "ctrl_prog.h"
 #include "ctrl_thread.h"
 #include "ctrl_var.h"
+#include "dmc_cmd.h"
 #include "dmc_text.h"
 
 /* ---- statements ------------------------------------------------------ */
@@ -171,6 +172,34 @@ static int is_axis_assign(const char *w, size_t n)
 	       (!strcmp(name, "IH") && strchr("ST", w[2]));
 }
 
+/*
+ * "MTA=", "VDS=": a command of the DMC table (pc/dmc/dmc_cmd.h) followed by
+ * an axis or plane letter. A controller never turns these into variables;
+ * those galil-sim does not run answer TC 1 (docs/galil-sim-controller.md).
+ */
+static int is_command_form(const char *w, size_t n)
+{
+	char name[3];
+
+	if (n != 3 || !isupper((unsigned char)w[0]) ||
+	    !isupper((unsigned char)w[1]) || !strchr("ABCDEFGHMNST", w[2]))
+		return 0;
+	memcpy(name, w, 2);
+	name[2] = '\0';
+	return dmc_cmd_find(name) != NULL;
+}
+
+/* "SPA?" is "SPA=?" (command reference: "n = ?" queries). */
+static int axis_query(struct ctrl_xc *x, const char *s)
+{
+	char name[3], arg[4];
+
+	memcpy(name, s, 2);
+	name[2] = '\0';
+	snprintf(arg, sizeof(arg), "%c=?", s[2]);
+	return ctrl_cmd_dispatch(x, name, arg);
+}
+
 static int word_stmt(struct ctrl_xc *x, const char *s)
 {
 	size_t n = ctrl_ident_len(s);
@@ -182,10 +211,16 @@ static int word_stmt(struct ctrl_xc *x, const char *s)
 		return ctrl_flow_cmd(x, n == 4 ? "ELSE" : "ENDIF", after);
 	if (dmc_is_rem(s, n))
 		return 0; /* the one REM rule (dmc_text.h) */
+	if (*after == '?' && *ctrl_skip(after + 1) == '\0' &&
+	    is_axis_assign(s, n))
+		return axis_query(x, s);
 	if ((*after == '=' || *after == '[') && !is_axis_assign(s, n) &&
 	    !(n == 2 && isupper((unsigned char)s[0]) &&
-	      isupper((unsigned char)s[1])))
+	      isupper((unsigned char)s[1]))) {
+		if (is_command_form(s, n))
+			return 1; /* MTA=1, VDS=1: never a variable */
 		return var_stmt(x, s, n);
+	}
 	if (n < 2 || !isupper((unsigned char)s[0]) ||
 	    !isupper((unsigned char)s[1]))
 		return 1;

@@ -286,7 +286,7 @@ struct ctrl_flash {
 	struct ctrl_prog prog;
 	int have_par;
 	struct ctrl_axis_par ax[CTRL_AXES];
-	int cw_hibit, cw_drop, cn0, sample_us, vf_m, vf_n, pf_m, pf_n, lz;
+	int cw_hibit, cw_drop, cn0, cn[4], sample_us, vf_m, vf_n, pf_m, pf_n, lz;
 	uint32_t outputs;
 	int have_vars;
 	struct ctrl_vars vars;
@@ -308,6 +308,7 @@ struct ctrl {
 	int amp_ok;  /* motor power present */
 	uint8_t ta0; /* _TA0 amplifier status */
 	int cn0;     /* CN limit polarity: -1 active low */
+	int cn[4];   /* CN n1..n4: home polarity, latch, abort, abort end */
 	int co;	     /* CO extended I/O configuration (stored only) */
 
 	struct ctrl_prog prog;

@@ -5,9 +5,10 @@
  *   leading zeros   {$m.n} hexadecimal   {Sn} the value as n characters
  *   {^n} character n   {N} no CR LF at the end   {Ex} to handle x
  *   {Pn} to serial port n (the simulator has no serial port: dropped)
- * A number format right after an expression applies to that expression;
- * anywhere else it applies to the expressions that follow. Numbers are
- * printed with a sign position (space or '-'): MG 1+2*3 prints " 9.0000".
+ * A number format right after an expression (also after its {N}) applies
+ * to that expression; anywhere else it applies to the expressions that
+ * follow. Decimal numbers start with a space, negative ones then '-':
+ * MG 1+2*3 prints " 9.0000", MG -1,-2 " -1.0000 -2.0000".
  */
 #include <ctype.h>
 #include <stdlib.h>
@@ -81,6 +82,11 @@ static int other_fmt(struct ctrl_xc *x, const char *s, const char **p,
 	return 0;
 }
 
+/*
+ * A number: a decimal one starts with a space, also before its '-' (the
+ * command reference's MG examples: " 9.0000", " -90.0000"), so several
+ * values stay apart. Deviation mg-join drops the space before '-'.
+ */
 static int put_value(struct ctrl_xc *x, double v, const struct ctrl_fmt *f)
 {
 	char num[64];
@@ -88,7 +94,34 @@ static int put_value(struct ctrl_xc *x, double v, const struct ctrl_fmt *f)
 
 	if (n < 0)
 		return 53;
+	if (num[0] == '-' && !(x->c->cfg.deviate & CTRL_DEV_MG_JOIN) &&
+	    ctrl_buf_puts(&x->c->tmp, " "))
+		return 1;
 	return ctrl_buf_puts(&x->c->tmp, num) ? 1 : 0;
+}
+
+/* Formatters right after an expression: {N} and one number format. */
+static int after_value(const char **p, struct ctrl_fmt *f, int *crlf)
+{
+	const char *s = ctrl_skip(*p);
+	int rc, have_fmt = 0;
+
+	for (;;) {
+		if (s[0] == '{' && s[1] == 'N' && s[2] == '}') {
+			*crlf = 0;
+			s = ctrl_skip(s + 3);
+		} else if (!have_fmt && is_num_fmt(s)) {
+			rc = num_fmt(s + 1, &s, f);
+			if (rc)
+				return rc;
+			have_fmt = 1;
+			s = ctrl_skip(s);
+		} else {
+			break;
+		}
+	}
+	*p = s;
+	return 0;
 }
 
 static int mg_item(struct ctrl_xc *x, const char **p, struct ctrl_fmt *cur,
@@ -115,11 +148,9 @@ static int mg_item(struct ctrl_xc *x, const char **p, struct ctrl_fmt *cur,
 	if (rc)
 		return rc;
 	f = *cur;
-	if (is_num_fmt(ctrl_skip(s))) {
-		rc = num_fmt(ctrl_skip(s) + 1, &s, &f);
-		if (rc)
-			return rc;
-	}
+	rc = after_value(&s, &f, crlf);
+	if (rc)
+		return rc;
 	*p = s;
 	return put_value(x, v, &f);
 }

@@ -96,7 +96,13 @@ static int fmt_dec(char *out, size_t cap, double v, const struct ctrl_fmt *f)
 	return snprintf(out, cap, "%c%s", neg ? '-' : ' ', digits);
 }
 
-/* Hex: '$', m hex digits of the integer part, '.', n of the fraction. */
+/*
+ * Hex: '$', m hex digits of the integer part, '.', n of the fraction. A
+ * negative value shows the low m digits of its two's complement (command
+ * reference TP: PF-6.0 prints -10 as $FFFFF6); a positive one too big for
+ * m digits saturates to all F, as {Fm.n} saturates to all 9
+ * (UNCONFIRMED: the reference shows no overflow).
+ */
 static int fmt_hex(char *out, size_t cap, double v, const struct ctrl_fmt *f)
 {
 	uint64_t u = (uint64_t)ctrl_fx_raw(v) & (((uint64_t)1 << 48) - 1);
@@ -107,6 +113,11 @@ static int fmt_hex(char *out, size_t cap, double v, const struct ctrl_fmt *f)
 
 	if (m < 1 || m > 8 || n < 0 || n > 4)
 		return -1;
+	if (!(u >> 47) && m < 8 && ip >> (4 * m)) {
+		/* too big for m digits: saturate as {Fm.n} does ("$FF") */
+		ip = (1u << (4 * m)) - 1;
+		fp = 0xFFFF;
+	}
 	snprintf(ib, sizeof(ib), "%08X", (unsigned)ip);
 	snprintf(fb, sizeof(fb), "%04X", fp);
 	if (n > 0)

@@ -45,8 +45,8 @@ static int digit_op(struct ctrl_xc *x, const char *code, int d, double *v)
 		*v = d == 0 ? c->ed_line : d == 1 ? c->ed_thread : x->thread;
 	else if (!strcmp(code, "OP") && d == 0)
 		*v = c->outputs & 0xFFFF;
-	else if (!strcmp(code, "CN") && d == 0)
-		*v = c->cn0;
+	else if (!strcmp(code, "CN") && d <= 4)
+		*v = d == 0 ? c->cn0 : c->cn[d - 1];
 	else if (!strcmp(code, "CW") && d == 4)
 		*v = c->cw_drop;
 	else if (!strcmp(code, "IA") && d <= 5)
@@ -98,6 +98,10 @@ static int plain_op(struct ctrl_xc *x, const char *code, double *v)
 		*v = (thread_mask(c) ? 128 : 0);
 	else if (!strcmp(code, "RS"))
 		*v = 0;
+	else if (!strcmp(code, "XQ")) /* choice: _XQ is _XQ0 */
+		*v = ctrl_thread_line(c, 0);
+	else if (!strcmp(code, "TA")) /* choice: _TA is _TA0 */
+		*v = c->ta0;
 	else
 		return 1;
 	return 0;

@@ -73,7 +73,7 @@ static void axis_fill(const struct ctrl *c, int i, struct gl_rec_axis *r)
 int ctrl_record(struct ctrl *c, uint8_t *buf, size_t cap)
 {
 	struct gl_record r;
-	int i;
+	int i, n;
 
 	memset(&r, 0, sizeof(r));
 	r.layout = GL_LAYOUT_4000;
@@ -92,5 +92,8 @@ int ctrl_record(struct ctrl *c, uint8_t *buf, size_t cap)
 	r.amp_status = (uint32_t)c->ta0 << 24;
 	for (i = 0; i < CTRL_AXES; i++)
 		axis_fill(c, i, &r.axis[i]);
-	return gl_record_encode(&r, buf, cap);
+	n = gl_record_encode(&r, buf, cap);
+	if (n > 1 && (c->cfg.deviate & CTRL_DEV_QR_HEADER))
+		buf[1] &= (uint8_t)~0x04u; /* deviation qr-header: 0x03 */
+	return n;
 }

@@ -35,6 +35,7 @@ void ctrl_burn_params(struct ctrl *c)
 	f->cw_hibit = c->cw_hibit;
 	f->cw_drop = c->cw_drop;
 	f->cn0 = c->cn0;
+	memcpy(f->cn, c->cn, sizeof(f->cn));
 	f->sample_us = c->sample_us;
 	f->vf_m = c->vf_m;
 	f->vf_n = c->vf_n;
