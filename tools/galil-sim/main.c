@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "ctrl.h"
 #include "gl_err.h"
 #include "sim.h"
 #include "sim_bench.h"
@@ -26,6 +27,7 @@
 #define DEFAULT_RELAY_LINK   "/tmp/roboelf-relay"
 #define DEFAULT_PROTOCOL     "devantech"
 #define ERR_LEN		     512
+#define MAX_REPEAT	     16 /* --miswire given at most this often */
 
 struct opts {
 	int port, control_port;
@@ -36,6 +38,9 @@ struct opts {
 	int no_amp_uv;	      /* --no-amp-undervoltage */
 	int power_output;     /* --power-output N, -1: the plant file's */
 	unsigned long serial; /* --serial N, 0: the default */
+	const char *miswire[MAX_REPEAT]; /* --miswire SPEC, in order */
+	int n_miswire;
+	unsigned deviate; /* --deviate NAME: CTRL_DEV_* bits */
 };
 
 static volatile sig_atomic_t stop;
@@ -54,7 +59,8 @@ static void usage(FILE *f)
 	    "                 [--relay-link PATH | --no-relay-link]\n"
 	    "                 [--relay-protocol NAME] [--seed N] [--verbose]\n"
 	    "                 [--no-amp-undervoltage] [--power-output N]\n"
-	    "                 [--serial N]\n"
+	    "                 [--serial N] [--miswire SPEC]... [--deviate "
+	    "NAME]...\n"
 	    "       galil-sim --bench [SECONDS]\n"
 	    "       galil-sim --help | --version\n"
 	    "  --port N            command port on 127.0.0.1 (default %d, 0 = "
@@ -76,6 +82,15 @@ static void usage(FILE *f)
 	    "N (1..8; 0 = none)\n"
 	    "  --serial N          the controller's serial number, MG _BN "
 	    "(default 403001)\n"
+	    "  --miswire SPEC      wire the robot wrong on purpose: "
+	    "encoder-reversed:A,\n"
+	    "                      limits-swapped:B, relay-unwired, "
+	    "pot-reversed:C,\n"
+	    "                      joystick-swap:5,7, dead-input:6, "
+	    "joystick-polarity\n"
+	    "  --deviate NAME      answer differently from the reference: "
+	    "mg-join,\n"
+	    "                      dm-exists, qr-header, ul-trim, mo-moving\n"
 	    "  --bench [SECONDS]   measure virtual-time speed with 8 busy "
 	    "threads\n",
 	    DEFAULT_PORT, DEFAULT_CONTROL_PORT, DEFAULT_RELAY_LINK,
@@ -101,6 +116,27 @@ static int parse_serial(const char *arg, struct opts *o)
 			arg);
 		return -1;
 	}
+	return 0;
+}
+
+/* --miswire SPEC: checked on the default robot now, applied after the
+ * plant file is loaded. */
+static int parse_miswire(const char *arg, struct opts *o)
+{
+	struct sim_plant_cfg cfg;
+	char err[ERR_LEN];
+
+	sim_plant_cfg_default(&cfg);
+	if (sim_plant_cfg_miswire(&cfg, arg, err, sizeof(err)) < 0) {
+		fprintf(stderr, "galil-sim: %s\n", err);
+		return -1;
+	}
+	if (o->n_miswire == MAX_REPEAT) {
+		fprintf(stderr, "galil-sim: more than %d --miswire\n",
+			MAX_REPEAT);
+		return -1;
+	}
+	o->miswire[o->n_miswire++] = arg;
 	return 0;
 }
 
@@ -134,6 +170,17 @@ static int parse_opt(int c, const char *arg, struct opts *o)
 		o->power_output = (int)v;
 		return 0;
 	case 'S': return parse_serial(arg, o);
+	case 'm': return parse_miswire(arg, o);
+	case 'd':
+		if (!sim_deviation_bit(arg)) {
+			fprintf(stderr,
+				"galil-sim: unknown deviation '%s' (mg-join, "
+				"dm-exists, qr-header, ul-trim, mo-moving)\n",
+				arg);
+			return -1;
+		}
+		o->deviate |= sim_deviation_bit(arg);
+		return 0;
 	case 's':
 		if (parse_ulong(arg, 0xFFFFFFFFUL, &o->seed) < 0) {
 			fprintf(stderr, "galil-sim: bad seed '%s'\n", arg);
@@ -168,6 +215,8 @@ static int parse_args(int argc, char **argv, struct opts *o)
 	    {"no-amp-undervoltage", no_argument, NULL, 'u'},
 	    {"power-output", required_argument, NULL, 'o'},
 	    {"serial", required_argument, NULL, 'S'},
+	    {"miswire", required_argument, NULL, 'm'},
+	    {"deviate", required_argument, NULL, 'd'},
 	    {"bench", optional_argument, NULL, 'b'},
 	    {"help", no_argument, NULL, 'h'},
 	    {"version", no_argument, NULL, 'V'},
@@ -275,18 +324,13 @@ static int serve(struct sim *s, const struct opts *o)
 
 int main(int argc, char **argv)
 {
-	struct opts o = {DEFAULT_PORT,
-			 DEFAULT_CONTROL_PORT,
-			 NULL,
-			 DEFAULT_RELAY_LINK,
-			 DEFAULT_PROTOCOL,
-			 0,
-			 0,
-			 0,
-			 0,
-			 0,
-			 -1,
-			 0};
+	struct opts o = {
+	    .port = DEFAULT_PORT,
+	    .control_port = DEFAULT_CONTROL_PORT,
+	    .relay_link = DEFAULT_RELAY_LINK,
+	    .protocol = DEFAULT_PROTOCOL,
+	    .power_output = -1,
+	};
 	char err[ERR_LEN];
 	struct sim *s;
 	int rc = parse_args(argc, argv, &o);
@@ -306,6 +350,16 @@ int main(int argc, char **argv)
 		sim_plant_set_amp_undervoltage(sim_get_plant(s), 0);
 	if (o.power_output >= 0)
 		sim_plant_set_power_output(sim_get_plant(s), o.power_output);
+	for (int i = 0; i < o.n_miswire; i++) {
+		if (sim_plant_miswire(sim_get_plant(s), o.miswire[i], err,
+				      sizeof(err)) < 0) {
+			fprintf(stderr, "galil-sim: --miswire %s: %s\n",
+				o.miswire[i], err);
+			sim_free(s);
+			return 2;
+		}
+	}
+	ctrl_set_deviate(sim_ctrl(s), o.deviate);
 	if (o.verbose)
 		sim_set_event_hook(s, print_event, NULL);
 	rc = sim_attach_relay(s, o.protocol, o.relay_link, err, sizeof(err));

@@ -62,6 +62,25 @@ void sim_set_event_hook(struct sim *s,
 	s->hook_ud = ud;
 }
 
+/* ---- deviations -------------------------------------------------------- */
+
+unsigned sim_deviation_bit(const char *name)
+{
+	static const struct {
+		const char *name;
+		unsigned bit;
+	} dev[] = {
+	    {"mg-join", CTRL_DEV_MG_JOIN},     {"dm-exists", CTRL_DEV_DM_EXISTS},
+	    {"qr-header", CTRL_DEV_QR_HEADER}, {"ul-trim", CTRL_DEV_UL_TRIM},
+	    {"mo-moving", CTRL_DEV_MO_MOVING},
+	};
+
+	for (size_t i = 0; i < sizeof(dev) / sizeof(dev[0]); i++)
+		if (!strcmp(name, dev[i].name))
+			return dev[i].bit;
+	return 0;
+}
+
 /* ---- life cycle ------------------------------------------------------- */
 
 static int make_parts(struct sim *s, const struct sim_plant_cfg *pc,

@@ -108,6 +108,14 @@ struct ctrl *sim_ctrl(struct sim *s);
 struct sim_plant *sim_get_plant(struct sim *s);
 struct sim_relay *sim_get_relay(struct sim *s);
 
+/*
+ * sim_deviation_bit() - the CTRL_DEV_* bit (ctrl.h) of a deviation name of
+ * galil-sim --deviate: "mg-join", "dm-exists", "qr-header", "ul-trim",
+ * "mo-moving" (docs/galil-sim.md, "Firmware deviations").
+ * Return: the bit, or 0 for an unknown name.
+ */
+unsigned sim_deviation_bit(const char *name);
+
 /* sim_seed() - restart the potentiometer noise generator from @seed. */
 void sim_seed(struct sim *s, unsigned long seed);
 

@@ -53,6 +53,9 @@ static const struct sim_plant_axis_cfg default_axis[SIM_PLANT_AXES] = {
      0,
      40000,
      2,
+     0,
+     0,
+     0,
      {1, 0.5, 4.5, 0.05, 0.002, SIM_PLANT_NOISE_GAUSSIAN, 0.0}},
     {1,
      -50000,
@@ -61,6 +64,9 @@ static const struct sim_plant_axis_cfg default_axis[SIM_PLANT_AXES] = {
      0,
      40000,
      2,
+     0,
+     0,
+     0,
      {2, 0.5, 4.5, 0.05, 0.002, SIM_PLANT_NOISE_GAUSSIAN, 0.0}},
     {0,
      -40000,
@@ -69,6 +75,9 @@ static const struct sim_plant_axis_cfg default_axis[SIM_PLANT_AXES] = {
      0,
      30000,
      2,
+     0,
+     0,
+     0,
      {3, 0.5, 4.5, 0.04, 0.002, SIM_PLANT_NOISE_GAUSSIAN, 0.0}},
 };
 
@@ -84,6 +93,8 @@ void sim_plant_cfg_default(struct sim_plant_cfg *cfg)
 	cfg->seed = 1;
 	cfg->amp_undervoltage = 1;
 	cfg->power_output = 0;
+	cfg->relay_wired = 1;
+	cfg->dead_inputs = 0;
 }
 
 static int check_pot(const struct sim_plant_pot_cfg *pot, char *err,
@@ -94,16 +105,16 @@ static int check_pot(const struct sim_plant_pot_cfg *pot, char *err,
 			 CTRL_ANALOG);
 		return GL_ERR_CONFIG;
 	}
-	if (!(pot->fwd_v > pot->rev_v) || fabs(pot->rev_v) > POT_RAIL_V ||
+	if (!(pot->fwd_v != pot->rev_v) || fabs(pot->rev_v) > POT_RAIL_V ||
 	    fabs(pot->fwd_v) > POT_RAIL_V) {
 		snprintf(err, errlen,
-			 "pot needs -10 <= rev_v < fwd_v <= 10 volts");
+			 "pot needs rev_v != fwd_v, both -10..10 volts");
 		return GL_ERR_CONFIG;
 	}
-	if (!(fabs(pot->nonlinear_v) * M_PI < pot->fwd_v - pot->rev_v)) {
+	if (!(fabs(pot->nonlinear_v) * M_PI < fabs(pot->fwd_v - pot->rev_v))) {
 		snprintf(err, errlen,
-			 "pot nonlinear_v %g too large: the curve must rise "
-			 "(|nonlinear_v| * pi < fwd_v - rev_v)",
+			 "pot nonlinear_v %g too large: the curve must be "
+			 "monotonic (|nonlinear_v| * pi < |fwd_v - rev_v|)",
 			 pot->nonlinear_v);
 		return GL_ERR_CONFIG;
 	}
@@ -135,6 +146,18 @@ static int check_axis(const struct sim_plant_axis_cfg *a, char *err,
 		snprintf(err, errlen,
 			 "start must lie between the limit "
 			 "switches");
+		return GL_ERR_CONFIG;
+	}
+	if (!(a->home >= a->rev_limit && a->home <= a->fwd_limit)) {
+		snprintf(err, errlen,
+			 "home must lie between the limit switches");
+		return GL_ERR_CONFIG;
+	}
+	if ((a->encoder_reversed != 0 && a->encoder_reversed != 1) ||
+	    (a->limits_swapped != 0 && a->limits_swapped != 1)) {
+		snprintf(err, errlen,
+			 "encoder_reversed and limits_swapped must be true "
+			 "or false");
 		return GL_ERR_CONFIG;
 	}
 	if (!(a->max_speed > 0 && a->max_speed <= 1e8) ||
@@ -179,6 +202,10 @@ static int check_power(const struct sim_plant_cfg *cfg, char *err,
 {
 	if (cfg->amp_undervoltage != 0 && cfg->amp_undervoltage != 1) {
 		snprintf(err, errlen, "amp_undervoltage must be true or false");
+		return GL_ERR_CONFIG;
+	}
+	if (cfg->relay_wired != 0 && cfg->relay_wired != 1) {
+		snprintf(err, errlen, "relay_wired must be true or false");
 		return GL_ERR_CONFIG;
 	}
 	if (cfg->power_output < 0 ||
@@ -320,13 +347,21 @@ double sim_plant_pot_volts(const struct sim_plant_axis_cfg *ax,
 	return v;
 }
 
-static double encoder_count(const struct plant_axis *a)
+/* The count register: against the motor when the encoder is reversed. */
+static double encoder_count(const struct plant_axis *a, int reversed)
 {
+	double x = reversed ? a->origin - a->pos : a->pos - a->origin;
+
 	switch (a->enc_fault) {
 	case SIM_PLANT_ENC_STUCK: return a->enc_stuck;
-	case SIM_PLANT_ENC_SLIP: return round(a->pos - a->origin + a->slip);
-	default: return round(a->pos - a->origin);
+	case SIM_PLANT_ENC_SLIP: return round(x + a->slip);
+	default: return round(x);
 	}
+}
+
+static double axis_count(const struct sim_plant *p, int i)
+{
+	return encoder_count(&p->ax[i], p->cfg.axis[i].encoder_reversed);
 }
 
 static double pot_reading(struct sim_plant *p, int i)
@@ -362,6 +397,10 @@ static uint32_t input_word(const struct sim_plant *p)
 		if (level)
 			w |= 1u << (p->cfg.joy_input[j] - 1);
 	}
+	if (p->cfg.joy_closed_level) /* dead inputs read the open level */
+		w &= ~p->cfg.dead_inputs;
+	else
+		w |= p->cfg.dead_inputs;
 	return (w & ~p->in_forced) | (p->in_level & p->in_forced);
 }
 
@@ -372,9 +411,12 @@ void sim_plant_sense(struct sim_plant *p, int power, struct ctrl_sense *out)
 		const struct sim_plant_axis_cfg *ac = &p->cfg.axis[i];
 		struct plant_axis *a = &p->ax[i];
 
-		out->enc[i] = encoder_count(a);
-		out->fwd_limit[i] = a->pos >= ac->fwd_limit;
-		out->rev_limit[i] = a->pos <= ac->rev_limit;
+		int fwd = a->pos >= ac->fwd_limit, rev = a->pos <= ac->rev_limit;
+
+		out->enc[i] = axis_count(p, i);
+		out->fwd_limit[i] = ac->limits_swapped ? rev : fwd;
+		out->rev_limit[i] = ac->limits_swapped ? fwd : rev;
+		out->home[i] = a->pos < ac->home;
 		a->pot_v = pot_reading(p, i);
 		out->an_v[ac->pot.input - 1] = a->pot_v;
 	}
@@ -391,7 +433,22 @@ int sim_plant_motor_power(const struct sim_plant *p, int relay_on,
 {
 	int n = p->cfg.power_output;
 
-	return relay_on && (n == 0 || ((outputs >> (n - 1)) & 1));
+	return (relay_on || !p->cfg.relay_wired) &&
+	       (n == 0 || ((outputs >> (n - 1)) & 1));
+}
+
+int sim_plant_miswire(struct sim_plant *p, const char *spec, char *err,
+		      size_t errlen)
+{
+	struct sim_plant_cfg c = p->cfg;
+	int rc = sim_plant_cfg_miswire(&c, spec, err, errlen);
+
+	if (rc)
+		return rc;
+	if (sim_plant_cfg_check(&c, err, errlen) < 0)
+		return GL_ERR_ARG;
+	p->cfg = c;
+	return 0;
 }
 
 int sim_plant_set_amp_undervoltage(struct sim_plant *p, int on)
@@ -422,7 +479,8 @@ static void move_axis(struct sim_plant *p, int i, const struct ctrl_drive *d,
 	if (dt_ms <= 0)
 		return;
 	if (power && d->motor_on[i] && !a->blocked) {
-		dx = d->ref[i] - encoder_count(a);
+		/* the motor turns the way the controller's error says */
+		dx = d->ref[i] - axis_count(p, i);
 		if (ac->lag_ms > 0)
 			dx *= 1 - exp(-dt_ms / ac->lag_ms);
 		lim = ac->max_speed * dt_ms / 1000;
@@ -481,7 +539,7 @@ int sim_plant_set_enc_fault(struct sim_plant *p, int axis,
 	    f > SIM_PLANT_ENC_SLIP)
 		return GL_ERR_ARG;
 	a = &p->ax[axis];
-	a->enc_stuck = encoder_count(a);
+	a->enc_stuck = axis_count(p, axis);
 	a->enc_fault = f;
 	a->slip = f == SIM_PLANT_ENC_SLIP ? round(slip_counts) : 0;
 	return 0;
@@ -567,10 +625,11 @@ int sim_plant_axis(const struct sim_plant *p, int axis,
 	a = &p->ax[axis];
 	out->pos = a->pos;
 	out->vel = a->vel;
-	out->enc = encoder_count(a);
+	out->enc = axis_count(p, axis);
 	out->pot_v = a->pot_v;
 	out->fwd_limit = a->pos >= p->cfg.axis[axis].fwd_limit;
 	out->rev_limit = a->pos <= p->cfg.axis[axis].rev_limit;
+	out->home = a->pos < p->cfg.axis[axis].home;
 	out->blocked = a->blocked;
 	out->pot_fault = a->pot_fault;
 	out->enc_fault = a->enc_fault;

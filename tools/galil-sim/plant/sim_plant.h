@@ -30,7 +30,8 @@ enum sim_plant_noise {
 struct sim_plant_pot_cfg {
 	int input;	    /* analog input 1..8 */
 	double rev_v;	    /* volts at the reverse limit switch */
-	double fwd_v;	    /* volts at the forward limit switch (> rev_v) */
+	double fwd_v;	    /* volts at the forward limit switch (!= rev_v;
+			       below rev_v: a pot wired reversed) */
 	double nonlinear_v; /* amplitude of the sine bow, volts */
 	double noise_v;	    /* noise bound, volts (>= 0) */
 	enum sim_plant_noise noise;
@@ -46,6 +47,15 @@ struct sim_plant_axis_cfg {
 	double start;	  /* position at start-up, counts */
 	double max_speed; /* fastest the motor turns, counts/s */
 	double lag_ms;	  /* servo first-order lag, ms (0 = none) */
+	/* home switch: grounded (active) below this position, pulled up at
+	 * and above it; rev_limit..fwd_limit, counts (default 0 = centre) */
+	double home;
+	/* miswiring (0 = wired right): the encoder counts against the motor
+	 * (the controller reads -x for a plant position x); the forward switch
+	 * wired to the reverse limit input and the reverse one to the forward
+	 * input */
+	int encoder_reversed;
+	int limits_swapped;
 	struct sim_plant_pot_cfg pot;
 };
 
@@ -65,6 +75,12 @@ struct sim_plant_cfg {
 	/* 0: none; 1..SIM_PLANT_POWER_OUTPUTS: a controller digital output
 	 * that must be set, besides the relay, for motor power */
 	int power_output;
+	/* 1: the relay board switches the amplifiers' motor power; 0
+	 * (miswired): motor power stays on whatever the relay does */
+	int relay_wired;
+	/* inputs that never close (miswired): bit n-1 = input n reads the
+	 * open level of a joystick switch (galil-sim --miswire dead-input:N) */
+	uint32_t dead_inputs;
 };
 
 #define SIM_PLANT_POWER_OUTPUTS 8 /* power_output: outputs 1..8 */
@@ -94,7 +110,8 @@ struct sim_plant_axis_state {
 	double vel;   /* true velocity over the last sample, counts/s */
 	double enc;   /* encoder count register */
 	double pot_v; /* last potentiometer reading, volts */
-	int fwd_limit, rev_limit; /* switch active */
+	int fwd_limit, rev_limit; /* switch active (physically) */
+	int home;		  /* home switch active (grounded) */
 	int blocked;		  /* mechanical jam injected */
 	enum sim_plant_pot_fault pot_fault;
 	enum sim_plant_enc_fault enc_fault;
@@ -139,6 +156,27 @@ int sim_plant_cfg_check(const struct sim_plant_cfg *cfg, char *err,
 			size_t errlen);
 
 /*
+ * sim_plant_cfg_miswire() - apply one miswiring @spec to @cfg (galil-sim
+ * --miswire): "encoder-reversed:A", "limits-swapped:B", "relay-unwired",
+ * "pot-reversed:C" (rev_v and fwd_v exchanged), "joystick-swap:5,7" (the
+ * switches wired to inputs 5 and 7 exchange inputs; an input with no
+ * switch takes the other's), "dead-input:6" (input 6 never closes),
+ * "joystick-polarity" (closed_level inverted).
+ * @cfg: [in,out] left untouched on error. @err: [out] the reason, @errlen.
+ * Return: 0 or GL_ERR_ARG.
+ */
+int sim_plant_cfg_miswire(struct sim_plant_cfg *cfg, const char *spec,
+			  char *err, size_t errlen);
+
+/*
+ * sim_plant_miswire() - sim_plant_cfg_miswire() on the configuration of a
+ * running robot @p (the change applies from the next sample).
+ * Return: 0 or GL_ERR_ARG (@err says why; nothing changed).
+ */
+int sim_plant_miswire(struct sim_plant *p, const char *spec, char *err,
+		      size_t errlen);
+
+/*
  * sim_plant_new() / sim_plant_free() - a robot at its start positions,
  * joysticks neutral, no fault, encoders reading 0 at the centre of travel;
  * and its release (NULL is a no-op).
@@ -157,7 +195,8 @@ void sim_plant_seed(struct sim_plant *p, unsigned long seed);
 
 /*
  * sim_plant_sense() - what the controller reads now: encoders, limit
- * switches, analog inputs (pots + forced values), digital inputs (joystick
+ * and home switches (through the miswiring of the configuration), analog
+ * inputs (pots + forced values), digital inputs (joystick
  * switches + forced levels), and what the amplifiers report as amp_power:
  * @power (motor power present), or always 1 when amp_undervoltage is 0.
  * Draws new noise.
@@ -166,7 +205,7 @@ void sim_plant_sense(struct sim_plant *p, int power, struct ctrl_sense *out);
 
 /*
  * sim_plant_motor_power() - 1 when the motors have power: the relay is on
- * (@relay_on) and, when power_output is configured, that bit of the
+ * (@relay_on; ignored when relay_wired is 0) and, when power_output is configured, that bit of the
  * controller's digital outputs @outputs (bit n-1 = output n) is set.
  */
 int sim_plant_motor_power(const struct sim_plant *p, int relay_on,

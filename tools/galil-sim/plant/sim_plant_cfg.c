@@ -70,6 +70,9 @@ static const struct field axis_fields[] = {
     {"start", F_DOUBLE, AX(start), NULL},
     {"max_speed", F_DOUBLE, AX(max_speed), NULL},
     {"lag_ms", F_DOUBLE, AX(lag_ms), NULL},
+    {"home", F_DOUBLE, AX(home), NULL},
+    {"encoder_reversed", F_BOOL, AX(encoder_reversed), NULL},
+    {"limits_swapped", F_BOOL, AX(limits_swapped), NULL},
     {"pot", F_MAP, AX(pot), pot_fields},
     {NULL, F_INT, 0, NULL},
 };
@@ -86,6 +89,7 @@ static const struct field root_fields[] = {
     {"joystick", F_MAP, 0, joy_fields},
     {"amp_undervoltage", F_BOOL, CFG(amp_undervoltage), NULL},
     {"power_output", F_INT, CFG(power_output), NULL},
+    {"relay_wired", F_BOOL, CFG(relay_wired), NULL},
     {NULL, F_INT, 0, NULL},
 };
 
