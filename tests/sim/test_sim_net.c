@@ -719,6 +719,64 @@ static void test_usage_errors(void **state)
 	run_expect(
 	    (char *const[]){(char *)"--power-output", (char *)"9", NULL}, 2,
 	    "galil-sim: bad power output '9' (0..8)\ntry 'galil-sim --help'\n");
+	run_expect(
+	    (char *const[]){(char *)"--miswire", (char *)"encoder-reversed:D",
+			    NULL},
+	    2,
+	    "galil-sim: bad miswiring 'encoder-reversed:D' "
+	    "(encoder-reversed:AXIS, limits-swapped:AXIS, relay-unwired, "
+	    "pot-reversed:AXIS, joystick-swap:N,M, dead-input:N, "
+	    "joystick-polarity; AXIS A..C, inputs 1..32)\n"
+	    "try 'galil-sim --help'\n");
+	run_expect((char *const[]){(char *)"--deviate", (char *)"mg", NULL}, 2,
+		   "galil-sim: unknown deviation 'mg' (mg-join, dm-exists, "
+		   "qr-header, ul-trim, mo-moving)\ntry 'galil-sim --help'\n");
+}
+
+/* --miswire and --deviate reach the robot and the controller; TH shows
+ * this connection's real peer (reference TH layout). */
+static void test_miswire_deviate_options(void **state)
+{
+	static char *const extra[] = {
+	    (char *)"--miswire", (char *)"relay-unwired",
+	    (char *)"--miswire", (char *)"joystick-swap:1,3",
+	    (char *)"--deviate", (char *)"mg-join",
+	    NULL};
+	struct fx *f = *state;
+	struct sockaddr_in me;
+	socklen_t len = sizeof(me);
+	char buf[1024], want[96];
+	int fd;
+
+	proc_kill(&f->sim.p);
+	close(f->ctl);
+	f->ctl = -1;
+	assert_int_equal(
+	    proc_sim_start(&f->sim, bin_dir(), NULL, extra, START_MS), 0);
+	f->ctl = proc_ctl_connect(f->sim.ctl_port, REPLY_MS);
+	assert_true(f->ctl >= 0);
+	fd = cmd_connect(f);
+	assert_int_equal(state_long(f, "power"), 1); /* relay off */
+	expect_reply(fd, "MG -1,-2", "-1.0000-2.0000\r\n:");
+	expect_reply(fd, "MG _TA0", " 0.0000\r\n:");
+	assert_string_equal(ctl(f, "joy A fwd a"), "ok");
+	for (long long end = proc_now_ms() + REPLY_MS;; poll(NULL, 0, 5)) {
+		send_cmd(fd, "MG @IN[1],@IN[3]\r");
+		assert_true(read_reply(fd, buf, sizeof(buf), REPLY_MS) > 0);
+		if (!strcmp(buf, " 0.0000 1.0000\r\n:"))
+			break; /* switch A fwd a is wired to input 3 */
+		if (proc_now_ms() > end)
+			fail_msg("MG @IN[1],@IN[3] still '%s'", buf);
+	}
+	assert_int_equal(getsockname(fd, (struct sockaddr *)&me, &len), 0);
+	send_cmd(fd, "TH\r");
+	assert_true(read_reply(fd, buf, sizeof(buf), REPLY_MS) > 0);
+	snprintf(want, sizeof(want),
+		 "\r\nIHA TCP PORT %d TO IP ADDRESS 127,0,0,1 PORT %d\r\n",
+		 f->sim.port, ntohs(me.sin_port));
+	if (!strstr(buf, want))
+		fail_msg("TH '%s' lacks '%s'", buf, want);
+	close(fd);
 }
 
 /* A relay link path holding a regular file is refused: exit 1, the file
@@ -986,6 +1044,8 @@ int main(void)
 	    T(test_sigterm),
 	    cmocka_unit_test(test_bad_plant_file),
 	    cmocka_unit_test(test_usage_errors),
+	    cmocka_unit_test_setup_teardown(test_miswire_deviate_options, setup,
+					    teardown),
 	    cmocka_unit_test(test_link_not_symlink),
 	    cmocka_unit_test(test_port_in_use),
 	};
