@@ -531,7 +531,12 @@ static void assert_cfg_equal(const struct sim_plant_cfg *a,
 		assert_true(x->pot.noise_v == y->pot.noise_v);
 		assert_int_equal(x->pot.noise, y->pot.noise);
 		assert_true(x->pot.open_v == y->pot.open_v);
+		assert_true(x->home == y->home);
+		assert_int_equal(x->encoder_reversed, y->encoder_reversed);
+		assert_int_equal(x->limits_swapped, y->limits_swapped);
 	}
+	assert_int_equal(a->relay_wired, b->relay_wired);
+	assert_int_equal(a->dead_inputs, b->dead_inputs);
 	for (int j = 0; j < 12; j++)
 		assert_int_equal(a->joy_input[j], b->joy_input[j]);
 	assert_int_equal(a->joy_closed_level, b->joy_closed_level);
@@ -564,9 +569,12 @@ static void test_config_file_is_the_default(void **state)
 		a->pot.rev_v = a->pot.fwd_v = a->pot.nonlinear_v = 0.25;
 		a->pot.noise_v = a->pot.open_v = 0.25;
 		a->pot.noise = SIM_PLANT_NOISE_UNIFORM;
+		a->home = 0.5;
+		a->encoder_reversed = a->limits_swapped = 1;
 	}
 	for (int j = 0; j < 12; j++)
 		file.joy_input[j] = 21 + j % 10;
+	file.relay_wired = 0;
 	file.joy_closed_level = 0;
 	file.seed = 99;
 	file.amp_undervoltage = 0;
