@@ -144,12 +144,9 @@ static void test_mo_moving(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	    cmocka_unit_test(test_names),
-	    cmocka_unit_test(test_mg_join),
-	    cmocka_unit_test(test_dm_exists),
-	    cmocka_unit_test(test_qr_header),
-	    cmocka_unit_test(test_ul_trim),
-	    cmocka_unit_test(test_mo_moving),
+	    cmocka_unit_test(test_names),     cmocka_unit_test(test_mg_join),
+	    cmocka_unit_test(test_dm_exists), cmocka_unit_test(test_qr_header),
+	    cmocka_unit_test(test_ul_trim),   cmocka_unit_test(test_mo_moving),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

@@ -191,8 +191,8 @@ static void test_dm_existing_array(void **state)
 		     " 7.0000 5.0000 23995.0000 29.0000\r\n");
 	expect_reply(p, "DA a[];DM a[8];MG a[0],a[-1],_DM",
 		     ":: 0.0000 8.0000 23992.0000\r\n");
-	assert_int_equal(
-	    tp_load(p, "#P\rDA a[]\rDM a[8]\rDM a[9]\rok=1\rEN\r"), GL_OK);
+	assert_int_equal(tp_load(p, "#P\rDA a[]\rDM a[8]\rDM a[9]\rok=1\rEN\r"),
+			 GL_OK);
 	expect_reply(p, "ok=0;XQ #P", ":");
 	tp_step(p, 5);
 	assert_true(tp_has_event(p, "program error thread 0 line 3 TC 57 Bad "

@@ -195,8 +195,9 @@ static void test_id(void **state)
 {
 	struct tplant *p = *state;
 
-	reply(p, "ID", "FW, DMC4030 Rev 1.2h-sim\r\nDMC, 4030, Rev 1\r\n"
-		       "AMP1, 43040, Rev 1\r\n");
+	reply(p, "ID",
+	      "FW, DMC4030 Rev 1.2h-sim\r\nDMC, 4030, Rev 1\r\n"
+	      "AMP1, 43040, Rev 1\r\n");
 	refused(p, "ID 1");
 }
 

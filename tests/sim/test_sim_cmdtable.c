@@ -97,9 +97,9 @@ static void test_table_commands_in_sim(void **state)
 static void test_unimplemented_families(void **state)
 {
 	static const char *const cmds[] = {
-	    "MTA=1", "MTA=-1", "HMA=1", "HM A", "FEA",	   "ALA",    "ITA=1",
+	    "MTA=1", "MTA=-1", "HMA=1", "HM A",	 "FEA",	     "ALA",	"ITA=1",
 	    "KSA=2", "CEA=2",  "TKA=5", "AGA=1", "BMA=4000", "HVA=500", "LCA=1",
-	    "DEA=0", "AFA=1",  "VDS=1", "VAS=9", "FE",	   "HM",
+	    "DEA=0", "AFA=1",  "VDS=1", "VAS=9", "FE",	     "HM",
 	};
 	struct tplant p;
 	char resp[256];

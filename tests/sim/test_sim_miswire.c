@@ -198,10 +198,8 @@ static void test_pot_reversed(void **state)
 
 	miswire(f, "pot-reversed:C");
 	assert_true(c->axis[2].pot.rev_v == 4.5 && c->axis[2].pot.fwd_v == 0.5);
-	assert_float_equal(sim_plant_pot_volts(&c->axis[2], -40000), 4.5,
-			   1e-9);
-	assert_float_equal(sim_plant_pot_volts(&c->axis[2], 40000), 0.5,
-			   1e-9);
+	assert_float_equal(sim_plant_pot_volts(&c->axis[2], -40000), 4.5, 1e-9);
+	assert_float_equal(sim_plant_pot_volts(&c->axis[2], 40000), 0.5, 1e-9);
 	ctl(f, "pot C noise 0");
 	ctl(f, "relay on");
 	sim_advance_ms(f->s, 2);
@@ -330,10 +328,12 @@ static void test_plant_file_keys(void **state)
 static void test_miswire_errors(void **state)
 {
 	static const char *const bad[] = {
-	    "encoder-reversed",	   "encoder-reversed:D", "limits-swapped:AB",
-	    "relay-unwired:A",	   "pot-reversed:",	 "joystick-swap:5",
-	    "joystick-swap:5,5",   "joystick-swap:0,7",	 "joystick-swap:5,33",
-	    "dead-input:6,7",	   "dead-input:x",	 "joystick-polarity:1",
+	    "encoder-reversed",	   "encoder-reversed:D",
+	    "limits-swapped:AB",   "relay-unwired:A",
+	    "pot-reversed:",	   "joystick-swap:5",
+	    "joystick-swap:5,5",   "joystick-swap:0,7",
+	    "joystick-swap:5,33",  "dead-input:6,7",
+	    "dead-input:x",	   "joystick-polarity:1",
 	    "encoders-reversed:A", "",
 	};
 	struct sim_plant_cfg c, def;
@@ -343,12 +343,13 @@ static void test_miswire_errors(void **state)
 	sim_plant_cfg_default(&def);
 	for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
 		c = def;
-		snprintf(want, sizeof(want),
-			 "bad miswiring '%s' (encoder-reversed:AXIS, "
-			 "limits-swapped:AXIS, relay-unwired, pot-reversed:AXIS, "
-			 "joystick-swap:N,M, dead-input:N, joystick-polarity; "
-			 "AXIS A..C, inputs 1..32)",
-			 bad[i]);
+		snprintf(
+		    want, sizeof(want),
+		    "bad miswiring '%s' (encoder-reversed:AXIS, "
+		    "limits-swapped:AXIS, relay-unwired, pot-reversed:AXIS, "
+		    "joystick-swap:N,M, dead-input:N, joystick-polarity; "
+		    "AXIS A..C, inputs 1..32)",
+		    bad[i]);
 		assert_int_equal(sim_plant_cfg_miswire(&c, bad[i], err, 512),
 				 GL_ERR_ARG);
 		assert_string_equal(err, want);

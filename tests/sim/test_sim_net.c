@@ -737,11 +737,13 @@ static void test_usage_errors(void **state)
  * this connection's real peer (reference TH layout). */
 static void test_miswire_deviate_options(void **state)
 {
-	static char *const extra[] = {
-	    (char *)"--miswire", (char *)"relay-unwired",
-	    (char *)"--miswire", (char *)"joystick-swap:1,3",
-	    (char *)"--deviate", (char *)"mg-join",
-	    NULL};
+	static char *const extra[] = {(char *)"--miswire",
+				      (char *)"relay-unwired",
+				      (char *)"--miswire",
+				      (char *)"joystick-swap:1,3",
+				      (char *)"--deviate",
+				      (char *)"mg-join",
+				      NULL};
 	struct fx *f = *state;
 	struct sockaddr_in me;
 	socklen_t len = sizeof(me);

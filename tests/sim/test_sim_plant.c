@@ -1,7 +1,8 @@
 /*
- * test_sim_plant.c - galil-sim's robot model (tools/galil-sim/plant/sim_plant.h):
- * potentiometer curve and noise, faults, motion, limit switches, joystick
- * inputs, and the YAML plant file (config/plant.yaml = built-in defaults).
+ * test_sim_plant.c - galil-sim's robot model
+ * (tools/galil-sim/plant/sim_plant.h): potentiometer curve and noise, faults,
+ * motion, limit switches, joystick inputs, and the YAML plant file
+ * (config/plant.yaml = built-in defaults).
  */
 #include <math.h>
 #include <setjmp.h>

@@ -70,8 +70,10 @@ unsigned sim_deviation_bit(const char *name)
 		const char *name;
 		unsigned bit;
 	} dev[] = {
-	    {"mg-join", CTRL_DEV_MG_JOIN},     {"dm-exists", CTRL_DEV_DM_EXISTS},
-	    {"qr-header", CTRL_DEV_QR_HEADER}, {"ul-trim", CTRL_DEV_UL_TRIM},
+	    {"mg-join", CTRL_DEV_MG_JOIN},
+	    {"dm-exists", CTRL_DEV_DM_EXISTS},
+	    {"qr-header", CTRL_DEV_QR_HEADER},
+	    {"ul-trim", CTRL_DEV_UL_TRIM},
 	    {"mo-moving", CTRL_DEV_MO_MOVING},
 	};
 

@@ -74,7 +74,8 @@ static double *par_slot(struct ctrl *c, int axis, const void *ud)
 	return ctrl_par_ptr(&c->ax[axis].p, ud);
 }
 
-static int cmd_par(struct ctrl_xc *x, const struct ctrl_par_desc *d, const char *a)
+static int cmd_par(struct ctrl_xc *x, const struct ctrl_par_desc *d,
+		   const char *a)
 {
 	struct ctrl_args args;
 	int i, rc;
@@ -100,7 +101,8 @@ static int cmd_par(struct ctrl_xc *x, const struct ctrl_par_desc *d, const char 
 	return axis_values(x, a, d->lo, d->hi, d->step, d->fmt, par_slot, d);
 }
 
-static int cmd_ipar(struct ctrl_xc *x, const struct ctrl_ipar_desc *d, const char *a)
+static int cmd_ipar(struct ctrl_xc *x, const struct ctrl_ipar_desc *d,
+		    const char *a)
 {
 	struct ctrl_args args;
 	double cur[CTRL_AXES];

@@ -155,7 +155,7 @@ static const struct cmd_ent *cmd_find(const char *name)
 const char *ctrl_cmd_name_at(size_t i)
 {
 	return i < sizeof(cmd_table) / sizeof(cmd_table[0]) ? cmd_table[i].name
-							     : NULL;
+							    : NULL;
 }
 
 int ctrl_cmd_assignable(const char *name)
@@ -452,8 +452,7 @@ static int cmd_dm(struct ctrl_xc *x, const char *a)
 		if (n != (int)n)
 			return 6;
 		if ((x->c->cfg.deviate & CTRL_DEV_DM_EXISTS) && n >= 1 &&
-		    n <= CTRL_ARRAY_SPACE &&
-		    ctrl_array_find(&x->c->vars, key))
+		    n <= CTRL_ARRAY_SPACE && ctrl_array_find(&x->c->vars, key))
 			ctrl_array_free(&x->c->vars, key); /* re-dimension */
 		rc = ctrl_array_dim(&x->c->vars, key, (int)n);
 		if (rc)
@@ -748,7 +747,8 @@ static int cmd_cn(struct ctrl_xc *x, const char *a)
 	for (i = 0; i < 5; i++) {
 		if (!(got & (1u << i)))
 			continue;
-		if (i < 3 ? (v[i] != -1 && v[i] != 1) : (v[i] != 0 && v[i] != 1))
+		if (i < 3 ? (v[i] != -1 && v[i] != 1)
+			  : (v[i] != 0 && v[i] != 1))
 			return 6;
 	}
 	for (i = 0; i < 5; i++) {

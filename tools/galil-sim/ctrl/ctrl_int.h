@@ -40,17 +40,17 @@
 #include "dmc_model.h"
 
 /* Limits of a DMC-40x0: from the one model table (pc/dmc/dmc_model.h). */
-#define CTRL_LINE_MAX	 DMC_LINE_MAX	  /* characters per line */
-#define CTRL_PROG_LINES	 DMC_40X0_LINES	  /* program lines */
+#define CTRL_LINE_MAX	 DMC_LINE_MAX	 /* characters per line */
+#define CTRL_PROG_LINES	 DMC_40X0_LINES	 /* program lines */
 #define CTRL_LABELS	 DMC_40X0_LABELS /* labels */
-#define CTRL_VARS	 DMC_40X0_VARS	  /* variables */
+#define CTRL_VARS	 DMC_40X0_VARS	 /* variables */
 #define CTRL_VAR_SLOTS	 1024  /* hash slots, power of two > 2 * CTRL_VARS */
 #define CTRL_ARRAYS	 30    /* arrays */
 #define CTRL_ARRAY_SPACE 24000 /* array elements in total */
 #define CTRL_STACK_DEPTH 16    /* JS nesting (TC 12) */
 #define CTRL_NAME_MAX	 DMC_NAME_MAX  /* variable / array name characters */
 #define CTRL_LABEL_MAX	 DMC_LABEL_MAX /* label characters after '#' */
-#define CTRL_NPARAM	 8     /* ^a .. ^h */
+#define CTRL_NPARAM	 8	       /* ^a .. ^h */
 
 /* Model choices (documented in docs/galil-sim-controller.md). */
 #define CTRL_LINES_PER_SAMPLE 16   /* program lines per servo sample */
@@ -286,7 +286,8 @@ struct ctrl_flash {
 	struct ctrl_prog prog;
 	int have_par;
 	struct ctrl_axis_par ax[CTRL_AXES];
-	int cw_hibit, cw_drop, cn0, cn[4], sample_us, vf_m, vf_n, pf_m, pf_n, lz;
+	int cw_hibit, cw_drop, cn0, cn[4], sample_us, vf_m, vf_n, pf_m, pf_n,
+	    lz;
 	uint32_t outputs;
 	int have_vars;
 	struct ctrl_vars vars;

@@ -411,7 +411,8 @@ void sim_plant_sense(struct sim_plant *p, int power, struct ctrl_sense *out)
 		const struct sim_plant_axis_cfg *ac = &p->cfg.axis[i];
 		struct plant_axis *a = &p->ax[i];
 
-		int fwd = a->pos >= ac->fwd_limit, rev = a->pos <= ac->rev_limit;
+		int fwd = a->pos >= ac->fwd_limit,
+		    rev = a->pos <= ac->rev_limit;
 
 		out->enc[i] = axis_count(p, i);
 		out->fwd_limit[i] = ac->limits_swapped ? rev : fwd;

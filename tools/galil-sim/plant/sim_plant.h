@@ -205,8 +205,9 @@ void sim_plant_sense(struct sim_plant *p, int power, struct ctrl_sense *out);
 
 /*
  * sim_plant_motor_power() - 1 when the motors have power: the relay is on
- * (@relay_on; ignored when relay_wired is 0) and, when power_output is configured, that bit of the
- * controller's digital outputs @outputs (bit n-1 = output n) is set.
+ * (@relay_on; ignored when relay_wired is 0) and, when power_output is
+ * configured, that bit of the controller's digital outputs @outputs (bit n-1 =
+ * output n) is set.
  */
 int sim_plant_motor_power(const struct sim_plant *p, int relay_on,
 			  uint32_t outputs);

@@ -62,8 +62,7 @@ static int per_axis(struct sim_plant_cfg *cfg, const char *what,
 	return 0;
 }
 
-static int inputs(struct sim_plant_cfg *cfg, const char *what,
-		  const char *arg)
+static int inputs(struct sim_plant_cfg *cfg, const char *what, const char *arg)
 {
 	char *end = NULL;
 	int a = input_arg(arg, &end), b;
@@ -76,8 +75,7 @@ static int inputs(struct sim_plant_cfg *cfg, const char *what,
 		cfg->dead_inputs |= 1u << (a - 1);
 		return 0;
 	}
-	if (*end != ',' || (b = input_arg(end + 1, &end)) < 0 || *end ||
-	    a == b)
+	if (*end != ',' || (b = input_arg(end + 1, &end)) < 0 || *end || a == b)
 		return -1;
 	joystick_swap(cfg, a, b);
 	return 0;
@@ -109,12 +107,13 @@ int sim_plant_cfg_miswire(struct sim_plant_cfg *cfg, const char *spec,
 		rc = 0;
 	}
 	if (rc < 0) {
-		snprintf(err, errlen,
-			 "bad miswiring '%s' (encoder-reversed:AXIS, "
-			 "limits-swapped:AXIS, relay-unwired, pot-reversed:AXIS, "
-			 "joystick-swap:N,M, dead-input:N, joystick-polarity; "
-			 "AXIS A..C, inputs 1..%d)",
-			 spec, CTRL_INPUTS);
+		snprintf(
+		    err, errlen,
+		    "bad miswiring '%s' (encoder-reversed:AXIS, "
+		    "limits-swapped:AXIS, relay-unwired, pot-reversed:AXIS, "
+		    "joystick-swap:N,M, dead-input:N, joystick-polarity; "
+		    "AXIS A..C, inputs 1..%d)",
+		    spec, CTRL_INPUTS);
 		return GL_ERR_ARG;
 	}
 	*cfg = c;
