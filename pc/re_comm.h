@@ -18,9 +18,12 @@
  *                asked for in turn (tripped by hand) and seen on its input
  *   6 relay      the relay closes and opens motor power, seen as the
  *                amplifiers' under-voltage on the controller (_TA0 bit 3)
- *   7 motion     per axis a small torque-limited move each way: the
+ *   7 motion     the controller program started and in its service state
+ *                (its watchdog, bounds and fault handling on), per axis a
+ *                small torque-limited move each way asked of it: the
  *                encoder counts with the motor, the potentiometer moves in
- *                the configured direction; MO refused while moving
+ *                the configured direction; then, with the program halted,
+ *                two bounded direct probes (MO refused while moving, PT)
  * Motor power is switched on only in steps 6 and 7, each time after the
  * technician confirmed it, and is off again at the end of the step.
  *
@@ -96,6 +99,7 @@ struct re_comm {
 	int n;
 	const char *failed_step; /* NULL when every step passed */
 	bool power_on_seen;	 /* motor power was switched on */
+	long hbpc;		 /* the heartbeat in the service state */
 	char model[64];		 /* in: ^R^V (re_ctl_identify()) */
 	long serial;		 /* in: MG _BN */
 	char id_text[RE_COMM_IDTEXT]; /* ID */

@@ -179,7 +179,7 @@ static void test_clean_robot(void **state)
 				    "of _TA0 cleared after"));
 	assert_non_null(strstr(rep, "PASS  pt-tracking"));
 	assert_non_null(strstr(rep, "PASS  ul-identical"));
-	assert_non_null(strstr(rep, "encoder: commanded +2000 counts"));
+	assert_non_null(strstr(rep, "encoder: asked the program for +2000 counts"));
 	assert_true(is_png(dir, "pots-at-rest.png"));
 	assert_true(is_png(dir, "move-A.png"));
 	assert_true(is_png(dir, "move-B.png"));
