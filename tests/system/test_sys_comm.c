@@ -16,6 +16,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -69,11 +70,12 @@ static int technician(struct sys_case *c, const char *line)
 	return 0;
 }
 
-/* Play the technician until roboelf exits; its exit code. */
-static int run_comm(struct sys_case *c)
+/* Play the technician until roboelf prints a line starting with @stop
+ * (returns 0) or, with @stop NULL, until it exits (returns its exit code).
+ * *@pos: how far roboelf's output was read. */
+static int drive(struct sys_case *c, const char *stop, size_t *pos)
 {
 	long long end = proc_now_ms() + RUN_TIMEOUT_MS;
-	size_t pos = 0;
 	int status = 0;
 
 	while (proc_now_ms() < end) {
@@ -81,21 +83,31 @@ static int run_comm(struct sys_case *c)
 
 		proc_pump(&c->re, 20);
 		out = proc_output(&c->re, PROC_STDOUT);
-		while ((nl = strchr(out + pos, '\n')) != NULL) {
+		while ((nl = strchr(out + *pos, '\n')) != NULL) {
 			char line[512];
-			size_t n = (size_t)(nl - (out + pos));
+			size_t n = (size_t)(nl - (out + *pos));
 
-			snprintf(line, sizeof(line), "%.*s", (int)n, out + pos);
-			pos += n + 1;
+			snprintf(line, sizeof(line), "%.*s", (int)n, out + *pos);
+			*pos += n + 1;
+			if (stop && !strncmp(line, stop, strlen(stop)))
+				return 0;
 			if (technician(c, line) < 0)
 				fail_msg("technician: %s", c->err);
 		}
-		if (proc_wait_exit(&c->re, 0, &status) == 0)
+		if (!stop && proc_wait_exit(&c->re, 0, &status) == 0)
 			return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 	}
-	fail_msg("roboelf --commission did not end within %d s",
-		 RUN_TIMEOUT_MS / 1000);
+	fail_msg("roboelf --commission: no %s within %d s",
+		 stop ? stop : "exit", RUN_TIMEOUT_MS / 1000);
 	return -1;
+}
+
+/* Play the technician until roboelf exits; its exit code. */
+static int run_comm(struct sys_case *c)
+{
+	size_t pos = 0;
+
+	return drive(c, NULL, &pos);
 }
 
 /* Start galil-sim (with @sim_args), galil-load and roboelf --commission. */
@@ -193,10 +205,60 @@ static void test_clean_robot(void **state)
 	sys_case_stop(&c);
 }
 
+/* SIGKILL while the controller program moves axis B for the
+ * commissioning: its watchdog stops the move and switches every motor off
+ * within its deadline (wdto + one main-loop pass + a sample + slack). */
+static void test_kill_during_move(void **state)
+{
+	static const double at[] = {300, 1100, 1900}; /* counts into the move */
+	double deadline = env.wdto_ms + SYS_MAINMS + 1 + 25;
+
+	(void)state;
+	for (size_t k = 0; k < sizeof(at) / sizeof(at[0]); k++) {
+		struct sys_case c;
+		char dir[256], st[4096];
+		double t_sig, off = -1, b0;
+		long long end;
+		size_t pos = 0;
+
+		start(&c, NULL, dir, sizeof(dir));
+		assert_int_equal(drive(&c, "commission: axis B: a +2000-count "
+					   "move",
+				       &pos),
+				 0);
+		assert_true(sys_state(&c, st, sizeof(st)) >= 0);
+		b0 = sys_state_num(st, "B.pos");
+		end = proc_now_ms() + 5000;
+		while (sys_state(&c, st, sizeof(st)) >= 0 &&
+		       sys_state_num(st, "B.pos") < b0 + at[k] &&
+		       proc_now_ms() < end)
+			;
+		assert_true(sys_state_num(st, "B.pos") >= b0 + at[k]);
+		t_sig = sys_sim_time(&c);
+		assert_int_equal(proc_signal(&c.re, SIGKILL), 0);
+		proc_wait_exit(&c.re, 2000, NULL);
+		end = proc_now_ms() + 2000;
+		while (off < 0 && proc_now_ms() < end) {
+			assert_true(sys_events(&c) >= 0);
+			off = sys_motors_off_time(&c, t_sig);
+		}
+		print_message("[ MEASURE ] kill %.0f counts into B's move: "
+			      "motors off %.0f ms after the kill (deadline "
+			      "%.0f)\n",
+			      at[k], off - t_sig, deadline);
+		assert_true(off >= t_sig);
+		assert_true(off - t_sig <= deadline);
+		if (sys_check_safe(&c, 1, 200) < 0)
+			fail_msg("%s", c.err);
+		sys_case_stop(&c);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_clean_robot),
+	    cmocka_unit_test(test_kill_during_move),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);
