@@ -254,11 +254,95 @@ static void test_kill_during_move(void **state)
 	}
 }
 
+/* One galil-sim option, the line roboelf must end with, its exit code. */
+struct wrong {
+	const char *opt, *arg;
+	int exit;
+	const char *line; /* the console's verdict (prefix) */
+	const char *report; /* a line of the report (substring), or NULL */
+};
+
+static const struct wrong wrongs[] = {
+    {"--miswire", "joystick-swap:5,7", 5,
+     "commission: FAILED at step joystick (B forward): swapped pair: input 5 "
+     "(B forward channel a) did not close and input 7 (B reverse channel a) "
+     "did: the switch of B forward channel a is wired to input 7 - fix: "
+     "exchange the wires on inputs 5 and 7 (or the two numbers in "
+     "joystick.inputs)",
+     NULL},
+    {"--miswire", "dead-input:6", 5,
+     "commission: FAILED at step joystick (B forward): dead switch: input 6 "
+     "(B forward channel b) did not close; the other channel did - fix: ",
+     NULL},
+    {"--miswire", "joystick-polarity", 5,
+     "commission: FAILED at step joystick (polarity): with nothing pressed "
+     "all 12 joystick inputs read 0, which the configuration (active_low: "
+     "false) takes for closed: the polarity is the wrong way round - fix: "
+     "set joystick.active_low: true",
+     NULL},
+    {"--miswire", "limits-swapped:B", 5,
+     "commission: FAILED at step limits (B fwd): swapped: the forward limit "
+     "switch of axis B was held and the controller saw the reverse limit "
+     "switch of axis B - fix: exchange the forward and reverse limit switch "
+     "wires of that axis",
+     NULL},
+    {"--miswire", "relay-unwired", 5,
+     "commission: FAILED at step relay (open): with the relay OFF the "
+     "amplifiers report power (MG _TA0 = 0, bit 3 'under-voltage' clear; "
+     "reference: TA): the relay does not switch the motors' power",
+     NULL},
+    {"--miswire", "encoder-reversed:A", 5,
+     "commission: FAILED at step motion (A): encoder reversed: asked for "
+     "+2000 counts, the encoder counted -",
+     NULL},
+    {"--miswire", "pot-reversed:C", 5,
+     "commission: FAILED at step motion (C): potentiometer reversed: -0.",
+     NULL},
+    {"--deviate", "mg-join", 0, "commission: PASSED: every step passed",
+     "NOTE  mg-separate      sent 'MG -1,-2'; reference (MG): each number "
+     "keeps its sign position (' -1.0000 -2.0000'); seen '-1.0000-2.0000' "
+     "(roboelf and galil-load read one value per MG: safe)"},
+    {"--deviate", "qr-header", 5,
+     "commission: FAILED at step firmware (qr-record): QR; reference (QR, "
+     "QZ): a record of the announced length whose header names axes A-C; "
+     "the record did not decode",
+     NULL},
+};
+
+/* Each miswiring and deviation galil-sim models, found at its step. */
+static void test_wrong_robot(void **state)
+{
+	(void)state;
+	for (size_t k = 0; k < sizeof(wrongs) / sizeof(wrongs[0]); k++) {
+		const struct wrong *w = &wrongs[k];
+		char *args[] = {(char *)w->opt, (char *)w->arg, NULL};
+		char dir[256], path[320], line[1024];
+		const char *rep;
+		struct sys_case c;
+
+		print_message("[ CASE     ] %s %s\n", w->opt, w->arg);
+		start(&c, args, dir, sizeof(dir));
+		assert_int_equal(run_comm(&c), w->exit);
+		if (proc_find_line(&c.re, PROC_STDOUT, w->line, line,
+				   sizeof(line)) != 0)
+			fail_msg("%s %s: no line '%s' in:\n%s", w->opt, w->arg,
+				 w->line, proc_output(&c.re, PROC_STDOUT));
+		snprintf(path, sizeof(path), "%s/commissioning.txt", dir);
+		rep = slurp(path);
+		assert_non_null(rep);
+		if (w->report && !strstr(rep, w->report))
+			fail_msg("%s %s: the report lacks '%s':\n%s", w->opt,
+				 w->arg, w->report, rep);
+		sys_case_stop(&c);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_clean_robot),
 	    cmocka_unit_test(test_kill_during_move),
+	    cmocka_unit_test(test_wrong_robot),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);
