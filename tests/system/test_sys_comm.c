@@ -276,7 +276,7 @@ static const struct wrong wrongs[] = {
      NULL},
     {"--miswire", "joystick-polarity", 5,
      "commission: FAILED at step joystick (polarity): with nothing pressed "
-     "all 12 joystick inputs read 0, which the configuration (active_low: "
+     "all 12 joystick inputs read 1, which the configuration (active_low: "
      "false) takes for closed: the polarity is the wrong way round - fix: "
      "set joystick.active_low: true",
      NULL},
