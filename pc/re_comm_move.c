@@ -21,18 +21,19 @@
 
 #include "gl_err.h"
 #include "re_comm.h"
-#include "re_comm_int.h"
+#include "re_comm_steps.h"
+#include "re_comm_util.h"
 #include "re_ctl.h"
 #include "re_dmcif.h"
 #include "re_fault.h"
 #include "re_plan.h"
 
-#define TA_UNDERVOLT  8	    /* _TA0 bit 3: under-voltage, axes A-D */
-#define RC_AMP_MS     1000  /* the amplifiers see power change within */
-#define RC_MOVE_CPS   2000  /* speed of a small move, counts/s */
-#define RC_MOVE_TL_V  2.0   /* torque limit during the moves, V */
-#define RC_MOVE_MS    4000  /* deadline of one small move */
-#define RC_SAMPLE_MS  10
+#define TA_UNDERVOLT 8	  /* _TA0 bit 3: under-voltage, axes A-D */
+#define RC_AMP_MS    1000 /* the amplifiers see power change within */
+#define RC_MOVE_CPS  2000 /* speed of a small move, counts/s */
+#define RC_MOVE_TL_V 2.0  /* torque limit during the moves, V */
+#define RC_MOVE_MS   4000 /* deadline of one small move */
+#define RC_SAMPLE_MS 10
 
 /* Wait until _TA0 bit 3 is @want (1 set, 0 clear): the time it took,
  * ms, or -1 after RC_AMP_MS. */
@@ -326,10 +327,11 @@ static void move_judge(struct re_comm *c, int ax, int counts,
 			    counts, moved);
 		return;
 	}
-	re_comm_add(c, "motion", a->name, RE_COMM_PASS, NULL,
-		    "encoder: asked the program for %+d counts at %d counts/s, TL at "
-		    "most %.1f V: counted %+.0f with the motor",
-		    counts, RC_MOVE_CPS, RC_MOVE_TL_V, moved);
+	re_comm_add(
+	    c, "motion", a->name, RE_COMM_PASS, NULL,
+	    "encoder: asked the program for %+d counts at %d counts/s, TL at "
+	    "most %.1f V: counted %+.0f with the motor",
+	    counts, RC_MOVE_CPS, RC_MOVE_TL_V, moved);
 	snprintf(fix, sizeof(fix),
 		 "exchange the potentiometer's two outer wires (supply and "
 		 "ground) on analog input %d, or mount it the other way",

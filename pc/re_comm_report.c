@@ -45,7 +45,8 @@ void re_comm_summary(const struct re_comm *c, char *buf, size_t cap)
 		const struct re_comm_item *it = &c->item[i];
 
 		if (it->res == RE_COMM_FAIL) {
-			snprintf(buf, cap, "FAILED at step %s (%s): %s - fix: %s",
+			snprintf(buf, cap,
+				 "FAILED at step %s (%s): %s - fix: %s",
 				 it->step, it->name, it->text, it->fix);
 			return;
 		}
@@ -98,7 +99,8 @@ static int plot_noise(const struct re_comm *c, const char *dir)
 	}
 	snprintf(script, sizeof(script),
 		 "set title 'potentiometers at rest, motor power off: "
-		 "reading minus its mean'\nset xlabel 'sample (10 ms apart plus the reply time)'\n"
+		 "reading minus its mean'\nset xlabel 'sample (10 ms apart "
+		 "plus the reply time)'\n"
 		 "set ylabel 'mV'\nplot '-' w lp t '%s', '-' w lp t '%s', "
 		 "'-' w lp t '%s'\n",
 		 c->cfg->axes[0].name, c->cfg->axes[1].name,
@@ -110,7 +112,8 @@ static int plot_noise(const struct re_comm *c, const char *dir)
 static void put_trace(struct buf *d, const struct re_comm_trace *t, int pot)
 {
 	for (int i = 0; i < t->n; i++)
-		put(d, "%.1f %.4f\n", t->t_ms[i], pot ? t->pot_v[i] : t->enc[i]);
+		put(d, "%.1f %.4f\n", t->t_ms[i],
+		    pot ? t->pot_v[i] : t->enc[i]);
 	put(d, "e\n");
 }
 
@@ -130,11 +133,13 @@ static int plot_move(const struct re_comm *c, int ax, const char *dir)
 	    "plot '-' w l t 'encoder'\n",
 	    c->cfg->axes[ax].name);
 	put_trace(&d, t, 0);
-	put(&d, "set ylabel 'potentiometer, V'\nplot '-' w l t 'analog input "
-		"%d'\n",
+	put(&d,
+	    "set ylabel 'potentiometer, V'\nplot '-' w l t 'analog input "
+	    "%d'\n",
 	    c->cfg->axes[ax].analog.input);
 	put_trace(&d, t, 1);
-	snprintf(png, sizeof(png), "%s/move-%s.png", dir, c->cfg->axes[ax].name);
+	snprintf(png, sizeof(png), "%s/move-%s.png", dir,
+		 c->cfg->axes[ax].name);
 	return gnuplot_png(png, "", data) == 0 ? 1 : -1;
 }
 

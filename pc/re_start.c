@@ -43,12 +43,12 @@ static int fail(struct app *a, const char *what)
 	int64_t ms = stalled_ms(a);
 
 	if (ms)
-		re_console_msg(&a->con,
-			       "roboelf: error: roboelf did not run for %lld ms "
-			       "(limit %lld ms: stopped, e.g. SIGSTOP or a "
-			       "debugger); then: %s",
-			       (long long)ms, (long long)re_start_stall_limit_ms(a),
-			       what);
+		re_console_msg(
+		    &a->con,
+		    "roboelf: error: roboelf did not run for %lld ms "
+		    "(limit %lld ms: stopped, e.g. SIGSTOP or a "
+		    "debugger); then: %s",
+		    (long long)ms, (long long)re_start_stall_limit_ms(a), what);
 	else
 		re_console_msg(&a->con, "roboelf: error: %s", what);
 	re_log_msg(&a->log, RE_LOG_WARN, "start-up refused: %s%s", what,
@@ -66,8 +66,7 @@ static int take_locks(struct app *a)
 
 	if (re_lock_controller_key(a->cfg.controller.address, key,
 				   sizeof(key)) != GL_OK) {
-		snprintf(a->err, sizeof(a->err),
-			 "bad controller address '%s'",
+		snprintf(a->err, sizeof(a->err), "bad controller address '%s'",
 			 a->cfg.controller.address);
 		return fail(a, a->err);
 	}
@@ -142,8 +141,10 @@ static int amp_check(struct app *a, int want_on, int timeout_ms)
 		return 0;
 	if (a->cfg.mode == RE_MODE_CLINICAL)
 		return fail(a, a->err);
-	re_console_msg(&a->con, "roboelf: warning: %s (development mode: "
-				"continuing)", a->err);
+	re_console_msg(&a->con,
+		       "roboelf: warning: %s (development mode: "
+		       "continuing)",
+		       a->err);
 	re_log_msg(&a->log, RE_LOG_WARN, "%s (development mode)", a->err);
 	return 0;
 }
@@ -155,8 +156,7 @@ static int prepare_controller(struct app *a)
 	re_plan_make(&a->cfg, 0, &a->plan);
 	progress(a, "halting the controller program; every motor off");
 	if (re_ctl_halt(&a->io, a->err, sizeof(a->err)) ||
-	    re_ctl_configure(&a->io, &a->cfg, &a->plan, a->err,
-			     sizeof(a->err)))
+	    re_ctl_configure(&a->io, &a->cfg, &a->plan, a->err, sizeof(a->err)))
 		return fail(a, a->err);
 	progress(a, "controller configured and read back");
 	if (amp_check(a, 0, 200))
@@ -474,12 +474,14 @@ static int choose_calibration(struct app *a)
 			    "its reverse and forward limit switches, then to "
 			    "the centre of its travel");
 	else
-		progress(a, "calibration from the file: every axis will move "
-			    "to the centre of its calibrated travel (A %.0f, "
-			    "B %.0f, C %.0f counts)",
-			 (a->cal->axis[0].soft_rev + a->cal->axis[0].soft_fwd) / 2,
-			 (a->cal->axis[1].soft_rev + a->cal->axis[1].soft_fwd) / 2,
-			 (a->cal->axis[2].soft_rev + a->cal->axis[2].soft_fwd) / 2);
+		progress(
+		    a,
+		    "calibration from the file: every axis will move "
+		    "to the centre of its calibrated travel (A %.0f, "
+		    "B %.0f, C %.0f counts)",
+		    (a->cal->axis[0].soft_rev + a->cal->axis[0].soft_fwd) / 2,
+		    (a->cal->axis[1].soft_rev + a->cal->axis[1].soft_fwd) / 2,
+		    (a->cal->axis[2].soft_rev + a->cal->axis[2].soft_fwd) / 2);
 	return 0;
 }
 
@@ -580,16 +582,16 @@ typedef int (*startup_step)(struct app *a);
 int re_start(struct app *a)
 {
 	static const startup_step steps[] = {
-	    start_relay,   start_link, choose_calibration, prepare_controller,
-	    init_super,	   power_on,   enter_service,	   calibrate,
-	    arm,
+	    start_relay,	start_link, choose_calibration,
+	    prepare_controller, init_super, power_on,
+	    enter_service,	calibrate,  arm,
 	};
 	int rc = take_locks(a);
 
 	re_sig.cont_real = &a->real;
 	/* a stop while the operator chooses is no stall: nothing is on */
-	for (size_t i = 0; !rc && !re_sig.quit && i < sizeof(steps) /
-		 sizeof(steps[0]); i++) {
+	for (size_t i = 0;
+	     !rc && !re_sig.quit && i < sizeof(steps) / sizeof(steps[0]); i++) {
 		rc = steps[i](a);
 		if (steps[i] == choose_calibration)
 			re_sig.continued = 0;
@@ -626,13 +628,11 @@ static int commission_link(struct app *a)
 			      a->err, sizeof(a->err)))
 		return fail(a, a->err);
 	a->ctl_ours = 1;
-	progress(a, "controller %s, serial %ld", a->info.model,
-		 a->info.serial);
+	progress(a, "controller %s, serial %ld", a->info.model, a->info.serial);
 	re_plan_make(&a->cfg, 0, &a->plan);
 	progress(a, "halting the controller program; every motor off");
 	if (re_ctl_halt(&a->io, a->err, sizeof(a->err)) ||
-	    re_ctl_configure(&a->io, &a->cfg, &a->plan, a->err,
-			     sizeof(a->err)))
+	    re_ctl_configure(&a->io, &a->cfg, &a->plan, a->err, sizeof(a->err)))
 		return fail(a, a->err);
 	progress(a, "controller configured and read back; motor power off");
 	return 0;

@@ -28,11 +28,11 @@
 #include "re_super.h"
 
 /* roboelf's exit codes (roboelf.1). */
-#define EXIT_USAGE     2
-#define EXIT_CONNECT   3
-#define EXIT_FAULT     4
+#define EXIT_USAGE	2
+#define EXIT_CONNECT	3
+#define EXIT_FAULT	4
 #define EXIT_COMMISSION 5 /* the commissioning run found a fault */
-#define DEFAULT_CONFIG "config/roboelf.yaml"
+#define DEFAULT_CONFIG	"config/roboelf.yaml"
 
 struct opts {
 	const char *config;
@@ -41,7 +41,7 @@ struct opts {
 	const char *log;
 	const char *show_cal;
 	const char *commission; /* report directory */
-	int wait_s;		/* commissioning: each wait for the technician */
+	int wait_s;    /* commissioning: each wait for the technician */
 	int period_ms; /* 0: from the configuration */
 	enum re_calib_choice calib;
 };

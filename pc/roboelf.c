@@ -334,8 +334,9 @@ static void retry_log(struct app *a, int64_t *next_ns)
 		return;
 	*next_ns = now + 1000000000LL;
 	if (re_super_retry(a->sup) == GL_OK)
-		re_console_msg(&a->con, "roboelf: the log '%s' is written "
-					"again",
+		re_console_msg(&a->con,
+			       "roboelf: the log '%s' is written "
+			       "again",
 			       a->cfg.log.path);
 	else
 		re_console_msg(&a->con,
@@ -374,10 +375,10 @@ static void run(struct app *a)
 	    "late p50=%.3f p99=%.3f max=%.3f ms; reply age worst=%.1f ms; "
 	    "status frames dropped=%llu",
 	    (unsigned long long)a->sup->cycles,
-	    (unsigned long long)a->sup->overruns,
-	    ms_of_ns(a->sup->period_ns), re_super_late_ms(a->sup, 50),
-	    re_super_late_ms(a->sup, 99), re_super_late_ms(a->sup, 100),
-	    ms_of_ns(a->sup->age_worst_ns), (unsigned long long)a->con.dropped);
+	    (unsigned long long)a->sup->overruns, ms_of_ns(a->sup->period_ns),
+	    re_super_late_ms(a->sup, 50), re_super_late_ms(a->sup, 99),
+	    re_super_late_ms(a->sup, 100), ms_of_ns(a->sup->age_worst_ns),
+	    (unsigned long long)a->con.dropped);
 }
 
 /* Power-off, the reverse of power-on: the program back to its safe
@@ -399,8 +400,9 @@ static void power_off(struct app *a, int latched)
 	gl_link_close(a->real.link);
 	a->real.link = NULL;
 	if (!a->powered) {
-		re_console_msg(&a->con, "roboelf: motor power was never "
-					"switched on; %s",
+		re_console_msg(&a->con,
+			       "roboelf: motor power was never "
+			       "switched on; %s",
 			       latched ? "a fault was latched" : "bye");
 		re_log_msg(&a->log, RE_LOG_INFO, "stop: motor power never on");
 		return;
@@ -538,8 +540,8 @@ static int comm_steps(struct app *a)
 	re_console_msg(&a->con, "commission: %s", line);
 	re_log_msg(&a->log, rc ? RE_LOG_WARN : RE_LOG_INFO, "commission: %s",
 		   line);
-	if (re_comm_report(&c, &w, a->o.commission, &plots, err,
-			   sizeof(err)) != GL_OK) {
+	if (re_comm_report(&c, &w, a->o.commission, &plots, err, sizeof(err)) !=
+	    GL_OK) {
 		re_console_msg(&a->con, "roboelf: error: %s", err);
 		return EXIT_CONNECT;
 	}

@@ -87,7 +87,8 @@ static int drive(struct sys_case *c, const char *stop, size_t *pos)
 			char line[512];
 			size_t n = (size_t)(nl - (out + *pos));
 
-			snprintf(line, sizeof(line), "%.*s", (int)n, out + *pos);
+			snprintf(line, sizeof(line), "%.*s", (int)n,
+				 out + *pos);
 			*pos += n + 1;
 			if (stop && !strncmp(line, stop, strlen(stop)))
 				return 0;
@@ -191,7 +192,8 @@ static void test_clean_robot(void **state)
 				    "of _TA0 cleared after"));
 	assert_non_null(strstr(rep, "PASS  pt-tracking"));
 	assert_non_null(strstr(rep, "PASS  ul-identical"));
-	assert_non_null(strstr(rep, "encoder: asked the program for +2000 counts"));
+	assert_non_null(
+	    strstr(rep, "encoder: asked the program for +2000 counts"));
 	assert_true(is_png(dir, "pots-at-rest.png"));
 	assert_true(is_png(dir, "move-A.png"));
 	assert_true(is_png(dir, "move-B.png"));
@@ -222,8 +224,9 @@ static void test_kill_during_move(void **state)
 		size_t pos = 0;
 
 		start(&c, NULL, dir, sizeof(dir));
-		assert_int_equal(drive(&c, "commission: axis B: a +2000-count "
-					   "move",
+		assert_int_equal(drive(&c,
+				       "commission: axis B: a +2000-count "
+				       "move",
 				       &pos),
 				 0);
 		assert_true(sys_state(&c, st, sizeof(st)) >= 0);
@@ -258,7 +261,7 @@ static void test_kill_during_move(void **state)
 struct wrong {
 	const char *opt, *arg;
 	int exit;
-	const char *line; /* the console's verdict (prefix) */
+	const char *line;   /* the console's verdict (prefix) */
 	const char *report; /* a line of the report (substring), or NULL */
 };
 

@@ -496,8 +496,7 @@ int sim_plant_set_block(struct sim_plant *p, int axis, int blocked)
 	return 0;
 }
 
-int sim_plant_hold_limit(struct sim_plant *p, int axis, int reverse,
-			 int held)
+int sim_plant_hold_limit(struct sim_plant *p, int axis, int reverse, int held)
 {
 	if (axis < 0 || axis >= SIM_PLANT_AXES)
 		return GL_ERR_ARG;

@@ -225,8 +225,7 @@ int sim_plant_set_block(struct sim_plant *p, int axis, int blocked);
  * run asks for each switch in turn).
  * Return: 0, or GL_ERR_ARG for an axis out of range.
  */
-int sim_plant_hold_limit(struct sim_plant *p, int axis, int reverse,
-			 int held);
+int sim_plant_hold_limit(struct sim_plant *p, int axis, int reverse, int held);
 
 /*
  * sim_plant_set_joy() - set the switches of @axis (0..2): @dir with channel
