@@ -121,15 +121,65 @@ static int set_start_label(struct opts *o, const char *arg)
 	return 0;
 }
 
+/* @c with control bytes shown in caret notation (0x12 -> "^R"). */
+static const char *shown(const char *c, char out[2 * GL_LINE_MAX + 8])
+{
+	size_t o = 0;
+
+	for (; *c && o < 2 * GL_LINE_MAX + 4; c++) {
+		unsigned char b = (unsigned char)*c;
+
+		if (b < 0x20 || b == 0x7f) {
+			out[o++] = '^';
+			out[o++] = (char)(b ^ 0x40);
+		} else {
+			out[o++] = (char)b;
+		}
+	}
+	out[o] = '\0';
+	return out;
+}
+
+/* A control-character request: ^R^V, or ^L^K ? (the lock state); the
+ * others change the controller (command reference ^R^S, ^L^K). */
+static int check_ctrl_request(const char *cmd, enum gl_ctrl_kind k)
+{
+	char sh[2 * GL_LINE_MAX + 8];
+	const char *a = cmd + 2;
+
+	while (*a == ' ')
+		a++;
+	if (k == GL_CTRL_REVISION || (k == GL_CTRL_LOCK && !strcmp(a, "?")))
+		return 0;
+	if (k == GL_CTRL_RESET)
+		return usage_error("'^R^S' (master reset: erases the "
+				   "controller's EEPROM and its IP address) "
+				   "is not sent by galil-load");
+	if (k == GL_CTRL_LOCK)
+		return usage_error("'%s': only '^L^K ?' (is the program "
+				   "locked?) may be sent with -c",
+				   shown(cmd, sh));
+	return usage_error("'%s' holds a control character: only the "
+			   "requests ^R^V and '^L^K ?' may be sent with -c",
+			   shown(cmd, sh));
+}
+
 static int add_command(struct opts *o, const char *cmd)
 {
 	static const char *const refused[] = {"DL", "UL", "ED",
 					      "QD", "QU", "QR"};
+	enum gl_ctrl_kind k = gl_link_ctrl_kind(cmd);
 	size_t i;
 
 	if (o->ncmds == MAX_COMMANDS)
 		return usage_error("too many -c commands (at most %d)",
 				   MAX_COMMANDS);
+	if (k != GL_CTRL_NONE && check_ctrl_request(cmd, k))
+		return GLOAD_EXIT_USAGE;
+	if (k != GL_CTRL_NONE) {
+		o->cmds[o->ncmds++] = cmd;
+		return 0;
+	}
 	if (strlen(cmd) == 0 || strlen(cmd) > GL_LINE_MAX)
 		return usage_error("command '%s' is empty or longer than 80 "
 				   "characters",
@@ -528,8 +578,9 @@ static int identify_and_halt(gl_link *l, const struct opts *o)
 		return rc;
 	rc = halt(l, o, &running, failed);
 	if (rc == GL_ERR_MISMATCH && running < 0) {
-		fprintf(stderr, "galil-load: a motor is still on after 'MO' "
-				"('%s')\n",
+		fprintf(stderr,
+			"galil-load: a motor is still on after 'MO' "
+			"('%s')\n",
 			failed);
 		return GLOAD_EXIT_CTRL;
 	}
@@ -619,7 +670,7 @@ static void print_reply(const char *s)
 static int run_commands(gl_link *l, const struct opts *o)
 {
 	static char resp[64 * 1024];
-	char what[GL_LINE_MAX + 8];
+	char what[2 * GL_LINE_MAX + 16], sh[2 * GL_LINE_MAX + 8];
 	int i, rc, tmo;
 
 	for (i = 0; i < o->ncmds; i++) {
@@ -631,8 +682,12 @@ static int run_commands(gl_link *l, const struct opts *o)
 			  : o->timeout_ms;
 		if (tmo < o->timeout_ms)
 			tmo = o->timeout_ms;
-		rc = gl_link_command(l, c, resp, sizeof(resp), tmo);
-		snprintf(what, sizeof(what), "'%s'", c);
+		if (gl_link_ctrl_kind(c) > GL_CTRL_NONE)
+			rc =
+			    gl_link_ctrl_request(l, c, resp, sizeof(resp), tmo);
+		else
+			rc = gl_link_command(l, c, resp, sizeof(resp), tmo);
+		snprintf(what, sizeof(what), "'%s'", shown(c, sh));
 		if (rc < 0)
 			return link_failed(l, what, rc, tmo);
 		print_reply(resp);
