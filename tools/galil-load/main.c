@@ -24,7 +24,7 @@
 #include "gload_prep.h"
 
 #define DEFAULT_TIMEOUT_MS 5000 /* gclib's default [galil-notes 1.6] */
-#define STOP_MS		   3000 /* every axis stopped after ST within */
+#define STOP_MS		   3000 /* default --stop-wait: axes stopped after ST */
 #define BUSY_WATCH_MS	   250	/* a supervisor's heartbeat changes within */
 #define MAX_COMMANDS	   64
 
@@ -36,6 +36,7 @@ struct opts {
 	int start;
 	int force;
 	int timeout_ms;
+	int stop_ms;
 	char start_label[DMC_LABEL_MAX + 1];
 	const char *output;
 	const char *cmds[MAX_COMMANDS];
@@ -64,6 +65,10 @@ static const char usage_text[] =
     "                             after any download)\n"
     "  -t, --timeout MS           reply timeout (default 5000; DL, UL and BP\n"
     "                             take at least 10000)\n"
+    "      --stop-wait MS         how long the axes may take to stop after ST\n"
+    "                             before loading (default 3000); an axis\n"
+    "                             still moving then is aborted and nothing\n"
+    "                             is loaded\n"
     "  -h, --help                 this text\n"
     "\n"
     "A DIR is loaded through DIR/MANIFEST (one file name per line, '#'\n"
@@ -195,7 +200,7 @@ static int add_command(struct opts *o, const char *cmd)
 	return 0;
 }
 
-enum { OPT_CHECK = 256, OPT_BURN, OPT_START, OPT_NO_START };
+enum { OPT_CHECK = 256, OPT_BURN, OPT_START, OPT_NO_START, OPT_STOP_WAIT };
 
 static const struct option long_opts[] = {
     {"address", required_argument, NULL, 'a'},
@@ -208,6 +213,7 @@ static const struct option long_opts[] = {
     {"no-start", no_argument, NULL, OPT_NO_START},
     {"command", required_argument, NULL, 'c'},
     {"timeout", required_argument, NULL, 't'},
+    {"stop-wait", required_argument, NULL, OPT_STOP_WAIT},
     {"help", no_argument, NULL, 'h'},
     {NULL, 0, NULL, 0},
 };
@@ -233,6 +239,12 @@ static int parse_opt(struct opts *o, int ch, const char *arg)
 	case 't':
 		return parse_int(arg, 1, 600000, &o->timeout_ms)
 			   ? usage_error("invalid timeout '%s' (1..600000 "
+					 "ms)",
+					 arg)
+			   : 0;
+	case OPT_STOP_WAIT:
+		return parse_int(arg, 1, 60000, &o->stop_ms)
+			   ? usage_error("invalid --stop-wait '%s' (1..60000 "
 					 "ms)",
 					 arg)
 			   : 0;
@@ -274,6 +286,7 @@ static int parse_args(int argc, char **argv, struct opts *o)
 	memset(o, 0, sizeof(*o));
 	o->model = dmc_model_default();
 	o->timeout_ms = DEFAULT_TIMEOUT_MS;
+	o->stop_ms = STOP_MS;
 	opterr = 0;
 	while ((ch = getopt_long(argc, argv, ":a:m:o:fc:t:h", long_opts,
 				 NULL)) != -1) {
@@ -428,7 +441,7 @@ static int halt(gl_link *l, const struct opts *o, int *running,
 
 	if (axes < 0)
 		axes = 8; /* no QZ answer: every axis letter the family has */
-	return gload_dl_halt(l, o->model->threads, axes, STOP_MS, running,
+	return gload_dl_halt(l, o->model->threads, axes, o->stop_ms, running,
 			     failed, o->timeout_ms);
 }
 
@@ -577,6 +590,21 @@ static int identify_and_halt(gl_link *l, const struct opts *o)
 	if (rc)
 		return rc;
 	rc = halt(l, o, &running, failed);
+	if (rc == GL_ERR_MISMATCH && running == GLOAD_HALT_LATE) {
+		fprintf(stderr,
+			"galil-load: axis %c still moving %d ms after 'ST': "
+			"aborted it (AB 1) and switched the motors off; "
+			"nothing downloaded (see --stop-wait)\n",
+			failed[6], o->stop_ms);
+		return GLOAD_EXIT_CTRL;
+	}
+	if (rc == GL_ERR_TIMEOUT && !strncmp(failed, "MG _BG", 6)) {
+		fprintf(stderr,
+			"galil-load: axis %c still moving after 'ST' and "
+			"'AB 1'; motors left on; nothing downloaded\n",
+			failed[6]);
+		return GLOAD_EXIT_CTRL;
+	}
 	if (rc == GL_ERR_MISMATCH && running < 0) {
 		fprintf(stderr,
 			"galil-load: a motor is still on after 'MO' "
