@@ -17,6 +17,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "gl_disc.h"
 #include "gl_err.h"
 #include "gl_link.h"
 #include "gload_check.h"
@@ -27,6 +28,8 @@
 #define STOP_MS		   3000 /* default --stop-wait: axes stopped after ST */
 #define BUSY_WATCH_MS	   250	/* a supervisor's heartbeat changes within */
 #define MAX_COMMANDS	   64
+#define FIND_MS		   1000 /* discovery window (GAddresses: about 1 s) */
+#define FIND_MAX	   32
 
 struct opts {
 	const char *addr;
@@ -37,6 +40,10 @@ struct opts {
 	int force;
 	int timeout_ms;
 	int stop_ms;
+	int timeout_set;
+	int find;
+	const char *find_addr;
+	int find_port;
 	char start_label[DMC_LABEL_MAX + 1];
 	const char *output;
 	const char *cmds[MAX_COMMANDS];
@@ -69,6 +76,13 @@ static const char usage_text[] =
     "                             before loading (default 3000); an axis\n"
     "                             still moving then is aborted and nothing\n"
     "                             is loaded\n"
+    "      --find                 list the Galil controllers that answer on\n"
+    "                             the local network (-t MS: how long to\n"
+    "                             listen, default 1000); also offered when\n"
+    "                             -a does not answer\n"
+    "      --find-addr ADDR       where the discovery probe goes (default\n"
+    "                             255.255.255.255)\n"
+    "      --find-port PORT       its UDP port (default 50000)\n"
     "  -h, --help                 this text\n"
     "\n"
     "A DIR is loaded through DIR/MANIFEST (one file name per line, '#'\n"
@@ -200,7 +214,16 @@ static int add_command(struct opts *o, const char *cmd)
 	return 0;
 }
 
-enum { OPT_CHECK = 256, OPT_BURN, OPT_START, OPT_NO_START, OPT_STOP_WAIT };
+enum {
+	OPT_CHECK = 256,
+	OPT_BURN,
+	OPT_START,
+	OPT_NO_START,
+	OPT_STOP_WAIT,
+	OPT_FIND,
+	OPT_FIND_ADDR,
+	OPT_FIND_PORT
+};
 
 static const struct option long_opts[] = {
     {"address", required_argument, NULL, 'a'},
@@ -214,6 +237,9 @@ static const struct option long_opts[] = {
     {"command", required_argument, NULL, 'c'},
     {"timeout", required_argument, NULL, 't'},
     {"stop-wait", required_argument, NULL, OPT_STOP_WAIT},
+    {"find", no_argument, NULL, OPT_FIND},
+    {"find-addr", required_argument, NULL, OPT_FIND_ADDR},
+    {"find-port", required_argument, NULL, OPT_FIND_PORT},
     {"help", no_argument, NULL, 'h'},
     {NULL, 0, NULL, 0},
 };
@@ -237,10 +263,17 @@ static int parse_opt(struct opts *o, int ch, const char *arg)
 					      "41x3, 21x3, 30010)",
 					      arg);
 	case 't':
+		o->timeout_set = 1;
 		return parse_int(arg, 1, 600000, &o->timeout_ms)
 			   ? usage_error("invalid timeout '%s' (1..600000 "
 					 "ms)",
 					 arg)
+			   : 0;
+	case OPT_FIND: o->find = 1; return 0;
+	case OPT_FIND_ADDR: o->find_addr = arg; return 0;
+	case OPT_FIND_PORT:
+		return parse_int(arg, 1, 65535, &o->find_port)
+			   ? usage_error("invalid --find-port '%s'", arg)
 			   : 0;
 	case OPT_STOP_WAIT:
 		return parse_int(arg, 1, 60000, &o->stop_ms)
@@ -270,6 +303,11 @@ static int check_combination(const struct opts *o)
 				   "--burn, --start and -o need program "
 				   "files (only a checked program is burned or "
 				   "started)");
+	if (o->find && (o->npaths || o->ncmds || o->addr || o->check_only))
+		return usage_error("%s", "--find only lists controllers; give "
+					 "it no -a, -c, --check or files");
+	if (o->find)
+		return 0;
 	if (o->npaths == 0 && o->ncmds == 0)
 		return usage_error("%s", "no program files and no commands");
 	if (!o->check_only && !o->addr)
@@ -287,6 +325,8 @@ static int parse_args(int argc, char **argv, struct opts *o)
 	o->model = dmc_model_default();
 	o->timeout_ms = DEFAULT_TIMEOUT_MS;
 	o->stop_ms = STOP_MS;
+	o->find_addr = GL_DISC_BCAST;
+	o->find_port = GL_DISC_PORT;
 	opterr = 0;
 	while ((ch = getopt_long(argc, argv, ":a:m:o:fc:t:h", long_opts,
 				 NULL)) != -1) {
@@ -431,6 +471,56 @@ static int open_link(const struct opts *o, gl_link **l)
 		return GLOAD_EXIT_CONN;
 	}
 	return 0;
+}
+
+/* Probe the network; print what answered to @f. Return the number found
+ * (>= 0) or -1 (the message is printed). */
+static int find(const struct opts *o, struct gl_disc_ctrl *list, FILE *f)
+{
+	char err[GL_ERRTEXT_LEN] = "";
+	int i, ms = o->find && o->timeout_set ? o->timeout_ms : FIND_MS;
+	int n = gl_disc_probe(o->find_addr, (unsigned)o->find_port, ms, list,
+			      FIND_MAX, err);
+
+	if (n < 0) {
+		fprintf(stderr, "galil-load: %s\n",
+			err[0] ? err : gl_strerror(n));
+		return -1;
+	}
+	if (n == 0)
+		fprintf(stderr,
+			"galil-load: no Galil controller answered the "
+			"discovery probe (UDP %s:%d) within %d ms\n",
+			o->find_addr, o->find_port, ms);
+	for (i = 0; i < n; i++)
+		fprintf(f, "%3d  %-15s  %s Rev %s\n", i + 1, list[i].addr,
+			list[i].model, list[i].rev);
+	return n;
+}
+
+/* -a did not answer: list the controllers that do and, on a terminal, let
+ * the technician pick one (never chosen silently). Return 0 with *@l open,
+ * or GLOAD_EXIT_CONN. */
+static int offer_found(struct opts *o, gl_link **l)
+{
+	static struct gl_disc_ctrl list[FIND_MAX];
+	static char chosen[sizeof(list[0].addr)];
+	char line[32];
+	int n, k;
+
+	fprintf(stderr, "galil-load: Galil controllers that answer on this "
+			"network:\n");
+	n = find(o, list, stderr);
+	if (n <= 0 || !isatty(STDIN_FILENO))
+		return GLOAD_EXIT_CONN;
+	fprintf(stderr, "connect to which one (1-%d, Enter: none)? ", n);
+	if (!fgets(line, sizeof(line), stdin) ||
+	    parse_int(strtok(line, "\n") ? line : "", 1, n, &k))
+		return GLOAD_EXIT_CONN;
+	snprintf(chosen, sizeof(chosen), "%s", list[k - 1].addr);
+	o->addr = chosen;
+	printf("connecting to %s (chosen from the list)\n", chosen);
+	return open_link(o, l);
 }
 
 /* gload_dl_halt() with the controller's own number of axes. */
@@ -743,7 +833,15 @@ int main(int argc, char **argv)
 	if (ex || o.check_only)
 		goto out_free;
 	fflush(stdout);
+	if (o.find) {
+		static struct gl_disc_ctrl list[FIND_MAX];
+
+		ex = find(&o, list, stdout) > 0 ? 0 : GLOAD_EXIT_CONN;
+		goto out_free;
+	}
 	ex = open_link(&o, &l);
+	if (ex)
+		ex = offer_found(&o, &l);
 	if (!ex && o.npaths > 0)
 		ex = load(&l, &o, &p);
 	if (!ex && l)
