@@ -290,8 +290,9 @@ static void test_project_dmc(void **state)
 static void test_connection_refused(void **state)
 {
 	char addr[32], port[16], want[512];
-	const char *args[] = {"-a", addr, "--find-addr", "127.0.0.1",
-			      "--find-port", port, "-c", "MG 1", NULL};
+	const char *args[] = {"-a",	   addr,	  "--find-addr",
+			      "127.0.0.1", "--find-port", port,
+			      "-c",	   "MG 1",	  NULL};
 	struct proc p;
 
 	(void)state;
