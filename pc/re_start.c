@@ -14,6 +14,7 @@
 #include "base_clock.h"
 #include "gl_err.h"
 #include "gl_link.h"
+#include "re_comm_find.h"
 
 struct re_signals re_sig;
 
@@ -609,6 +610,51 @@ int re_start(struct app *a)
  * run by another supervisor; halted, every motor read back off,
  * configured and read back; the relay open and off. Its program is not
  * checked (commissioning may come before the first galil-load). */
+/* The configured address did not answer (@why): list the controllers
+ * that answer the discovery probe and, on a terminal, let the technician
+ * pick one (never chosen silently). Return 0 with a->cfg's address set to
+ * the choice, or EXIT_CONNECT. */
+static int commission_find(struct app *a, const char *why)
+{
+	static struct re_comm_found list[RE_COMM_FIND_MAX];
+	const char *bc = a->o.find_addr ? a->o.find_addr : RE_COMM_FIND_BCAST;
+	int port = a->o.find_port ? a->o.find_port : RE_COMM_FIND_PORT;
+	char line[32], *end;
+	long k;
+	int n;
+
+	progress(a,
+		 "%s; looking for Galil controllers (discovery probe to "
+		 "UDP %s:%d, %d ms)",
+		 why, bc, port, RE_COMM_FIND_MS);
+	n = re_comm_find(bc, (unsigned)port, RE_COMM_FIND_MS, list,
+			 RE_COMM_FIND_MAX, a->err, sizeof(a->err));
+	if (n < 0)
+		return fail(a, a->err);
+	if (n == 0)
+		return fail(a, "no Galil controller answered: check the "
+			       "controller's power and Ethernet cable, and "
+			       "controller.address in the configuration");
+	for (int i = 0; i < n; i++)
+		re_console_msg(&a->con, "  %d) %s  %s", i + 1, list[i].addr,
+			       list[i].what);
+	if (!a->con.tty_in)
+		return fail(a, "the configured controller does not answer; "
+			       "the controllers listed above do: run again "
+			       "with --galil ADDRESS");
+	re_console_msg(&a->con, "connect to which one (1-%d, Enter: none)?", n);
+	if (!fgets(line, sizeof(line), stdin) ||
+	    (k = strtol(line, &end, 10)) < 1 || k > n || (*end && *end != '\n'))
+		return fail(a, "no controller chosen");
+	snprintf(a->cfg.controller.address, sizeof(a->cfg.controller.address),
+		 "%s", list[k - 1].addr);
+	progress(a,
+		 "using %s (chosen from the list; set "
+		 "controller.address or --galil for the next time)",
+		 a->cfg.controller.address);
+	return 0;
+}
+
 static int commission_link(struct app *a)
 {
 	char e[GL_ERRTEXT_LEN];
@@ -617,8 +663,14 @@ static int commission_link(struct app *a)
 	progress(a, "connecting to the controller at %s",
 		 a->cfg.controller.address);
 	if (gl_link_open(&l, a->cfg.controller.address,
-			 a->cfg.controller.connect_timeout_ms, e) != GL_OK)
-		return fail(a, e);
+			 a->cfg.controller.connect_timeout_ms, e) != GL_OK) {
+		if (commission_find(a, e))
+			return EXIT_CONNECT; /* said why */
+		if (gl_link_open(&l, a->cfg.controller.address,
+				 a->cfg.controller.connect_timeout_ms,
+				 e) != GL_OK)
+			return fail(a, e);
+	}
 	gl_link_set_timeout(l, a->cfg.controller.timeout_ms);
 	a->real.link = l;
 	a->real.address = a->cfg.controller.address;

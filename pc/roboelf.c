@@ -125,6 +125,9 @@ static void usage(FILE *f)
 	    "in DIR\n"
 	    "      --wait S             commissioning: each wait for the "
 	    "technician (60 s)\n"
+	    "      --find-addr A, --find-port P  commissioning: where the "
+	    "discovery probe goes\n"
+	    "                           (255.255.255.255, 50000)\n"
 	    "  -h, --help               this text\n"
 	    "\n"
 	    "exit: 0 quit, 2 usage/config, 3 no relay/controller, "
@@ -165,6 +168,13 @@ static int opt_value(struct opts *o, int c, const char *arg)
 	case 'l': o->log = arg; return 0;
 	case 's': o->show_cal = arg; return 0;
 	case 'M': o->commission = arg; return 0;
+	case 'F': o->find_addr = arg; return 0;
+	case 'P':
+		o->find_port = atoi(arg);
+		if (o->find_port >= 1 && o->find_port <= 65535)
+			return 0;
+		fprintf(stderr, "roboelf: error: invalid port '%s'\n", arg);
+		return -1;
 	case 'W':
 		o->wait_s = atoi(arg);
 		if (o->wait_s >= 1 && o->wait_s <= 3600)
@@ -207,6 +217,8 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 	    {"show-calibration", required_argument, NULL, 's'},
 	    {"commission", required_argument, NULL, 'M'},
 	    {"wait", required_argument, NULL, 'W'},
+	    {"find-addr", required_argument, NULL, 'F'},
+	    {"find-port", required_argument, NULL, 'P'},
 	    {"help", no_argument, NULL, 'h'},
 	    {NULL, 0, NULL, 0},
 	};

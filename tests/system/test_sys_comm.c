@@ -16,7 +16,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <pthread.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -340,12 +345,103 @@ static void test_wrong_robot(void **state)
 	}
 }
 
+/* A controller of our own on loopback answering the discovery probe
+ * (^R^V CR, docs/galil-load.md) with a revision report. */
+struct lsn {
+	int fd, port, probes;
+	pthread_t th;
+};
+
+static void *lsn_main(void *arg)
+{
+	static const char reply[] = "DMC4030 Rev 1.2h-lsn\r\n:";
+	struct lsn *s = arg;
+	struct pollfd pfd = {.fd = s->fd, .events = POLLIN};
+	struct sockaddr_in from;
+	socklen_t flen;
+	char b[64];
+	ssize_t n;
+
+	while (poll(&pfd, 1, 10000) == 1) {
+		flen = sizeof(from);
+		n = recvfrom(s->fd, b, sizeof(b), 0, (struct sockaddr *)&from,
+			     &flen);
+		if (n <= 0)
+			break;
+		if (n == 3 && !memcmp(b, "\x12\x16\r", 3)) {
+			s->probes++;
+			sendto(s->fd, reply, strlen(reply), 0,
+			       (struct sockaddr *)&from, flen);
+		}
+	}
+	return NULL;
+}
+
+/* The configured address does not answer: the commissioning run lists the
+ * controllers that answer the discovery probe, and without a terminal to
+ * pick one it stops (exit 3): it never connects elsewhere by itself. */
+static void test_find_controller(void **state)
+{
+	struct sockaddr_in a = {.sin_family = AF_INET};
+	socklen_t len = sizeof(a);
+	struct lsn l = {0};
+	char dir[256], port[16], line[512];
+	char *re_args[] = {(char *)"--commission",
+			   dir,
+			   (char *)"--galil",
+			   (char *)"127.0.0.1:1",
+			   (char *)"--find-addr",
+			   (char *)"127.0.0.1",
+			   (char *)"--find-port",
+			   port,
+			   NULL};
+	struct sys_opts o = {0};
+	struct sys_case c;
+	int status = -1;
+
+	(void)state;
+	l.fd = socket(AF_INET, SOCK_DGRAM, 0);
+	a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+	assert_true(l.fd >= 0);
+	assert_int_equal(bind(l.fd, (struct sockaddr *)&a, sizeof(a)), 0);
+	assert_int_equal(getsockname(l.fd, (struct sockaddr *)&a, &len), 0);
+	l.port = ntohs(a.sin_port);
+	snprintf(port, sizeof(port), "%d", l.port);
+	assert_int_equal(pthread_create(&l.th, NULL, lsn_main, &l), 0);
+	snprintf(dir, sizeof(dir), "%s/comm-find", env.dir);
+	o.re_args = re_args;
+	o.no_ready = 1;
+	if (sys_case_start(&c, &env, &o) < 0)
+		fail_msg("case start: %s", c.err);
+	assert_int_equal(proc_wait_exit(&c.re, 20000, &status), 0);
+	assert_true(WIFEXITED(status));
+	assert_int_equal(WEXITSTATUS(status), 3);
+	if (proc_find_line(&c.re, PROC_STDOUT,
+			   "  1) 127.0.0.1  DMC4030 Rev "
+			   "1.2h-lsn",
+			   line, sizeof(line)) != 0)
+		fail_msg("no list in:\n%s", proc_output(&c.re, PROC_STDOUT));
+	assert_int_equal(proc_find_line(&c.re, PROC_STDOUT,
+					"roboelf: error: the configured "
+					"controller does not answer; the "
+					"controllers listed above do: run "
+					"again with --galil ADDRESS",
+					NULL, 0),
+			 0);
+	assert_int_equal(l.probes, 1);
+	sys_case_stop(&c);
+	shutdown(l.fd, SHUT_RDWR);
+	pthread_join(l.th, NULL);
+	close(l.fd);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_clean_robot),
 	    cmocka_unit_test(test_kill_during_move),
 	    cmocka_unit_test(test_wrong_robot),
+	    cmocka_unit_test(test_find_controller),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);
