@@ -8,13 +8,13 @@
  * technician's yes; rc_safe() (AB 1;MO ABC, relay off) ends every step
  * that switched anything on and the run itself, on every path.
  */
-#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "gl_err.h"
 #include "re_comm.h"
-#include "re_comm_int.h"
+#include "re_comm_steps.h"
+#include "re_comm_util.h"
 
 void re_comm_init(struct re_comm *c)
 {
@@ -32,107 +32,6 @@ const char *re_comm_res_name(enum re_comm_res res)
 	}
 }
 
-enum re_comm_res re_comm_add(struct re_comm *c, const char *step,
-			     const char *name, enum re_comm_res res,
-			     const char *fix, const char *fmt, ...)
-{
-	struct re_comm_item *it;
-	va_list ap;
-
-	if (c->n >= RE_COMM_ITEMS)
-		return res;
-	it = &c->item[c->n++];
-	snprintf(it->step, sizeof(it->step), "%s", step);
-	snprintf(it->name, sizeof(it->name), "%s", name);
-	it->res = res;
-	snprintf(it->fix, sizeof(it->fix), "%s", fix ? fix : "");
-	va_start(ap, fmt);
-	vsnprintf(it->text, sizeof(it->text), fmt, ap);
-	va_end(ap);
-	if (res == RE_COMM_FAIL && !c->failed_step)
-		c->failed_step = it->step;
-	return res;
-}
-
-void rc_say(struct re_comm *c, const char *fmt, ...)
-{
-	char line[512];
-	va_list ap;
-	int n = snprintf(line, sizeof(line), "%s", RC_PROMPT);
-
-	va_start(ap, fmt);
-	vsnprintf(line + n, sizeof(line) - (size_t)n, fmt, ap);
-	va_end(ap);
-	if (c->ui.say)
-		c->ui.say(c->ui.ud, line);
-}
-
-int rc_cmd(struct re_comm *c, const char *cmd, char *resp, size_t cap)
-{
-	char dummy[64];
-
-	if (!resp) {
-		resp = dummy;
-		cap = sizeof(dummy);
-	}
-	return c->io->ops->command(c->io->ud, cmd, resp, cap, 0);
-}
-
-const char *rc_tc(struct re_comm *c, int *code)
-{
-	return c->io->ops->ctrl_error(c->io->ud, code);
-}
-
-int rc_num(struct re_comm *c, const char *expr, double *v)
-{
-	return re_io_read(c->io, expr, v, 0);
-}
-
-int rc_quit(const struct re_comm *c)
-{
-	return c->quit && *c->quit;
-}
-
-double rc_now_ms(struct re_comm *c)
-{
-	return (double)c->io->ops->now_ns(c->io->ud) / 1e6;
-}
-
-void rc_sleep_ms(struct re_comm *c, int ms)
-{
-	int64_t t = c->io->ops->now_ns(c->io->ud) + (int64_t)ms * 1000000;
-
-	c->io->ops->sleep_until(c->io->ud, t);
-}
-
-int rc_link_fail(struct re_comm *c, const char *step, const char *what,
-		 int rc)
-{
-	int code = 0;
-	const char *tc = rc == GL_ERR_CTRL ? rc_tc(c, &code) : "";
-
-	if (rc == GL_ERR_CTRL)
-		re_comm_add(c, step, "controller", RE_COMM_FAIL,
-			    "read the command reference for that error; check "
-			    "the model and firmware of the controller",
-			    "%s: the controller refused it: %d %s", what,
-			    code, tc);
-	else
-		re_comm_add(c, step, "link", RE_COMM_FAIL,
-			    "check the Ethernet cable and the controller's "
-			    "power, then run the commissioning again",
-			    "%s: %s", what, gl_strerror(rc));
-	return rc;
-}
-
-int rc_safe(struct re_comm *c)
-{
-	int rc = rc_cmd(c, RE_STOP_ALL, NULL, 0);
-	int rr = c->io->ops->relay_off(c->io->ud);
-
-	return rc < 0 ? rc : rr;
-}
-
 static const struct {
 	const char *name;
 	const char *what;
@@ -144,8 +43,7 @@ static const struct {
     {"joystick", "the joystick switches", rc_step_joystick},
     {"pots", "the potentiometers at rest", rc_step_pots},
     {"limits", "the limit switches", rc_step_limits},
-    {"relay", "the E-stop relay and the amplifiers' power",
-     rc_step_relay},
+    {"relay", "the E-stop relay and the amplifiers' power", rc_step_relay},
     {"motion", "encoders and potentiometers against the motors",
      rc_step_motion},
 };
@@ -161,11 +59,11 @@ int re_comm_run(struct re_comm *c)
 		if (rc == GL_OK && c->failed_step)
 			rc = GL_ERR_MISMATCH;
 		if (rc == GL_ERR_AGAIN && !c->failed_step)
-			re_comm_add(c, steps[i].name, "interrupted",
-				    RE_COMM_FAIL,
-				    "run the commissioning again from the start",
-				    "the run was interrupted (Ctrl-C or a "
-				    "signal) during this step");
+			re_comm_add(
+			    c, steps[i].name, "interrupted", RE_COMM_FAIL,
+			    "run the commissioning again from the start",
+			    "the run was interrupted (Ctrl-C or a "
+			    "signal) during this step");
 		else if (rc != GL_OK && !c->failed_step)
 			rc_link_fail(c, steps[i].name, "the step", rc);
 	}

@@ -18,9 +18,12 @@
  *                asked for in turn (tripped by hand) and seen on its input
  *   6 relay      the relay closes and opens motor power, seen as the
  *                amplifiers' under-voltage on the controller (_TA0 bit 3)
- *   7 motion     per axis a small torque-limited move each way: the
+ *   7 motion     the controller program started and in its service state
+ *                (its watchdog, bounds and fault handling on), per axis a
+ *                small torque-limited move each way asked of it: the
  *                encoder counts with the motor, the potentiometer moves in
- *                the configured direction; MO refused while moving
+ *                the configured direction; then, with the program halted,
+ *                two bounded direct probes (MO refused while moving, PT)
  * Motor power is switched on only in steps 6 and 7, each time after the
  * technician confirmed it, and is off again at the end of the step.
  *
@@ -40,12 +43,12 @@
 #include "re_io.h"
 #include "re_relay.h"
 
-#define RE_COMM_ITEMS	 96
-#define RE_COMM_TEXT	 384
-#define RE_COMM_FIX	 256
-#define RE_COMM_NOISE_N	 50  /* potentiometer samples at rest */
-#define RE_COMM_TRACE_N	 400 /* samples of one axis's move */
-#define RE_COMM_IDTEXT	 1024
+#define RE_COMM_ITEMS	96
+#define RE_COMM_TEXT	384
+#define RE_COMM_FIX	256
+#define RE_COMM_NOISE_N 50  /* potentiometer samples at rest */
+#define RE_COMM_TRACE_N 400 /* samples of one axis's move */
+#define RE_COMM_IDTEXT	1024
 
 enum re_comm_res {
 	RE_COMM_PASS = 0, /* as expected */
@@ -56,11 +59,11 @@ enum re_comm_res {
 
 /* One line of the report: a probe or a check of one step. */
 struct re_comm_item {
-	char step[16];		  /* "identity", "firmware", ... */
-	char name[48];		  /* e.g. "mo-moving", "A fwd" */
+	char step[16]; /* "identity", "firmware", ... */
+	char name[48]; /* e.g. "mo-moving", "A fwd" */
 	enum re_comm_res res;
-	char text[RE_COMM_TEXT];  /* what was sent, expected, seen */
-	char fix[RE_COMM_FIX];	  /* for a FAIL: what to do */
+	char text[RE_COMM_TEXT]; /* what was sent, expected, seen */
+	char fix[RE_COMM_FIX];	 /* for a FAIL: what to do */
 };
 
 /* The technician's side: @say shows one line (a prompt or progress);
@@ -83,21 +86,22 @@ struct re_comm_trace {
 struct re_comm {
 	/* in */
 	const struct re_io *io;
-	gl_link *link;	   /* the same link, for UL; NULL: not probed */
+	gl_link *link; /* the same link, for UL; NULL: not probed */
 	re_relay *relay;
 	const struct re_config *cfg;
 	struct re_comm_ui ui;
-	int wait_ms;	   /* deadline of one thing the technician does */
-	int move_counts;   /* each small move, counts (default 2000) */
+	int wait_ms;	 /* deadline of one thing the technician does */
+	int move_counts; /* each small move, counts (default 2000) */
 	/* non-zero: stop at the next wait (a signal handler sets it) */
 	const volatile sig_atomic_t *quit;
 	/* out */
 	struct re_comm_item item[RE_COMM_ITEMS];
 	int n;
-	const char *failed_step; /* NULL when every step passed */
-	bool power_on_seen;	 /* motor power was switched on */
-	char model[64];		 /* in: ^R^V (re_ctl_identify()) */
-	long serial;		 /* in: MG _BN */
+	const char *failed_step;      /* NULL when every step passed */
+	bool power_on_seen;	      /* motor power was switched on */
+	long hbpc;		      /* the heartbeat in the service state */
+	char model[64];		      /* in: ^R^V (re_ctl_identify()) */
+	long serial;		      /* in: MG _BN */
 	char id_text[RE_COMM_IDTEXT]; /* ID */
 	char th_text[RE_COMM_IDTEXT]; /* TH */
 	double noise_v[RE_AXES][RE_COMM_NOISE_N];
@@ -123,16 +127,6 @@ void re_comm_init(struct re_comm *c);
  *         (also recorded as a FAIL item).
  */
 int re_comm_run(struct re_comm *c);
-
-/*
- * re_comm_add() - append a report item (printf-style text); the fix may be
- * NULL. Returns @res, so that a check can `return re_comm_add(...)`.
- * An item beyond RE_COMM_ITEMS is dropped (the count stays).
- */
-enum re_comm_res re_comm_add(struct re_comm *c, const char *step,
-			     const char *name, enum re_comm_res res,
-			     const char *fix, const char *fmt, ...)
-    __attribute__((format(printf, 6, 7)));
 
 /* re_comm_res_name() - "PASS", "NOTE" or "FAIL". */
 const char *re_comm_res_name(enum re_comm_res res);

@@ -19,7 +19,8 @@
 #include "gl_err.h"
 #include "gl_ident.h"
 #include "re_comm.h"
-#include "re_comm_int.h"
+#include "re_comm_steps.h"
+#include "re_comm_util.h"
 #include "re_ctl.h"
 
 #define STEP "firmware"
@@ -45,7 +46,7 @@ static void clean_lines(char *s)
 	for (; *s; s++)
 		if (*s != '\r')
 			*o++ = (*s == '\n' || (*s >= 0x20 && *s <= 0x7e)) ? *s
-									: '.';
+									  : '.';
 	while (o > start && o[-1] == '\n')
 		o--;
 	*o = '\0';
@@ -162,7 +163,8 @@ static int probe_tm(struct re_comm *c)
 
 	if (rc != GL_OK)
 		return rc;
-	re_comm_add(c, STEP, "tm-1000", tm == 1000 ? RE_COMM_PASS : RE_COMM_FAIL,
+	re_comm_add(c, STEP, "tm-1000",
+		    tm == 1000 ? RE_COMM_PASS : RE_COMM_FAIL,
 		    "set the servo sample time with 'TM 1000' and burn it "
 		    "('BN'); every time in dmc/ assumes 1 ms",
 		    "MG _TM; dmc/ needs 1000 (us; TM: the default sample "
@@ -271,7 +273,8 @@ static int probe_handle(struct re_comm *c)
 	snprintf(expr, sizeof(expr), "_IH%c2", h[2]);
 	if ((rc = rc_num(c, expr, &v)) != GL_OK)
 		return rc;
-	re_comm_add(c, STEP, "handle-open", v != 0 ? RE_COMM_PASS : RE_COMM_FAIL,
+	re_comm_add(c, STEP, "handle-open",
+		    v != 0 ? RE_COMM_PASS : RE_COMM_FAIL,
 		    "do not use this firmware: #FORGN would not see a second "
 		    "connection",
 		    "MG %s of this connection (%c); reference (IH): 2 TCP "
@@ -403,8 +406,8 @@ static const struct {
 int rc_step_firmware(struct re_comm *c)
 {
 	int (*const probe[])(struct re_comm *) = {
-	    probe_unknown, probe_tm,	 probe_mg,     probe_dm, probe_handle,
-	    probe_cn,	   probe_in9,	 probe_record, probe_upload,
+	    probe_unknown, probe_tm,  probe_mg,	    probe_dm,	  probe_handle,
+	    probe_cn,	   probe_in9, probe_record, probe_upload,
 	};
 	int rc;
 

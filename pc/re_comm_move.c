@@ -21,14 +21,19 @@
 
 #include "gl_err.h"
 #include "re_comm.h"
-#include "re_comm_int.h"
+#include "re_comm_steps.h"
+#include "re_comm_util.h"
+#include "re_ctl.h"
+#include "re_dmcif.h"
+#include "re_fault.h"
+#include "re_plan.h"
 
-#define TA_UNDERVOLT  8	    /* _TA0 bit 3: under-voltage, axes A-D */
-#define RC_AMP_MS     1000  /* the amplifiers see power change within */
-#define RC_MOVE_CPS   2000  /* speed of a small move, counts/s */
-#define RC_MOVE_TL_V  2.0   /* torque limit during the moves, V */
-#define RC_MOVE_MS    4000  /* deadline of one small move */
-#define RC_SAMPLE_MS  10
+#define TA_UNDERVOLT 8	  /* _TA0 bit 3: under-voltage, axes A-D */
+#define RC_AMP_MS    1000 /* the amplifiers see power change within */
+#define RC_MOVE_CPS  2000 /* speed of a small move, counts/s */
+#define RC_MOVE_TL_V 2.0  /* torque limit during the moves, V */
+#define RC_MOVE_MS   4000 /* deadline of one small move */
+#define RC_SAMPLE_MS 10
 
 /* Wait until _TA0 bit 3 is @want (1 set, 0 clear): the time it took,
  * ms, or -1 after RC_AMP_MS. */
@@ -161,14 +166,17 @@ static int pot_mean(struct re_comm *c, int in, int n, double *mean)
 	return GL_OK;
 }
 
-/* One sample of axis @x during a move: encoder, pot, motor off, moving. */
+/* One sample of axis @x in the service state, carrying the heartbeat:
+ * encoder, pot, the program's state, profiler running. */
 static int move_sample(struct re_comm *c, char x, int in, double *v)
 {
 	char line[80], resp[160], *p, *end;
 	int rc;
 
-	snprintf(line, sizeof(line), "MG _TP%c;MG @AN[%d];MG _MO%c;MG _BG%c",
-		 x, in, x, x);
+	c->hbpc = (c->hbpc + 1) % RE_HBPC_WRAP;
+	snprintf(line, sizeof(line),
+		 "hbpc=%ld;MG _TP%c;MG @AN[%d];MG state;MG _BG%c", c->hbpc, x,
+		 in, x);
 	if ((rc = rc_cmd(c, line, resp, sizeof(resp))) < 0)
 		return rc;
 	p = resp;
@@ -180,36 +188,60 @@ static int move_sample(struct re_comm *c, char x, int in, double *v)
 	return GL_OK;
 }
 
+/* Wait @ms in the service state, the heartbeat going every sample. */
+static int hb_wait(struct re_comm *c, int ax, int ms)
+{
+	double v[4], t0 = rc_now_ms(c);
+	int rc;
+
+	while (rc_now_ms(c) - t0 < ms) {
+		rc_sleep_ms(c, RC_SAMPLE_MS);
+		if ((rc = move_sample(c, (char)('A' + ax),
+				      c->cfg->axes[ax].analog.input, v)) !=
+		    GL_OK)
+			return rc;
+	}
+	return GL_OK;
+}
+
 struct move_res {
 	double enc0, enc1, pot0, pot1;
-	int motor_off, timed_out;
+	double fcode, faxis; /* the fault the program latched */
+	int latched, timed_out;
 };
 
-/* PR @counts on axis @ax, torque-limited, sampled (into the trace when
- * @trace). The old TL is put back. */
+/* Ask the program for a service move of @counts on axis @ax. */
+static int move_request(struct re_comm *c, int ax, double target)
+{
+	char cmd[80];
+	int rc;
+
+	snprintf(cmd, sizeof(cmd), "mvtg[%d]=%.0f;mvsp[%d]=%d;mvto=%d", ax,
+		 target, ax, RC_MOVE_CPS, RC_MOVE_MS);
+	if ((rc = rc_cmd(c, cmd, NULL, 0)) < 0)
+		return rc;
+	snprintf(cmd, sizeof(cmd), "mvax[0]=%d;mvax[1]=%d;mvax[2]=%d;mvreq=1",
+		 ax == 0, ax == 1, ax == 2);
+	return rc_cmd(c, cmd, NULL, 0) < 0 ? GL_ERR_CTRL : GL_OK;
+}
+
+/* A service move of @counts on axis @ax, sampled (into the trace when
+ * @trace) until the profiler ended, a fault latched or RC_MOVE_MS. */
 static int move_axis(struct re_comm *c, int ax, int counts, int trace,
 		     struct move_res *m)
 {
 	const struct re_config_axis *a = &c->cfg->axes[ax];
 	struct re_comm_trace *tr = &c->trace[ax];
-	char x = (char)('A' + ax), cmd[80], ex[8];
-	double tl = 0, v[4], t0;
-	int rc;
+	char x = (char)('A' + ax);
+	double v[4], t0;
+	int rc, started = 0;
 
 	memset(m, 0, sizeof(*m));
-	snprintf(ex, sizeof(ex), "_TL%c", x);
-	if ((rc = rc_num(c, ex, &tl)) != GL_OK)
-		return rc;
-	snprintf(cmd, sizeof(cmd), "TL%c=%.4f;SP%c=%d;SH %c", x,
-		 fmin(tl, RC_MOVE_TL_V), x, RC_MOVE_CPS, x);
-	if ((rc = rc_cmd(c, cmd, NULL, 0)) < 0 ||
-	    (rc = pot_mean(c, a->analog.input, 10, &m->pot0)) != GL_OK ||
-	    (rc = move_sample(c, x, a->analog.input, v)) != GL_OK)
+	if ((rc = pot_mean(c, a->analog.input, 10, &m->pot0)) != GL_OK ||
+	    (rc = move_sample(c, x, a->analog.input, v)) != GL_OK ||
+	    (rc = move_request(c, ax, v[0] + counts)) != GL_OK)
 		return rc;
 	m->enc0 = v[0];
-	snprintf(cmd, sizeof(cmd), "PR%c=%d;BG %c", x, counts, x);
-	if ((rc = rc_cmd(c, cmd, NULL, 0)) < 0)
-		return rc;
 	t0 = rc_now_ms(c);
 	for (;;) {
 		rc_sleep_ms(c, RC_SAMPLE_MS);
@@ -220,21 +252,24 @@ static int move_axis(struct re_comm *c, int ax, int counts, int trace,
 			tr->enc[tr->n] = v[0];
 			tr->pot_v[tr->n++] = v[1];
 		}
+		started |= v[3] != 0;
 		m->enc1 = v[0];
-		m->motor_off = v[2] != 0;
-		m->timed_out = rc_now_ms(c) - t0 > RC_MOVE_MS;
-		if (v[3] == 0 || m->motor_off || m->timed_out)
+		m->latched = v[2] == RE_DMC_FAULT;
+		m->timed_out = rc_now_ms(c) - t0 > RC_MOVE_MS + 500;
+		if ((started && v[3] == 0) || m->latched || m->timed_out)
 			break;
 		if (rc_quit(c))
 			return GL_ERR_AGAIN;
 	}
-	rc_sleep_ms(c, 100);
-	snprintf(cmd, sizeof(cmd), "AB 1;MO %c;TL%c=%.4f", x, x, tl);
-	if ((rc = rc_cmd(c, cmd, NULL, 0)) < 0 ||
+	if ((rc = hb_wait(c, ax, 100)) != GL_OK ||
 	    (rc = pot_mean(c, a->analog.input, 10, &m->pot1)) != GL_OK ||
 	    (rc = move_sample(c, x, a->analog.input, v)) != GL_OK)
 		return rc;
 	m->enc1 = v[0];
+	m->latched |= v[2] == RE_DMC_FAULT;
+	if (m->latched && ((rc = rc_num(c, "fcode", &m->fcode)) != GL_OK ||
+			   (rc = rc_num(c, "faxis", &m->faxis)) != GL_OK))
+		return rc;
 	return GL_OK;
 }
 
@@ -249,37 +284,40 @@ static void move_judge(struct re_comm *c, int ax, int counts,
 		     a->travel_counts;
 	char fix[RE_COMM_FIX];
 
-	if (m->motor_off || m->timed_out) {
+	if (m->latched || m->timed_out) {
+		char why[96];
+
+		if (m->latched)
+			snprintf(why, sizeof(why),
+				 "the controller program latched fault %.0f "
+				 "(axis %.0f) and switched the motors off",
+				 m->fcode, m->faxis);
+		else
+			snprintf(why, sizeof(why), "the deadline of %d ms",
+				 RC_MOVE_MS + 500);
 		if (moved * counts < 0 && fabs(moved) > er / 4)
 			re_comm_add(c, "motion", a->name, RE_COMM_FAIL,
 				    "exchange the encoder's channels A and B "
 				    "(or reverse the motor leads) of this axis",
-				    "encoder reversed: commanded %+d counts, "
-				    "the encoder counted %+.0f until the "
-				    "position error passed ER %.0f and the "
-				    "motor was switched off: the encoder "
-				    "counts against its motor",
-				    counts, moved, er);
+				    "encoder reversed: asked for %+d counts, "
+				    "the encoder counted %+.0f (the servo ran "
+				    "away from the target) until %s: the "
+				    "encoder counts against its motor",
+				    counts, moved, why);
 		else if (fabs(moved) < er / 4)
 			re_comm_add(c, "motion", a->name, RE_COMM_FAIL,
 				    "check the amplifier, the motor cable, a "
 				    "brake or a jam on this axis",
-				    "did not move: commanded %+d counts, the "
+				    "did not move: asked for %+d counts, the "
 				    "encoder counted %+.0f before %s",
-				    counts, moved,
-				    m->motor_off ? "the position error "
-						   "switched the motor off"
-						 : "the deadline");
+				    counts, moved, why);
 		else
 			re_comm_add(c, "motion", a->name, RE_COMM_FAIL,
 				    "check the axis for a jam and the gains "
 				    "(kp, ki, kd) and torque_limit_v",
 				    "stopped short: %+.0f of %+d counts before "
 				    "%s",
-				    moved, counts,
-				    m->motor_off ? "the position error switched "
-						   "the motor off"
-						 : "the deadline");
+				    moved, counts, why);
 		return;
 	}
 	if (fabs(moved - counts) > er) {
@@ -289,10 +327,11 @@ static void move_judge(struct re_comm *c, int ax, int counts,
 			    counts, moved);
 		return;
 	}
-	re_comm_add(c, "motion", a->name, RE_COMM_PASS, NULL,
-		    "encoder: commanded %+d counts at %d counts/s, TL at "
-		    "most %.1f V: counted %+.0f with the motor",
-		    counts, RC_MOVE_CPS, RC_MOVE_TL_V, moved);
+	re_comm_add(
+	    c, "motion", a->name, RE_COMM_PASS, NULL,
+	    "encoder: asked the program for %+d counts at %d counts/s, TL at "
+	    "most %.1f V: counted %+.0f with the motor",
+	    counts, RC_MOVE_CPS, RC_MOVE_TL_V, moved);
 	snprintf(fix, sizeof(fix),
 		 "exchange the potentiometer's two outer wires (supply and "
 		 "ground) on analog input %d, or mount it the other way",
@@ -340,9 +379,9 @@ static int probe_mo_moving(struct re_comm *c)
 	int code = 0, rc;
 	const char *tc = "";
 
-	if ((rc = rc_cmd(c, "SH A;JGA=500;BG A", NULL, 0)) < 0)
+	if ((rc = rc_cmd(c, "SH A;SPA=1000;PRA=300;BG A", NULL, 0)) < 0)
 		return rc;
-	rc_sleep_ms(c, 100);
+	rc_sleep_ms(c, 50);
 	rc = rc_cmd(c, "MO A", NULL, 0);
 	if (rc == GL_ERR_CTRL)
 		tc = rc_tc(c, &code);
@@ -350,7 +389,7 @@ static int probe_mo_moving(struct re_comm *c)
 		return rc;
 	re_comm_add(c, "firmware", "mo-moving",
 		    rc == GL_ERR_CTRL ? RE_COMM_PASS : RE_COMM_NOTE, NULL,
-		    "MO A while jogging at 500 counts/s; reference (MO): not "
+		    "MO A during a 300-count move; reference (MO): not "
 		    "valid while in motion; seen %s%d %s%s",
 		    rc == GL_ERR_CTRL ? "?, TC1 " : "accepted", code, tc,
 		    rc == GL_ERR_CTRL ? ""
@@ -389,12 +428,12 @@ static int probe_pt(struct re_comm *c)
 		return rc;
 	t0 = rc_now_ms(c);
 	while ((rc = rc_num(c, "_TPA", &p)) == GL_OK &&
-	       fabs(p - (p0 + 300)) > 20 && rc_now_ms(c) - t0 < 1500)
+	       fabs(p - (p0 + 300)) > 2 && rc_now_ms(c) - t0 < 1500)
 		rc_sleep_ms(c, RC_SAMPLE_MS);
 	if (rc != GL_OK)
 		return rc;
 	re_comm_add(c, "firmware", "pt-tracking",
-		    fabs(p - (p0 + 300)) <= 20 ? RE_COMM_PASS : RE_COMM_FAIL,
+		    fabs(p - (p0 + 300)) <= 2 ? RE_COMM_PASS : RE_COMM_FAIL,
 		    "the armed joystick motion of dmc/ needs PT to retarget "
 		    "the move with PA: check the firmware revision with Galil",
 		    "PT 1, then PAA=%.0f without BG; reference (PT): the axis "
@@ -407,30 +446,107 @@ static int probe_pt(struct re_comm *c)
 	return rc_cmd(c, "MO A", NULL, 0) < 0 ? GL_ERR_CTRL : GL_OK;
 }
 
-int rc_step_motion(struct re_comm *c)
+/* TL of every axis at most RC_MOVE_TL_V (@restore 0), or back to the
+ * values in @tl (@restore 1). */
+static int torque(struct re_comm *c, double *tl, int restore)
 {
-	struct move_res m;
+	char cmd[80], ex[8];
+	int rc, n = 0;
+
+	for (int ax = 0; ax < RE_AXES; ax++) {
+		snprintf(ex, sizeof(ex), "_TL%c", 'A' + ax);
+		if (!restore && (rc = rc_num(c, ex, &tl[ax])) != GL_OK)
+			return rc;
+		n += snprintf(cmd + n, sizeof(cmd) - (size_t)n, "%sTL%c=%.4f",
+			      ax ? ";" : "", 'A' + ax,
+			      restore ? tl[ax] : fmin(tl[ax], RC_MOVE_TL_V));
+	}
+	return rc_cmd(c, cmd, NULL, 0) < 0 ? GL_ERR_CTRL : GL_OK;
+}
+
+/* The program started with its parameters, in the service state with
+ * motor power on. */
+static int enter_service(struct re_comm *c)
+{
+	struct re_ctl_info info = {0};
+	struct re_plan plan;
+	struct re_fault f;
+	char err[256];
 	double ms;
 	int rc, ta0;
 
+	re_plan_make(c->cfg, 0, &plan);
+	if (re_ctl_start_program(c->io, &info, err, sizeof(err)) != GL_OK ||
+	    (re_plan_make(c->cfg, info.mainms, &plan),
+	     re_ctl_write_params(c->io, c->cfg, &plan, NULL, err,
+				 sizeof(err)) != GL_OK)) {
+		re_comm_add(c, "motion", "program", RE_COMM_FAIL,
+			    "load dmc/ with galil-load (section 4) and run the "
+			    "commissioning again",
+			    "the controller program, which supervises the "
+			    "moves, could not be started: %s",
+			    err);
+		return GL_OK;
+	}
 	if ((rc = power_on(c, "motion")) != GL_OK)
 		return rc == GL_ERR_MISMATCH || rc == GL_ERR_RELAY ? GL_OK : rc;
 	if ((rc = amp_wait(c, 0, &ms, &ta0)) != GL_OK)
 		return rc;
+	c->hbpc = re_ctl_session();
+	rc = re_ctl_service(c->io, &c->hbpc, &f, err, sizeof(err));
+	if (rc == RE_FAULT)
+		re_fault_what(&f, NULL, err, sizeof(err));
+	if (rc == RE_FAULT || rc == GL_ERR_TIMEOUT)
+		re_comm_add(c, "motion", "service", RE_COMM_FAIL,
+			    "read the fault in docs/operator.md; correct the "
+			    "configuration or the wiring it names",
+			    "the controller program refused its service state: "
+			    "%s",
+			    err);
+	return rc == RE_FAULT || rc == GL_ERR_TIMEOUT ? GL_OK : rc;
+}
+
+/* Each axis +move_counts and back, asked of the program. */
+static int moves(struct re_comm *c)
+{
+	struct move_res m;
+	int rc = GL_OK;
+
 	for (int ax = 0; ax < RE_AXES && !c->failed_step; ax++) {
-		rc_say(c, "axis %s: a %+d-count move and back", c->cfg->axes[ax].name,
-		       c->move_counts);
+		rc_say(c, "axis %s: a %+d-count move and back",
+		       c->cfg->axes[ax].name, c->move_counts);
 		if ((rc = move_axis(c, ax, c->move_counts, 1, &m)) != GL_OK)
-			break;
+			return rc;
 		move_judge(c, ax, c->move_counts, &m);
 		if (c->failed_step ||
 		    (rc = move_axis(c, ax, -c->move_counts, 0, &m)) != GL_OK)
-			break;
+			return rc;
 	}
+	return rc;
+}
+
+int rc_step_motion(struct re_comm *c)
+{
+	double tl[RE_AXES];
+	char err[256];
+	int rc;
+
+	if ((rc = torque(c, tl, 0)) != GL_OK)
+		return rc;
+	rc = enter_service(c);
+	if (rc == GL_OK && !c->failed_step)
+		rc = moves(c);
 	if (rc == GL_OK && !c->failed_step &&
+	    re_ctl_off(c->io, &c->hbpc, err, sizeof(err)) != GL_OK)
+		rc = GL_ERR_TIMEOUT;
+	/* the bounded direct probes need the program halted */
+	if (rc == GL_OK && !c->failed_step &&
+	    (rc = re_ctl_halt(c->io, err, sizeof(err))) == GL_OK &&
 	    (rc = probe_mo_moving(c)) == GL_OK)
 		rc = probe_pt(c);
 	if (rc_safe(c) != GL_OK && rc == GL_OK)
 		rc = GL_ERR_RELAY;
+	if (torque(c, tl, 1) != GL_OK && rc == GL_OK)
+		rc = GL_ERR_CTRL;
 	return rc;
 }

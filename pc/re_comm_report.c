@@ -45,7 +45,8 @@ void re_comm_summary(const struct re_comm *c, char *buf, size_t cap)
 		const struct re_comm_item *it = &c->item[i];
 
 		if (it->res == RE_COMM_FAIL) {
-			snprintf(buf, cap, "FAILED at step %s (%s): %s - fix: %s",
+			snprintf(buf, cap,
+				 "FAILED at step %s (%s): %s - fix: %s",
 				 it->step, it->name, it->text, it->fix);
 			return;
 		}
@@ -92,13 +93,14 @@ static int plot_noise(const struct re_comm *c, const char *dir)
 		for (int i = 0; i < c->noise_n; i++)
 			mean += c->noise_v[ax][i] / c->noise_n;
 		for (int i = 0; i < c->noise_n; i++)
-			put(&d, "%d %.3f\n", i * 10,
+			put(&d, "%d %.3f\n", i,
 			    (c->noise_v[ax][i] - mean) * 1e3);
 		put(&d, "e\n");
 	}
 	snprintf(script, sizeof(script),
 		 "set title 'potentiometers at rest, motor power off: "
-		 "reading minus its mean'\nset xlabel 'ms'\n"
+		 "reading minus its mean'\nset xlabel 'sample (10 ms apart "
+		 "plus the reply time)'\n"
 		 "set ylabel 'mV'\nplot '-' w lp t '%s', '-' w lp t '%s', "
 		 "'-' w lp t '%s'\n",
 		 c->cfg->axes[0].name, c->cfg->axes[1].name,
@@ -107,34 +109,40 @@ static int plot_noise(const struct re_comm *c, const char *dir)
 	return gnuplot_png(png, script, data) == 0 ? 1 : -1;
 }
 
+static void put_trace(struct buf *d, const struct re_comm_trace *t, int pot)
+{
+	for (int i = 0; i < t->n; i++)
+		put(d, "%.1f %.4f\n", t->t_ms[i],
+		    pot ? t->pot_v[i] : t->enc[i]);
+	put(d, "e\n");
+}
+
 static int plot_move(const struct re_comm *c, int ax, const char *dir)
 {
-	static char data[2 * RE_COMM_TRACE_N * 40];
+	static char data[2 * RE_COMM_TRACE_N * 40 + 1024];
 	const struct re_comm_trace *t = &c->trace[ax];
-	char script[768], png[1024];
+	char png[1024];
 	struct buf d = {data, 0, sizeof(data)};
 
 	if (t->n < 2)
 		return 0;
-	for (int pass = 0; pass < 2; pass++) {
-		for (int i = 0; i < t->n; i++)
-			put(&d, "%.1f %.4f\n", t->t_ms[i],
-			    pass ? t->pot_v[i] : t->enc[i]);
-		put(&d, "e\n");
-	}
-	snprintf(script, sizeof(script),
-		 "set multiplot layout 2,1 title 'axis %s: the small move "
-		 "(encoder against motor, potentiometer against "
-		 "encoder)'\nset xlabel 'ms after BG'\n"
-		 "set ylabel 'encoder, counts'\nplot '-' w l t 'encoder'\n"
-		 "set ylabel 'potentiometer, V'\n"
-		 "plot '-' w l t 'analog input %d'\n",
-		 c->cfg->axes[ax].name, c->cfg->axes[ax].analog.input);
-	snprintf(png, sizeof(png), "%s/move-%s.png", dir, c->cfg->axes[ax].name);
-	return gnuplot_png(png, script, data) == 0 ? 1 : -1;
+	put(&d,
+	    "set multiplot layout 2,1 title 'axis %s: the small move "
+	    "(encoder against motor, potentiometer against encoder)'\n"
+	    "set xlabel 'ms after BG'\nset ylabel 'encoder, counts'\n"
+	    "plot '-' w l t 'encoder'\n",
+	    c->cfg->axes[ax].name);
+	put_trace(&d, t, 0);
+	put(&d,
+	    "set ylabel 'potentiometer, V'\nplot '-' w l t 'analog input "
+	    "%d'\n",
+	    c->cfg->axes[ax].analog.input);
+	put_trace(&d, t, 1);
+	snprintf(png, sizeof(png), "%s/move-%s.png", dir,
+		 c->cfg->axes[ax].name);
+	return gnuplot_png(png, "", data) == 0 ? 1 : -1;
 }
 
-/* Each line of @text indented. */
 static void put_lines(struct buf *b, const char *text)
 {
 	while (*text) {

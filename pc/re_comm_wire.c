@@ -15,22 +15,22 @@
 
 #include "gl_err.h"
 #include "re_comm.h"
-#include "re_comm_int.h"
+#include "re_comm_steps.h"
+#include "re_comm_util.h"
 
 #define RC_STEADY_MS 300 /* the same switches closed this long */
 #define RC_POLL_MS   20
 #define NJOY	     RE_JOY_INPUTS
 
 static const char *const cmd_name[NJOY / 2] = {
-    "A forward", "A reverse", "B forward", "B reverse", "C forward",
-    "C reverse",
+    "A forward", "A reverse", "B forward",
+    "B reverse", "C forward", "C reverse",
 };
 
 /* "B forward channel b" for joystick switch @i (0..11). */
 static const char *sw_name(int i, char *buf, size_t cap)
 {
-	snprintf(buf, cap, "%s channel %c", cmd_name[i / 2],
-		 i % 2 ? 'b' : 'a');
+	snprintf(buf, cap, "%s channel %c", cmd_name[i / 2], i % 2 ? 'b' : 'a');
 	return buf;
 }
 
@@ -118,8 +118,8 @@ static void list_inputs(const struct re_comm *c, unsigned mask, char *buf,
 	buf[0] = '\0';
 	for (int i = 0; i < NJOY && n < cap; i++)
 		if (mask & (1u << i))
-			n += (size_t)snprintf(buf + n, cap - n, "%sinput %d (%s)",
-					      n ? ", " : "",
+			n += (size_t)snprintf(buf + n, cap - n,
+					      "%sinput %d (%s)", n ? ", " : "",
 					      c->cfg->joystick.inputs[i],
 					      sw_name(i, nm, sizeof(nm)));
 }
@@ -172,8 +172,8 @@ static void joy_judge(struct re_comm *c, int k, unsigned mask, int timed_out)
 
 	if (mask == want) {
 		re_comm_add(c, "joystick", cmd_name[k], RE_COMM_PASS, NULL,
-			    "inputs %d and %d closed, nothing else",
-			    in[2 * k], in[2 * k + 1]);
+			    "inputs %d and %d closed, nothing else", in[2 * k],
+			    in[2 * k + 1]);
 		return;
 	}
 	if (timed_out && !mask) {
@@ -187,7 +187,8 @@ static void joy_judge(struct re_comm *c, int k, unsigned mask, int timed_out)
 	}
 	list_inputs(c, missing, lm, sizeof(lm));
 	list_inputs(c, extra, ls, sizeof(ls));
-	if (__builtin_popcount(missing) == 1 && __builtin_popcount(extra) == 1) {
+	if (__builtin_popcount(missing) == 1 &&
+	    __builtin_popcount(extra) == 1) {
 		int m = __builtin_ctz(missing), e = __builtin_ctz(extra);
 
 		snprintf(fix, sizeof(fix),
@@ -209,8 +210,8 @@ static void joy_judge(struct re_comm *c, int k, unsigned mask, int timed_out)
 		re_comm_add(c, "joystick", cmd_name[k], RE_COMM_FAIL,
 			    "check the wiring of those inputs",
 			    "asked for %s: %s%s%s closed", cmd_name[k],
-			    missing ? lm : "", missing ? " did not close; " : "",
-			    ls);
+			    missing ? lm : "",
+			    missing ? " did not close; " : "", ls);
 	}
 }
 
@@ -251,8 +252,8 @@ int rc_step_joystick(struct re_comm *c)
 /* The supervisor's tolerance at the table step, V. */
 static double pot_tol_v(const struct re_config_axis *a)
 {
-	return a->allowed_error * a->analog.expected_range_v *
-	       a->step_counts / a->travel_counts;
+	return a->allowed_error * a->analog.expected_range_v * a->step_counts /
+	       a->travel_counts;
 }
 
 static void pot_judge(struct re_comm *c, int ax)
@@ -382,7 +383,8 @@ static void lim_judge(struct re_comm *c, int i, unsigned mask, int to)
 			    "check which switch is wired to which axis's limit "
 			    "inputs",
 			    "%s was held and the controller saw %s%s", want,
-			    got, __builtin_popcount(mask) > 1 ? " and more" : "");
+			    got,
+			    __builtin_popcount(mask) > 1 ? " and more" : "");
 }
 
 int rc_step_limits(struct re_comm *c)

@@ -14,6 +14,7 @@
 #include "base_clock.h"
 #include "gl_err.h"
 #include "gl_link.h"
+#include "re_comm_find.h"
 
 struct re_signals re_sig;
 
@@ -43,12 +44,12 @@ static int fail(struct app *a, const char *what)
 	int64_t ms = stalled_ms(a);
 
 	if (ms)
-		re_console_msg(&a->con,
-			       "roboelf: error: roboelf did not run for %lld ms "
-			       "(limit %lld ms: stopped, e.g. SIGSTOP or a "
-			       "debugger); then: %s",
-			       (long long)ms, (long long)re_start_stall_limit_ms(a),
-			       what);
+		re_console_msg(
+		    &a->con,
+		    "roboelf: error: roboelf did not run for %lld ms "
+		    "(limit %lld ms: stopped, e.g. SIGSTOP or a "
+		    "debugger); then: %s",
+		    (long long)ms, (long long)re_start_stall_limit_ms(a), what);
 	else
 		re_console_msg(&a->con, "roboelf: error: %s", what);
 	re_log_msg(&a->log, RE_LOG_WARN, "start-up refused: %s%s", what,
@@ -66,8 +67,7 @@ static int take_locks(struct app *a)
 
 	if (re_lock_controller_key(a->cfg.controller.address, key,
 				   sizeof(key)) != GL_OK) {
-		snprintf(a->err, sizeof(a->err),
-			 "bad controller address '%s'",
+		snprintf(a->err, sizeof(a->err), "bad controller address '%s'",
 			 a->cfg.controller.address);
 		return fail(a, a->err);
 	}
@@ -142,8 +142,10 @@ static int amp_check(struct app *a, int want_on, int timeout_ms)
 		return 0;
 	if (a->cfg.mode == RE_MODE_CLINICAL)
 		return fail(a, a->err);
-	re_console_msg(&a->con, "roboelf: warning: %s (development mode: "
-				"continuing)", a->err);
+	re_console_msg(&a->con,
+		       "roboelf: warning: %s (development mode: "
+		       "continuing)",
+		       a->err);
 	re_log_msg(&a->log, RE_LOG_WARN, "%s (development mode)", a->err);
 	return 0;
 }
@@ -155,8 +157,7 @@ static int prepare_controller(struct app *a)
 	re_plan_make(&a->cfg, 0, &a->plan);
 	progress(a, "halting the controller program; every motor off");
 	if (re_ctl_halt(&a->io, a->err, sizeof(a->err)) ||
-	    re_ctl_configure(&a->io, &a->cfg, &a->plan, a->err,
-			     sizeof(a->err)))
+	    re_ctl_configure(&a->io, &a->cfg, &a->plan, a->err, sizeof(a->err)))
 		return fail(a, a->err);
 	progress(a, "controller configured and read back");
 	if (amp_check(a, 0, 200))
@@ -474,12 +475,14 @@ static int choose_calibration(struct app *a)
 			    "its reverse and forward limit switches, then to "
 			    "the centre of its travel");
 	else
-		progress(a, "calibration from the file: every axis will move "
-			    "to the centre of its calibrated travel (A %.0f, "
-			    "B %.0f, C %.0f counts)",
-			 (a->cal->axis[0].soft_rev + a->cal->axis[0].soft_fwd) / 2,
-			 (a->cal->axis[1].soft_rev + a->cal->axis[1].soft_fwd) / 2,
-			 (a->cal->axis[2].soft_rev + a->cal->axis[2].soft_fwd) / 2);
+		progress(
+		    a,
+		    "calibration from the file: every axis will move "
+		    "to the centre of its calibrated travel (A %.0f, "
+		    "B %.0f, C %.0f counts)",
+		    (a->cal->axis[0].soft_rev + a->cal->axis[0].soft_fwd) / 2,
+		    (a->cal->axis[1].soft_rev + a->cal->axis[1].soft_fwd) / 2,
+		    (a->cal->axis[2].soft_rev + a->cal->axis[2].soft_fwd) / 2);
 	return 0;
 }
 
@@ -580,16 +583,16 @@ typedef int (*startup_step)(struct app *a);
 int re_start(struct app *a)
 {
 	static const startup_step steps[] = {
-	    start_relay,   start_link, choose_calibration, prepare_controller,
-	    init_super,	   power_on,   enter_service,	   calibrate,
-	    arm,
+	    start_relay,	start_link, choose_calibration,
+	    prepare_controller, init_super, power_on,
+	    enter_service,	calibrate,  arm,
 	};
 	int rc = take_locks(a);
 
 	re_sig.cont_real = &a->real;
 	/* a stop while the operator chooses is no stall: nothing is on */
-	for (size_t i = 0; !rc && !re_sig.quit && i < sizeof(steps) /
-		 sizeof(steps[0]); i++) {
+	for (size_t i = 0;
+	     !rc && !re_sig.quit && i < sizeof(steps) / sizeof(steps[0]); i++) {
 		rc = steps[i](a);
 		if (steps[i] == choose_calibration)
 			re_sig.continued = 0;
@@ -607,6 +610,51 @@ int re_start(struct app *a)
  * run by another supervisor; halted, every motor read back off,
  * configured and read back; the relay open and off. Its program is not
  * checked (commissioning may come before the first galil-load). */
+/* The configured address did not answer (@why): list the controllers
+ * that answer the discovery probe and, on a terminal, let the technician
+ * pick one (never chosen silently). Return 0 with a->cfg's address set to
+ * the choice, or EXIT_CONNECT. */
+static int commission_find(struct app *a, const char *why)
+{
+	static struct re_comm_found list[RE_COMM_FIND_MAX];
+	const char *bc = a->o.find_addr ? a->o.find_addr : RE_COMM_FIND_BCAST;
+	int port = a->o.find_port ? a->o.find_port : RE_COMM_FIND_PORT;
+	char line[32], *end;
+	long k;
+	int n;
+
+	progress(a,
+		 "%s; looking for Galil controllers (discovery probe to "
+		 "UDP %s:%d, %d ms)",
+		 why, bc, port, RE_COMM_FIND_MS);
+	n = re_comm_find(bc, (unsigned)port, RE_COMM_FIND_MS, list,
+			 RE_COMM_FIND_MAX, a->err, sizeof(a->err));
+	if (n < 0)
+		return fail(a, a->err);
+	if (n == 0)
+		return fail(a, "no Galil controller answered: check the "
+			       "controller's power and Ethernet cable, and "
+			       "controller.address in the configuration");
+	for (int i = 0; i < n; i++)
+		re_console_msg(&a->con, "  %d) %s  %s", i + 1, list[i].addr,
+			       list[i].what);
+	if (!a->con.tty_in)
+		return fail(a, "the configured controller does not answer; "
+			       "the controllers listed above do: run again "
+			       "with --galil ADDRESS");
+	re_console_msg(&a->con, "connect to which one (1-%d, Enter: none)?", n);
+	if (!fgets(line, sizeof(line), stdin) ||
+	    (k = strtol(line, &end, 10)) < 1 || k > n || (*end && *end != '\n'))
+		return fail(a, "no controller chosen");
+	snprintf(a->cfg.controller.address, sizeof(a->cfg.controller.address),
+		 "%s", list[k - 1].addr);
+	progress(a,
+		 "using %s (chosen from the list; set "
+		 "controller.address or --galil for the next time)",
+		 a->cfg.controller.address);
+	return 0;
+}
+
 static int commission_link(struct app *a)
 {
 	char e[GL_ERRTEXT_LEN];
@@ -615,8 +663,14 @@ static int commission_link(struct app *a)
 	progress(a, "connecting to the controller at %s",
 		 a->cfg.controller.address);
 	if (gl_link_open(&l, a->cfg.controller.address,
-			 a->cfg.controller.connect_timeout_ms, e) != GL_OK)
-		return fail(a, e);
+			 a->cfg.controller.connect_timeout_ms, e) != GL_OK) {
+		if (commission_find(a, e))
+			return EXIT_CONNECT; /* said why */
+		if (gl_link_open(&l, a->cfg.controller.address,
+				 a->cfg.controller.connect_timeout_ms,
+				 e) != GL_OK)
+			return fail(a, e);
+	}
 	gl_link_set_timeout(l, a->cfg.controller.timeout_ms);
 	a->real.link = l;
 	a->real.address = a->cfg.controller.address;
@@ -626,13 +680,11 @@ static int commission_link(struct app *a)
 			      a->err, sizeof(a->err)))
 		return fail(a, a->err);
 	a->ctl_ours = 1;
-	progress(a, "controller %s, serial %ld", a->info.model,
-		 a->info.serial);
+	progress(a, "controller %s, serial %ld", a->info.model, a->info.serial);
 	re_plan_make(&a->cfg, 0, &a->plan);
 	progress(a, "halting the controller program; every motor off");
 	if (re_ctl_halt(&a->io, a->err, sizeof(a->err)) ||
-	    re_ctl_configure(&a->io, &a->cfg, &a->plan, a->err,
-			     sizeof(a->err)))
+	    re_ctl_configure(&a->io, &a->cfg, &a->plan, a->err, sizeof(a->err)))
 		return fail(a, a->err);
 	progress(a, "controller configured and read back; motor power off");
 	return 0;

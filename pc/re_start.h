@@ -28,11 +28,11 @@
 #include "re_super.h"
 
 /* roboelf's exit codes (roboelf.1). */
-#define EXIT_USAGE     2
-#define EXIT_CONNECT   3
-#define EXIT_FAULT     4
+#define EXIT_USAGE	2
+#define EXIT_CONNECT	3
+#define EXIT_FAULT	4
 #define EXIT_COMMISSION 5 /* the commissioning run found a fault */
-#define DEFAULT_CONFIG "config/roboelf.yaml"
+#define DEFAULT_CONFIG	"config/roboelf.yaml"
 
 struct opts {
 	const char *config;
@@ -41,8 +41,10 @@ struct opts {
 	const char *log;
 	const char *show_cal;
 	const char *commission; /* report directory */
-	int wait_s;		/* commissioning: each wait for the technician */
-	int period_ms; /* 0: from the configuration */
+	int wait_s;	       /* commissioning: each wait for the technician */
+	const char *find_addr; /* commissioning: discovery probe address */
+	int find_port;	       /* and its port (0: the defaults) */
+	int period_ms;	       /* 0: from the configuration */
 	enum re_calib_choice calib;
 };
 

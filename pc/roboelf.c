@@ -125,6 +125,9 @@ static void usage(FILE *f)
 	    "in DIR\n"
 	    "      --wait S             commissioning: each wait for the "
 	    "technician (60 s)\n"
+	    "      --find-addr A, --find-port P  commissioning: where the "
+	    "discovery probe goes\n"
+	    "                           (255.255.255.255, 50000)\n"
 	    "  -h, --help               this text\n"
 	    "\n"
 	    "exit: 0 quit, 2 usage/config, 3 no relay/controller, "
@@ -165,6 +168,13 @@ static int opt_value(struct opts *o, int c, const char *arg)
 	case 'l': o->log = arg; return 0;
 	case 's': o->show_cal = arg; return 0;
 	case 'M': o->commission = arg; return 0;
+	case 'F': o->find_addr = arg; return 0;
+	case 'P':
+		o->find_port = atoi(arg);
+		if (o->find_port >= 1 && o->find_port <= 65535)
+			return 0;
+		fprintf(stderr, "roboelf: error: invalid port '%s'\n", arg);
+		return -1;
 	case 'W':
 		o->wait_s = atoi(arg);
 		if (o->wait_s >= 1 && o->wait_s <= 3600)
@@ -207,6 +217,8 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 	    {"show-calibration", required_argument, NULL, 's'},
 	    {"commission", required_argument, NULL, 'M'},
 	    {"wait", required_argument, NULL, 'W'},
+	    {"find-addr", required_argument, NULL, 'F'},
+	    {"find-port", required_argument, NULL, 'P'},
 	    {"help", no_argument, NULL, 'h'},
 	    {NULL, 0, NULL, 0},
 	};
@@ -334,8 +346,9 @@ static void retry_log(struct app *a, int64_t *next_ns)
 		return;
 	*next_ns = now + 1000000000LL;
 	if (re_super_retry(a->sup) == GL_OK)
-		re_console_msg(&a->con, "roboelf: the log '%s' is written "
-					"again",
+		re_console_msg(&a->con,
+			       "roboelf: the log '%s' is written "
+			       "again",
 			       a->cfg.log.path);
 	else
 		re_console_msg(&a->con,
@@ -374,10 +387,10 @@ static void run(struct app *a)
 	    "late p50=%.3f p99=%.3f max=%.3f ms; reply age worst=%.1f ms; "
 	    "status frames dropped=%llu",
 	    (unsigned long long)a->sup->cycles,
-	    (unsigned long long)a->sup->overruns,
-	    ms_of_ns(a->sup->period_ns), re_super_late_ms(a->sup, 50),
-	    re_super_late_ms(a->sup, 99), re_super_late_ms(a->sup, 100),
-	    ms_of_ns(a->sup->age_worst_ns), (unsigned long long)a->con.dropped);
+	    (unsigned long long)a->sup->overruns, ms_of_ns(a->sup->period_ns),
+	    re_super_late_ms(a->sup, 50), re_super_late_ms(a->sup, 99),
+	    re_super_late_ms(a->sup, 100), ms_of_ns(a->sup->age_worst_ns),
+	    (unsigned long long)a->con.dropped);
 }
 
 /* Power-off, the reverse of power-on: the program back to its safe
@@ -399,8 +412,9 @@ static void power_off(struct app *a, int latched)
 	gl_link_close(a->real.link);
 	a->real.link = NULL;
 	if (!a->powered) {
-		re_console_msg(&a->con, "roboelf: motor power was never "
-					"switched on; %s",
+		re_console_msg(&a->con,
+			       "roboelf: motor power was never "
+			       "switched on; %s",
 			       latched ? "a fault was latched" : "bye");
 		re_log_msg(&a->log, RE_LOG_INFO, "stop: motor power never on");
 		return;
@@ -538,8 +552,8 @@ static int comm_steps(struct app *a)
 	re_console_msg(&a->con, "commission: %s", line);
 	re_log_msg(&a->log, rc ? RE_LOG_WARN : RE_LOG_INFO, "commission: %s",
 		   line);
-	if (re_comm_report(&c, &w, a->o.commission, &plots, err,
-			   sizeof(err)) != GL_OK) {
+	if (re_comm_report(&c, &w, a->o.commission, &plots, err, sizeof(err)) !=
+	    GL_OK) {
 		re_console_msg(&a->con, "roboelf: error: %s", err);
 		return EXIT_CONNECT;
 	}

@@ -658,6 +658,44 @@ int gl_link_identify(gl_link *l, char *model, size_t cap, long *serial)
 	return GL_OK;
 }
 
+enum gl_ctrl_kind gl_link_ctrl_kind(const char *cmd)
+{
+	size_t i, n = strlen(cmd);
+	enum gl_ctrl_kind k = GL_CTRL_NONE;
+
+	if (n >= 2 && cmd[0] == 0x12 && cmd[1] == 0x16)
+		k = n == 2 ? GL_CTRL_REVISION : GL_CTRL_OTHER;
+	else if (n >= 2 && cmd[0] == 0x12 && cmd[1] == 0x13)
+		k = n == 2 ? GL_CTRL_RESET : GL_CTRL_OTHER;
+	else if (n >= 2 && cmd[0] == 0x0c && cmd[1] == 0x0b)
+		k = GL_CTRL_LOCK;
+	for (i = k == GL_CTRL_NONE ? 0 : 2; i < n; i++)
+		if ((unsigned char)cmd[i] < 0x20 ||
+		    (unsigned char)cmd[i] > 0x7e)
+			return GL_CTRL_OTHER;
+	return k;
+}
+
+int gl_link_ctrl_request(gl_link *l, const char *req, char *resp, size_t cap,
+			 int timeout_ms)
+{
+	struct xfer x = {.line = req, .n_term = 1};
+	struct gl_reply r;
+	int rc, t = l ? pick_timeout(l, timeout_ms) : GL_ERR_ARG;
+
+	if (!l || !req || t < 0 || strlen(req) > GL_LINE_MAX ||
+	    gl_link_ctrl_kind(req) <= GL_CTRL_NONE)
+		return GL_ERR_ARG;
+	ctrl_clear(l);
+	x.len = strlen(req);
+	rc = xfer(l, &l->cmd, &x, t, &r);
+	if (rc < 0)
+		return rc;
+	if (r.n_err)
+		return fetch_tc1(l);
+	return text_out(&r, resp, cap);
+}
+
 /* ---- download / upload --------------------------------------------------- */
 
 /* Length of the line at @p (up to CR or LF) and of its line end. */
@@ -704,7 +742,8 @@ static int dl_validate(const char *prog, size_t len, int *bad_line)
  */
 static int dl_early_reject(gl_link *l, struct gl_reply *r, bool *done)
 {
-	int64_t deadline = l->dl_pace_ms > 0 ? base_now_ms() + l->dl_pace_ms : -1;
+	int64_t deadline =
+	    l->dl_pace_ms > 0 ? base_now_ms() + l->dl_pace_ms : -1;
 	int rc, n_err = 0;
 
 	rc = chan_read(l, &l->cmd, deadline);

@@ -99,6 +99,37 @@ int gl_link_record(gl_link *l, const char *prefix, struct gl_record *rec,
 		   int timeout_ms);
 
 /*
+ * gl_link_ctrl_request() - send a control-character request of the command
+ * reference and read its reply: ^R^V (0x12 0x16, firmware revision), ^R^S
+ * (0x12 0x13, master reset) or ^L^K (0x0C 0x0B, lock; printable arguments
+ * may follow, e.g. " ?"). Policy (which of them a program may send) is the
+ * caller's; see gl_link_ctrl_kind().
+ * @req: the request bytes, NUL-terminated, at most GL_LINE_MAX bytes.
+ * @resp, @cap, @timeout_ms: as for gl_link_command().
+ * Return: as for gl_link_command(); GL_ERR_ARG (nothing sent) for anything
+ *         that is not one of the requests above.
+ */
+int gl_link_ctrl_request(gl_link *l, const char *req, char *resp, size_t cap,
+			 int timeout_ms);
+
+/* The control-character requests of the command reference. */
+enum gl_ctrl_kind {
+	GL_CTRL_NONE = 0,     /* no control character at all */
+	GL_CTRL_REVISION = 1, /* ^R^V alone */
+	GL_CTRL_RESET = 2,    /* ^R^S alone: master reset (erases EEPROM) */
+	GL_CTRL_LOCK = 3,     /* ^L^K, then printable arguments */
+	GL_CTRL_OTHER = -1,   /* a control byte anywhere else */
+};
+
+/*
+ * gl_link_ctrl_kind() - classify @cmd (NUL-terminated): which control-
+ * character request it is (pure, no I/O). A command without control bytes
+ * is GL_CTRL_NONE; a control byte that is not the start of one of the three
+ * requests (or ^R^V / ^R^S followed by anything) is GL_CTRL_OTHER.
+ */
+enum gl_ctrl_kind gl_link_ctrl_kind(const char *cmd);
+
+/*
  * gl_link_query_layout() - send QZ and remember the record layout.
  * Return: GL_OK or an error as for gl_link_command().
  */

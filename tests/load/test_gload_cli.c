@@ -285,18 +285,25 @@ static void test_project_dmc(void **state)
 	proc_kill(&p);
 }
 
-/* Nobody listening: exit 3 with the reason. */
+/* Nobody listening: exit 3 with the reason, and the (here empty) list of
+ * controllers that answer the discovery probe, sent to loopback. */
 static void test_connection_refused(void **state)
 {
-	char addr[32], want[128];
-	const char *args[] = {"-a", addr, "-c", "MG 1", NULL};
+	char addr[32], port[16], want[512];
+	const char *args[] = {"-a",	   addr,	  "--find-addr",
+			      "127.0.0.1", "--find-port", port,
+			      "-c",	   "MG 1",	  NULL};
 	struct proc p;
 
 	(void)state;
 	snprintf(addr, sizeof(addr), "127.0.0.1:%d", closed_port());
+	snprintf(port, sizeof(port), "%d", closed_port());
 	snprintf(want, sizeof(want),
-		 "galil-load: cannot connect to '%s': Connection refused\n",
-		 addr);
+		 "galil-load: cannot connect to '%s': Connection refused\n"
+		 "galil-load: Galil controllers that answer on this network:\n"
+		 "galil-load: no Galil controller answered the discovery "
+		 "probe (UDP 127.0.0.1:%s) within 1000 ms\n",
+		 addr, port);
 	assert_int_equal(run(&p, args), 3);
 	assert_string_equal(proc_output(&p, PROC_STDERR), want);
 	proc_kill(&p);

@@ -12,7 +12,7 @@
  * faults; test_gload_stub.c uses it for what it offers.
  *
  * How the fake differs from a DMC-4030: one connection at a time; it knows
- * only ^R^V, MG _BN, QZ, MG _XQn, MG _BGx, MG _MOx, HXn, ST, MO (refused
+ * only ^R^V, MG _BN, QZ, MG _XQn, MG _BGx, MG _MOx, HXn, ST, AB 1, MO (refused
  * with TC 7 while an axis moves), DL, UL, BP, XQ #L,0, TC1, "x=n"/"MG x"
  * for one variable, any other "name=n" (accepted, forgotten), and MG state
  * / MG hbpc when a supervisor is simulated (hbpc advancing); a rejected DL
@@ -57,10 +57,11 @@ struct fake {
 	int corrupt_ul;	    /* the first UL after a DL differs */
 	int stuck_thread;   /* this thread ignores HX (-1: none) */
 	int reject_bp;
-	int xq_no_run; /* XQ answers ':' but the thread stays off */
-	int supervised; /* the RoboELF program runs armed, hbpc advancing */
+	int xq_no_run;	  /* XQ answers ':' but the thread stays off */
+	int supervised;	  /* the RoboELF program runs armed, hbpc advancing */
 	int moving_polls; /* after ST, MG _BGA answers 1 this many times */
 	int jogging;	  /* axis A moves until ST */
+	int st_ignored;	  /* ST does not stop axis A (AB 1 does) */
 	/* state */
 	char prog[PROG_CAP]; /* lines, each ending in '\n' */
 	size_t prog_len;
@@ -184,9 +185,12 @@ static void fk_command(int fd, const char *cmd)
 	else if (!strcmp(cmd, "QZ"))
 		fk_send(fd, " 3, 52, 26, 36\r\n:");
 	else if (!strcmp(cmd, "ST"))
+		fk.jogging = fk.jogging && fk.st_ignored, fk_send(fd, ":");
+	else if (!strcmp(cmd, "AB 1"))
 		fk.jogging = 0, fk_send(fd, ":");
 	else if (sscanf(cmd, "MG _BG%c", &c) == 1 && c >= 'A' && c <= 'C')
-		fk_number(fd, c == 'A' && (fk.jogging || fk.moving_polls-- > 0));
+		fk_number(fd,
+			  c == 'A' && (fk.jogging || fk.moving_polls-- > 0));
 	else if (!strcmp(cmd, "MO") && (fk.jogging || fk.moving_polls > 0))
 		fk_reject(fd, 7, "Command not valid while running");
 	else if (!strcmp(cmd, "MO"))
@@ -408,7 +412,7 @@ static void dl_lines(char *out, size_t cap, const char *prog)
 /* The halt: prun=0, every thread, ST, every axis stopped, MO, every motor
  * read back off, no thread running (the axes from QZ). */
 #define HALT_CMDS                                                              \
-	"QZ\nprun=0\nHX0\nHX1\nHX2\nHX3\nHX4\nHX5\nHX6\nHX7\nST\n"            \
+	"QZ\nprun=0\nHX0\nHX1\nHX2\nHX3\nHX4\nHX5\nHX6\nHX7\nST\n"             \
 	"MG _BGA\nMG _BGB\nMG _BGC\nMO\nMG _MOA\nMG _MOB\nMG _MOC\n"           \
 	"MG _XQ0\nMG _XQ1\nMG _XQ2\nMG _XQ3\nMG _XQ4\nMG _XQ5\nMG _XQ6\n"      \
 	"MG _XQ7\n"
@@ -697,8 +701,9 @@ static void test_busy_refused(void **state)
 	assert_int_equal(fk.downloads, 0);
 	proc_kill(&p);
 	assert_int_equal(run(&p, force), 0);
-	assert_true(has(&p, PROC_STDOUT, "warning: --force: halting a program "
-					 "that roboelf drives (armed)"));
+	assert_true(has(&p, PROC_STDOUT,
+			"warning: --force: halting a program "
+			"that roboelf drives (armed)"));
 	assert_int_equal(fk.running[0], 0);
 	assert_int_equal(fk.motors_on, 0);
 	assert_int_equal(fk.downloads, 1);
@@ -732,6 +737,35 @@ static void test_load_while_jogging(void **state)
 	proc_kill(&p);
 }
 
+/* Axis A keeps moving after ST (st_ignored) past --stop-wait: galil-load
+ * aborts it (AB 1), switches the motors off, names the axis, exits 4 and
+ * downloads nothing. */
+static void test_axis_not_stopping(void **state)
+{
+	static const char *const args[] = {"--stop-wait", "200",
+					   GOOD "clean.dmc", NULL};
+	struct proc p;
+
+	(void)state;
+	fk.jogging = 1;
+	fk.st_ignored = 1;
+	fk.motors_on = 1;
+	assert_int_equal(run(&p, args), 4);
+	assert_string_equal(proc_output(&p, PROC_STDERR),
+			    "galil-load: axis A still moving 200 ms after "
+			    "'ST': aborted it (AB 1) and switched the motors "
+			    "off; nothing downloaded (see --stop-wait)\n");
+	pthread_mutex_lock(&fk.mu);
+	assert_non_null(strstr(fk.log, "MG _BGC\nAB 1\nMG _BGA\nMG _BGB\n"
+				       "MG _BGC\nMO\nMG _MOA\n"));
+	assert_null(strstr(fk.log, "DL\n"));
+	assert_null(strstr(fk.log, "UL\n"));
+	pthread_mutex_unlock(&fk.mu);
+	assert_int_equal(fk.motors_on, 0);
+	assert_int_equal(fk.downloads, 0);
+	proc_kill(&p);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -753,6 +787,8 @@ int main(void)
 	    cmocka_unit_test_setup_teardown(test_busy_refused, fk_start,
 					    fk_stop),
 	    cmocka_unit_test_setup_teardown(test_load_while_jogging, fk_start,
+					    fk_stop),
+	    cmocka_unit_test_setup_teardown(test_axis_not_stopping, fk_start,
 					    fk_stop),
 	};
 

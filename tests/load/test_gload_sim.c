@@ -5,7 +5,7 @@
  * verified as roboelf does at start-up; a second load found unchanged; a
  * running program halted before a forced reload; --burn then a power cycle
  * runs #AUTO (and without --burn the power cycle leaves nothing); -c round
- * trips and a rejected command.
+ * trips and a rejected command; ^R^V through -c; a load while an axis jogs.
  *
  * Needs $ROBOELF_BIN/galil-sim and galil-load. One simulator per test,
  * started with --port 0 --control-port 0, killed by pid.
@@ -276,6 +276,86 @@ static void test_commands(void **state)
 	sim_stop(&c);
 }
 
+/* The firmware revision request ^R^V (0x12 0x16, command reference ^R^V)
+ * goes through -c and prints the reply exactly; ^R^S (master reset) and
+ * other control bytes are refused before anything is sent (exit 2). */
+static void test_ctrl_requests(void **state)
+{
+	static const char *const rv[] = {"-c", "\x12\x16", NULL};
+	static const char *const rs[] = {"-c", "\x12\x13", NULL};
+	static const char *const other[] = {"-c", "MG 1\x01", NULL};
+	struct simctx c;
+	struct proc p;
+
+	(void)state;
+	sim_start(&c);
+	assert_int_equal(run(&p, &c, rv), 0);
+	assert_string_equal(proc_output(&p, PROC_STDOUT),
+			    "DMC4030 Rev 1.2h-sim\n");
+	assert_string_equal(proc_output(&p, PROC_STDERR), "");
+	proc_kill(&p);
+	assert_int_equal(run(&p, &c, rs), 2);
+	assert_true(has(&p, PROC_STDERR,
+			"galil-load: '^R^S' (master reset: erases the "
+			"controller's EEPROM and its IP address) is not sent "
+			"by galil-load\n"));
+	proc_kill(&p);
+	assert_int_equal(run(&p, &c, other), 2);
+	assert_true(
+	    has(&p, PROC_STDERR,
+		"galil-load: 'MG 1^A' holds a control character: only "
+		"the requests ^R^V and '^L^K ?' may be sent with -c\n"));
+	proc_kill(&p);
+	sim_stop(&c);
+}
+
+/* An axis jogs when galil-load comes (galil-sim refuses MO while its
+ * profiler runs, TC 7, as the command reference MO says): galil-load
+ * stops it, waits, switches the motors off and loads; afterwards the axis
+ * is at rest, every motor off, the program verified. */
+static void test_load_while_jogging(void **state)
+{
+	static const char *const args[] = {GOOD "clean.dmc", NULL};
+	struct simctx c;
+	struct proc p;
+	gl_link *l;
+	char resp[64];
+	double v;
+
+	(void)state;
+	sim_start(&c);
+	l = sim_link(&c);
+	assert_true(gl_link_command(l, "SH ABC", resp, sizeof(resp), 2000) >=
+		    0);
+	assert_true(gl_link_command(l, "JG 20000", resp, sizeof(resp), 2000) >=
+		    0);
+	assert_true(gl_link_command(l, "BG A", resp, sizeof(resp), 2000) >= 0);
+	/* the simulator's MO refusal this test relies on */
+	assert_int_equal(gl_link_command(l, "MO", resp, sizeof(resp), 2000),
+			 GL_ERR_CTRL);
+	assert_string_equal(gl_link_ctrl_error(l, NULL),
+			    "Command not valid while running");
+	gl_link_close(l);
+	assert_int_equal(sim_query(&c, "MG _BGA", &v), GL_OK);
+	assert_true(v == 1);
+	assert_int_equal(run(&p, &c, args), 0);
+	assert_true(has(&p, PROC_STDOUT,
+			"halted: threads stopped, axes stopped, motors off\n"
+			"downloading 19 lines to "));
+	assert_true(has(&p, PROC_STDOUT,
+			"verified: the read-back matches, "
+			"identity 32DC74A870EEBF04\n"));
+	assert_string_equal(proc_output(&p, PROC_STDERR), "");
+	proc_kill(&p);
+	assert_int_equal(sim_query(&c, "MG _BGA", &v), GL_OK);
+	assert_true(v == 0);
+	assert_int_equal(sim_query(&c, "MG _TVA", &v), GL_OK);
+	assert_true(v == 0);
+	assert_int_equal(sim_query(&c, "MG _MOA+_MOB+_MOC", &v), GL_OK);
+	assert_true(v == 3);
+	sim_stop(&c);
+}
+
 /* A controller that stops answering (control port "link stall"): exit 3
  * after the command timeout; answering again ("link ok"): exit 0. */
 static void test_stalled(void **state)
@@ -310,6 +390,8 @@ int main(void)
 	    cmocka_unit_test(test_burn_power_cycle),
 	    cmocka_unit_test(test_commands),
 	    cmocka_unit_test(test_stalled),
+	    cmocka_unit_test(test_ctrl_requests),
+	    cmocka_unit_test(test_load_while_jogging),
 	};
 
 	return cmocka_run_group_tests(tests, setup_group, NULL);

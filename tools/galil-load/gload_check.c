@@ -18,7 +18,6 @@
  * smaller commonly quoted values are used. Threads [3.4].
  */
 
-
 /* Axis letters after a command ("KPA=10"). */
 static const char axis_letters[] = "ABCDEFGHSTWXYZ";
 

@@ -47,7 +47,6 @@ static int send_simple(gl_link *l, const char *cmd, int timeout_ms)
 	return rc < 0 ? rc : GL_OK;
 }
 
-
 int gload_dl_busy(gl_link *l, int watch_ms, int *state, int timeout_ms)
 {
 	double xq = -1, st = -1, hb0 = 0, hb1 = 0;
@@ -69,7 +68,8 @@ int gload_dl_busy(gl_link *l, int watch_ms, int *state, int timeout_ms)
 	return 1;
 }
 
-/* Every profiler stopped (_BGx = 0), waited for at most @stop_ms. */
+/* Every profiler stopped (_BGx = 0), waited for at most @stop_ms; on
+ * GL_ERR_TIMEOUT @failed names the first axis still moving ("MG _BGB"). */
 static int wait_stopped(gl_link *l, int axes, int stop_ms,
 			char failed[GLOAD_CMD_LEN], int timeout_ms)
 {
@@ -78,18 +78,44 @@ static int wait_stopped(gl_link *l, int axes, int stop_ms,
 	int i, rc, moving;
 
 	do {
-		moving = 0;
+		moving = -1;
 		for (i = 0; i < axes; i++) {
-			snprintf(failed, GLOAD_CMD_LEN, "MG _BG%c", 'A' + i);
-			rc = gload_query_number(l, failed, &bg, timeout_ms);
-			if (rc)
+			char cmd[GLOAD_CMD_LEN];
+
+			snprintf(cmd, sizeof(cmd), "MG _BG%c", 'A' + i);
+			rc = gload_query_number(l, cmd, &bg, timeout_ms);
+			if (rc) {
+				memcpy(failed, cmd, sizeof(cmd));
 				return rc;
-			moving |= bg != 0;
+			}
+			if (bg != 0 && moving < 0) {
+				moving = i;
+				memcpy(failed, cmd, sizeof(cmd));
+			}
 		}
-		if (moving)
+		if (moving >= 0)
 			base_sleep_ms(10);
-	} while (moving && base_now_ms() < end);
-	return moving ? GL_ERR_TIMEOUT : GL_OK;
+	} while (moving >= 0 && base_now_ms() < end);
+	return moving >= 0 ? GL_ERR_TIMEOUT : GL_OK;
+}
+
+/* An axis still moves @stop_ms after ST: AB 1 ends the motion at once (the
+ * program threads are already halted), then wait again for the profilers.
+ * @failed keeps the axis that did not stop. */
+static int abort_motion(gl_link *l, int axes, int stop_ms,
+			char failed[GLOAD_CMD_LEN], int timeout_ms)
+{
+	char axis[GLOAD_CMD_LEN];
+	int rc;
+
+	memcpy(axis, failed, sizeof(axis));
+	snprintf(failed, GLOAD_CMD_LEN, "AB 1");
+	rc = send_simple(l, failed, timeout_ms);
+	if (!rc)
+		rc = wait_stopped(l, axes, stop_ms, failed, timeout_ms);
+	if (!rc)
+		memcpy(failed, axis, sizeof(axis));
+	return rc;
 }
 
 /* Motors off (MO: never while a profiler runs) and read back off. */
@@ -112,11 +138,12 @@ static int motors_off(gl_link *l, int axes, int *running,
 	return rc;
 }
 
-int gload_dl_halt(gl_link *l, int threads, int axes, int stop_ms,
-		  int *running, char failed[GLOAD_CMD_LEN], int timeout_ms)
+int gload_dl_halt(gl_link *l, int threads, int axes, int stop_ms, int *running,
+		  char failed[GLOAD_CMD_LEN], int timeout_ms)
 {
+	char axis[GLOAD_CMD_LEN];
 	double xq;
-	int i, rc;
+	int i, rc, late = 0;
 
 	/* a controller without the RoboELF program makes prun a variable */
 	snprintf(failed, GLOAD_CMD_LEN, "prun=0");
@@ -133,8 +160,10 @@ int gload_dl_halt(gl_link *l, int threads, int axes, int stop_ms,
 	if (!rc)
 		rc = wait_stopped(l, axes, stop_ms, failed, timeout_ms);
 	if (rc == GL_ERR_TIMEOUT) {
-		snprintf(failed, GLOAD_CMD_LEN, "AB 1");
-		rc = send_simple(l, failed, timeout_ms);
+		rc = abort_motion(l, axes, stop_ms, failed, timeout_ms);
+		late = rc == GL_OK;
+		if (late)
+			memcpy(axis, failed, sizeof(axis));
 	}
 	if (!rc)
 		rc = motors_off(l, axes, running, failed, timeout_ms);
@@ -145,6 +174,12 @@ int gload_dl_halt(gl_link *l, int threads, int axes, int stop_ms,
 			*running = i;
 			rc = GL_ERR_MISMATCH;
 		}
+	}
+	if (!rc && late) {
+		/* halted, but an axis did not stop after ST in time */
+		memcpy(failed, axis, sizeof(axis));
+		*running = GLOAD_HALT_LATE;
+		return GL_ERR_MISMATCH;
 	}
 	if (!rc)
 		failed[0] = '\0';

@@ -56,26 +56,35 @@ int gload_query_number(gl_link *l, const char *cmd, double *v, int timeout_ms);
  */
 int gload_dl_busy(gl_link *l, int watch_ms, int *state, int timeout_ms);
 
+/* gload_dl_halt()'s *running when an axis did not stop in time. */
+#define GLOAD_HALT_LATE (-2)
+
 /*
  * gload_dl_halt() - make the controller safe to load: prun=0 (the RoboELF
  * program's automatic routines then only make safe: docs/dmc-interface.md),
  * stop every program thread (HX0..HXn-1), stop the axes (ST, decelerating),
- * wait until no profiler runs (_BGx = 0 on every axis, at most
- * @stop_ms; past that AB 1 ends the motion at once), switch the motors off
- * (MO: the controller refuses it while an axis moves, "7 Command not
- * valid while running") and read every motor back off (_MOx = 1); then
- * confirm with MG _XQn that no thread runs.
+ * wait until no profiler runs (_BGx = 0 on every axis, at most @stop_ms),
+ * switch the motors off (MO: the controller refuses it while an axis
+ * moves, command reference MO "Not Valid while in motion", TC 7) and read
+ * every motor back off (_MOx = 1); then confirm with MG _XQn that no thread
+ * runs. An axis still moving @stop_ms after ST is stopped at once (AB 1,
+ * motion only), waited for again, the motors switched off, and the halt
+ * fails (GLOAD_HALT_LATE): something kept it moving, so nothing is loaded.
  * @threads: number of threads of the model (8 on a DMC-40x0).
  * @axes: number of axes to stop and read back (3 on a DMC-4030).
- * @running: [out] on GL_ERR_MISMATCH, the thread still running, or -1
- *           when a motor is still on.
+ * @stop_ms: how long the axes may take to stop after ST.
+ * @running: [out] on GL_ERR_MISMATCH, the thread still running (>= 0), -1
+ *           when a motor is still on, GLOAD_HALT_LATE when an axis did not
+ *           stop after ST within @stop_ms (@failed is then "MG _BGx" of the
+ *           first such axis).
  * @failed: [out] the command that failed (or found the thread running),
  *          e.g. "MG _XQ3"; GLOAD_CMD_LEN bytes.
- * Return: GL_OK, GL_ERR_MISMATCH, or a link error (GL_ERR_CTRL: see
+ * Return: GL_OK, GL_ERR_MISMATCH, GL_ERR_TIMEOUT (an axis still moves even
+ *         after AB 1; @failed names it), or a link error (GL_ERR_CTRL: see
  *         gl_link_ctrl_error()).
  */
-int gload_dl_halt(gl_link *l, int threads, int axes, int stop_ms,
-		  int *running, char failed[GLOAD_CMD_LEN], int timeout_ms);
+int gload_dl_halt(gl_link *l, int threads, int axes, int stop_ms, int *running,
+		  char failed[GLOAD_CMD_LEN], int timeout_ms);
 
 /*
  * gload_dl_compare() - compare the program meant (@want) with the one read

@@ -17,6 +17,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "gl_disc.h"
 #include "gl_err.h"
 #include "gl_link.h"
 #include "gload_check.h"
@@ -24,9 +25,11 @@
 #include "gload_prep.h"
 
 #define DEFAULT_TIMEOUT_MS 5000 /* gclib's default [galil-notes 1.6] */
-#define STOP_MS		   3000 /* every axis stopped after ST within */
+#define STOP_MS		   3000 /* default --stop-wait: axes stopped after ST */
 #define BUSY_WATCH_MS	   250	/* a supervisor's heartbeat changes within */
 #define MAX_COMMANDS	   64
+#define FIND_MS		   1000 /* discovery window (GAddresses: about 1 s) */
+#define FIND_MAX	   32
 
 struct opts {
 	const char *addr;
@@ -36,6 +39,11 @@ struct opts {
 	int start;
 	int force;
 	int timeout_ms;
+	int stop_ms;
+	int timeout_set;
+	int find;
+	const char *find_addr;
+	int find_port;
 	char start_label[DMC_LABEL_MAX + 1];
 	const char *output;
 	const char *cmds[MAX_COMMANDS];
@@ -64,6 +72,17 @@ static const char usage_text[] =
     "                             after any download)\n"
     "  -t, --timeout MS           reply timeout (default 5000; DL, UL and BP\n"
     "                             take at least 10000)\n"
+    "      --stop-wait MS         how long the axes may take to stop after ST\n"
+    "                             before loading (default 3000); an axis\n"
+    "                             still moving then is aborted and nothing\n"
+    "                             is loaded\n"
+    "      --find                 list the Galil controllers that answer on\n"
+    "                             the local network (-t MS: how long to\n"
+    "                             listen, default 1000); also offered when\n"
+    "                             -a does not answer\n"
+    "      --find-addr ADDR       where the discovery probe goes (default\n"
+    "                             255.255.255.255)\n"
+    "      --find-port PORT       its UDP port (default 50000)\n"
     "  -h, --help                 this text\n"
     "\n"
     "A DIR is loaded through DIR/MANIFEST (one file name per line, '#'\n"
@@ -121,15 +140,65 @@ static int set_start_label(struct opts *o, const char *arg)
 	return 0;
 }
 
+/* @c with control bytes shown in caret notation (0x12 -> "^R"). */
+static const char *shown(const char *c, char out[2 * GL_LINE_MAX + 8])
+{
+	size_t o = 0;
+
+	for (; *c && o < 2 * GL_LINE_MAX + 4; c++) {
+		unsigned char b = (unsigned char)*c;
+
+		if (b < 0x20 || b == 0x7f) {
+			out[o++] = '^';
+			out[o++] = (char)(b ^ 0x40);
+		} else {
+			out[o++] = (char)b;
+		}
+	}
+	out[o] = '\0';
+	return out;
+}
+
+/* A control-character request: ^R^V, or ^L^K ? (the lock state); the
+ * others change the controller (command reference ^R^S, ^L^K). */
+static int check_ctrl_request(const char *cmd, enum gl_ctrl_kind k)
+{
+	char sh[2 * GL_LINE_MAX + 8];
+	const char *a = cmd + 2;
+
+	while (*a == ' ')
+		a++;
+	if (k == GL_CTRL_REVISION || (k == GL_CTRL_LOCK && !strcmp(a, "?")))
+		return 0;
+	if (k == GL_CTRL_RESET)
+		return usage_error("'^R^S' (master reset: erases the "
+				   "controller's EEPROM and its IP address) "
+				   "is not sent by galil-load");
+	if (k == GL_CTRL_LOCK)
+		return usage_error("'%s': only '^L^K ?' (is the program "
+				   "locked?) may be sent with -c",
+				   shown(cmd, sh));
+	return usage_error("'%s' holds a control character: only the "
+			   "requests ^R^V and '^L^K ?' may be sent with -c",
+			   shown(cmd, sh));
+}
+
 static int add_command(struct opts *o, const char *cmd)
 {
 	static const char *const refused[] = {"DL", "UL", "ED",
 					      "QD", "QU", "QR"};
+	enum gl_ctrl_kind k = gl_link_ctrl_kind(cmd);
 	size_t i;
 
 	if (o->ncmds == MAX_COMMANDS)
 		return usage_error("too many -c commands (at most %d)",
 				   MAX_COMMANDS);
+	if (k != GL_CTRL_NONE && check_ctrl_request(cmd, k))
+		return GLOAD_EXIT_USAGE;
+	if (k != GL_CTRL_NONE) {
+		o->cmds[o->ncmds++] = cmd;
+		return 0;
+	}
 	if (strlen(cmd) == 0 || strlen(cmd) > GL_LINE_MAX)
 		return usage_error("command '%s' is empty or longer than 80 "
 				   "characters",
@@ -145,7 +214,16 @@ static int add_command(struct opts *o, const char *cmd)
 	return 0;
 }
 
-enum { OPT_CHECK = 256, OPT_BURN, OPT_START, OPT_NO_START };
+enum {
+	OPT_CHECK = 256,
+	OPT_BURN,
+	OPT_START,
+	OPT_NO_START,
+	OPT_STOP_WAIT,
+	OPT_FIND,
+	OPT_FIND_ADDR,
+	OPT_FIND_PORT
+};
 
 static const struct option long_opts[] = {
     {"address", required_argument, NULL, 'a'},
@@ -158,6 +236,10 @@ static const struct option long_opts[] = {
     {"no-start", no_argument, NULL, OPT_NO_START},
     {"command", required_argument, NULL, 'c'},
     {"timeout", required_argument, NULL, 't'},
+    {"stop-wait", required_argument, NULL, OPT_STOP_WAIT},
+    {"find", no_argument, NULL, OPT_FIND},
+    {"find-addr", required_argument, NULL, OPT_FIND_ADDR},
+    {"find-port", required_argument, NULL, OPT_FIND_PORT},
     {"help", no_argument, NULL, 'h'},
     {NULL, 0, NULL, 0},
 };
@@ -181,8 +263,21 @@ static int parse_opt(struct opts *o, int ch, const char *arg)
 					      "41x3, 21x3, 30010)",
 					      arg);
 	case 't':
+		o->timeout_set = 1;
 		return parse_int(arg, 1, 600000, &o->timeout_ms)
 			   ? usage_error("invalid timeout '%s' (1..600000 "
+					 "ms)",
+					 arg)
+			   : 0;
+	case OPT_FIND: o->find = 1; return 0;
+	case OPT_FIND_ADDR: o->find_addr = arg; return 0;
+	case OPT_FIND_PORT:
+		return parse_int(arg, 1, 65535, &o->find_port)
+			   ? usage_error("invalid --find-port '%s'", arg)
+			   : 0;
+	case OPT_STOP_WAIT:
+		return parse_int(arg, 1, 60000, &o->stop_ms)
+			   ? usage_error("invalid --stop-wait '%s' (1..60000 "
 					 "ms)",
 					 arg)
 			   : 0;
@@ -208,6 +303,11 @@ static int check_combination(const struct opts *o)
 				   "--burn, --start and -o need program "
 				   "files (only a checked program is burned or "
 				   "started)");
+	if (o->find && (o->npaths || o->ncmds || o->addr || o->check_only))
+		return usage_error("%s", "--find only lists controllers; give "
+					 "it no -a, -c, --check or files");
+	if (o->find)
+		return 0;
 	if (o->npaths == 0 && o->ncmds == 0)
 		return usage_error("%s", "no program files and no commands");
 	if (!o->check_only && !o->addr)
@@ -224,6 +324,9 @@ static int parse_args(int argc, char **argv, struct opts *o)
 	memset(o, 0, sizeof(*o));
 	o->model = dmc_model_default();
 	o->timeout_ms = DEFAULT_TIMEOUT_MS;
+	o->stop_ms = STOP_MS;
+	o->find_addr = GL_DISC_BCAST;
+	o->find_port = GL_DISC_PORT;
 	opterr = 0;
 	while ((ch = getopt_long(argc, argv, ":a:m:o:fc:t:h", long_opts,
 				 NULL)) != -1) {
@@ -370,6 +473,56 @@ static int open_link(const struct opts *o, gl_link **l)
 	return 0;
 }
 
+/* Probe the network; print what answered to @f. Return the number found
+ * (>= 0) or -1 (the message is printed). */
+static int find(const struct opts *o, struct gl_disc_ctrl *list, FILE *f)
+{
+	char err[GL_ERRTEXT_LEN] = "";
+	int i, ms = o->find && o->timeout_set ? o->timeout_ms : FIND_MS;
+	int n = gl_disc_probe(o->find_addr, (unsigned)o->find_port, ms, list,
+			      FIND_MAX, err);
+
+	if (n < 0) {
+		fprintf(stderr, "galil-load: %s\n",
+			err[0] ? err : gl_strerror(n));
+		return -1;
+	}
+	if (n == 0)
+		fprintf(stderr,
+			"galil-load: no Galil controller answered the "
+			"discovery probe (UDP %s:%d) within %d ms\n",
+			o->find_addr, o->find_port, ms);
+	for (i = 0; i < n; i++)
+		fprintf(f, "%3d  %-15s  %s Rev %s\n", i + 1, list[i].addr,
+			list[i].model, list[i].rev);
+	return n;
+}
+
+/* -a did not answer: list the controllers that do and, on a terminal, let
+ * the technician pick one (never chosen silently). Return 0 with *@l open,
+ * or GLOAD_EXIT_CONN. */
+static int offer_found(struct opts *o, gl_link **l)
+{
+	static struct gl_disc_ctrl list[FIND_MAX];
+	static char chosen[sizeof(list[0].addr)];
+	char line[32];
+	int n, k;
+
+	fprintf(stderr, "galil-load: Galil controllers that answer on this "
+			"network:\n");
+	n = find(o, list, stderr);
+	if (n <= 0 || !isatty(STDIN_FILENO))
+		return GLOAD_EXIT_CONN;
+	fprintf(stderr, "connect to which one (1-%d, Enter: none)? ", n);
+	if (!fgets(line, sizeof(line), stdin) ||
+	    parse_int(strtok(line, "\n") ? line : "", 1, n, &k))
+		return GLOAD_EXIT_CONN;
+	snprintf(chosen, sizeof(chosen), "%s", list[k - 1].addr);
+	o->addr = chosen;
+	printf("connecting to %s (chosen from the list)\n", chosen);
+	return open_link(o, l);
+}
+
 /* gload_dl_halt() with the controller's own number of axes. */
 static int halt(gl_link *l, const struct opts *o, int *running,
 		char failed[GLOAD_CMD_LEN])
@@ -378,7 +531,7 @@ static int halt(gl_link *l, const struct opts *o, int *running,
 
 	if (axes < 0)
 		axes = 8; /* no QZ answer: every axis letter the family has */
-	return gload_dl_halt(l, o->model->threads, axes, STOP_MS, running,
+	return gload_dl_halt(l, o->model->threads, axes, o->stop_ms, running,
 			     failed, o->timeout_ms);
 }
 
@@ -527,9 +680,25 @@ static int identify_and_halt(gl_link *l, const struct opts *o)
 	if (rc)
 		return rc;
 	rc = halt(l, o, &running, failed);
+	if (rc == GL_ERR_MISMATCH && running == GLOAD_HALT_LATE) {
+		fprintf(stderr,
+			"galil-load: axis %c still moving %d ms after 'ST': "
+			"aborted it (AB 1) and switched the motors off; "
+			"nothing downloaded (see --stop-wait)\n",
+			failed[6], o->stop_ms);
+		return GLOAD_EXIT_CTRL;
+	}
+	if (rc == GL_ERR_TIMEOUT && !strncmp(failed, "MG _BG", 6)) {
+		fprintf(stderr,
+			"galil-load: axis %c still moving after 'ST' and "
+			"'AB 1'; motors left on; nothing downloaded\n",
+			failed[6]);
+		return GLOAD_EXIT_CTRL;
+	}
 	if (rc == GL_ERR_MISMATCH && running < 0) {
-		fprintf(stderr, "galil-load: a motor is still on after 'MO' "
-				"('%s')\n",
+		fprintf(stderr,
+			"galil-load: a motor is still on after 'MO' "
+			"('%s')\n",
 			failed);
 		return GLOAD_EXIT_CTRL;
 	}
@@ -619,7 +788,7 @@ static void print_reply(const char *s)
 static int run_commands(gl_link *l, const struct opts *o)
 {
 	static char resp[64 * 1024];
-	char what[GL_LINE_MAX + 8];
+	char what[2 * GL_LINE_MAX + 16], sh[2 * GL_LINE_MAX + 8];
 	int i, rc, tmo;
 
 	for (i = 0; i < o->ncmds; i++) {
@@ -631,8 +800,12 @@ static int run_commands(gl_link *l, const struct opts *o)
 			  : o->timeout_ms;
 		if (tmo < o->timeout_ms)
 			tmo = o->timeout_ms;
-		rc = gl_link_command(l, c, resp, sizeof(resp), tmo);
-		snprintf(what, sizeof(what), "'%s'", c);
+		if (gl_link_ctrl_kind(c) > GL_CTRL_NONE)
+			rc =
+			    gl_link_ctrl_request(l, c, resp, sizeof(resp), tmo);
+		else
+			rc = gl_link_command(l, c, resp, sizeof(resp), tmo);
+		snprintf(what, sizeof(what), "'%s'", shown(c, sh));
 		if (rc < 0)
 			return link_failed(l, what, rc, tmo);
 		print_reply(resp);
@@ -660,7 +833,15 @@ int main(int argc, char **argv)
 	if (ex || o.check_only)
 		goto out_free;
 	fflush(stdout);
+	if (o.find) {
+		static struct gl_disc_ctrl list[FIND_MAX];
+
+		ex = find(&o, list, stdout) > 0 ? 0 : GLOAD_EXIT_CONN;
+		goto out_free;
+	}
 	ex = open_link(&o, &l);
+	if (ex)
+		ex = offer_found(&o, &l);
 	if (!ex && o.npaths > 0)
 		ex = load(&l, &o, &p);
 	if (!ex && l)

@@ -255,6 +255,22 @@ static int req_block(struct sim *s, char **arg, int n, struct out *o)
 	return ok(o);
 }
 
+static int req_limit(struct sim *s, char **arg, int n, struct out *o)
+{
+	int axis, rev = !strcmp(arg[1], "rev"), held = !strcmp(arg[2], "press");
+
+	(void)n;
+	if (parse_axis(arg[0], &axis) < 0)
+		return fail(o, "bad axis '%s' (A, B or C)", arg[0]);
+	if (!rev && strcmp(arg[1], "fwd"))
+		return fail(o, "bad switch '%s' (fwd or rev)", arg[1]);
+	if (!held && strcmp(arg[2], "release"))
+		return fail(o, "bad action '%s' (press or release)", arg[2]);
+	sim_plant_hold_limit(s->plant, axis, rev, held);
+	sim_event(s, "inject: limit %s %s %s", arg[0], arg[1], arg[2]);
+	return ok(o);
+}
+
 /* ---- link, relay, controller ------------------------------------------ */
 
 #define LINE_FAULT_USAGE                                                       \
@@ -533,6 +549,7 @@ static const struct request requests[] = {
     {"pot", 2, 3, req_pot, "pot <A|B|C> <ok|offset V|stuck|open|noise V>"},
     {"enc", 2, 3, req_enc, "enc <A|B|C> <ok|stuck|slip COUNTS>"},
     {"block", 2, 2, req_block, "block <A|B|C> <0|1>"},
+    {"limit", 3, 3, req_limit, "limit <A|B|C> <fwd|rev> <press|release>"},
     {"link", 1, 3, req_link, "link <ok|drop|stall|delay MS>"},
     {"relay", 0, 1, req_relay, "relay [on|off]"},
     {"relayfault", 1, 1, req_relayfault,

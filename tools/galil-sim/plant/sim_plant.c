@@ -32,6 +32,7 @@ struct plant_axis {
 	double pot_v;	/* last reading */
 	double noise_v; /* current noise bound */
 	int blocked;
+	int held[2]; /* [0] forward, [1] reverse switch tripped by hand */
 };
 
 struct sim_plant {
@@ -411,8 +412,10 @@ void sim_plant_sense(struct sim_plant *p, int power, struct ctrl_sense *out)
 		const struct sim_plant_axis_cfg *ac = &p->cfg.axis[i];
 		struct plant_axis *a = &p->ax[i];
 
-		int fwd = a->pos >= ac->fwd_limit,
-		    rev = a->pos <= ac->rev_limit;
+		/* the physical switches (a hand-held one too), then the wiring
+		 */
+		int fwd = a->pos >= ac->fwd_limit || a->held[0],
+		    rev = a->pos <= ac->rev_limit || a->held[1];
 
 		out->enc[i] = axis_count(p, i);
 		out->fwd_limit[i] = ac->limits_swapped ? rev : fwd;
@@ -554,6 +557,14 @@ int sim_plant_set_block(struct sim_plant *p, int axis, int blocked)
 	return 0;
 }
 
+int sim_plant_hold_limit(struct sim_plant *p, int axis, int reverse, int held)
+{
+	if (axis < 0 || axis >= SIM_PLANT_AXES)
+		return GL_ERR_ARG;
+	p->ax[axis].held[reverse ? 1 : 0] = held ? 1 : 0;
+	return 0;
+}
+
 int sim_plant_set_joy(struct sim_plant *p, int axis, enum sim_plant_dir dir,
 		      unsigned chan)
 {
@@ -628,8 +639,8 @@ int sim_plant_axis(const struct sim_plant *p, int axis,
 	out->vel = a->vel;
 	out->enc = axis_count(p, axis);
 	out->pot_v = a->pot_v;
-	out->fwd_limit = a->pos >= p->cfg.axis[axis].fwd_limit;
-	out->rev_limit = a->pos <= p->cfg.axis[axis].rev_limit;
+	out->fwd_limit = a->pos >= p->cfg.axis[axis].fwd_limit || a->held[0];
+	out->rev_limit = a->pos <= p->cfg.axis[axis].rev_limit || a->held[1];
 	out->home = a->pos < p->cfg.axis[axis].home;
 	out->blocked = a->blocked;
 	out->pot_fault = a->pot_fault;

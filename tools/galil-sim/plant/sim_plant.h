@@ -259,6 +259,15 @@ int sim_plant_set_enc_fault(struct sim_plant *p, int axis,
 int sim_plant_set_block(struct sim_plant *p, int axis, int blocked);
 
 /*
+ * sim_plant_hold_limit() - a person trips the forward (@reverse 0) or the
+ * reverse (@reverse 1) limit switch of @axis by hand (@held 1) or lets it
+ * go (0): the switch reads active wherever the axis is (the commissioning
+ * run asks for each switch in turn).
+ * Return: 0, or GL_ERR_ARG for an axis out of range.
+ */
+int sim_plant_hold_limit(struct sim_plant *p, int axis, int reverse, int held);
+
+/*
  * sim_plant_set_joy() - set the switches of @axis (0..2): @dir with channel
  * mask @chan (bit 0 = a, bit 1 = b; 3 = both) closed, every other switch of
  * that axis open. SIM_PLANT_NEUTRAL opens all four.

@@ -1,15 +1,25 @@
 /*
- * re_comm_int.h - what the commissioning run's modules share (re_comm.c,
- * re_comm_fw.c, re_comm_wire.c, re_comm_move.c): the steps and the small
- * controller helpers. Not for use outside the re_comm modules.
+ * re_comm_util.h - the small controller helpers the commissioning run's
+ * steps share (re_comm_fw.c, re_comm_wire.c, re_comm_move.c). Not for use
+ * outside the re_comm modules.
  */
-#ifndef RE_COMM_INT_H
-#define RE_COMM_INT_H
+#ifndef RE_COMM_UTIL_H
+#define RE_COMM_UTIL_H
 
 #include "re_comm.h"
 
 /* Technician-facing prompts start with this (tests wait for it). */
 #define RC_PROMPT "commission: "
+
+/*
+ * re_comm_add() - append a report item (printf-style text); the fix may be
+ * NULL. Returns @res, so that a check can `return re_comm_add(...)`.
+ * An item beyond RE_COMM_ITEMS is dropped (the count stays).
+ */
+enum re_comm_res re_comm_add(struct re_comm *c, const char *step,
+			     const char *name, enum re_comm_res res,
+			     const char *fix, const char *fmt, ...)
+    __attribute__((format(printf, 6, 7)));
 
 /*
  * rc_say() - one line to the technician (printf-style), prefixed with
@@ -50,8 +60,7 @@ double rc_now_ms(struct re_comm *c);
  * rc_link_fail() - record a FAIL item for a link or controller error @rc
  * met in @step while doing @what. Return: @rc.
  */
-int rc_link_fail(struct re_comm *c, const char *step, const char *what,
-		 int rc);
+int rc_link_fail(struct re_comm *c, const char *step, const char *what, int rc);
 
 /*
  * rc_safe() - stop every axis and switch the motors off (AB 1;MO ABC), then
@@ -60,16 +69,4 @@ int rc_link_fail(struct re_comm *c, const char *step, const char *what,
  */
 int rc_safe(struct re_comm *c);
 
-/*
- * The steps (re_comm.h). Each returns GL_OK when it passed (notes allowed),
- * GL_ERR_MISMATCH after recording its FAIL item, or a link error.
- */
-int rc_step_identity(struct re_comm *c);
-int rc_step_firmware(struct re_comm *c);
-int rc_step_joystick(struct re_comm *c);
-int rc_step_pots(struct re_comm *c);
-int rc_step_limits(struct re_comm *c);
-int rc_step_relay(struct re_comm *c);
-int rc_step_motion(struct re_comm *c);
-
-#endif /* RE_COMM_INT_H */
+#endif /* RE_COMM_UTIL_H */

@@ -1,0 +1,448 @@
+/*
+ * test_sys_comm.c - the commissioning run (roboelf --commission DIR)
+ * against galil-sim: a clean robot passes every step with its report and
+ * plots; each miswiring galil-sim can model (--miswire) is found at the
+ * right step with the right words; a controller that answers differently
+ * from the reference (--deviate) is named in the report.
+ *
+ * The test plays the technician: it reads roboelf's prompts
+ * ("commission: PRESS and hold the joystick B forward ...", "TRIP the
+ * forward limit switch of axis A ...", "... [y/N]") and answers through
+ * galil-sim's control port (joy, limit) and roboelf's stdin (y).
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <pthread.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "proc.h"
+#include "sys_h.h"
+
+#define RUN_TIMEOUT_MS 120000
+
+static struct sys_env env;
+
+static int setup(void **state)
+{
+	(void)state;
+	if (sys_env_init(&env) < 0) {
+		fprintf(stderr, "setup: %s\n", env.err);
+		return -1;
+	}
+	return 0;
+}
+
+static int teardown(void **state)
+{
+	(void)state;
+	sys_env_cleanup(&env);
+	return 0;
+}
+
+/* Answer one prompt line as the technician would. */
+static int technician(struct sys_case *c, const char *line)
+{
+	char ax, dir[8];
+
+	if (sscanf(line, "commission: PRESS and hold the joystick %c %7s", &ax,
+		   dir) == 2)
+		return sys_ctl(c, "joy %c %s", ax,
+			       !strcmp(dir, "forward") ? "fwd" : "rev");
+	if (sscanf(line, "commission: RELEASE the joystick %c", &ax) == 1)
+		return sys_ctl(c, "joy %c neutral", ax);
+	if (sscanf(line, "commission: TRIP the %7s limit switch of axis %c",
+		   dir, &ax) == 2)
+		return sys_ctl(c, "limit %c %s press", ax,
+			       !strcmp(dir, "forward") ? "fwd" : "rev");
+	if (sscanf(line, "commission: RELEASE the %7s limit switch of axis %c",
+		   dir, &ax) == 2)
+		return sys_ctl(c, "limit %c %s release", ax,
+			       !strcmp(dir, "forward") ? "fwd" : "rev");
+	if (strstr(line, "[y/N]"))
+		return proc_write(&c->re, "y\n");
+	return 0;
+}
+
+/* Play the technician until roboelf prints a line starting with @stop
+ * (returns 0) or, with @stop NULL, until it exits (returns its exit code).
+ * *@pos: how far roboelf's output was read. */
+static int drive(struct sys_case *c, const char *stop, size_t *pos)
+{
+	long long end = proc_now_ms() + RUN_TIMEOUT_MS;
+	int status = 0;
+
+	while (proc_now_ms() < end) {
+		const char *out, *nl;
+
+		proc_pump(&c->re, 20);
+		out = proc_output(&c->re, PROC_STDOUT);
+		while ((nl = strchr(out + *pos, '\n')) != NULL) {
+			char line[512];
+			size_t n = (size_t)(nl - (out + *pos));
+
+			snprintf(line, sizeof(line), "%.*s", (int)n,
+				 out + *pos);
+			*pos += n + 1;
+			if (stop && !strncmp(line, stop, strlen(stop)))
+				return 0;
+			if (technician(c, line) < 0)
+				fail_msg("technician: %s", c->err);
+		}
+		if (!stop && proc_wait_exit(&c->re, 0, &status) == 0)
+			return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+	}
+	fail_msg("roboelf --commission: no %s within %d s",
+		 stop ? stop : "exit", RUN_TIMEOUT_MS / 1000);
+	return -1;
+}
+
+/* Play the technician until roboelf exits; its exit code. */
+static int run_comm(struct sys_case *c)
+{
+	size_t pos = 0;
+
+	return drive(c, NULL, &pos);
+}
+
+/* Start galil-sim (with @sim_args), galil-load and roboelf --commission. */
+static int start(struct sys_case *c, char *const *sim_args, char *dir,
+		 size_t cap)
+{
+	static int n;
+	struct sys_opts o = {0};
+	char *re_args[5];
+
+	snprintf(dir, cap, "%s/comm-%d", env.dir, ++n);
+	re_args[0] = (char *)"--commission";
+	re_args[1] = dir;
+	re_args[2] = (char *)"--wait";
+	re_args[3] = (char *)"5";
+	re_args[4] = NULL;
+	o.sim_args = sim_args;
+	o.re_args = re_args;
+	o.no_ready = 1;
+	if (sys_case_start(c, &env, &o) < 0)
+		fail_msg("case start: %s", c->err);
+	return 0;
+}
+
+static char *slurp(const char *path)
+{
+	static char buf[65536];
+	FILE *f = fopen(path, "r");
+	size_t n;
+
+	if (!f)
+		return NULL;
+	n = fread(buf, 1, sizeof(buf) - 1, f);
+	buf[n] = '\0';
+	fclose(f);
+	return buf;
+}
+
+static int is_png(const char *dir, const char *name)
+{
+	char path[600], head[8] = {0};
+	FILE *f;
+	size_t n;
+
+	snprintf(path, sizeof(path), "%s/%s", dir, name);
+	f = fopen(path, "rb");
+	if (!f)
+		return 0;
+	n = fread(head, 1, sizeof(head), f);
+	fclose(f);
+	return n == 8 && !memcmp(head, "\x89PNG\r\n\x1a\n", 8);
+}
+
+/* Every step passes on the default robot; report, plots, safe at the end. */
+static void test_clean_robot(void **state)
+{
+	struct sys_case c;
+	char dir[256], st[4096], path[320];
+	const char *rep;
+
+	(void)state;
+	start(&c, NULL, dir, sizeof(dir));
+	assert_int_equal(run_comm(&c), 0);
+	assert_int_equal(proc_find_line(&c.re, PROC_STDOUT,
+					"commission: PASSED: every step passed",
+					NULL, 0),
+			 0);
+	snprintf(path, sizeof(path), "%s/commissioning.txt", dir);
+	rep = slurp(path);
+	assert_non_null(rep);
+	assert_non_null(strstr(rep, "result: PASSED"));
+	assert_null(strstr(rep, "FAIL "));
+	assert_non_null(strstr(rep, "motor power switched on during the run: "
+				    "yes"));
+	assert_non_null(strstr(rep, "PASS  B forward        inputs 5 and 6 "
+				    "closed, nothing else"));
+	assert_non_null(strstr(rep, "PASS  C rev            _LRC read 0 "
+				    "(active) while the reverse limit switch "
+				    "of axis C was held, nothing else"));
+	assert_non_null(strstr(rep, "PASS  close            relay ON: bit 3 "
+				    "of _TA0 cleared after"));
+	assert_non_null(strstr(rep, "PASS  pt-tracking"));
+	assert_non_null(strstr(rep, "PASS  ul-identical"));
+	assert_non_null(
+	    strstr(rep, "encoder: asked the program for +2000 counts"));
+	assert_true(is_png(dir, "pots-at-rest.png"));
+	assert_true(is_png(dir, "move-A.png"));
+	assert_true(is_png(dir, "move-B.png"));
+	assert_true(is_png(dir, "move-C.png"));
+	/* the run leaves the robot safe: relay off, every motor off */
+	assert_true(sys_state(&c, st, sizeof(st)) >= 0);
+	assert_non_null(strstr(st, " relay=off "));
+	assert_true(sys_state_num(st, "A.mo") == 1 &&
+		    sys_state_num(st, "B.mo") == 1 &&
+		    sys_state_num(st, "C.mo") == 1);
+	sys_case_stop(&c);
+}
+
+/* SIGKILL while the controller program moves axis B for the
+ * commissioning: its watchdog stops the move and switches every motor off
+ * within its deadline (wdto + one main-loop pass + a sample + slack). */
+static void test_kill_during_move(void **state)
+{
+	static const double at[] = {300, 1100, 1900}; /* counts into the move */
+	double deadline = env.wdto_ms + SYS_MAINMS + 1 + 25;
+
+	(void)state;
+	for (size_t k = 0; k < sizeof(at) / sizeof(at[0]); k++) {
+		struct sys_case c;
+		char dir[256], st[4096];
+		double t_sig, off = -1, b0;
+		long long end;
+		size_t pos = 0;
+
+		start(&c, NULL, dir, sizeof(dir));
+		assert_int_equal(drive(&c,
+				       "commission: axis B: a +2000-count "
+				       "move",
+				       &pos),
+				 0);
+		assert_true(sys_state(&c, st, sizeof(st)) >= 0);
+		b0 = sys_state_num(st, "B.pos");
+		end = proc_now_ms() + 5000;
+		while (sys_state(&c, st, sizeof(st)) >= 0 &&
+		       sys_state_num(st, "B.pos") < b0 + at[k] &&
+		       proc_now_ms() < end)
+			;
+		assert_true(sys_state_num(st, "B.pos") >= b0 + at[k]);
+		t_sig = sys_sim_time(&c);
+		assert_int_equal(proc_signal(&c.re, SIGKILL), 0);
+		proc_wait_exit(&c.re, 2000, NULL);
+		end = proc_now_ms() + 2000;
+		while (off < 0 && proc_now_ms() < end) {
+			assert_true(sys_events(&c) >= 0);
+			off = sys_motors_off_time(&c, t_sig);
+		}
+		print_message("[ MEASURE ] kill %.0f counts into B's move: "
+			      "motors off %.0f ms after the kill (deadline "
+			      "%.0f)\n",
+			      at[k], off - t_sig, deadline);
+		assert_true(off >= t_sig);
+		assert_true(off - t_sig <= deadline);
+		if (sys_check_safe(&c, 1, 200) < 0)
+			fail_msg("%s", c.err);
+		sys_case_stop(&c);
+	}
+}
+
+/* One galil-sim option, the line roboelf must end with, its exit code. */
+struct wrong {
+	const char *opt, *arg;
+	int exit;
+	const char *line;   /* the console's verdict (prefix) */
+	const char *report; /* a line of the report (substring), or NULL */
+};
+
+static const struct wrong wrongs[] = {
+    {"--miswire", "joystick-swap:5,7", 5,
+     "commission: FAILED at step joystick (B forward): swapped pair: input 5 "
+     "(B forward channel a) did not close and input 7 (B reverse channel a) "
+     "did: the switch of B forward channel a is wired to input 7 - fix: "
+     "exchange the wires on inputs 5 and 7 (or the two numbers in "
+     "joystick.inputs)",
+     NULL},
+    {"--miswire", "dead-input:6", 5,
+     "commission: FAILED at step joystick (B forward): dead switch: input 6 "
+     "(B forward channel b) did not close; the other channel did - fix: ",
+     NULL},
+    {"--miswire", "joystick-polarity", 5,
+     "commission: FAILED at step joystick (polarity): with nothing pressed "
+     "all 12 joystick inputs read 1, which the configuration (active_low: "
+     "false) takes for closed: the polarity is the wrong way round - fix: "
+     "set joystick.active_low: true",
+     NULL},
+    {"--miswire", "limits-swapped:B", 5,
+     "commission: FAILED at step limits (B fwd): swapped: the forward limit "
+     "switch of axis B was held and the controller saw the reverse limit "
+     "switch of axis B - fix: exchange the forward and reverse limit switch "
+     "wires of that axis",
+     NULL},
+    {"--miswire", "relay-unwired", 5,
+     "commission: FAILED at step relay (open): with the relay OFF the "
+     "amplifiers report power (MG _TA0 = 0, bit 3 'under-voltage' clear; "
+     "reference: TA): the relay does not switch the motors' power",
+     NULL},
+    {"--miswire", "encoder-reversed:A", 5,
+     "commission: FAILED at step motion (A): encoder reversed: asked for "
+     "+2000 counts, the encoder counted -",
+     NULL},
+    {"--miswire", "pot-reversed:C", 5,
+     "commission: FAILED at step motion (C): potentiometer reversed: -0.",
+     NULL},
+    {"--deviate", "mg-join", 0, "commission: PASSED: every step passed",
+     "NOTE  mg-separate      sent 'MG -1,-2'; reference (MG): each number "
+     "keeps its sign position (' -1.0000 -2.0000'); seen '-1.0000-2.0000' "
+     "(roboelf and galil-load read one value per MG: safe)"},
+    {"--deviate", "qr-header", 5,
+     "commission: FAILED at step firmware (qr-record): QR; reference (QR, "
+     "QZ): a record of the announced length whose header names axes A-C; "
+     "the record did not decode",
+     NULL},
+};
+
+/* Each miswiring and deviation galil-sim models, found at its step. */
+static void test_wrong_robot(void **state)
+{
+	(void)state;
+	for (size_t k = 0; k < sizeof(wrongs) / sizeof(wrongs[0]); k++) {
+		const struct wrong *w = &wrongs[k];
+		char *args[] = {(char *)w->opt, (char *)w->arg, NULL};
+		char dir[256], path[320], line[1024];
+		const char *rep;
+		struct sys_case c;
+
+		print_message("[ CASE     ] %s %s\n", w->opt, w->arg);
+		start(&c, args, dir, sizeof(dir));
+		assert_int_equal(run_comm(&c), w->exit);
+		if (proc_find_line(&c.re, PROC_STDOUT, w->line, line,
+				   sizeof(line)) != 0)
+			fail_msg("%s %s: no line '%s' in:\n%s", w->opt, w->arg,
+				 w->line, proc_output(&c.re, PROC_STDOUT));
+		snprintf(path, sizeof(path), "%s/commissioning.txt", dir);
+		rep = slurp(path);
+		assert_non_null(rep);
+		if (w->report && !strstr(rep, w->report))
+			fail_msg("%s %s: the report lacks '%s':\n%s", w->opt,
+				 w->arg, w->report, rep);
+		sys_case_stop(&c);
+	}
+}
+
+/* A controller of our own on loopback answering the discovery probe
+ * (^R^V CR, docs/galil-load.md) with a revision report. */
+struct lsn {
+	int fd, port, probes;
+	pthread_t th;
+};
+
+static void *lsn_main(void *arg)
+{
+	static const char reply[] = "DMC4030 Rev 1.2h-lsn\r\n:";
+	struct lsn *s = arg;
+	struct pollfd pfd = {.fd = s->fd, .events = POLLIN};
+	struct sockaddr_in from;
+	socklen_t flen;
+	char b[64];
+	ssize_t n;
+
+	while (poll(&pfd, 1, 10000) == 1) {
+		flen = sizeof(from);
+		n = recvfrom(s->fd, b, sizeof(b), 0, (struct sockaddr *)&from,
+			     &flen);
+		if (n <= 0)
+			break;
+		if (n == 3 && !memcmp(b, "\x12\x16\r", 3)) {
+			s->probes++;
+			sendto(s->fd, reply, strlen(reply), 0,
+			       (struct sockaddr *)&from, flen);
+		}
+	}
+	return NULL;
+}
+
+/* The configured address does not answer: the commissioning run lists the
+ * controllers that answer the discovery probe, and without a terminal to
+ * pick one it stops (exit 3): it never connects elsewhere by itself. */
+static void test_find_controller(void **state)
+{
+	struct sockaddr_in a = {.sin_family = AF_INET};
+	socklen_t len = sizeof(a);
+	struct lsn l = {0};
+	char dir[256], port[16], line[512];
+	char *re_args[] = {(char *)"--commission",
+			   dir,
+			   (char *)"--galil",
+			   (char *)"127.0.0.1:1",
+			   (char *)"--find-addr",
+			   (char *)"127.0.0.1",
+			   (char *)"--find-port",
+			   port,
+			   NULL};
+	struct sys_opts o = {0};
+	struct sys_case c;
+	int status = -1;
+
+	(void)state;
+	l.fd = socket(AF_INET, SOCK_DGRAM, 0);
+	a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+	assert_true(l.fd >= 0);
+	assert_int_equal(bind(l.fd, (struct sockaddr *)&a, sizeof(a)), 0);
+	assert_int_equal(getsockname(l.fd, (struct sockaddr *)&a, &len), 0);
+	l.port = ntohs(a.sin_port);
+	snprintf(port, sizeof(port), "%d", l.port);
+	assert_int_equal(pthread_create(&l.th, NULL, lsn_main, &l), 0);
+	snprintf(dir, sizeof(dir), "%s/comm-find", env.dir);
+	o.re_args = re_args;
+	o.no_ready = 1;
+	if (sys_case_start(&c, &env, &o) < 0)
+		fail_msg("case start: %s", c.err);
+	assert_int_equal(proc_wait_exit(&c.re, 20000, &status), 0);
+	assert_true(WIFEXITED(status));
+	assert_int_equal(WEXITSTATUS(status), 3);
+	if (proc_find_line(&c.re, PROC_STDOUT,
+			   "  1) 127.0.0.1  DMC4030 Rev "
+			   "1.2h-lsn",
+			   line, sizeof(line)) != 0)
+		fail_msg("no list in:\n%s", proc_output(&c.re, PROC_STDOUT));
+	assert_int_equal(proc_find_line(&c.re, PROC_STDOUT,
+					"roboelf: error: the configured "
+					"controller does not answer; the "
+					"controllers listed above do: run "
+					"again with --galil ADDRESS",
+					NULL, 0),
+			 0);
+	assert_int_equal(l.probes, 1);
+	sys_case_stop(&c);
+	shutdown(l.fd, SHUT_RDWR);
+	pthread_join(l.th, NULL);
+	close(l.fd);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	    cmocka_unit_test(test_clean_robot),
+	    cmocka_unit_test(test_kill_during_move),
+	    cmocka_unit_test(test_wrong_robot),
+	    cmocka_unit_test(test_find_controller),
+	};
+
+	return cmocka_run_group_tests(tests, setup, teardown);
+}
