@@ -377,24 +377,26 @@ static int wait_stopped(struct re_comm *c, char x)
 static int probe_mo_moving(struct re_comm *c)
 {
 	int code = 0, rc;
-	const char *tc = "";
+	char seen[160] = "accepted (the motor went off while moving; dmc/ "
+			"and roboelf send AB 1 first, galil-load waits for "
+			"the stop: safe)";
 
 	if ((rc = rc_cmd(c, "SH A;SPA=1000;PRA=300;BG A", NULL, 0)) < 0)
 		return rc;
 	rc_sleep_ms(c, 50);
 	rc = rc_cmd(c, "MO A", NULL, 0);
-	if (rc == GL_ERR_CTRL)
-		tc = rc_tc(c, &code);
-	else if (rc < 0)
+	if (rc == GL_ERR_CTRL) {
+		const char *tc = rc_tc(c, &code);
+
+		snprintf(seen, sizeof(seen), "?, TC1 %d %s", code, tc);
+	} else if (rc < 0) {
 		return rc;
+	}
 	re_comm_add(c, "firmware", "mo-moving",
 		    rc == GL_ERR_CTRL ? RE_COMM_PASS : RE_COMM_NOTE, NULL,
 		    "MO A during a 300-count move; reference (MO): not "
-		    "valid while in motion; seen %s%d %s%s",
-		    rc == GL_ERR_CTRL ? "?, TC1 " : "accepted", code, tc,
-		    rc == GL_ERR_CTRL ? ""
-				      : " (dmc/ and roboelf send AB 1 first, "
-					"galil-load waits for the stop: safe)");
+		    "valid while in motion; seen %s",
+		    seen);
 	if ((rc = rc_cmd(c, "ST A", NULL, 0)) < 0 ||
 	    (rc = wait_stopped(c, 'A')) != GL_OK)
 		return rc;

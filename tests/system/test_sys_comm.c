@@ -310,6 +310,15 @@ static const struct wrong wrongs[] = {
      "NOTE  mg-separate      sent 'MG -1,-2'; reference (MG): each number "
      "keeps its sign position (' -1.0000 -2.0000'); seen '-1.0000-2.0000' "
      "(roboelf and galil-load read one value per MG: safe)"},
+    {"--deviate", "mo-moving", 0, "commission: PASSED: every step passed",
+     "NOTE  mo-moving        MO A during a 300-count move; reference (MO): "
+     "not valid while in motion; seen accepted (the motor went off while "
+     "moving; dmc/ and roboelf send AB 1 first, galil-load waits for the "
+     "stop: safe)"},
+    {"--deviate", "dm-exists", 0, "commission: PASSED: every step passed",
+     "NOTE  dm-exists        DM cmqz[4] twice; reference (DM): silent on an "
+     "array that exists (UNCONFIRMED); first ':', second ':'; dmc/ "
+     "deallocates every array first (DA *[]): safe on either"},
     {"--deviate", "qr-header", 5,
      "commission: FAILED at step firmware (qr-record): QR; reference (QR, "
      "QZ): a record of the announced length whose header names axes A-C; "
