@@ -378,8 +378,8 @@ static int probe_mo_moving(struct re_comm *c)
 {
 	int code = 0, rc;
 	char seen[160] = "accepted (the motor went off while moving; dmc/ "
-			"and roboelf send AB 1 first, galil-load waits for "
-			"the stop: safe)";
+			 "and roboelf send AB 1 first, galil-load waits for "
+			 "the stop: safe)";
 
 	if ((rc = rc_cmd(c, "SH A;SPA=1000;PRA=300;BG A", NULL, 0)) < 0)
 		return rc;
