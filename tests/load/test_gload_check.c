@@ -85,64 +85,70 @@ struct fixture_case {
 static const struct fixture_case cases[] = {
     {"line_too_long.dmc", "40x0",
      BAD "line_too_long.dmc:7: line is 81 characters long after "
-	 "preprocessing (limit 80)\n"},
+	 "preprocessing (limit 80) [line-length]\n"},
     {"label_syntax.dmc", "40x0",
-     BAD "label_syntax.dmc:6: invalid label '#1ABC' (a letter, then "
-	 "letters, digits or '_')\n" BAD
-	 "label_syntax.dmc:8: invalid label '#A-B' (a letter, then "
-	 "letters, digits or '_')\n" BAD
+     BAD "label_syntax.dmc:6: invalid label '#1ABC' (a letter, then letters or "
+	 "digits) [label-syntax]\n" BAD
+	 "label_syntax.dmc:8: invalid label '#A-B' (a letter, then letters or "
+	 "digits) [label-syntax]\n" BAD
 	 "label_syntax.dmc:10: label '#X' is not at the start of a "
-	 "line\n"},
+	 "line [label-position]\n"},
     {"label_long.dmc", "40x0",
      BAD "label_long.dmc:6: label '#TOOLONGL' is longer than 7 "
-	 "characters\n"},
+	 "characters [label-length]\n"},
     {"label_duplicate.dmc", "40x0",
      BAD "label_duplicate.dmc:9: duplicate label '#LOOP' (first at " BAD
-	 "label_duplicate.dmc:6)\n"},
+	 "label_duplicate.dmc:6) [label-duplicate]\n"},
     {"label_undefined.dmc", "40x0",
-     BAD "label_undefined.dmc:7: undefined label '#NOWHERE' in 'JP'\n" BAD
-	 "label_undefined.dmc:8: undefined label '#SUB' in 'JS'\n" BAD
-	 "label_undefined.dmc:9: undefined label '#THR' in 'XQ'\n"},
+     BAD "label_undefined.dmc:7: undefined label '#NOWHERE' in 'JP' "
+	 "[label-undefined]\n" BAD "label_undefined.dmc:8: undefined label "
+				   "'#SUB' in 'JS' [label-undefined]\n" BAD
+	 "label_undefined.dmc:9: undefined label '#THR' in 'XQ' "
+	 "[label-undefined]\n"},
     {"var_name.dmc", "40x0",
-     BAD "var_name.dmc:6: variable name 'position12' is longer than 8 "
-	 "characters\n" BAD
-	 "var_name.dmc:7: variable name 'TIME' is a reserved word\n" BAD
-	 "var_name.dmc:8: variable name 'TP' is a command name\n" BAD
-	 "var_name.dmc:9: invalid variable name 'ab_c' (a letter, then "
-	 "letters or digits)\n" BAD
-	 "var_name.dmc:10: variable name 'toolongarr' is longer than 8 "
-	 "characters\n" BAD
-	 "var_name.dmc:11: variable name 'distance12' is longer than 8 "
-	 "characters\n"},
+     BAD
+     "var_name.dmc:6: variable name 'position12' is longer than 8 "
+     "characters [var-length]\n" BAD "var_name.dmc:7: variable name 'TIME' is "
+				     "a reserved word [var-reserved]\n" BAD
+     "var_name.dmc:8: variable name 'TP' is a command name [var-command]\n" BAD
+     "var_name.dmc:9: invalid variable name '9ab' (a letter, then "
+     "letters, digits or '_') [var-syntax]\n" BAD
+     "var_name.dmc:10: variable name 'toolongarr' is longer than 8 "
+     "characters [var-length]\n" BAD
+     "var_name.dmc:11: variable name 'distance12' is longer than 8 "
+     "characters [var-length]\n"},
     {"backslash.dmc", "40x0",
-     BAD "backslash.dmc:6: '\\' ends the download early\n"},
+     BAD "backslash.dmc:6: '\\' ends the download early [backslash]\n"},
     {"lowercase.dmc", "40x0",
      BAD "lowercase.dmc:8: lower-case command 'bg' (commands are upper "
-	 "case)\n" BAD
+	 "case) [lower-case]\n" BAD
 	 "lowercase.dmc:9: lower-case command 'mg' (commands are upper "
-	 "case)\n" BAD
+	 "case) [lower-case]\n" BAD
 	 "lowercase.dmc:10: lower-case command 'if' (commands are upper "
-	 "case)\n" BAD
+	 "case) [lower-case]\n" BAD
 	 "lowercase.dmc:12: lower-case command 'endif' (commands are "
-	 "upper case)\n"},
+	 "upper case) [lower-case]\n"},
     {"no_semicolon.dmc", "40x0",
      BAD "no_semicolon.dmc:6: ';' ends the NO comment: the rest of the "
-	 "line runs as commands\n"},
+	 "line runs as commands [no-semicolon]\n"},
     {"string_open.dmc", "40x0",
      BAD "string_open.dmc:5: missing closing '\"'\n"},
     {"if_nesting.dmc", "40x0",
-     BAD "if_nesting.dmc:7: 'ENDIF' without 'IF'\n" BAD
-	 "if_nesting.dmc:8: 'ELSE' without 'IF'\n" BAD
-	 "if_nesting.dmc:9: 'IF' without 'ENDIF'\n"},
+     BAD "if_nesting.dmc:7: 'ENDIF' without 'IF' [if-match]\n" BAD
+	 "if_nesting.dmc:8: 'ELSE' without 'IF' [if-match]\n" BAD
+	 "if_nesting.dmc:9: 'IF' without 'ENDIF' [if-match]\n"},
     {"non_ascii.dmc", "40x0",
-     BAD "non_ascii.dmc:5: character 0xC2 is not printable ASCII\n"},
+     BAD "non_ascii.dmc:5: character 0xC2 is not printable ASCII "
+	 "[char-printable]\n"},
     {"too_many_lines.dmc", "21x3",
      BAD "too_many_lines.dmc:1003: program is 1001 lines long with the "
-	 "identity line (DMC-21x3 limit 1000)\n"},
+	 "identity line (DMC-21x3 limit 1000) [lines-limit]\n"},
     {"too_many_labels.dmc", "21x3",
-     BAD "too_many_labels.dmc:258: 255 labels (DMC-21x3 limit 254)\n"},
+     BAD "too_many_labels.dmc:258: 255 labels (DMC-21x3 limit 254) "
+	 "[labels-limit]\n"},
     {"too_many_vars.dmc", "21x3",
-     BAD "too_many_vars.dmc:55: 255 variables (DMC-21x3 limit 254)\n"},
+     BAD
+     "too_many_vars.dmc:55: 255 variables (DMC-21x3 limit 254) [vars-limit]\n"},
     {"missing_dir", "40x0",
      BAD "missing_dir/MANIFEST:3: cannot open "
 	 "'" BAD "missing_dir/absent.dmc': No such file or directory\n"},
@@ -245,14 +251,14 @@ static void test_several_per_line(void **state)
 
 	(void)state;
 	out = check_text("#A\nbg;JP #B;st AB;zs\nEN\n", &n);
-	assert_string_equal(out,
-			    "mem.dmc:2: lower-case command 'bg' (commands are "
-			    "upper case)\n"
-			    "mem.dmc:2: lower-case command 'st' (commands are "
-			    "upper case)\n"
-			    "mem.dmc:2: lower-case command 'zs' (commands are "
-			    "upper case)\n"
-			    "mem.dmc:2: undefined label '#B' in 'JP'\n");
+	assert_string_equal(
+	    out, "mem.dmc:2: lower-case command 'bg' (commands are "
+		 "upper case) [lower-case]\n"
+		 "mem.dmc:2: lower-case command 'st' (commands are "
+		 "upper case) [lower-case]\n"
+		 "mem.dmc:2: lower-case command 'zs' (commands are "
+		 "upper case) [lower-case]\n"
+		 "mem.dmc:2: undefined label '#B' in 'JP' [label-undefined]\n");
 	free(out);
 }
 
@@ -264,8 +270,8 @@ static void test_empty_program(void **state)
 
 	(void)state;
 	out = check_text("REM nothing\n' nothing\n\n", &n);
-	assert_string_equal(out,
-			    "mem.dmc: no program lines after preprocessing\n");
+	assert_string_equal(
+	    out, "mem.dmc: no program lines after preprocessing [empty]\n");
 	assert_int_equal(n, 1);
 	free(out);
 }
@@ -278,10 +284,11 @@ static void test_label_case_and_length(void **state)
 
 	(void)state;
 	out = check_text("#Loop\nJP #LOOP\n#ABCDEFG\n#ABCDEFGH\nEN\n", &n);
-	assert_string_equal(out,
-			    "mem.dmc:2: undefined label '#LOOP' in 'JP'\n"
-			    "mem.dmc:4: label '#ABCDEFGH' is longer than 7 "
-			    "characters\n");
+	assert_string_equal(
+	    out,
+	    "mem.dmc:2: undefined label '#LOOP' in 'JP' [label-undefined]\n"
+	    "mem.dmc:4: label '#ABCDEFGH' is longer than 7 "
+	    "characters [label-length]\n");
 	free(out);
 }
 

@@ -8,6 +8,7 @@
 
 #include "gl_err.h"
 #include "dmc_cmd.h"
+#include "dmc_rule.h"
 #include "dmc_text.h"
 #include "gload_check.h"
 
@@ -62,10 +63,12 @@ static size_t word_len(const char *s, size_t n)
 	return i;
 }
 
-static void report(struct chk *c, int idx, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
+static void report(struct chk *c, int idx, enum dmc_rule_id rule,
+		   const char *fmt, ...) __attribute__((format(printf, 4, 5)));
 
-static void report(struct chk *c, int idx, const char *fmt, ...)
+/* One finding: "FILE:LINE: message [rule]" (dmc_rule.h). */
+static void report(struct chk *c, int idx, enum dmc_rule_id rule,
+		   const char *fmt, ...)
 {
 	const struct gload_line *l = &c->p->lines[idx];
 	char msg[400];
@@ -75,7 +78,8 @@ static void report(struct chk *c, int idx, const char *fmt, ...)
 	vsnprintf(msg, sizeof(msg), fmt, ap);
 	va_end(ap);
 	if (gload_diags_add(c->d, c->p->file_order[l->file],
-			    c->p->files[l->file], l->src_line, "%s", msg))
+			    c->p->files[l->file], l->src_line, "%s [%s]", msg,
+			    dmc_rule(rule)->name))
 		c->nomem = 1;
 	c->problems++;
 }
@@ -135,14 +139,15 @@ static void check_label_def(struct chk *c, int idx, const char *s, size_t n)
 {
 	size_t wl = word_len(s + 1, n - 1);
 
-	if (wl != n - 1 || wl == 0 || !isalpha((unsigned char)s[1]))
-		report(c, idx,
-		       "invalid label '%.*s' (a letter, then letters, digits "
-		       "or '_')",
+	if (wl != n - 1 || !dmc_label_ok(s + 1, wl))
+		report(c, idx, DMC_R_LABEL_SYNTAX,
+		       "invalid label '%.*s' (a letter, then letters or "
+		       "digits)",
 		       (int)n, s);
 	else if (wl > DMC_LABEL_MAX)
-		report(c, idx, "label '%.*s' is longer than %d characters",
-		       (int)n, s, DMC_LABEL_MAX);
+		report(c, idx, DMC_R_LABEL_LENGTH,
+		       "label '%.*s' is longer than %d characters", (int)n, s,
+		       DMC_LABEL_MAX);
 	sym_add(c, &c->labels, s + 1, n - 1, idx);
 }
 
@@ -166,7 +171,7 @@ static void check_expr(struct chk *c, int idx, const char *s, size_t n)
 		} else if (isalpha((unsigned char)ch)) {
 			wl = word_len(s + i, n - i);
 			if (wl > DMC_NAME_MAX)
-				report(c, idx,
+				report(c, idx, DMC_R_VAR_LENGTH,
 				       "variable name '%.*s' is longer "
 				       "than %d characters",
 				       (int)wl, s + i, DMC_NAME_MAX);
@@ -182,18 +187,15 @@ static int check_var_name(struct chk *c, int idx, const char *w, size_t n)
 {
 	size_t i;
 
-	for (i = 0; i < n; i++)
-		if (!isalnum((unsigned char)w[i]))
-			break;
-	if (i < n || !isalpha((unsigned char)w[0])) {
-		report(c, idx,
+	if (!dmc_var_ok(w, n)) {
+		report(c, idx, DMC_R_VAR_SYNTAX,
 		       "invalid variable name '%.*s' (a letter, then "
-		       "letters or digits)",
+		       "letters, digits or '_')",
 		       (int)n, w);
 		return 0;
 	}
 	if (n > DMC_NAME_MAX) {
-		report(c, idx,
+		report(c, idx, DMC_R_VAR_LENGTH,
 		       "variable name '%.*s' is longer than %d "
 		       "characters",
 		       (int)n, w, DMC_NAME_MAX);
@@ -201,14 +203,14 @@ static int check_var_name(struct chk *c, int idx, const char *w, size_t n)
 	}
 	for (i = 0; i < sizeof(reserved) / sizeof(reserved[0]); i++)
 		if (strlen(reserved[i]) == n && !memcmp(reserved[i], w, n)) {
-			report(c, idx,
+			report(c, idx, DMC_R_VAR_RESERVED,
 			       "variable name '%.*s' is a reserved word",
 			       (int)n, w);
 			return 0;
 		}
 	if (n == 2 && is_command(w)) {
-		report(c, idx, "variable name '%.*s' is a command name", (int)n,
-		       w);
+		report(c, idx, DMC_R_VAR_COMMAND,
+		       "variable name '%.*s' is a command name", (int)n, w);
 		return 0;
 	}
 	return 1;
@@ -275,7 +277,11 @@ static void check_jump(struct chk *c, int idx, const char *s, size_t n)
 	if (r)
 		memcpy(r->cmd, s, 2);
 	i += 1 + wl;
-	if (s[0] == 'J' && s[1] == 'S' && i < n && s[i] == '(')
+	if (s[0] == 'J' && s[1] == 'P' && i < n && s[i] == '(')
+		report(c, idx, DMC_R_JP_ARGS,
+		       "'JP #%.*s(...)': JP passes no arguments (JS does)",
+		       (int)wl, s + (i - wl));
+	if (s[0] == 'J' && i < n && s[i] == '(')
 		i = skip_parens(s, n, i);
 	if (s[0] == 'J' && i < n && s[i] == ',')
 		check_expr(c, idx, s + i + 1, n - i - 1);
@@ -299,7 +305,7 @@ static void check_if(struct chk *c, int idx, const char *kw, const char *s,
 		c->ifs[c->nifs++] = idx;
 		check_expr(c, idx, s + 2, n - 2);
 	} else if (c->nifs == 0) {
-		report(c, idx, "'%s' without 'IF'", kw);
+		report(c, idx, DMC_R_IF_MATCH, "'%s' without 'IF'", kw);
 	} else if (!strcmp(kw, "ENDIF")) {
 		c->nifs--;
 	}
@@ -344,7 +350,7 @@ static void check_command(struct chk *c, int idx, const char *s, size_t n,
 		while (i < n && s[i] == ' ')
 			i++;
 		if (i < n && more)
-			report(c, idx,
+			report(c, idx, DMC_R_NO_SEMICOLON,
 			       "';' ends the NO comment: the rest of "
 			       "the line runs as commands");
 	} else if ((s[0] == 'J' && (s[1] == 'P' || s[1] == 'S')) ||
@@ -353,6 +359,46 @@ static void check_command(struct chk *c, int idx, const char *s, size_t n,
 	} else if (s[0] == 'D' && (s[1] == 'M' || s[1] == 'A')) {
 		check_arrays(c, idx, s + 2, n - 2);
 	}
+}
+
+/* "==" outside "strings" and {formats}: not a DMC operator. */
+static int has_eqeq(const char *s, size_t n)
+{
+	for (size_t i = 0; i + 1 < n; i++) {
+		if (s[i] == '"' || s[i] == '{') {
+			const char *e = memchr(
+			    s + i + 1, s[i] == '"' ? '"' : '}', n - i - 1);
+
+			if (!e)
+				return 0;
+			i = (size_t)(e - s);
+		} else if (s[i] == '=' && s[i + 1] == '=') {
+			return 1;
+		}
+	}
+	return 0;
+}
+
+/* Commands that only a host sends, and WT=n: a wrong statement that the
+ * controller may take without complaint. Return 1 when reported. */
+static int check_host_only(struct chk *c, int idx, const char *s, size_t n,
+			   size_t wl, size_t i)
+{
+	if (wl == 2 && is_command(s) &&
+	    ((s[0] == 'D' && s[1] == 'L') || (s[0] == 'U' && s[1] == 'L'))) {
+		report(c, idx, DMC_R_DL_IN_PROGRAM,
+		       "'%.2s' inside a program (a host command: it would end "
+		       "or dump the program)",
+		       s);
+		return 1;
+	}
+	if (wl == 2 && s[0] == 'W' && s[1] == 'T' && i < n && s[i] == '=') {
+		report(c, idx, DMC_R_WT_ASSIGN,
+		       "'%.*s' does not wait (write 'WT %.*s')", (int)n, s,
+		       (int)(n - i - 1), s + i + 1);
+		return 1;
+	}
+	return 0;
 }
 
 static void check_stmt(struct chk *c, int idx, const char *s, size_t n,
@@ -365,7 +411,7 @@ static void check_stmt(struct chk *c, int idx, const char *s, size_t n,
 		if (first)
 			check_label_def(c, idx, s, n);
 		else
-			report(c, idx,
+			report(c, idx, DMC_R_LABEL_POSITION,
 			       "label '%.*s' is not at the start of a "
 			       "line",
 			       (int)n, s);
@@ -376,6 +422,11 @@ static void check_stmt(struct chk *c, int idx, const char *s, size_t n,
 	wl = word_len(s, n);
 	for (i = wl; i < n && s[i] == ' ';)
 		i++;
+	if (!(wl == 2 && s[0] == 'N' && s[1] == 'O') && has_eqeq(s, n))
+		report(c, idx, DMC_R_EQ_EQ,
+		       "'==' is not a DMC operator ('=' compares)");
+	if (check_host_only(c, idx, s, n, wl, i))
+		return;
 	kw = keyword(s, wl);
 	if (kw && !strncmp(s, kw, wl) && (wl == 2 || i == n)) {
 		check_if(c, idx, kw, s, n);
@@ -384,7 +435,7 @@ static void check_stmt(struct chk *c, int idx, const char *s, size_t n,
 	if (i < n && (s[i] == '=' || s[i] == '[') && !is_command_form(s, wl))
 		check_assignment(c, idx, s, n, wl);
 	else if (is_lower_command(s, wl))
-		report(c, idx,
+		report(c, idx, DMC_R_LOWER_CASE,
 		       "lower-case command '%.*s' (commands are upper "
 		       "case)",
 		       (int)wl, s);
@@ -424,7 +475,7 @@ static void check_chars(struct chk *c, int idx)
 	int bad = 0, bslash = 0;
 
 	if (l->len > (size_t)c->m->line_chars)
-		report(c, idx,
+		report(c, idx, DMC_R_LINE_LENGTH,
 		       "line is %zu characters long after "
 		       "preprocessing (limit %d)",
 		       l->len, c->m->line_chars);
@@ -432,9 +483,10 @@ static void check_chars(struct chk *c, int idx)
 		unsigned char ch = (unsigned char)l->text[i];
 
 		if (ch == '\\' && !bslash++)
-			report(c, idx, "'\\' ends the download early");
+			report(c, idx, DMC_R_BACKSLASH,
+			       "'\\' ends the download early");
 		else if ((ch < 0x20 || ch > 0x7e) && !bad++)
-			report(c, idx,
+			report(c, idx, DMC_R_CHAR,
 			       "character 0x%02X is not printable "
 			       "ASCII",
 			       ch);
@@ -478,8 +530,9 @@ static void check_labels(struct chk *c)
 	int i, first = 0;
 
 	if (t->n > c->m->max_labels)
-		report(c, t->v[c->m->max_labels].idx, "%d labels (%s limit %d)",
-		       t->n, c->m->title, c->m->max_labels);
+		report(c, t->v[c->m->max_labels].idx, DMC_R_LABELS_LIMIT,
+		       "%d labels (%s limit %d)", t->n, c->m->title,
+		       c->m->max_labels);
 	if (t->n > 1)
 		qsort(t->v, (size_t)t->n, sizeof(*t->v), sym_cmp_name);
 	for (i = 1; i < t->n; i++) {
@@ -488,16 +541,17 @@ static void check_labels(struct chk *c)
 			continue;
 		}
 		where(c, t->v[first].idx, at, sizeof(at));
-		report(c, t->v[i].idx, "duplicate label '#%s' (first at %s)",
-		       t->v[i].name, at);
+		report(c, t->v[i].idx, DMC_R_LABEL_DUPLICATE,
+		       "duplicate label '#%s' (first at %s)", t->v[i].name, at);
 	}
 	for (i = 0; i < c->refs.n; i++) {
 		const struct sym *r = &c->refs.v[i];
 
 		if (t->n == 0 || !bsearch(r, t->v, (size_t)t->n, sizeof(*t->v),
 					  sym_cmp_name_only))
-			report(c, r->idx, "undefined label '#%s' in '%s'",
-			       r->name, r->cmd);
+			report(c, r->idx, DMC_R_LABEL_UNDEFINED,
+			       "undefined label '#%s' in '%s'", r->name,
+			       r->cmd);
 	}
 }
 
@@ -516,7 +570,7 @@ static void check_vars(struct chk *c)
 	if (n > 1)
 		qsort(t->v, (size_t)n, sizeof(*t->v), sym_cmp_seq);
 	if (n > c->m->max_vars)
-		report(c, t->v[c->m->max_vars].idx,
+		report(c, t->v[c->m->max_vars].idx, DMC_R_VARS_LIMIT,
 		       "%d variables (%s limit %d)", n, c->m->title,
 		       c->m->max_vars);
 }
@@ -528,11 +582,12 @@ static void check_end(struct chk *c)
 	int i;
 
 	for (i = 0; i < c->nifs; i++)
-		report(c, c->ifs[i], "'IF' without 'ENDIF'");
+		report(c, c->ifs[i], DMC_R_IF_MATCH, "'IF' without 'ENDIF'");
 	if (total > m->max_lines)
 		report(c,
 		       m->max_lines < c->p->nlines ? m->max_lines
 						   : c->p->nlines - 1,
+		       DMC_R_LINES_LIMIT,
 		       "program is %d lines long with the identity line "
 		       "(%s limit %d)",
 		       total, m->title, m->max_lines);
@@ -551,7 +606,8 @@ int gload_check(const struct gload_prog *p, const struct dmc_model *m,
 	if (p->nlines == 0) {
 		gload_diags_add(d, p->nfiles ? p->file_order[0] : -1,
 				p->nfiles ? p->files[0] : "(no files)", 0,
-				"no program lines after preprocessing");
+				"no program lines after preprocessing [%s]",
+				dmc_rule(DMC_R_EMPTY)->name);
 		return 1;
 	}
 	for (i = 0; i < p->nlines; i++) {

@@ -17,6 +17,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "dmc_rule.h"
 #include "gl_disc.h"
 #include "gl_err.h"
 #include "gl_link.h"
@@ -119,7 +120,7 @@ static int parse_int(const char *s, int lo, int hi, int *out)
 
 static int set_start_label(struct opts *o, const char *arg)
 {
-	size_t i, n;
+	size_t n;
 
 	o->start = 1;
 	if (!arg)
@@ -127,15 +128,8 @@ static int set_start_label(struct opts *o, const char *arg)
 	if (arg[0] == '#')
 		arg++;
 	n = strlen(arg);
-	if (n == 0 || n > DMC_LABEL_MAX ||
-	    !((arg[0] >= 'A' && arg[0] <= 'Z') ||
-	      (arg[0] >= 'a' && arg[0] <= 'z')))
+	if (n > DMC_LABEL_MAX || !dmc_label_ok(arg, n))
 		return -1;
-	for (i = 0; i < n; i++)
-		if (!(arg[i] == '_' || (arg[i] >= '0' && arg[i] <= '9') ||
-		      (arg[i] >= 'A' && arg[i] <= 'Z') ||
-		      (arg[i] >= 'a' && arg[i] <= 'z')))
-			return -1;
 	memcpy(o->start_label, arg, n + 1);
 	return 0;
 }

@@ -10,13 +10,18 @@
 #include <string.h>
 
 #include "ctrl_var.h"
+#include "dmc_text.h"
 
-/* ctrl_ident_len() - length of the run of letters and digits at @s. */
+/* ctrl_ident_len() - length of the run of letters, digits and '_' at
+ * @s ('_' inside a variable name runs on hardware: real-controller-
+ * facts); 0 at a '_' (an operand such as _TPA starts there). */
 size_t ctrl_ident_len(const char *s)
 {
 	size_t n = 0;
 
-	while (isalnum((unsigned char)s[n]))
+	if (s[0] == '_')
+		return 0;
+	while (dmc_is_name_char(s[n]))
 		n++;
 	return n;
 }
@@ -33,7 +38,7 @@ int ctrl_name_key(const char *s, size_t n, uint64_t *key)
 	if (n < 1 || n > CTRL_NAME_MAX || !isalpha((unsigned char)s[0]))
 		return 9;
 	for (i = 0; i < n; i++) {
-		if (!isalnum((unsigned char)s[i]))
+		if (!dmc_is_name_char(s[i]))
 			return 9;
 		k |= (uint64_t)(uint8_t)s[i] << (8 * i);
 	}

@@ -9,7 +9,8 @@
 
 #include "ctrl_int.h"
 
-/* ctrl_ident_len() - length of the run of letters and digits at @s. */
+/* ctrl_ident_len() - length of the run of letters, digits and '_' at @s
+ * (0 when @s starts with '_': an operand). */
 size_t ctrl_ident_len(const char *s);
 /*
  * ctrl_name_key() - the key of a variable/array/label name: the @n
