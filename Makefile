@@ -153,7 +153,7 @@ lint:
 		pc tools tests
 
 # ---- dependencies ------------------------------------------------------------
-DEB_PKGS = gcc make pkg-config libserialport-dev libyaml-dev libcmocka-dev gnuplot-nox \
+DEB_PKGS = gcc make pkg-config libserialport-dev libyaml-dev libcmocka-dev gnuplot-nox tmux \
            clang-format cppcheck
 deps:
 	@missing=""; for p in $(DEB_PKGS); do \

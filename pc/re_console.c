@@ -11,6 +11,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -146,25 +147,76 @@ static void board_erase(struct re_console *c)
 	c->board_lines = 0;
 }
 
+static void term_size(struct re_console *c, int *cols, int *rows);
+
+/* @text on the output; on a terminal wrapped at word boundaries to the
+ * terminal's width (continuation lines indented by two spaces), so that
+ * nothing wraps by itself; in @colour when given. */
+static void put_wrapped(struct re_console *c, const char *text,
+			const char *colour)
+{
+	int cols, rows, w, first = 1;
+
+	if (!c->tty_out) {
+		fprintf(c->out, "%s\n", text);
+		return;
+	}
+	term_size(c, &cols, &rows);
+	w = cols - 1;
+	while (*text || first) {
+		int room = first ? w : w - 2, n = (int)strlen(text);
+
+		if (room < 20)
+			room = 20;
+		if (n > room) {
+			n = room;
+			while (n > room / 2 && text[n] != ' ')
+				n--;
+			if (text[n] != ' ')
+				n = room;
+		}
+		fprintf(c->out, "%s%s%.*s%s\n", first ? "" : "  ",
+			colour ? colour : "", n, text, colour ? ANSI_OFF : "");
+		text += n;
+		while (*text == ' ')
+			text++;
+		first = 0;
+	}
+}
+
 void re_console_msg(struct re_console *c, const char *fmt, ...)
 {
+	char text[2048];
 	va_list ap;
 
 	board_erase(c);
 	va_start(ap, fmt);
-	vfprintf(c->out, fmt, ap);
+	vsnprintf(text, sizeof(text), fmt, ap);
 	va_end(ap);
-	fputc('\n', c->out);
+	put_wrapped(c, text, NULL);
 	fflush(c->out);
+}
+
+/* Keep @line for the board: the first for good, later ones newest first. */
+static void fault_keep(struct re_console *c, const char *line)
+{
+	c->nfaults++;
+	if (!c->fault[0]) {
+		snprintf(c->fault, sizeof(c->fault), "%s", line);
+		return;
+	}
+	for (int i = RE_CONSOLE_LATER - 1; i > 0; i--)
+		memcpy(c->later[i], c->later[i - 1], sizeof(c->later[i]));
+	snprintf(c->later[0], sizeof(c->later[0]), "%s", line);
+	if (c->nlater < RE_CONSOLE_LATER)
+		c->nlater++;
 }
 
 void re_console_fault(struct re_console *c, const char *line)
 {
+	fault_keep(c, line);
 	board_erase(c);
-	if (c->color)
-		fprintf(c->out, ANSI_RED "%s" ANSI_OFF "\n", line);
-	else
-		fprintf(c->out, "%s\n", line);
+	put_wrapped(c, line, c->color ? ANSI_RED : NULL);
 	fflush(c->out);
 }
 
@@ -202,13 +254,33 @@ static const char *cmd_text(int k)
 	return k <= 6 ? cmd_names[k] : "?";
 }
 
+/* The controller program's fault codes in words (docs/dmc-interface.md). */
+static const char *const fcode_names[RE_DMC_F_MAX + 1] = {
+    "none",	  "PARAMETER",
+    "WATCHDOG",	  "INPUT",
+    "JAM",	  "LIMIT",
+    "COMMAND",	  "TCP",
+    "AMPLIFIER",  "ENCODER",
+    "MOTOR OFF",  "THREAD",
+    "SUPERVISOR", "UNCOMMANDED MOTION",
+    "SETTINGS",	  "SERVICE MOVE",
+    "POT RANGE",
+};
+
 static void ctrl_text(const struct re_status *st, char *buf, size_t cap)
 {
+	int f = st->have_za ? st->za.fcode : 0;
+
 	if (!st->have_za)
 		snprintf(buf, cap, "no data");
-	else if (st->za.state == RE_DMC_FAULT || st->za.fcode)
-		snprintf(buf, cap, "FAULT code %d axis %d", st->za.fcode,
-			 st->za.faxis);
+	else if ((st->za.state == RE_DMC_FAULT || f) && st->za.faxis >= 1 &&
+		 st->za.faxis <= 3)
+		snprintf(buf, cap, "FAULT %s axis %c (code %d)",
+			 f >= 0 && f <= RE_DMC_F_MAX ? fcode_names[f] : "?",
+			 (char)('A' + st->za.faxis - 1), f);
+	else if (st->za.state == RE_DMC_FAULT || f)
+		snprintf(buf, cap, "FAULT %s (code %d)",
+			 f >= 0 && f <= RE_DMC_F_MAX ? fcode_names[f] : "?", f);
 	else
 		snprintf(buf, cap, "%s",
 			 st->za.state == RE_DMC_ARMED	  ? "armed"
@@ -289,7 +361,54 @@ static const char *col(const struct re_console *c, const char *code)
 	return c->color ? code : "";
 }
 
-static void board_axis(struct re_console *c, const struct re_status *st, int i)
+/* Add @text (one line, may hold colour sequences "\033[...m") to the
+ * frame, cut to @width - 1 visible characters so that it never wraps; a
+ * cut inside a colour ends the colour. */
+static void frame_line(struct re_console *c, const char *text, int width)
+{
+	char out[RE_CONSOLE_FRAME / 4];
+	size_t n = 0, i = 0;
+	int vis = 0, colour = 0;
+
+	while (text[i] && text[i] != '\n' && n + 8 < sizeof(out)) {
+		if (text[i] == '\033') {
+			size_t j = i;
+
+			while (text[j] && text[j] != 'm')
+				j++;
+			if (!text[j])
+				break;
+			colour = strncmp(text + i, ANSI_OFF, j + 1 - i) != 0;
+			memcpy(out + n, text + i, j + 1 - i);
+			n += j + 1 - i;
+			i = j + 1;
+			continue;
+		}
+		if (vis >= width - 1)
+			break;
+		out[n++] = text[i++];
+		vis++;
+	}
+	out[n] = '\0';
+	frame_add(c, "%s%s\n", out, colour ? ANSI_OFF : "");
+}
+
+static void board_printf(struct re_console *c, int width, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static void board_printf(struct re_console *c, int width, const char *fmt, ...)
+{
+	char line[1024];
+	va_list ap;
+
+	va_start(ap, fmt);
+	vsnprintf(line, sizeof(line), fmt, ap);
+	va_end(ap);
+	frame_line(c, line, width);
+}
+
+static void board_axis(struct re_console *c, const struct re_status *st, int i,
+		       int width)
 {
 	const struct re_axis_status *a = &st->axis[i];
 	char b[BAR_WIDTH + 3], exp[48] = "    -      -";
@@ -300,41 +419,128 @@ static void board_axis(struct re_console *c, const struct re_status *st, int i)
 			 a->pot_expected_v,
 			 col(c, a->margin_v < 0 ? ANSI_RED : ""), a->margin_v,
 			 col(c, a->margin_v < 0 ? ANSI_OFF : ""));
-	frame_add(c, "%-2.2s %7d %s %3.0f%% %5.3f %s %6.0f %-7s %-3s %s\n",
-		  st->axis_names[i], (int)a->enc_counts, b,
-		  a->pos_pct < 0 ? 0.0 : a->pos_pct, a->pot_v, exp, a->vel_cps,
-		  motion_text(a), limit_text(a), a->motor_off ? "off" : "on");
+	board_printf(
+	    c, width, "%-2.2s %7d %s %3.0f%% %5.3f %s %6.0f %-7s %-3s %s",
+	    st->axis_names[i], (int)a->enc_counts, b,
+	    a->pos_pct < 0 ? 0.0 : a->pos_pct, a->pot_v, exp, a->vel_cps,
+	    motion_text(a), limit_text(a), a->motor_off ? "off" : "on");
 }
 
-static void board_draw(struct re_console *c, const struct re_status *st)
+/* The kept FAULT, wrapped at word boundaries into at most 5 lines, then
+ * the later ones, one line each, newest first. */
+static void board_faults(struct re_console *c, int width)
 {
-	char ctl[48];
+	const char *p = c->fault;
+	int w = width - 1, k = 0;
+
+	if (!c->fault[0])
+		return;
+	while (*p && k++ < 5) {
+		int n = (int)strlen(p);
+
+		if (n > w) {
+			n = w;
+			while (n > w / 2 && p[n] != ' ')
+				n--;
+		}
+		board_printf(c, width, "%s%.*s%s", col(c, ANSI_RED), n, p,
+			     col(c, ANSI_OFF));
+		p += n;
+		while (*p == ' ')
+			p++;
+	}
+	for (int i = 0; i < c->nlater; i++)
+		board_printf(c, width, "later: %s", c->later[i]);
+}
+
+static int any_motor_on(const struct re_status *st)
+{
+	for (int i = 0; i < st->n_axes; i++)
+		if (!st->axis[i].motor_off)
+			return 1;
+	return 0;
+}
+
+/* The terminal's size (80x24 when it cannot be read). */
+static void term_size(struct re_console *c, int *cols, int *rows)
+{
+	struct winsize ws;
+
+	*cols = 80;
+	*rows = 24;
+	if (ioctl(c->out_fd, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0 &&
+	    ws.ws_row > 0) {
+		*cols = ws.ws_col;
+		*rows = ws.ws_row;
+	}
+}
+
+static void board_draw(struct re_console *c, const struct re_status *st,
+		       int width)
+{
+	char ctl[64];
 
 	if (c->board_lines > 0)
 		frame_add(c, "\033[%dA\r\033[J", c->board_lines);
 	ctrl_text(st, ctl, sizeof(ctl));
-	frame_add(c, "RoboELF  mode %s  up %.1f s  relay %s%s%s  link %s\n",
-		  st->mode_name, st->uptime_s,
-		  col(c, st->relay == RE_RELAY_ON ? ANSI_GREEN : ANSI_YELLOW),
-		  relay_text(st->relay), col(c, ANSI_OFF),
-		  st->link_ok ? "ok" : "DOWN");
-	frame_add(c, "ax encoder position         pot V expect margin"
-		     "  vel/s state   lim mot\n");
+	board_printf(
+	    c, width, "RoboELF  mode %s  up %.1f s  relay %s%s%s  link %s",
+	    st->mode_name, st->uptime_s,
+	    col(c, st->relay == RE_RELAY_ON ? ANSI_GREEN : ANSI_YELLOW),
+	    relay_text(st->relay), col(c, ANSI_OFF),
+	    st->link_ok ? "ok" : "DOWN");
+	board_faults(c, width);
+	board_printf(c, width,
+		     "ax encoder position         pot V expect "
+		     "margin  vel/s state   lim mot");
 	for (int i = 0; i < st->n_axes; i++)
-		board_axis(c, st, i);
-	frame_add(c,
-		  "watchdog %.1f ms (worst %.1f, warn %llu) period "
-		  "%.0f ms late %.1f/%.1f ms overruns %llu\n",
-		  st->wd_last_ms, st->wd_worst_ms,
-		  (unsigned long long)st->wd_warnings, st->period_ms,
-		  st->late_last_ms, st->late_worst_ms,
-		  (unsigned long long)st->overruns);
-	frame_add(c, "controller %s  joystick %s  moving %s  %s\n", ctl,
-		  st->have_za ? cmd_text(st->za.jcmd) : "-",
-		  st->have_za ? cmd_text(st->za.mcmd) : "-",
-		  st->latched ? "LATCHED: quit with q" : "q: quit");
+		board_axis(c, st, i, width);
+	board_printf(c, width,
+		     "watchdog %.1f ms (worst %.1f, warn %llu) period %.0f ms "
+		     "late %.1f/%.1f ms overruns %llu",
+		     st->wd_last_ms, st->wd_worst_ms,
+		     (unsigned long long)st->wd_warnings, st->period_ms,
+		     st->late_last_ms, st->late_worst_ms,
+		     (unsigned long long)st->overruns);
+	board_printf(c, width, "controller %s  joystick %s  moving %s", ctl,
+		     st->have_za ? cmd_text(st->za.jcmd) : "-",
+		     st->have_za && any_motor_on(st) ? cmd_text(st->za.mcmd)
+						     : "-");
+	board_printf(c, width, "%s",
+		     st->latched ? "LATCHED: every motor off; q quits"
+				 : "q: quit");
 	/* the lines now on screen: the next frame moves up over them */
 	c->board_lines = frame_send(c);
+}
+
+/* Board or status lines for this terminal: too small a terminal gets the
+ * lines (said once); a resize redraws the board from the top. */
+static int board_fits(struct re_console *c, int *width)
+{
+	int cols, rows;
+
+	term_size(c, &cols, &rows);
+	*width = cols;
+	if (cols < RE_CONSOLE_MIN_COLS || rows < RE_CONSOLE_MIN_ROWS) {
+		if (!c->small_said++)
+			re_console_msg(
+			    c,
+			    "roboelf: the terminal is %dx%d, smaller "
+			    "than %dx%d: the status is shown as "
+			    "lines",
+			    cols, rows, RE_CONSOLE_MIN_COLS,
+			    RE_CONSOLE_MIN_ROWS);
+		c->board_lines = 0;
+		return 0;
+	}
+	if ((cols != c->cols || rows != c->rows) && c->board_lines > 0) {
+		frame_add(c, "\033[H\033[2J");
+		c->board_lines = 0;
+	}
+	c->cols = cols;
+	c->rows = rows;
+	c->small_said = 0;
+	return 1;
 }
 
 void re_console_status(struct re_console *c, const struct re_status *st,
@@ -342,16 +548,20 @@ void re_console_status(struct re_console *c, const struct re_status *st,
 {
 	char line[1024];
 	int64_t gap = c->tty_out ? RE_CONSOLE_BOARD_NS : RE_CONSOLE_LINE_NS;
+	int width = 80;
 
 	if (!force && c->last_draw_ns && now_ns - c->last_draw_ns < gap)
 		return;
 	c->last_draw_ns = now_ns;
-	if (c->tty_out) {
-		board_draw(c, st);
+	if (c->tty_out && board_fits(c, &width)) {
+		board_draw(c, st, width);
 		return;
 	}
 	re_console_format_line(st, line, sizeof(line));
-	frame_add(c, "%s\n", line);
+	if (c->tty_out)
+		frame_line(c, line, width); /* never wraps on a terminal */
+	else
+		frame_add(c, "%s\n", line);
 	frame_send(c);
 }
 

@@ -8,7 +8,13 @@
  * against the expected value and the margin left, velocity, motion state,
  * limit switches, motor on/off; relay state, watchdog latency last/worst,
  * loop period, lateness and overruns, controller fault, operating mode).
- * Messages (progress, warnings, the FAULT line) scroll above the board.
+ * Messages (progress, warnings) scroll above the board. The first FAULT
+ * line is also kept on the board, in a panel under the header, until the
+ * program ends (later ones below it, newest first), so it cannot scroll
+ * away. Every board line is cut to the terminal's width (never wraps); a
+ * terminal narrower than RE_CONSOLE_MIN_COLS or lower than
+ * RE_CONSOLE_MIN_ROWS gets the status lines instead, said once; a resize
+ * redraws the board from the top of the screen.
  * Colour only on a terminal and only when NO_COLOR is unset (no-color.org)
  * and TERM is not "dumb". The keyboard is in raw mode (no echo, no line
  * buffering) between re_console_open() and re_console_close().
@@ -38,6 +44,10 @@
 #define RE_CONSOLE_BOARD_NS 100000000LL	 /* >= 100 ms between redraws */
 #define RE_CONSOLE_LINE_NS  1000000000LL /* 1 s between status lines */
 #define RE_CONSOLE_FRAME    4096	 /* one status frame, bytes */
+#define RE_CONSOLE_FAULT    512		 /* the first FAULT line kept, bytes */
+#define RE_CONSOLE_LATER    3  /* later FAULT lines kept on the board */
+#define RE_CONSOLE_MIN_COLS 60 /* narrower: status lines, no board */
+#define RE_CONSOLE_MIN_ROWS 16 /* lower: status lines, no board */
 
 struct re_console {
 	FILE *out; /* stdout */
@@ -54,6 +64,12 @@ struct re_console {
 	uint64_t dropped;     /* status frames not (fully) written */
 	size_t frame_len;
 	char frame[RE_CONSOLE_FRAME];
+	int cols, rows;		      /* the terminal at the last board */
+	int small_said;		      /* "terminal too small" was said */
+	char fault[RE_CONSOLE_FAULT]; /* the first FAULT, kept on the board */
+	char later[RE_CONSOLE_LATER][256]; /* later ones, newest first */
+	int nlater;
+	uint64_t nfaults; /* FAULT lines shown in all */
 };
 
 enum re_calib_choice {
@@ -92,7 +108,9 @@ void re_console_msg(struct re_console *c, const char *fmt, ...)
 
 /*
  * re_console_fault() - the FAULT line, exactly as given, on one line (in
- * red on a colour terminal), above the board; flushed at once.
+ * red on a colour terminal), above the board; flushed at once. On a
+ * terminal it is also kept for the board's fault panel: the first one
+ * for good, later ones in the history (newest first).
  */
 void re_console_fault(struct re_console *c, const char *line);
 

@@ -59,7 +59,7 @@ for dir in unit load sim dmc system; do
 done
 for s in tests/checks/*.sh; do
 	[ -f "$s" ] || continue
-	run "checks/$(basename "$s")" script sh "$s"
+	run "checks/$(basename "$s")" script "$(head -1 "$s" | grep -q bash && echo bash || echo sh)" "$s"
 done
 [ -n "$failures" ] && echo "failed:$failures"
 echo "$passed passed, $failed failed"

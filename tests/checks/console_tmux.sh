@@ -1,0 +1,108 @@
+#!/bin/bash
+# console_tmux.sh - the operator's board in a real terminal (tmux), as an
+# operator sees it: roboelf on galil-sim in a tmux pane of 80x24, 100x30
+# and 200x60; a potentiometer fault injected; the pane read back with
+# `tmux capture-pane -J` (wrapped lines joined, so a line that wrapped
+# shows longer than the width):
+#   - no line longer than the pane is wide, during the run and after the
+#     fault;
+#   - the board's header "RoboELF  mode" exactly once on the screen;
+#   - the FAULT text and its recovery still on the screen 10 s after the
+#     fault;
+#   - after a resize to 80x24 mid-run: the same.
+# Every wait polls a condition with a deadline. Needs tmux (make deps).
+set -u
+cd "$(dirname "$0")/../.." || exit 1
+BIN=${ROBOELF_BIN:-$PWD/${BUILD:-build}/bin}
+command -v tmux >/dev/null || { echo "console_tmux: tmux missing (make deps)"; exit 1; }
+tmp=$(mktemp -d) || exit 1
+sock="$tmp/tmux.sock"
+simpid=""
+cleanup() {
+	tmux -S "$sock" kill-server 2>/dev/null
+	[ -n "$simpid" ] && kill "$simpid" 2>/dev/null
+	[ -n "$simpid" ] && wait "$simpid" 2>/dev/null
+	[ -n "${KEEP:-}" ] || rm -rf "$tmp"
+}
+trap cleanup EXIT
+fail() { echo "console_tmux: FAIL: $*"; exit 1; }
+
+# wait_for SECONDS COMMAND...: poll every 0.1 s until COMMAND succeeds
+wait_for() {
+	t=$(( $1 * 10 )); shift
+	while [ "$t" -gt 0 ]; do
+		"$@" && return 0
+		sleep 0.1; t=$((t - 1))
+	done
+	return 1
+}
+
+"$BIN/galil-sim" --port 0 --control-port 0 --relay-link "$tmp/relay" \
+	>"$tmp/sim.out" 2>"$tmp/sim.err" &
+simpid=$!
+wait_for 10 grep -q "listening" "$tmp/sim.out" || fail "galil-sim did not start"
+port=$(sed -n 's/.*127.0.0.1:\([0-9]*\) control.*/\1/p' "$tmp/sim.out")
+ctl=$(sed -n 's/.* control \([0-9]*\) relay.*/\1/p' "$tmp/sim.out")
+sed -e "s#port_development: .*#port_development: $tmp/relay#" \
+    -e "s#icstation_state: .*#icstation_state: $tmp/ic.state#" \
+    -e "s#^  file: .*#  file: $tmp/cal.txt#" \
+    -e "s#^  path: .*#  path: $tmp/roboelf.log#" \
+    config/roboelf.yaml >"$tmp/roboelf.yaml"
+"$BIN/galil-load" -a "127.0.0.1:$port" --start dmc/ >"$tmp/load.out" 2>&1 ||
+	fail "galil-load: $(cat "$tmp/load.out")"
+
+ctlreq() { # one request on galil-sim's control port; prints its answer
+	local ans=""
+	exec 9<>"/dev/tcp/127.0.0.1/$ctl" || return 1
+	printf '%s\n' "$1" >&9
+	read -r -t 5 ans <&9
+	exec 9>&-
+	printf '%s\n' "${ans%$'\r'}"
+}
+
+# one full calibration, in line mode, to have a file for every size
+"$BIN/roboelf" -c "$tmp/roboelf.yaml" --galil "127.0.0.1:$port" \
+	--calibration full </dev/null >"$tmp/cal.out" 2>&1 &
+rpid=$!
+wait_for 120 grep -q "RoboELF Ready for Use" "$tmp/cal.out" ||
+	{ kill $rpid; fail "calibration: $(tail -3 "$tmp/cal.out")"; }
+kill -TERM $rpid; wait $rpid
+
+screen() { tmux -S "$sock" capture-pane -p -J -t re; }
+check_screen() { # WIDTH WHAT
+	screen >"$tmp/screen"
+	long=$(awk -v w="$1" 'length($0) > w' "$tmp/screen" | head -1)
+	[ -z "$long" ] || fail "$2: a line longer than $1: '$long'"
+	n=$(grep -c "^RoboELF  mode" "$tmp/screen")
+	[ "$n" = 1 ] || { cat "$tmp/screen"; fail "$2: header $n times"; }
+}
+ready() { screen | grep -q "RoboELF  mode"; }
+faulted() { screen | grep -q "FAULT ENCODER"; }
+
+for size in 80x24 100x30 200x60; do
+	w=${size%x*}; h=${size#*x}
+	tmux -S "$sock" new-session -d -s re -x "$w" -y "$h" \
+		"$BIN/roboelf -c $tmp/roboelf.yaml --galil 127.0.0.1:$port --calibration file; sleep 60"
+	wait_for 30 ready || { screen; fail "$size: no board"; }
+	check_screen "$w" "$size running"
+	[ "$(ctlreq 'pot B offset 0.5')" = ok ] || fail "inject"
+	wait_for 5 faulted || { screen; fail "$size: no FAULT on the board"; }
+	sleep 10 # the operator looks 10 s later: the fault must still be there
+	check_screen "$w" "$size 10 s after the fault"
+	grep -q "FAULT ENCODER" "$tmp/screen" || fail "$size: FAULT gone after 10 s"
+	grep -q "Recovery" "$tmp/screen" || { cat "$tmp/screen"; fail "$size: the recovery text is gone after 10 s"; }
+	if [ "$size" = 200x60 ]; then
+		tmux -S "$sock" resize-window -t re -x 80 -y 24 2>/dev/null ||
+			tmux -S "$sock" resize-pane -t re -x 80 -y 24
+		wait_for 5 sh -c "tmux -S '$sock' capture-pane -p -J -t re | awk 'length(\$0) > 80 { bad = 1 } END { exit bad }'" ||
+			{ screen; fail "after the resize to 80x24: lines wider than 80"; }
+		check_screen 80 "resized to 80x24"
+		grep -q "FAULT ENCODER" "$tmp/screen" || fail "resize: FAULT gone"
+	fi
+	[ -n "${SHOW:-}" ] && { echo "--- $size"; cat "$tmp/screen"; }
+	cp "$tmp/screen" "$tmp/screen-$size.txt"
+	tmux -S "$sock" send-keys -t re q
+	tmux -S "$sock" kill-session -t re 2>/dev/null
+	ctlreq 'pot B ok' >/dev/null
+done
+echo "console_tmux: ok (80x24, 100x30, 200x60 and a resize: no wrapped line, one header, the FAULT and its recovery on screen 10 s later)"
