@@ -26,6 +26,7 @@
 #include "base_file.h"
 #include "base_yaml.h"
 #include "gl_err.h"
+#include "gl_link.h"
 #include "gl_hash.h"
 
 _Static_assert(sizeof(enum re_mode) == sizeof(int) &&
@@ -835,8 +836,7 @@ static int check_axis_more(struct pctx *c, const struct re_config_axis *a)
 			       "controller's encoder-failure detection (OA, "
 			       "OT) does not work with KI 0");
 	if (span <= 2 * an->absolute_tolerance_v)
-		return fail_at(c,
-			       later_mark(c, &an->forward_v, &an->reverse_v),
+		return fail_at(c, later_mark(c, &an->forward_v, &an->reverse_v),
 			       "'forward_v' (%g) must be above 'reverse_v' "
 			       "(%g) by more than twice "
 			       "'absolute_tolerance_v' (%g)",
@@ -845,8 +845,7 @@ static int check_axis_more(struct pctx *c, const struct re_config_axis *a)
 	if ((seen_mark(c, &an->forward_v) || seen_mark(c, &an->reverse_v)) &&
 	    fabs(span - an->expected_range_v) >
 		an->range_tolerance * an->expected_range_v)
-		return fail_at(c,
-			       later_mark(c, &an->forward_v, &an->reverse_v),
+		return fail_at(c, later_mark(c, &an->forward_v, &an->reverse_v),
 			       "'forward_v' - 'reverse_v' (%g V) must agree "
 			       "with 'expected_range_v' (%g V) within "
 			       "'range_tolerance'",
@@ -1082,10 +1081,10 @@ static int check_calibration(struct pctx *c, const struct re_config *cfg)
 	for (int i = 0; i < RE_AXES; i++) {
 		const struct re_config_axis *a = &cfg->axes[i];
 		const struct re_config_analog *an = &a->analog;
-		double gain = (an->forward_v - an->reverse_v) /
-			      (double)a->travel_counts;
-		double room = an->reverse_v - an->absolute_tolerance_v -
-			      POT_OPEN_V;
+		double gain =
+		    (an->forward_v - an->reverse_v) / (double)a->travel_counts;
+		double room =
+		    an->reverse_v - an->absolute_tolerance_v - POT_OPEN_V;
 		double lo = room + POT_OPEN_V - k->near_margin_counts * gain;
 
 		if (an->reverse_v <= POT_OPEN_V || lo >= POT_OPEN_V)
@@ -1104,10 +1103,27 @@ static int check_calibration(struct pctx *c, const struct re_config *cfg)
 	return GL_OK;
 }
 
+/* The controller address as the link will read it (gl_link_addr_split):
+ * a bad port is refused here, before anything is opened. */
+static int check_address(struct pctx *c, const struct re_config *cfg)
+{
+	char host[RE_ADDR_MAX], port[16];
+
+	if (gl_link_addr_split(cfg->controller.address, host, sizeof(host),
+			       port, sizeof(port)) == GL_OK)
+		return GL_OK;
+	return fail_at(c, later_mark(c, cfg->controller.address, &cfg->mode),
+		       "'address' '%.*s' is not HOST, HOST:PORT or [V6]:PORT "
+		       "with a port 1..65535",
+		       TEXT_SHOWN, cfg->controller.address);
+}
+
 static int check_all(struct pctx *c, const struct re_config *cfg)
 {
 	int i, rc = check_table(c, root_fields, cfg);
 
+	if (!rc)
+		rc = check_address(c, cfg);
 	for (i = 0; !rc && i < RE_AXES; i++)
 		rc = check_axis(c, &cfg->axes[i]);
 	if (!rc)
@@ -1329,9 +1345,17 @@ int re_config_load_file(const char *path, struct re_config *out, char *err,
 
 	rc = base_file_read(path, CFG_FILE_MAX, &buf, &len);
 	if (rc != 0) {
-		/* a directory is "not a regular file" like any other */
-		e = rc == -EISDIR ? EINVAL : -rc;
-		if (err && errlen)
+		e = -rc;
+		if (err && errlen && rc == -EISDIR)
+			snprintf(
+			    err, errlen,
+			    "cannot read '%s': it is a directory; give the "
+			    "configuration file (e.g. %s/roboelf.yaml)",
+			    path, path);
+		else if (err && errlen && rc == -EINVAL)
+			snprintf(err, errlen,
+				 "cannot read '%s': not a regular file", path);
+		else if (err && errlen)
 			snprintf(err, errlen, "cannot read '%s': %s", path,
 				 strerror(e));
 		errno = e;

@@ -35,6 +35,7 @@
 #include <unistd.h>
 
 #include "base_clock.h"
+#include "base_version.h"
 #include "gl_err.h"
 #include "gl_link.h"
 #include "re_calfile.h"
@@ -129,6 +130,8 @@ static void usage(FILE *f)
 	    "discovery probe goes\n"
 	    "                           (255.255.255.255, 50000)\n"
 	    "  -h, --help               this text\n"
+	    "      --version            the release and the DMC interface "
+	    "it expects\n"
 	    "\n"
 	    "exit: 0 quit, 2 usage/config, 3 no relay/controller, "
 	    "4 fault latched, 5 commissioning found a fault\n",
@@ -220,6 +223,7 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 	    {"find-addr", required_argument, NULL, 'F'},
 	    {"find-port", required_argument, NULL, 'P'},
 	    {"help", no_argument, NULL, 'h'},
+	    {"version", no_argument, NULL, 'V'},
 	    {NULL, 0, NULL, 0},
 	};
 	int c;
@@ -229,6 +233,12 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 	while ((c = getopt_long(argc, argv, "c:h", lo, NULL)) != -1) {
 		if (c == 'h') {
 			usage(stdout);
+			return 1;
+		}
+		if (c == 'V') {
+			printf("roboelf %s (controller program interface %s, "
+			       "dmc/constants.dmc vers)\n",
+			       ROBOELF_VERSION, ROBOELF_DMC_VERSION);
 			return 1;
 		}
 		if (opt_value(o, c, optarg) < 0)

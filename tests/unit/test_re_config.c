@@ -29,6 +29,9 @@ struct bad_case {
 };
 
 static const struct bad_case bad_cases[] = {
+    {"bad_address_port.yaml", 2, 12,
+     "'address' '127.0.0.1:99999' is not HOST, HOST:PORT or [V6]:PORT with a "
+     "port 1..65535"},
     {"bad_analog_shared.yaml", 6, 14,
      "analog input 1 is used by axes 'A' and 'B'"},
     {"bad_axes_count.yaml", 3, 3,
@@ -737,8 +740,10 @@ static void test_missing_file(void **state)
 				 "': No such file or directory");
 	assert_int_equal(re_config_load_file(DATA_DIR, &c, err, sizeof(err)),
 			 GL_ERR_SYS);
-	assert_string_equal(err, "cannot read '" DATA_DIR "': Invalid "
-				 "argument");
+	assert_int_equal(errno, EISDIR);
+	assert_string_equal(err, "cannot read '" DATA_DIR "': it is a "
+				 "directory; give the configuration file "
+				 "(e.g. " DATA_DIR "/roboelf.yaml)");
 }
 
 /* A short error buffer is truncated, never overrun. */

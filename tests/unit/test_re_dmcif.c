@@ -16,6 +16,7 @@
 #include <cmocka.h>
 
 #include "base_file.h"
+#include "base_version.h"
 #include "re_dmcif.h"
 
 /* The supervisor's names of the codes, in the enum's words. */
@@ -100,12 +101,27 @@ static void test_docs_agree(void **state)
 	free(doc);
 }
 
+/* The interface version the programs print (--version) is the one
+ * dmc/constants.dmc sets. */
+static void test_version_agrees(void **state)
+{
+	char *text = NULL;
+	size_t len = 0;
+
+	(void)state;
+	assert_int_equal(
+	    base_file_read("dmc/constants.dmc", 1 << 20, &text, &len), 0);
+	assert_non_null(strstr(text, "\nvers=" ROBOELF_DMC_VERSION "\n"));
+	free(text);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_enum_complete),
 	    cmocka_unit_test(test_dmc_raises_known_codes),
 	    cmocka_unit_test(test_docs_agree),
+	    cmocka_unit_test(test_version_agrees),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -17,6 +17,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "base_version.h"
 #include "dmc_rule.h"
 #include "gl_disc.h"
 #include "gl_err.h"
@@ -85,6 +86,7 @@ static const char usage_text[] =
     "                             255.255.255.255)\n"
     "      --find-port PORT       its UDP port (default 50000)\n"
     "  -h, --help                 this text\n"
+    "      --version              the release and the DMC interface\n"
     "\n"
     "A DIR is loaded through DIR/MANIFEST (one file name per line, '#'\n"
     "comments). Exit: 0 ok, 1 check failed, 2 usage, 3 connection,\n"
@@ -216,7 +218,8 @@ enum {
 	OPT_STOP_WAIT,
 	OPT_FIND,
 	OPT_FIND_ADDR,
-	OPT_FIND_PORT
+	OPT_FIND_PORT,
+	OPT_VERSION
 };
 
 static const struct option long_opts[] = {
@@ -235,6 +238,7 @@ static const struct option long_opts[] = {
     {"find-addr", required_argument, NULL, OPT_FIND_ADDR},
     {"find-port", required_argument, NULL, OPT_FIND_PORT},
     {"help", no_argument, NULL, 'h'},
+    {"version", no_argument, NULL, OPT_VERSION},
     {NULL, 0, NULL, 0},
 };
 
@@ -250,6 +254,12 @@ static int parse_opt(struct opts *o, int ch, const char *arg)
 	case OPT_NO_START: o->start = 0; return 0;
 	case 'c': return add_command(o, arg);
 	case 'h': return -1;
+	case OPT_VERSION:
+		printf("galil-load %s (controller program interface %s; "
+		       "`galil-load --check dmc/` prints the identity it "
+		       "stamps)\n",
+		       ROBOELF_VERSION, ROBOELF_DMC_VERSION);
+		exit(EXIT_SUCCESS);
 	case 'm':
 		o->model = dmc_model_find(arg);
 		return o->model ? 0

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base_version.h"
 #include "ctrl.h"
 #include "gl_err.h"
 #include "sim.h"
@@ -21,7 +22,7 @@
 #include "sim_plant.h"
 #include "sim_relay.h"
 
-#define SIM_VERSION	     "1.0"
+#define SIM_VERSION	     ROBOELF_VERSION
 #define DEFAULT_PORT	     23023
 #define DEFAULT_CONTROL_PORT 23024
 #define DEFAULT_RELAY_LINK   "/tmp/roboelf-relay"
