@@ -519,8 +519,9 @@ double re_super_late_ms(const struct re_super *s, double pct)
 	want = (uint64_t)ceil((double)n * pct / 100.0);
 	for (k = 0; k < RE_LATE_BINS - 1; k++) {
 		seen += s->late_hist[k];
-		if (seen >= want)
-			return (k + 1) * RE_LATE_BIN_US / 1000.0;
+		if (seen >= want) /* the bin's upper edge, never past the worst */
+			return fmin((k + 1) * RE_LATE_BIN_US / 1000.0,
+				    ns_to_ms(s->late_worst_ns));
 	}
 	return ns_to_ms(s->late_worst_ns);
 }

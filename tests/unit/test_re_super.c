@@ -799,6 +799,13 @@ static void test_super_late_percentiles(void **state)
 	assert_true(re_super_late_ms(&s, 99) == 0.25);
 	assert_true(re_super_late_ms(&s, 99.5) == 123.456789);
 	assert_true(re_super_late_ms(&s, 100) == 123.456789);
+	/* a percentile never reads above the worst (it was p99=3.950
+	 * max=3.931: the bin's upper edge) */
+	memset(&s, 0, sizeof(s));
+	s.late_hist[3] = 100; /* 150..200 us */
+	s.late_worst_ns = 180000;
+	assert_true(re_super_late_ms(&s, 99) == 0.18);
+	assert_true(re_super_late_ms(&s, 100) == 0.18);
 }
 
 int main(void)
