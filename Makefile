@@ -30,6 +30,7 @@
 CC ?= cc
 CFLAGS ?= -O2 -g
 PREFIX ?= /usr/local
+SYSCONFDIR ?= /etc
 DESTDIR ?=
 INSTALL ?= install
 BUILD ?= build
@@ -181,6 +182,11 @@ install: all
 	$(if $(MAN5),$(INSTALL) -m 644 $(MAN5) "$(DESTDIR)$(PREFIX)/share/man/man5/")
 	$(INSTALL) -m 644 $(wildcard dmc/*.dmc dmc/MANIFEST) "$(DESTDIR)$(PREFIX)/share/roboelf/dmc/"
 	$(INSTALL) -m 644 $(wildcard config/*.yaml) "$(DESTDIR)$(PREFIX)/share/roboelf/config/"
+	@# the operator's configuration roboelf finds without -c; an existing
+	@# (edited) one is kept
+	$(INSTALL) -d "$(DESTDIR)$(SYSCONFDIR)/roboelf"
+	[ -e "$(DESTDIR)$(SYSCONFDIR)/roboelf/roboelf.yaml" ] || \
+		$(INSTALL) -m 644 config/roboelf.yaml "$(DESTDIR)$(SYSCONFDIR)/roboelf/roboelf.yaml"
 	$(INSTALL) -m 644 README.md $(wildcard docs/*.md) "$(DESTDIR)$(PREFIX)/share/doc/roboelf/"
 
 uninstall:

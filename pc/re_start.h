@@ -33,13 +33,15 @@
 #define EXIT_FAULT	4
 #define EXIT_COMMISSION 5 /* the commissioning run found a fault */
 #define DEFAULT_CONFIG	"config/roboelf.yaml"
+#define SYSTEM_CONFIG	"/etc/roboelf/roboelf.yaml" /* the installed one */
 
 struct opts {
-	const char *config;
+	const char *config; /* -c, or the one found (roboelf.1, FILES) */
 	const char *galil;
 	const char *relay;
 	const char *log;
 	const char *show_cal;
+	int config_searched;	/* no -c: find_config() chose it */
 	const char *commission; /* report directory */
 	int wait_s;	       /* commissioning: each wait for the technician */
 	const char *find_addr; /* commissioning: discovery probe address */

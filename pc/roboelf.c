@@ -112,7 +112,8 @@ static void usage(FILE *f)
 	    "       roboelf --commission DIR [-c FILE] [--galil ...] "
 	    "[--wait S]\n"
 	    "\n"
-	    "  -c, --config FILE        configuration (default %s)\n"
+	    "  -c, --config FILE        configuration (default %s, else "
+	    "%s)\n"
 	    "      --galil HOST[:PORT]  controller address (overrides the "
 	    "file)\n"
 	    "      --relay PORT         E-stop relay port for this mode\n"
@@ -135,7 +136,7 @@ static void usage(FILE *f)
 	    "\n"
 	    "exit: 0 quit, 2 usage/config, 3 no relay/controller, "
 	    "4 fault latched, 5 commissioning found a fault\n",
-	    DEFAULT_CONFIG);
+	    DEFAULT_CONFIG, SYSTEM_CONFIG);
 }
 
 static int parse_period(const char *s, int *out)
@@ -229,7 +230,7 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 	int c;
 
 	memset(o, 0, sizeof(*o));
-	o->config = DEFAULT_CONFIG;
+	o->config = NULL; /* searched for: find_config() */
 	while ((c = getopt_long(argc, argv, "c:h", lo, NULL)) != -1) {
 		if (c == 'h') {
 			usage(stdout);
@@ -286,11 +287,31 @@ static int check_analog(const struct re_config *c, char *err, size_t len)
 	return GL_OK;
 }
 
+/* Without -c: ./config/roboelf.yaml (the source tree), then the
+ * installed /etc/roboelf/roboelf.yaml; the first that exists. */
+static void find_config(struct opts *o)
+{
+	if (o->config)
+		return;
+	o->config_searched = 1;
+	o->config = access(DEFAULT_CONFIG, F_OK) == 0 ||
+			    access(SYSTEM_CONFIG, F_OK) != 0
+			? DEFAULT_CONFIG
+			: SYSTEM_CONFIG;
+}
+
 static int load_config(struct app *a)
 {
+	find_config(&a->o);
 	if (re_config_load_file(a->o.config, &a->cfg, a->err, sizeof(a->err)) !=
 	    GL_OK) {
 		fprintf(stderr, "%s\n", a->err);
+		if (errno == ENOENT && a->o.config_searched)
+			fprintf(stderr,
+				"roboelf: no configuration: neither '%s' (in "
+				"this directory) nor '%s' exists; give one "
+				"with -c FILE\n",
+				DEFAULT_CONFIG, SYSTEM_CONFIG);
 		return -1;
 	}
 	apply_overrides(a);
@@ -490,6 +511,7 @@ static int show_calibration(struct app *a)
 {
 	double allowed[RE_AXES];
 
+	find_config(&a->o);
 	if (re_config_load_file(a->o.config, &a->cfg, a->err, sizeof(a->err)) !=
 	    GL_OK)
 		re_config_defaults(&a->cfg);
