@@ -73,8 +73,11 @@ say "checking and downloading dmc/ with galil-load"
 
 if [ "${INTERACTIVE:-}" = 1 ]; then
 	exec 3</dev/tty
-	say "keys: a/z axis A fwd/rev, s/x B, d/c C, space neutral, i invalid (one channel),"
-	say "      p pot fault B, e encoder stuck A, j jam C, r relay unplug, q quit"
+	say "keys (read once roboelf is ready; anything typed before is dropped):"
+	say "  a/z axis A fwd/rev, s/x B, d/c C: the joystick STAYS pressed until space"
+	say "  space: every joystick neutral; i: A fwd on one channel only (invalid:"
+	say "  held 0.5 s it is an INPUT fault); p pot fault B, e encoder stuck A,"
+	say "  j jam C, r relay unplug, q quit"
 fi
 
 # roboelf runs on a pseudo-terminal made by script(1), so that it shows its
@@ -88,6 +91,10 @@ RE_PID=$!
 wait_line "$TMP/roboelf.out" 'RoboELF Ready for Use' 60 || die "roboelf did not become ready"
 
 if [ "${INTERACTIVE:-}" = 1 ]; then
+	# keys typed during start-up and calibration must not move the robot
+	# once it is armed: drop them
+	while IFS= read -r -s -n 1 -t 0.01 _ <&3; do :; done
+	say "keys are read now"
 	while IFS= read -r -s -n 1 key <&3; do
 		case "$key" in
 		a) ctl "joy A fwd" ;; z) ctl "joy A rev" ;;
