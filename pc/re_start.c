@@ -458,8 +458,19 @@ static int choose_calibration(struct app *a)
 
 	if (how == RE_CALIB_ASK)
 		how = re_console_ask_calibration(&a->con);
-	if (how != RE_CALIB_FULL && how != RE_CALIB_FILE)
-		return re_sig.quit ? 0 : EXIT_USAGE;
+	if (how != RE_CALIB_FULL && how != RE_CALIB_FILE) {
+		if (re_sig.quit)
+			return 0;
+		re_console_msg(&a->con, "roboelf: error: no answer to the "
+					"calibration question (end of input): "
+					"nothing moved, motor power stays off; "
+					"run again and answer f or l, or use "
+					"--calibration full|file");
+		re_log_msg(&a->log, RE_LOG_WARN,
+			   "start-up ended: no answer to the calibration "
+			   "question (end of input)");
+		return EXIT_USAGE;
+	}
 	a->cal = calloc(1, sizeof(*a->cal));
 	if (!a->cal)
 		return fail(a, "out of memory");

@@ -105,4 +105,14 @@ for size in 80x24 100x30 200x60; do
 	tmux -S "$sock" kill-session -t re 2>/dev/null
 	ctlreq 'pot B ok' >/dev/null
 done
-echo "console_tmux: ok (80x24, 100x30, 200x60 and a resize: no wrapped line, one header, the FAULT and its recovery on screen 10 s later)"
+# Ctrl-D at the calibration question: said, exit 2, nothing moved
+tmux -S "$sock" new-session -d -s re -x 80 -y 24 \
+	"$BIN/roboelf -c $tmp/roboelf.yaml --galil 127.0.0.1:$port; echo EXIT=\$?; sleep 60"
+asked() { screen | grep -q "Calibration: \[f\]ull"; }
+wait_for 30 asked || { screen; fail "no calibration question"; }
+tmux -S "$sock" send-keys -t re C-d
+said() { screen | grep -q "EXIT=2"; }
+wait_for 10 said || { screen; fail "Ctrl-D: no exit 2"; }
+screen | tr '\n' ' ' | tr -s ' ' | grep -q "no answer to the calibration question (end of input): nothing moved, motor power stays off" ||
+	{ screen; fail "Ctrl-D: no reason given"; }
+echo "console_tmux: ok (80x24, 100x30, 200x60 and a resize: no wrapped line, one header, the FAULT and its recovery on screen 10 s later; Ctrl-D at the calibration question explained, exit 2)"
