@@ -288,20 +288,41 @@ static void ctrl_text(const struct re_status *st, char *buf, size_t cap)
 							  : "safe");
 }
 
+#define AT_SOFT_PCT 0.5	  /* within this of 0 or 100 %: at a soft limit */
+#define STILL_CPS   100.0 /* |velocity| below this: not moving */
+
+/* At a soft limit: +1 forward, -1 reverse, 0 not (or no calibration). */
+static int at_soft(const struct re_axis_status *a)
+{
+	if (a->pos_pct < 0)
+		return 0;
+	if (a->pos_pct >= 100 - AT_SOFT_PCT)
+		return 1;
+	return a->pos_pct <= AT_SOFT_PCT ? -1 : 0;
+}
+
+/* What the axis does now: never "moving" while it stands at a soft limit
+ * (the tracking profiler stays busy there) or with its motor off. */
 static const char *motion_text(const struct re_axis_status *a)
 {
 	if (a->motor_off)
 		return "off";
+	if (at_soft(a) && a->vel_cps < STILL_CPS && a->vel_cps > -STILL_CPS)
+		return "at-lim";
 	return a->moving ? "moving" : "stopped";
 }
 
+/* Hard limit switches (FWD, REV, F+R) or, without one, a soft limit
+ * reached (sF, sR). */
 static const char *limit_text(const struct re_axis_status *a)
 {
 	if (a->fwd_limit && a->rev_limit)
 		return "F+R";
 	if (a->fwd_limit)
 		return "FWD";
-	return a->rev_limit ? "REV" : "-";
+	if (a->rev_limit)
+		return "REV";
+	return at_soft(a) > 0 ? "sF" : at_soft(a) < 0 ? "sR" : "-";
 }
 
 int re_console_format_line(const struct re_status *st, char *buf, size_t cap)

@@ -150,9 +150,41 @@ static void test_regular_file_appends(void **state)
 	assert_int_equal(c.dropped, 0);
 }
 
+/* The words of the status line: an axis standing at its forward soft
+ * limit (its tracking profiler still busy) is "at-lim" with "lim=sF", not
+ * "moving"; the controller's latched fault in words. */
+static void test_status_words(void **state)
+{
+	struct re_status st;
+	char line[1024];
+
+	(void)state;
+	status_of(&st);
+	st.axis[0].pos_pct = 100;
+	st.axis[0].moving = 1;
+	st.axis[1].pos_pct = 0.2;
+	st.axis[2].pos_pct = 50;
+	st.axis[2].moving = 1;
+	st.axis[2].vel_cps = 900;
+	st.have_za = 1;
+	st.za.state = RE_DMC_FAULT;
+	st.za.fcode = RE_DMC_F_ENCODER;
+	st.za.faxis = 2;
+	re_console_format_line(&st, line, sizeof(line));
+	assert_non_null(strstr(line, " A enc=1000 pot=0.000V vel=0 at-lim "
+				     "lim=sF "));
+	assert_non_null(strstr(line, " B enc=2000 pot=0.000V vel=0 at-lim "
+				     "lim=sR "));
+	assert_non_null(strstr(line, " C enc=3000 pot=0.000V vel=900 moving "
+				     "lim=- "));
+	assert_non_null(strstr(line, "ctrl=\"FAULT ENCODER axis B (code "
+				     "9)\""));
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+	    cmocka_unit_test(test_status_words),
 	    cmocka_unit_test(test_stalled_reader_never_blocks),
 	    cmocka_unit_test(test_regular_file_appends),
 	};
