@@ -258,8 +258,8 @@ static void check_arrays(struct lint *c, int line, const char *s, size_t n)
 
 /* The argument list "(a,b,...)" at @s[@i]: count the arguments and judge
  * the arrays passed ("name" in quotes). Return the index after it. */
-static size_t check_js_args(struct lint *c, int line, const char *s,
-			    size_t n, size_t i, size_t wl)
+static size_t check_js_args(struct lint *c, int line, const char *s, size_t n,
+			    size_t i, size_t wl)
 {
 	size_t start = i, e;
 	int depth = 0, args = 0;
@@ -484,8 +484,7 @@ static void check_no_rest(struct lint *c, int line, const char *st,
 }
 
 /* Split a line into statements at ';' outside strings (comments: none). */
-static void check_statements(struct lint *c, int line, const char *s,
-			     size_t n)
+static void check_statements(struct lint *c, int line, const char *s, size_t n)
 {
 	const char *end = s + n, *st;
 	int in_str, first = 1, comment;
@@ -531,7 +530,6 @@ static void check_chars(struct lint *c, int line, const char *s, size_t n)
 			       "character 0x%02X is not printable ASCII", ch);
 	}
 }
-
 
 static int sym_cmp_name(const void *a, const void *b)
 {
@@ -614,10 +612,10 @@ static void check_end(struct lint *c, int extra_lines)
 	int i;
 
 	for (i = 0; i < c->nifs; i++)
-		report(c, c->ifs[i], 0, DMC_R_IF_MATCH,
-		       "'IF' without 'ENDIF'");
+		report(c, c->ifs[i], 0, DMC_R_IF_MATCH, "'IF' without 'ENDIF'");
 	if (total > m->max_lines)
-		report(c, m->max_lines < c->nlines ? m->max_lines + 1 : c->nlines,
+		report(c,
+		       m->max_lines < c->nlines ? m->max_lines + 1 : c->nlines,
 		       0, DMC_R_LINES_LIMIT,
 		       "program is %d lines long (%s limit %d)", total,
 		       m->title, m->max_lines);
@@ -626,8 +624,8 @@ static void check_end(struct lint *c, int extra_lines)
 }
 
 /* The next line of @text from *@pos (LF, CR LF or CR ends it). */
-static int next_line(const char *text, size_t len, size_t *pos,
-		     const char **s, size_t *n)
+static int next_line(const char *text, size_t len, size_t *pos, const char **s,
+		     size_t *n)
 {
 	size_t i = *pos;
 

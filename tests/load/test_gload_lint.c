@@ -74,10 +74,12 @@ static const struct {
     {"string-open", NULL,
      L("string-open", 5) "string-open: missing closing '\"'\n"},
     {"label-syntax", NULL,
-     L("label-syntax", 9) "label-syntax: invalid label '#A_B' (a letter, "
-			  "then letters or digits)\n" L("label-syntax", 10)
-			      "label-syntax: invalid label '#1AB' (a letter, "
-			      "then letters or digits)\n"},
+     L("label-syntax",
+       9) "label-syntax: invalid label '#A_B' (a letter, "
+	  "then letters or digits)\n" L(
+	      "label-syntax",
+	      10) "label-syntax: invalid label '#1AB' (a letter, "
+		  "then letters or digits)\n"},
     {"label-length", NULL,
      L("label-length", 4) "label-length: label '#ABCDEFGH' is longer than 7 "
 			  "characters\n"},
@@ -88,20 +90,23 @@ static const struct {
      L("label-duplicate", 5) "label-duplicate: duplicate label '#LOOP' (first "
 			     "at " LINT "label-duplicate.dmc:3)\n"},
     {"label-undefined", NULL,
-     L("label-undefined", 5) "label-undefined: undefined label '#NOPE' in "
-			     "'JP'\n" L("label-undefined", 6)
-				 "label-undefined: undefined label '#GONE' in "
-				 "'JS'\n" L("label-undefined", 7)
-				     "label-undefined: undefined label '#THR' "
-				     "in 'XQ'\n"},
+     L("label-undefined",
+       5) "label-undefined: undefined label '#NOPE' in "
+	  "'JP'\n" L("label-undefined",
+		     6) "label-undefined: undefined label '#GONE' in "
+			"'JS'\n" L("label-undefined",
+				   7) "label-undefined: undefined label '#THR' "
+				      "in 'XQ'\n"},
     {"var-syntax", NULL,
      L("var-syntax", 5) "var-syntax: invalid variable name '9ab' (a letter, "
 			"then letters, digits or '_')\n"},
     {"var-length", NULL,
-     L("var-length", 5) "var-length: variable name 'position12' is longer "
-			"than 8 characters\n" L("var-length", 7)
-			    "var-length: variable name 'distance12' is longer "
-			    "than 8 characters\n"},
+     L("var-length",
+       5) "var-length: variable name 'position12' is longer "
+	  "than 8 characters\n" L(
+	      "var-length",
+	      7) "var-length: variable name 'distance12' is longer "
+		 "than 8 characters\n"},
     {"var-reserved", NULL,
      L("var-reserved", 5) "var-reserved: variable name 'TIME' is a reserved "
 			  "word\n"},
@@ -109,14 +114,18 @@ static const struct {
      L("var-command", 5) "var-command: variable name 'TP' is a command "
 			 "name\n"},
     {"if-match", NULL,
-     L("if-match", 5) "if-match: 'ENDIF' without 'IF'\n" L("if-match", 6)
-	 "if-match: 'ELSE' without 'IF'\n" L("if-match", 11)
-	     "if-match: 'IF' without 'ENDIF'\n"},
+     L("if-match", 5) "if-match: 'ENDIF' without 'IF'\n" L(
+	 "if-match",
+	 6) "if-match: 'ELSE' without 'IF'\n" L("if-match",
+						11) "if-match: 'IF' without "
+						    "'ENDIF'\n"},
     {"lower-case", NULL,
-     L("lower-case", 5) "lower-case: lower-case command 'bg' (commands are "
-			"upper case)\n" L("lower-case", 6)
-			    "lower-case: lower-case command 'mg' (commands are "
-			    "upper case)\n"},
+     L("lower-case",
+       5) "lower-case: lower-case command 'bg' (commands are "
+	  "upper case)\n" L(
+	      "lower-case",
+	      6) "lower-case: lower-case command 'mg' (commands are "
+		 "upper case)\n"},
     {"no-semicolon", NULL,
      L("no-semicolon", 5) "no-semicolon: ';' ends the NO comment: 'ST A' "
 			  "runs as commands\n"},
@@ -136,10 +145,12 @@ static const struct {
      L("jp-args", 5) "jp-args: 'JP #SUB(1)': JP takes no arguments (JS "
 		     "does)\n"},
     {"js-args", NULL,
-     L("js-args", 6) "js-args: 'JS #SUB' passes 9 arguments (at most 8: "
-		     "^a..^h)\n" L("js-args", 7)
-			 "js-args: array 'pos_log' passed on the JS stack has "
-			 "a name longer than 6 characters\n"},
+     L("js-args",
+       6) "js-args: 'JS #SUB' passes 9 arguments (at most 8: "
+	  "^a..^h)\n" L(
+	      "js-args",
+	      7) "js-args: array 'pos_log' passed on the JS stack has "
+		 "a name longer than 6 characters\n"},
     {"lines-limit", &tiny,
      L("lines-limit", 11) "lines-limit: program is 9 lines long (DMC-test "
 			  "limit 8)\n"},
