@@ -311,7 +311,7 @@ static void test_sim_agrees(void **state)
 {
 	struct tplant tp;
 	char path[256], text[8192], resp[64];
-	int src[256], flagged[64], sim_line, bad, rc;
+	int src[256], flagged[64], sim_line, bad, rc, refused = 0;
 	size_t n;
 
 	(void)state;
@@ -324,6 +324,7 @@ static void test_sim_agrees(void **state)
 		n = prep_text(path, NULL, text, sizeof(text), src);
 		bad = 0;
 		rc = ctrl_download(tp.c, text, n, &bad);
+		refused += rc == GL_ERR_CTRL;
 		if (sim_line && (rc != GL_ERR_CTRL || src[bad - 1] != sim_line))
 			fail_msg("%s: galil-sim rc %d at line %d, the linter "
 				 "flags line %d",
@@ -338,6 +339,8 @@ static void test_sim_agrees(void **state)
 				 "refused line %d",
 				 path, src[bad - 1]);
 	}
+	/* line-length, label-syntax, label-length, label-duplicate */
+	assert_int_equal(refused, 4);
 	/* '_' inside variable and array names runs */
 	n = prep_text(LINT "label-syntax.dmc", (const int[]){9, 10, 0}, text,
 		      sizeof(text), src);
