@@ -13,6 +13,10 @@ static const struct dmc_rule rules[DMC_R_COUNT] = {
 			   DMC_RULE_SIM},
     [DMC_R_CHAR] = {"char-printable", "CR, DL: the program is ASCII text", 0},
     [DMC_R_BACKSLASH] = {"backslash", "CR, DL: '\\' ends the download", 0},
+    [DMC_R_STRING_OPEN] = {"string-open",
+			   "CR, MG: a string is enclosed in '\"'; an open one "
+			   "swallows the rest of the line",
+			   0},
     [DMC_R_LABEL_SYNTAX] = {"label-syntax",
 			    "CR, # (label): a letter, then letters and "
 			    "digits; no '_'",
@@ -45,7 +49,7 @@ static const struct dmc_rule rules[DMC_R_COUNT] = {
 			  0},
     [DMC_R_NO_SEMICOLON] = {"no-semicolon",
 			    "CR, NO: ';' ends the comment; the rest of the "
-			    "line runs",
+			    "line runs (real-controller-facts)",
 			    0},
     [DMC_R_EQ_EQ] = {"eq-eq",
 		     "UM, operators: '=' compares; '==' is not an operator", 0},
@@ -53,7 +57,14 @@ static const struct dmc_rule rules[DMC_R_COUNT] = {
 			     "CR, DL and UL: not valid in a program", 0},
     [DMC_R_WT_ASSIGN] = {"wt-assign", "CR, WT: 'WT n' waits; 'WT=n' does not",
 			 0},
-    [DMC_R_JP_ARGS] = {"jp-args", "CR, JP and JS: only JS passes arguments", 0},
+    [DMC_R_JP_ARGS] = {"jp-args",
+		       "CR, JP: 'JP #str,(ex)' takes no argument list "
+		       "(JS does)",
+		       0},
+    [DMC_R_JS_ARGS] = {"js-args",
+		       "CR, JS: at most 8 arguments; an array passed by "
+		       "reference has a name of 6 characters or less",
+		       0},
     [DMC_R_LINES_LIMIT] = {"lines-limit",
 			   "UM: program lines per model (dmc_model)",
 			   DMC_RULE_SIM},

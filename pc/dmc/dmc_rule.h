@@ -1,11 +1,12 @@
 /*
  * dmc_rule.h - the ONE table of the DMC linter's rules: each rule's name
- * (printed with every finding, "FILE:LINE: message [rule]"), the source it
- * rests on, and what it guards against. galil-load's checker reports by
- * rule (tools/galil-load/gload_check.c), docs/galil-load.md lists the
- * table (a test holds them equal), and galil-sim's download refuses what
- * the rules marked DMC_RULE_SIM refuse (TC 60/61), so the checker and the
- * simulated firmware agree.
+ * (printed with every finding, "FILE:LINE: rule: message"), the source it
+ * rests on, and what it guards against. The linter (dmc_lint.h) applies
+ * them, galil-load's checker prints its findings
+ * (tools/galil-load/gload_check.c), docs/galil-load.md lists the table (a
+ * test holds them equal), and galil-sim's download refuses what the rules
+ * marked DMC_RULE_SIM refuse (TC 60/61/62), so the checker and the
+ * simulated firmware agree (tests/load/test_gload_lint.c).
  *
  * Pure data; no I/O.
  */
@@ -18,6 +19,7 @@ enum dmc_rule_id {
 	DMC_R_LINE_LENGTH,
 	DMC_R_CHAR,
 	DMC_R_BACKSLASH,
+	DMC_R_STRING_OPEN,
 	DMC_R_LABEL_SYNTAX,
 	DMC_R_LABEL_LENGTH,
 	DMC_R_LABEL_POSITION,
@@ -34,6 +36,7 @@ enum dmc_rule_id {
 	DMC_R_DL_IN_PROGRAM,
 	DMC_R_WT_ASSIGN,
 	DMC_R_JP_ARGS,
+	DMC_R_JS_ARGS,
 	DMC_R_LINES_LIMIT,
 	DMC_R_LABELS_LIMIT,
 	DMC_R_VARS_LIMIT,

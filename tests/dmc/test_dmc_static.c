@@ -21,6 +21,7 @@
 #include <cmocka.h>
 
 #include "dmc_h.h"
+#include "dmc_lint.h"
 #include "dmc_text.h"
 
 #define LINE_MAX_CH 80
@@ -190,6 +191,26 @@ static void scan_idents(const char *s, struct names *vars, struct names *refs)
 	}
 }
 
+/* The program as galil-load sends it passes every rule of the one linter
+ * galil-load --check uses (pc/dmc/dmc_lint.h) on the DMC-4030, with
+ * galil-load's identity line counted: no finding, and the counts fit. */
+static void test_lint_clean(void **state)
+{
+	struct dmc_lint r = {0};
+	int n;
+
+	(void)state;
+	n = dmc_lint_text(prog, (size_t)prog_len, dmc_model_default(), 1, &r);
+	for (int i = 0; i < r.n; i++)
+		fprintf(stderr, "program line %d: %s: %s\n", r.v[i].line,
+			dmc_rule(r.v[i].rule)->name, r.v[i].msg);
+	assert_int_equal(n, 0);
+	assert_true(r.lines > 100 && r.lines <= PROG_LINES);
+	assert_true(r.labels > 10 && r.labels <= LABELS_MAX);
+	assert_true(r.vars > 10 && r.vars <= VARS_MAX);
+	dmc_lint_free(&r);
+}
+
 /* Routines the interface names (docs/dmc-interface.md). */
 static const char *const auto_labels[] = {
     "AUTO",   "MAIN",	"MOTION", "POSERR", "LIMSWI",
@@ -341,11 +362,9 @@ static void test_bare_xq(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	    cmocka_unit_test(test_source_lines),
-	    cmocka_unit_test(test_lines),
-	    cmocka_unit_test(test_labels),
-	    cmocka_unit_test(test_statements),
-	    cmocka_unit_test(test_bare_xq),
+	    cmocka_unit_test(test_source_lines), cmocka_unit_test(test_lines),
+	    cmocka_unit_test(test_lint_clean),	 cmocka_unit_test(test_labels),
+	    cmocka_unit_test(test_statements),	 cmocka_unit_test(test_bare_xq),
 	};
 
 	return cmocka_run_group_tests(tests, setup_prog, NULL);

@@ -2,7 +2,9 @@
  * test_gload_check.c - galil-load's offline checker on the fixtures in
  * tests/data/dmc_bad (one per kind of error; each file's REM header says
  * what is expected where) and on small in-memory programs for the edges.
- * Every expectation is the exact "FILE:LINE: message" text.
+ * Every expectation is the exact "FILE:LINE: rule: message" text (the
+ * rules are pc/dmc/dmc_lint's; tests/load/test_gload_lint has one
+ * fixture per rule).
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -84,74 +86,71 @@ struct fixture_case {
 
 static const struct fixture_case cases[] = {
     {"line_too_long.dmc", "40x0",
-     BAD "line_too_long.dmc:7: line is 81 characters long after "
-	 "preprocessing (limit 80) [line-length]\n"},
+     BAD "line_too_long.dmc:7: line-length: line is 81 characters long "
+	 "(DMC-40x0 limit 80)\n"},
     {"label_syntax.dmc", "40x0",
-     BAD "label_syntax.dmc:6: invalid label '#1ABC' (a letter, then letters or "
-	 "digits) [label-syntax]\n" BAD
-	 "label_syntax.dmc:8: invalid label '#A-B' (a letter, then letters or "
-	 "digits) [label-syntax]\n" BAD
-	 "label_syntax.dmc:10: label '#X' is not at the start of a "
-	 "line [label-position]\n"},
+     BAD "label_syntax.dmc:6: label-syntax: invalid label '#1ABC' (a letter, "
+	 "then letters or digits)\n" BAD
+	 "label_syntax.dmc:8: label-syntax: invalid label '#A-B' (a letter, "
+	 "then letters or digits)\n" BAD
+	 "label_syntax.dmc:10: label-position: label '#X' is not at the start "
+	 "of a line\n"},
     {"label_long.dmc", "40x0",
-     BAD "label_long.dmc:6: label '#TOOLONGL' is longer than 7 "
-	 "characters [label-length]\n"},
+     BAD "label_long.dmc:6: label-length: label '#TOOLONGL' is longer than 7 "
+	 "characters\n"},
     {"label_duplicate.dmc", "40x0",
-     BAD "label_duplicate.dmc:9: duplicate label '#LOOP' (first at " BAD
-	 "label_duplicate.dmc:6) [label-duplicate]\n"},
+     BAD "label_duplicate.dmc:9: label-duplicate: duplicate label '#LOOP' "
+	 "(first at " BAD "label_duplicate.dmc:6)\n"},
     {"label_undefined.dmc", "40x0",
-     BAD "label_undefined.dmc:7: undefined label '#NOWHERE' in 'JP' "
-	 "[label-undefined]\n" BAD "label_undefined.dmc:8: undefined label "
-				   "'#SUB' in 'JS' [label-undefined]\n" BAD
-	 "label_undefined.dmc:9: undefined label '#THR' in 'XQ' "
-	 "[label-undefined]\n"},
+     BAD "label_undefined.dmc:7: label-undefined: undefined label '#NOWHERE' "
+	 "in 'JP'\n" BAD "label_undefined.dmc:8: label-undefined: undefined "
+			 "label '#SUB' in 'JS'\n" BAD
+	 "label_undefined.dmc:9: label-undefined: undefined label '#THR' in "
+	 "'XQ'\n"},
     {"var_name.dmc", "40x0",
      BAD
-     "var_name.dmc:6: variable name 'position12' is longer than 8 "
-     "characters [var-length]\n" BAD "var_name.dmc:7: variable name 'TIME' is "
-				     "a reserved word [var-reserved]\n" BAD
-     "var_name.dmc:8: variable name 'TP' is a command name [var-command]\n" BAD
-     "var_name.dmc:9: invalid variable name '9ab' (a letter, then "
-     "letters, digits or '_') [var-syntax]\n" BAD
-     "var_name.dmc:10: variable name 'toolongarr' is longer than 8 "
-     "characters [var-length]\n" BAD
-     "var_name.dmc:11: variable name 'distance12' is longer than 8 "
-     "characters [var-length]\n"},
+     "var_name.dmc:6: var-length: variable name 'position12' is longer than 8 "
+     "characters\n" BAD "var_name.dmc:7: var-reserved: variable name 'TIME' is "
+			"a reserved word\n" BAD
+     "var_name.dmc:8: var-command: variable name 'TP' is a command name\n" BAD
+     "var_name.dmc:9: var-syntax: invalid variable name '9ab' (a letter, then "
+     "letters, digits or '_')\n" BAD
+     "var_name.dmc:10: var-length: variable name 'toolongarr' is longer than 8 "
+     "characters\n" BAD "var_name.dmc:11: var-length: variable name "
+			"'distance12' is longer than 8 characters\n"},
     {"backslash.dmc", "40x0",
-     BAD "backslash.dmc:6: '\\' ends the download early [backslash]\n"},
+     BAD "backslash.dmc:6: backslash: '\\' ends the download early\n"},
     {"lowercase.dmc", "40x0",
-     BAD "lowercase.dmc:8: lower-case command 'bg' (commands are upper "
-	 "case) [lower-case]\n" BAD
-	 "lowercase.dmc:9: lower-case command 'mg' (commands are upper "
-	 "case) [lower-case]\n" BAD
-	 "lowercase.dmc:10: lower-case command 'if' (commands are upper "
-	 "case) [lower-case]\n" BAD
-	 "lowercase.dmc:12: lower-case command 'endif' (commands are "
-	 "upper case) [lower-case]\n"},
+     BAD "lowercase.dmc:8: lower-case: lower-case command 'bg' (commands are "
+	 "upper case)\n" BAD "lowercase.dmc:9: lower-case: lower-case command "
+			     "'mg' (commands are upper case)\n" BAD
+	 "lowercase.dmc:10: lower-case: lower-case command 'if' (commands are "
+	 "upper case)\n" BAD "lowercase.dmc:12: lower-case: lower-case command "
+			     "'endif' (commands are upper case)\n"},
     {"no_semicolon.dmc", "40x0",
-     BAD "no_semicolon.dmc:6: ';' ends the NO comment: the rest of the "
-	 "line runs as commands [no-semicolon]\n"},
+     BAD "no_semicolon.dmc:6: no-semicolon: ';' ends the NO comment: 'then ST "
+	 "A' runs as commands\n"},
     {"string_open.dmc", "40x0",
-     BAD "string_open.dmc:5: missing closing '\"'\n"},
+     BAD "string_open.dmc:5: string-open: missing closing '\"'\n"},
     {"if_nesting.dmc", "40x0",
-     BAD "if_nesting.dmc:7: 'ENDIF' without 'IF' [if-match]\n" BAD
-	 "if_nesting.dmc:8: 'ELSE' without 'IF' [if-match]\n" BAD
-	 "if_nesting.dmc:9: 'IF' without 'ENDIF' [if-match]\n"},
+     BAD "if_nesting.dmc:7: if-match: 'ENDIF' without 'IF'\n" BAD
+	 "if_nesting.dmc:8: if-match: 'ELSE' without 'IF'\n" BAD
+	 "if_nesting.dmc:9: if-match: 'IF' without 'ENDIF'\n"},
     {"non_ascii.dmc", "40x0",
-     BAD "non_ascii.dmc:5: character 0xC2 is not printable ASCII "
-	 "[char-printable]\n"},
+     BAD "non_ascii.dmc:5: char-printable: character 0xC2 is not printable "
+	 "ASCII\n"},
     {"too_many_lines.dmc", "21x3",
-     BAD "too_many_lines.dmc:1003: program is 1001 lines long with the "
-	 "identity line (DMC-21x3 limit 1000) [lines-limit]\n"},
+     BAD "too_many_lines.dmc:1003: lines-limit: program is 1001 lines long "
+	 "(DMC-21x3 limit 1000)\n"},
     {"too_many_labels.dmc", "21x3",
-     BAD "too_many_labels.dmc:258: 255 labels (DMC-21x3 limit 254) "
-	 "[labels-limit]\n"},
+     BAD "too_many_labels.dmc:258: labels-limit: 255 labels (DMC-21x3 limit "
+	 "254)\n"},
     {"too_many_vars.dmc", "21x3",
      BAD
-     "too_many_vars.dmc:55: 255 variables (DMC-21x3 limit 254) [vars-limit]\n"},
+     "too_many_vars.dmc:55: vars-limit: 255 variables (DMC-21x3 limit 254)\n"},
     {"missing_dir", "40x0",
-     BAD "missing_dir/MANIFEST:3: cannot open "
-	 "'" BAD "missing_dir/absent.dmc': No such file or directory\n"},
+     BAD "missing_dir/MANIFEST:3: cannot open '" BAD
+	 "missing_dir/absent.dmc': No such file or directory\n"},
 };
 
 /* Every fixture gives exactly the diagnostics its header announces. */
@@ -252,13 +251,13 @@ static void test_several_per_line(void **state)
 	(void)state;
 	out = check_text("#A\nbg;JP #B;st AB;zs\nEN\n", &n);
 	assert_string_equal(
-	    out, "mem.dmc:2: lower-case command 'bg' (commands are "
-		 "upper case) [lower-case]\n"
-		 "mem.dmc:2: lower-case command 'st' (commands are "
-		 "upper case) [lower-case]\n"
-		 "mem.dmc:2: lower-case command 'zs' (commands are "
-		 "upper case) [lower-case]\n"
-		 "mem.dmc:2: undefined label '#B' in 'JP' [label-undefined]\n");
+	    out, "mem.dmc:2: lower-case: lower-case command 'bg' (commands "
+		 "are upper case)\n"
+		 "mem.dmc:2: lower-case: lower-case command 'st' (commands "
+		 "are upper case)\n"
+		 "mem.dmc:2: lower-case: lower-case command 'zs' (commands "
+		 "are upper case)\n"
+		 "mem.dmc:2: label-undefined: undefined label '#B' in 'JP'\n");
 	free(out);
 }
 
@@ -270,8 +269,7 @@ static void test_empty_program(void **state)
 
 	(void)state;
 	out = check_text("REM nothing\n' nothing\n\n", &n);
-	assert_string_equal(
-	    out, "mem.dmc: no program lines after preprocessing [empty]\n");
+	assert_string_equal(out, "mem.dmc: empty: no program lines\n");
 	assert_int_equal(n, 1);
 	free(out);
 }
@@ -285,10 +283,9 @@ static void test_label_case_and_length(void **state)
 	(void)state;
 	out = check_text("#Loop\nJP #LOOP\n#ABCDEFG\n#ABCDEFGH\nEN\n", &n);
 	assert_string_equal(
-	    out,
-	    "mem.dmc:2: undefined label '#LOOP' in 'JP' [label-undefined]\n"
-	    "mem.dmc:4: label '#ABCDEFGH' is longer than 7 "
-	    "characters [label-length]\n");
+	    out, "mem.dmc:2: label-undefined: undefined label '#LOOP' in 'JP'\n"
+		 "mem.dmc:4: label-length: label '#ABCDEFGH' is longer than 7 "
+		 "characters\n");
 	free(out);
 }
 

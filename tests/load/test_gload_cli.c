@@ -175,12 +175,12 @@ static void test_check_fails(void **state)
 	(void)state;
 	assert_int_equal(run(&p, args), 1);
 	assert_string_equal(proc_output(&p, PROC_STDERR), BAD
-			    "label_undefined.dmc:7: undefined label "
-			    "'#NOWHERE' in 'JP' [label-undefined]\n" BAD
-			    "label_undefined.dmc:8: undefined label '#SUB' "
-			    "in 'JS' [label-undefined]\n" BAD
-			    "label_undefined.dmc:9: undefined label '#THR' "
-			    "in 'XQ' [label-undefined]\n"
+			    "label_undefined.dmc:7: label-undefined: undefined "
+			    "label '#NOWHERE' in 'JP'\n" BAD
+			    "label_undefined.dmc:8: label-undefined: undefined "
+			    "label '#SUB' in 'JS'\n" BAD
+			    "label_undefined.dmc:9: label-undefined: undefined "
+			    "label '#THR' in 'XQ'\n"
 			    "galil-load: check failed (3 problems); nothing "
 			    "was sent to the controller\n");
 	assert_string_equal(proc_output(&p, PROC_STDOUT), "");

@@ -1,12 +1,16 @@
 /*
- * test_gload_lint.c - the linter's rules that agree with the firmware
- * (pc/dmc/dmc_rule.h): one fixture per rule in tests/data/lint/, each
- * with the statement the rule must flag and the look-alikes it must not
- * (the exact "FILE:LINE: message [rule]" text); a program written in the
- * style of production DMC passes clean, and so do our own dmc/ files; the
- * rule table is complete and documented; and galil-sim's download agrees
- * with the rules it shares (DMC_RULE_SIM): it refuses the label with '_'
- * at the same line and runs the names with '_'.
+ * test_gload_lint.c - the linter that agrees with the firmware
+ * (pc/dmc/dmc_lint.h, rules in pc/dmc/dmc_rule.c): one fixture per rule in
+ * tests/data/lint/<rule>.dmc, each with the statements the rule must flag
+ * and look-alikes it must not, checked through galil-load's --check path
+ * for the exact "FILE:LINE: rule: message" text; the rules that depend on
+ * the model flag their fixture on a small model and not on the DMC-40x0;
+ * a program written in the style of production DMC passes clean, and so
+ * do our own dmc/ files; the rule table is complete and documented; and
+ * galil-sim's download agrees with every fixture: it refuses a program at
+ * the first line a rule it shares (DMC_RULE_SIM) flags, accepts a program
+ * no such rule flags, and accepts every fixture once the flagged lines are
+ * removed.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -20,6 +24,7 @@
 
 #include "../sim/test_ctrl_util.h"
 #include "base_file.h"
+#include "dmc_lint.h"
 #include "dmc_model.h"
 #include "dmc_rule.h"
 #include "gl_err.h"
@@ -28,16 +33,22 @@
 
 #define LINT "tests/data/lint/"
 
-/* Check @path for the DMC-40x0; every finding, one per line. */
-static void check_path(const char *path, char *out, size_t cap)
+/* A model with small limits, so that the per-model rules' fixtures stay
+ * small: 8 lines, 2 labels, 2 variables. */
+static const struct dmc_model tiny = {"tiny", "DMC-test", 80, 8, 2, 2, 8, 0};
+
+/* Check @path with @m as galil-load --check does; every finding, one per
+ * line, into @out. */
+static void check_path(const char *path, const struct dmc_model *m, char *out,
+		       size_t cap)
 {
 	struct gload_prog p = {0};
 	struct gload_diags d = {0};
 	size_t n = 0;
 
 	out[0] = '\0';
-	gload_prep_path(&p, path, &d);
-	assert_true(gload_check(&p, dmc_model_default(), &d, NULL) >= 0);
+	assert_int_equal(gload_prep_path(&p, path, &d), GL_OK);
+	assert_true(gload_check(&p, m, &d, NULL) >= 0);
 	gload_diags_sort(&d);
 	for (int i = 0; i < d.n && n < cap; i++)
 		n += (size_t)snprintf(out + n, cap - n, "%s\n", d.v[i].text);
@@ -45,49 +56,172 @@ static void check_path(const char *path, char *out, size_t cap)
 	gload_prog_free(&p);
 }
 
+#define L(f, line) LINT f ".dmc:" #line ": "
+
 static const struct {
-	const char *file, *expect;
+	const char *rule;
+	const struct dmc_model *model; /* NULL: the DMC-40x0 */
+	const char *expect;
 } cases[] = {
-    {"eq_eq.dmc", LINT "eq_eq.dmc:5: '==' is not a DMC operator ('=' compares) "
-		       "[eq-eq]\n"},
-    {"dl_in_program.dmc",
-     LINT "dl_in_program.dmc:5: 'DL' inside a program (a host command: it "
-	  "would end or dump the program) [dl-in-program]\n" LINT
-	  "dl_in_program.dmc:6: 'UL' inside a program (a host command: it "
-	  "would end or dump the program) [dl-in-program]\n"},
-    {"wt_assign.dmc",
-     LINT "wt_assign.dmc:5: 'WT=1000' does not wait (write 'WT 1000') "
-	  "[wt-assign]\n"},
-    {"jp_args.dmc",
-     LINT "jp_args.dmc:5: 'JP #SUB(...)': JP passes no arguments (JS does) "
-	  "[jp-args]\n"},
-    {"underscore.dmc",
-     LINT "underscore.dmc:8: invalid label '#A_B' (a letter, then letters or "
-	  "digits) [label-syntax]\n"},
-    {"production.dmc", ""},
+    {"line-length", NULL,
+     L("line-length", 6) "line-length: line is 81 characters long (DMC-40x0 "
+			 "limit 80)\n"},
+    {"char-printable", NULL,
+     L("char-printable", 5) "char-printable: character 0xC2 is not "
+			    "printable ASCII\n"},
+    {"backslash", NULL,
+     L("backslash", 5) "backslash: '\\' ends the download early\n"},
+    {"string-open", NULL,
+     L("string-open", 5) "string-open: missing closing '\"'\n"},
+    {"label-syntax", NULL,
+     L("label-syntax",
+       9) "label-syntax: invalid label '#A_B' (a letter, "
+	  "then letters or digits)\n" L(
+	      "label-syntax",
+	      10) "label-syntax: invalid label '#1AB' (a letter, "
+		  "then letters or digits)\n"},
+    {"label-length", NULL,
+     L("label-length", 4) "label-length: label '#ABCDEFGH' is longer than 7 "
+			  "characters\n"},
+    {"label-position", NULL,
+     L("label-position", 5) "label-position: label '#L' is not at the start "
+			    "of a line\n"},
+    {"label-duplicate", NULL,
+     L("label-duplicate", 5) "label-duplicate: duplicate label '#LOOP' (first "
+			     "at " LINT "label-duplicate.dmc:3)\n"},
+    {"label-undefined", NULL,
+     L("label-undefined",
+       5) "label-undefined: undefined label '#NOPE' in "
+	  "'JP'\n" L("label-undefined",
+		     6) "label-undefined: undefined label '#GONE' in "
+			"'JS'\n" L("label-undefined",
+				   7) "label-undefined: undefined label '#THR' "
+				      "in 'XQ'\n"},
+    {"var-syntax", NULL,
+     L("var-syntax", 5) "var-syntax: invalid variable name '9ab' (a letter, "
+			"then letters, digits or '_')\n"},
+    {"var-length", NULL,
+     L("var-length",
+       5) "var-length: variable name 'position12' is longer "
+	  "than 8 characters\n" L(
+	      "var-length",
+	      7) "var-length: variable name 'distance12' is longer "
+		 "than 8 characters\n"},
+    {"var-reserved", NULL,
+     L("var-reserved", 5) "var-reserved: variable name 'TIME' is a reserved "
+			  "word\n"},
+    {"var-command", NULL,
+     L("var-command", 5) "var-command: variable name 'TP' is a command "
+			 "name\n"},
+    {"if-match", NULL,
+     L("if-match", 5) "if-match: 'ENDIF' without 'IF'\n" L(
+	 "if-match",
+	 6) "if-match: 'ELSE' without 'IF'\n" L("if-match",
+						11) "if-match: 'IF' without "
+						    "'ENDIF'\n"},
+    {"lower-case", NULL,
+     L("lower-case",
+       5) "lower-case: lower-case command 'bg' (commands are "
+	  "upper case)\n" L(
+	      "lower-case",
+	      6) "lower-case: lower-case command 'mg' (commands are "
+		 "upper case)\n"},
+    {"no-semicolon", NULL,
+     L("no-semicolon", 5) "no-semicolon: ';' ends the NO comment: 'ST A' "
+			  "runs as commands\n"},
+    {"eq-eq", NULL,
+     L("eq-eq", 5) "eq-eq: '==' is not a DMC operator ('=' compares)\n"},
+    {"dl-in-program", NULL,
+     L("dl-in-program", 5) "dl-in-program: 'DL' inside a program (a host "
+			   "command: it would end or dump the program)\n" L(
+			       "dl-in-program", 6) "dl-in-program: 'UL' inside "
+						   "a program (a host command: "
+						   "it would end or dump the "
+						   "program)\n"},
+    {"wt-assign", NULL,
+     L("wt-assign", 5) "wt-assign: 'WT=1000' does not wait (write 'WT "
+		       "1000')\n"},
+    {"jp-args", NULL,
+     L("jp-args", 5) "jp-args: 'JP #SUB(1)': JP takes no arguments (JS "
+		     "does)\n"},
+    {"js-args", NULL,
+     L("js-args",
+       6) "js-args: 'JS #SUB' passes 9 arguments (at most 8: "
+	  "^a..^h)\n" L(
+	      "js-args",
+	      7) "js-args: array 'pos_log' passed on the JS stack has "
+		 "a name longer than 6 characters\n"},
+    {"lines-limit", &tiny,
+     L("lines-limit", 11) "lines-limit: program is 9 lines long (DMC-test "
+			  "limit 8)\n"},
+    {"labels-limit", &tiny,
+     L("labels-limit", 6) "labels-limit: 3 labels (DMC-test limit 2)\n"},
+    {"vars-limit", &tiny,
+     L("vars-limit", 4) "vars-limit: 3 variables (DMC-test limit 2)\n"},
+    {"empty", NULL, LINT "empty.dmc: empty: no program lines\n"},
 };
 
+#define NCASES ((int)(sizeof(cases) / sizeof(cases[0])))
+
+/* Each fixture gives exactly the findings listed (its true positives, and
+ * none of its false positives); a per-model rule's fixture is clean on
+ * the DMC-40x0. */
 static void test_rule_fixtures(void **state)
 {
-	char path[256], out[2048];
+	char path[256], out[4096];
 
 	(void)state;
-	for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
-		snprintf(path, sizeof(path), LINT "%s", cases[i].file);
-		check_path(path, out, sizeof(out));
+	for (int i = 0; i < NCASES; i++) {
+		const struct dmc_model *m =
+		    cases[i].model ? cases[i].model : dmc_model_default();
+
+		snprintf(path, sizeof(path), LINT "%s.dmc", cases[i].rule);
+		check_path(path, m, out, sizeof(out));
 		if (strcmp(out, cases[i].expect))
-			fail_msg("%s:\n got: %s\nwant: %s", cases[i].file, out,
+			fail_msg("%s:\n got: %s\nwant: %s", path, out,
 				 cases[i].expect);
+		if (cases[i].model) {
+			check_path(path, dmc_model_default(), out, sizeof(out));
+			if (out[0])
+				fail_msg("%s on the DMC-40x0: %s", path, out);
+		}
 	}
 }
 
-/* Our own programs pass every rule. */
-static void test_our_programs_clean(void **state)
+/* Every rule of the table has its fixture case, and only those. */
+static void test_fixture_per_rule(void **state)
+{
+	(void)state;
+	assert_int_equal(NCASES, DMC_R_COUNT);
+	for (int i = 0; i < DMC_R_COUNT; i++) {
+		const char *name = dmc_rule((enum dmc_rule_id)i)->name;
+		int found = 0;
+
+		for (int j = 0; j < NCASES; j++)
+			found += !strcmp(cases[j].rule, name);
+		if (found != 1)
+			fail_msg("rule '%s' has %d fixture cases", name, found);
+	}
+}
+
+/* Our own programs pass every rule: the MANIFEST directory, and
+ * constants.dmc alone; roboelf.dmc alone misses only the label its
+ * constants file defines. The production-style program passes too. */
+static void test_clean_programs(void **state)
 {
 	char out[2048];
 
 	(void)state;
-	check_path("dmc", out, sizeof(out));
+	check_path("dmc", dmc_model_default(), out, sizeof(out));
+	assert_string_equal(out, "");
+	check_path("dmc/constants.dmc", dmc_model_default(), out, sizeof(out));
+	assert_string_equal(out, "");
+	check_path("dmc/roboelf.dmc", dmc_model_default(), out, sizeof(out));
+	assert_non_null(strstr(out, "label-undefined: undefined label "
+				    "'#CONSTS' in 'JS'\n"));
+	assert_int_equal(strchr(out, '\n') - out + 1, (long)strlen(out));
+	check_path(LINT "production.dmc", dmc_model_default(), out,
+		   sizeof(out));
 	assert_string_equal(out, "");
 }
 
@@ -118,53 +252,105 @@ static void test_rule_table(void **state)
 	free(doc);
 }
 
-/* The preprocessed text of @path (LF lines), as galil-load downloads it;
- * @src: the source line of each downloaded line. */
-static size_t prep_text(const char *path, char *buf, size_t cap, int *src)
+/* The preprocessed text of @path (LF lines), as galil-load downloads it,
+ * without the lines whose source line is in @skip (0-terminated; NULL:
+ * none); @src: the source line of each kept line. */
+static size_t prep_text(const char *path, const int *skip, char *buf,
+			size_t cap, int *src)
 {
 	struct gload_prog p = {0};
 	struct gload_diags d = {0};
 	size_t n = 0;
+	int k = 0;
 
+	buf[0] = '\0';
 	gload_prep_path(&p, path, &d);
 	for (int i = 0; i < p.nlines; i++) {
+		int drop = 0;
+
+		for (int j = 0; skip && skip[j]; j++)
+			drop |= skip[j] == p.lines[i].src_line;
+		if (drop)
+			continue;
 		n += (size_t)snprintf(buf + n, cap - n, "%.*s\n",
 				      (int)p.lines[i].len, p.lines[i].text);
-		src[i] = p.lines[i].src_line;
+		src[k++] = p.lines[i].src_line;
 	}
 	gload_diags_free(&d);
 	gload_prog_free(&p);
 	return n;
 }
 
-/* galil-sim refuses the label with '_' (TC 61) at the line the linter
- * names, and runs '_' inside variable and array names. */
+/* The source lines the linter flags in @path (0-terminated), and in
+ * *@sim_line the first one flagged by a rule galil-sim shares (0: none). */
+static void lint_lines(const char *path, int *flagged, int *sim_line)
+{
+	char text[8192];
+	int src[256], k = 0;
+	struct dmc_lint r = {0};
+	size_t n = prep_text(path, NULL, text, sizeof(text), src);
+
+	*sim_line = 0;
+	assert_true(dmc_lint_text(text, n, dmc_model_default(), 1, &r) >= 0);
+	for (int i = 0; i < r.n && k < 63; i++) {
+		int line = r.v[i].line ? src[r.v[i].line - 1] : 0;
+
+		if (line)
+			flagged[k++] = line;
+		if (line && !*sim_line &&
+		    (dmc_rule(r.v[i].rule)->flags & DMC_RULE_SIM))
+			*sim_line = line;
+	}
+	flagged[k] = 0;
+	dmc_lint_free(&r);
+}
+
+/* galil-sim and the linter agree on every fixture of the DMC-40x0 (the
+ * per-model fixtures are linted on a test model galil-sim is not). */
 static void test_sim_agrees(void **state)
 {
 	struct tplant tp;
-	char text[4096], resp[64];
-	int src[64], bad = 0;
+	char path[256], text[8192], resp[64];
+	int src[256], flagged[64], sim_line, bad, rc, refused = 0;
 	size_t n;
 
 	(void)state;
 	assert_int_equal(tp_init(&tp), 0);
-	n = prep_text(LINT "underscore.dmc", text, sizeof(text), src);
-	assert_int_equal(ctrl_download(tp.c, text, n, &bad), GL_ERR_CTRL);
-	assert_int_equal(src[bad - 1], 8);
-	assert_int_equal(ctrl_command(tp.c, "TC", resp, sizeof(resp)), 0);
-	assert_int_equal(atoi(resp), 61);
-	/* without that line: loads, and the names with '_' work */
-	n = prep_text(LINT "underscore.dmc", text, sizeof(text), src);
-	text[n - strlen("#A_B\nEN\n")] = '\0';
-	strcat(text, "EN\n");
-	assert_int_equal(ctrl_download(tp.c, text, strlen(text), &bad), 0);
+	for (int i = 0; i < NCASES; i++) {
+		if (cases[i].model || !strcmp(cases[i].rule, "empty"))
+			continue;
+		snprintf(path, sizeof(path), LINT "%s.dmc", cases[i].rule);
+		lint_lines(path, flagged, &sim_line);
+		n = prep_text(path, NULL, text, sizeof(text), src);
+		bad = 0;
+		rc = ctrl_download(tp.c, text, n, &bad);
+		refused += rc == GL_ERR_CTRL;
+		if (sim_line && (rc != GL_ERR_CTRL || src[bad - 1] != sim_line))
+			fail_msg("%s: galil-sim rc %d at line %d, the linter "
+				 "flags line %d",
+				 path, rc, bad ? src[bad - 1] : 0, sim_line);
+		if (!sim_line && rc != 0)
+			fail_msg("%s: galil-sim refused line %d; no shared "
+				 "rule flags it",
+				 path, src[bad - 1]);
+		n = prep_text(path, flagged, text, sizeof(text), src);
+		if (ctrl_download(tp.c, text, n, &bad) != 0)
+			fail_msg("%s without its flagged lines: galil-sim "
+				 "refused line %d",
+				 path, src[bad - 1]);
+	}
+	/* line-length, label-syntax, label-length, label-duplicate */
+	assert_int_equal(refused, 4);
+	/* '_' inside variable and array names runs */
+	n = prep_text(LINT "label-syntax.dmc", (const int[]){9, 10, 0}, text,
+		      sizeof(text), src);
+	assert_int_equal(ctrl_download(tp.c, text, n, &bad), 0);
 	assert_int_equal(ctrl_command(tp.c, "XQ #A", resp, sizeof(resp)), 0);
 	tp_step(&tp, 20);
-	assert_int_equal(ctrl_command(tp.c, "MG a_rr[0]", resp, sizeof(resp)),
-			 0);
-	assert_true(strtod(resp, NULL) == 1.0);
+	assert_true(tp_mg(&tp, "a_rr[0]") == 1.0);
+	assert_true(tp_mg(&tp, "x_pos") == 1.0);
 	/* the production-style program loads as well */
-	n = prep_text(LINT "production.dmc", text, sizeof(text), src);
+	n = prep_text(LINT "production.dmc", NULL, text, sizeof(text), src);
 	if (ctrl_download(tp.c, text, n, &bad) != 0) {
 		ctrl_command(tp.c, "TC1", resp, sizeof(resp));
 		fail_msg("galil-sim refused production.dmc at line %d: %s",
@@ -177,7 +363,8 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_rule_fixtures),
-	    cmocka_unit_test(test_our_programs_clean),
+	    cmocka_unit_test(test_fixture_per_rule),
+	    cmocka_unit_test(test_clean_programs),
 	    cmocka_unit_test(test_rule_table),
 	    cmocka_unit_test(test_sim_agrees),
 	};

@@ -1,28 +1,11 @@
 /*
- * gload_check.h - galil-load's offline checker: the mistakes a DMC controller
+ * gload_check.h - galil-load's offline check: the mistakes a DMC controller
  * would reject at download or trip over at run time, found before anything
- * is sent, each reported as "FILE:LINE: message" at the source line.
- *
- * Checked on the preprocessed lines (what is downloaded), reported at the
- * source line they came from:
- *  - line length (the controller's limit applies to the downloaded line);
- *  - '\' anywhere (it ends a download early) and bytes that are not
- *    printable ASCII;
- *  - labels: '#', a letter, then letters, digits or '_', at most 7 after
- *    the '#'; only at the start of a line; no duplicates;
- *  - label references of JP, JS and XQ (also "JS #L(args)" and "JP #L,cond")
- *    that name no label;
- *  - variable names (assignment targets, DM arrays, names in expressions):
- *    a letter, then letters or digits, at most 8; not a reserved word or a
- *    two-letter command name;
- *  - lower-case commands ("bg", "mg", "if"): the controller answers '?';
- *  - a ';' after the text of a NO comment (the rest runs as commands);
- *  - IF / ELSE / ENDIF nesting;
- *  - the number of lines (with the identity line), labels and variables
- *    against the model's limits.
- * The checker does not know every command's arguments; it never reports an
- * upper-case statement it does not recognise (the controller's own download
- * check and the read-back still apply).
+ * is sent. The rules are the DMC front end's linter (pc/dmc/dmc_lint.h,
+ * table in pc/dmc/dmc_rule.c, listed in docs/galil-load.md); this module
+ * runs it on the preprocessed lines (what is downloaded, plus the identity
+ * line against the model's line limit) and reports each finding at the
+ * source line it came from, as "FILE:LINE: rule: message".
  */
 #ifndef GLOAD_CHECK_H
 #define GLOAD_CHECK_H

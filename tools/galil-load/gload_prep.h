@@ -63,7 +63,8 @@ struct gload_prog {
  * @p: the program (zero-initialised before the first call).
  * @path: the name used in messages (copied).
  * @buf: [in] the file's bytes, @len of them.
- * @d: [out] problems found ("FILE:LINE: missing closing '\"'").
+ * @d: [out] problems found; none today (an open string is the linter's
+ *     finding string-open), kept so that callers need not change.
  * Return: GL_OK (even with diagnostics), or GL_ERR_NOMEM.
  */
 int gload_prep_buffer(struct gload_prog *p, const char *path, const char *buf,
