@@ -13,7 +13,6 @@
 #include "base_clock.h"
 #include "gl_err.h"
 
-
 static int64_t now_ns(const struct re_super *s)
 {
 	return s->io.ops->now_ns(s->io.ud);
@@ -302,9 +301,10 @@ static int check_uncmd(struct re_super *s, struct re_fault *f)
 		    now - s->moving_ns[i] <= s->cfg.uncmd_grace_ns)
 			continue;
 		re_fault_set(f, RE_F_UNCMD, i);
-		snprintf(f->s, sizeof(f->s),
-			 "its profiler runs, seen by the supervisor for %.0f ms",
-			 ns_to_ms(now - s->moving_ns[i]));
+		snprintf(
+		    f->s, sizeof(f->s),
+		    "its profiler runs, seen by the supervisor for %.0f ms",
+		    ns_to_ms(now - s->moving_ns[i]));
 		return RE_FAULT;
 	}
 	return RE_OK;
@@ -519,10 +519,10 @@ double re_super_late_ms(const struct re_super *s, double pct)
 	want = (uint64_t)ceil((double)n * pct / 100.0);
 	for (k = 0; k < RE_LATE_BINS - 1; k++) {
 		seen += s->late_hist[k];
-		if (seen >= want) /* the bin's upper edge, never past the worst */
+		if (seen >=
+		    want) /* the bin's upper edge, never past the worst */
 			return fmin((k + 1) * RE_LATE_BIN_US / 1000.0,
 				    ns_to_ms(s->late_worst_ns));
 	}
 	return ns_to_ms(s->late_worst_ns);
 }
-

@@ -104,29 +104,29 @@ static const struct fixture_case cases[] = {
     {"label_undefined.dmc", "40x0",
      BAD "label_undefined.dmc:7: label-undefined: undefined label '#NOWHERE' "
 	 "in 'JP'\n" BAD "label_undefined.dmc:8: label-undefined: undefined "
-			 "label '#SUB' in 'JS'\n" BAD
+	 "label '#SUB' in 'JS'\n" BAD
 	 "label_undefined.dmc:9: label-undefined: undefined label '#THR' in "
 	 "'XQ'\n"},
     {"var_name.dmc", "40x0",
      BAD
      "var_name.dmc:6: var-length: variable name 'position12' is longer than 8 "
      "characters\n" BAD "var_name.dmc:7: var-reserved: variable name 'TIME' is "
-			"a reserved word\n" BAD
+     "a reserved word\n" BAD
      "var_name.dmc:8: var-command: variable name 'TP' is a command name\n" BAD
      "var_name.dmc:9: var-syntax: invalid variable name '9ab' (a letter, then "
      "letters, digits or '_')\n" BAD
      "var_name.dmc:10: var-length: variable name 'toolongarr' is longer than 8 "
      "characters\n" BAD "var_name.dmc:11: var-length: variable name "
-			"'distance12' is longer than 8 characters\n"},
+     "'distance12' is longer than 8 characters\n"},
     {"backslash.dmc", "40x0",
      BAD "backslash.dmc:6: backslash: '\\' ends the download early\n"},
     {"lowercase.dmc", "40x0",
      BAD "lowercase.dmc:8: lower-case: lower-case command 'bg' (commands are "
 	 "upper case)\n" BAD "lowercase.dmc:9: lower-case: lower-case command "
-			     "'mg' (commands are upper case)\n" BAD
+	 "'mg' (commands are upper case)\n" BAD
 	 "lowercase.dmc:10: lower-case: lower-case command 'if' (commands are "
 	 "upper case)\n" BAD "lowercase.dmc:12: lower-case: lower-case command "
-			     "'endif' (commands are upper case)\n"},
+	 "'endif' (commands are upper case)\n"},
     {"no_semicolon.dmc", "40x0",
      BAD "no_semicolon.dmc:6: no-semicolon: ';' ends the NO comment: 'then ST "
 	 "A' runs as commands\n"},

@@ -95,10 +95,11 @@ static void test_basic_answers(void **state)
 	sim_advance_ms(f->s, 123);
 	assert_string_equal(ctl(f, "time"), "123");
 	assert_string_equal(ctl(f, "relay"), "off");
-	assert_string_equal(ctl(f, "help"),
-			    "requests: joy in an release pot enc block limit link "
-			    "relay relayfault state watch unwatch events time "
-			    "power-cycle quit help");
+	assert_string_equal(
+	    ctl(f, "help"),
+	    "requests: joy in an release pot enc block limit link "
+	    "relay relayfault state watch unwatch events time "
+	    "power-cycle quit help");
 	assert_string_equal(ctl(f, "  time\t"), "123");
 }
 

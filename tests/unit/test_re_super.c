@@ -137,7 +137,8 @@ static int f_command(void *ud, const char *cmd, char *resp, size_t cap,
 	else if (!strcmp(cmd, "MG fhnew"))
 		snprintf(resp, cap, " %d.0000", fk.fhnew);
 	else if (!strncmp(cmd, "MG _MO", 6))
-		snprintf(resp, cap, " %d.0000", fk.motors_on_after_stop ? 0 : 1);
+		snprintf(resp, cap, " %d.0000",
+			 fk.motors_on_after_stop ? 0 : 1);
 	else
 		snprintf(resp, cap, "%s",
 			 strcmp(cmd, "MG fdet") ? "" : fk.mg_fdet);
@@ -496,8 +497,8 @@ static void test_super_consequences(void **state)
 	static const struct {
 		const char *fdet;
 		int then;
-	} cases[] = {{" 1.0000", 0}, {" 4.0000", 0}, {" 7.0000", 0},
-		     {" 8.0000", 1}};
+	} cases[] = {
+	    {" 1.0000", 0}, {" 4.0000", 0}, {" 7.0000", 0}, {" 8.0000", 1}};
 
 	for (size_t k = 0; k < sizeof(cases) / sizeof(cases[0]); k++) {
 		const char *line;
@@ -720,10 +721,9 @@ static void test_super_shutdown(void **state)
 	char what[128];
 
 	assert_int_equal(re_super_shutdown(&sup, what, sizeof(what)), GL_OK);
-	assert_string_equal(fk.seq,
-			    "cmd:offreq=1,cmd:AB 1;MO ABC,cmd:MG _MOA,"
-			    "cmd:MG _MOB,cmd:MG _MOC,relay_off_start,"
-			    "relay_off_finish");
+	assert_string_equal(fk.seq, "cmd:offreq=1,cmd:AB 1;MO ABC,cmd:MG _MOA,"
+				    "cmd:MG _MOB,cmd:MG _MOC,relay_off_start,"
+				    "relay_off_finish");
 	assert_string_equal(what, "motors off: confirmed; motor power off "
 				  "(relay): confirmed");
 }
