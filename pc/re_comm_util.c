@@ -103,8 +103,15 @@ int rc_link_fail(struct re_comm *c, const char *step, const char *what, int rc)
 
 int rc_safe(struct re_comm *c)
 {
+	int pout = c->cfg->controller.power_output;
 	int rc = rc_cmd(c, RE_STOP_ALL, NULL, 0);
 	int rr = c->io->ops->relay_off(c->io->ud);
+	char cb[16];
 
+	/* the motor-power output the motion step set (SB n) is cleared too,
+	 * so that the power chain is open twice, not once */
+	snprintf(cb, sizeof(cb), "CB %d", pout);
+	if (pout > 0 && rc_cmd(c, cb, NULL, 0) < 0 && rc >= 0)
+		rc = GL_ERR_CTRL;
 	return rc < 0 ? rc : rr;
 }

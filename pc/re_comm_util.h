@@ -64,7 +64,8 @@ int rc_link_fail(struct re_comm *c, const char *step, const char *what, int rc);
 
 /*
  * rc_safe() - stop every axis and switch the motors off (AB 1;MO ABC), then
- * the relay off (confirmed within its deadline). Best effort on every
+ * the relay off (confirmed within its deadline) and the configured
+ * motor-power output cleared (CB n). Best effort on every
  * path. Return: GL_OK when both were confirmed, else the first error.
  */
 int rc_safe(struct re_comm *c);
