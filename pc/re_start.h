@@ -24,6 +24,7 @@
 #include "re_lock.h"
 #include "re_log.h"
 #include "re_plan.h"
+#include "re_rec.h"
 #include "re_relay.h"
 #include "re_super.h"
 
@@ -63,6 +64,7 @@ struct app {
 	struct re_plan plan;
 	struct re_calset *cal;
 	struct re_super *sup;
+	struct re_rec *rec; /* flight recorder (issue 16), NULL: none */
 	const char *names[RE_AXES];
 	long hbpc;
 	int calib;   /* the operator's choice: RE_CALIB_FULL / _FILE */

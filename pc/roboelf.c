@@ -51,6 +51,7 @@
 #include "re_lock.h"
 #include "re_log.h"
 #include "re_plan.h"
+#include "re_rec.h"
 #include "re_relay.h"
 #include "re_start.h"
 #include "re_super.h"
@@ -58,6 +59,15 @@
 static void on_signal(int sig)
 {
 	re_sig.quit = sig;
+}
+
+/* SIGUSR1: write a trace of the flight recorder now (issue 16). */
+static volatile sig_atomic_t trace_asked;
+
+static void on_usr1(int sig)
+{
+	(void)sig;
+	trace_asked = 1;
 }
 
 /* A stop (SIGSTOP, a debugger) during start-up: the cycle measures its own
@@ -93,6 +103,8 @@ static void install_signals(void)
 	sa.sa_handler = on_cont;
 	sa.sa_flags = SA_RESTART;
 	sigaction(SIGCONT, &sa, NULL);
+	sa.sa_handler = on_usr1;
+	sigaction(SIGUSR1, &sa, NULL);
 	sa.sa_flags = 0;
 	sa.sa_handler = SIG_IGN;
 	for (size_t i = 0; i < sizeof(ignore) / sizeof(ignore[0]); i++)
@@ -109,6 +121,7 @@ static void usage(FILE *f)
 	    "               [--calibration full|file] [--period MS] "
 	    "[--log FILE]\n"
 	    "       roboelf --show-calibration FILE\n"
+	    "       roboelf --show-trace FILE [--window FROM:TO]\n"
 	    "       roboelf --commission DIR [-c FILE] [--galil ...] "
 	    "[--wait S]\n"
 	    "\n"
@@ -388,6 +401,100 @@ static void retry_log(struct app *a, int64_t *next_ns)
 			       a->cfg.log.path, strerror(errno));
 }
 
+/* ---- the flight recorder (issue 16) -------------------------------------- */
+
+/* The ring sized from the configuration; traces next to the log unless
+ * recorder.dir says otherwise. */
+static int open_recorder(struct app *a)
+{
+	static struct re_rec rec;
+	struct re_rec_cfg rc;
+	char dir[RE_PATH_MAX];
+	char *slash;
+	int err;
+
+	snprintf(dir, sizeof(dir), "%s",
+		 a->cfg.recorder.dir[0] ? a->cfg.recorder.dir
+					: a->cfg.log.path);
+	slash = strrchr(dir, '/');
+	if (a->cfg.recorder.dir[0])
+		; /* as configured */
+	else if (!slash)
+		snprintf(dir, sizeof(dir), ".");
+	else
+		slash[slash == dir] = '\0'; /* "/x.log": "/" */
+	memset(&rc, 0, sizeof(rc));
+	rc.seconds = a->cfg.recorder.seconds;
+	rc.after_fault_s = a->cfg.recorder.after_fault_s;
+	rc.period_ms = a->cfg.period_ms;
+	rc.dir = dir;
+	rc.n_axes = RE_AXES;
+	for (int i = 0; i < RE_AXES; i++)
+		rc.axis_names[i] = a->names[i];
+	rc.config_hash = re_config_hash(&a->cfg);
+	err = re_rec_init(&rec, &rc);
+	if (err != GL_OK) {
+		fprintf(stderr,
+			"roboelf: error: cannot set up the flight recorder: "
+			"%s\n",
+			gl_strerror(err));
+		return -1;
+	}
+	a->rec = &rec;
+	return 0;
+}
+
+/* Say what the recorder's writer finished: on the console and in the log. */
+static void trace_report(struct app *a)
+{
+	char path[RE_REC_PATH], err[RE_REC_ERR];
+	size_t n = 0;
+	double ms = 0;
+	int v;
+
+	while ((v = re_rec_done(a->rec, path, sizeof(path), err, sizeof(err),
+				&n, &ms)) != 0) {
+		if (v < 0) {
+			re_console_msg(&a->con,
+				       "roboelf: WARNING: cannot write the "
+				       "trace '%s': %s",
+				       path, err);
+			re_log_msg(&a->log, RE_LOG_WARN,
+				   "trace: cannot write '%s': %s", path, err);
+			continue;
+		}
+		re_console_msg(
+		    &a->con, "roboelf: trace %s written (%zu cycles)", path, n);
+		re_log_msg(&a->log, RE_LOG_INFO,
+			   "trace: %s written (%zu cycles, %.1f ms)", path, n,
+			   ms);
+	}
+}
+
+/* Between cycles: a trace asked for (SIGUSR1, key t), a fault's trace
+ * once after_fault_s has passed, what the writer finished. */
+static void trace_tick(struct app *a, int key)
+{
+	if (!a->rec)
+		return;
+	if ((trace_asked || key == 't' || key == 'T') &&
+	    re_rec_request(a->rec, re_io_now_ns()) == GL_OK)
+		trace_asked = 0;
+	re_rec_poll(a->rec, re_io_now_ns());
+	trace_report(a);
+}
+
+/* Quitting: a fault's trace still due is written now. */
+static void close_recorder(struct app *a)
+{
+	if (!a->rec)
+		return;
+	re_rec_finish(a->rec);
+	trace_report(a);
+	re_rec_free(a->rec);
+	a->rec = NULL;
+}
+
 /* Every period until the operator quits; a latched fault keeps the status
  * board running. A terminal that went away (end of input) quits. */
 static void run(struct app *a)
@@ -406,6 +513,7 @@ static void run(struct app *a)
 		re_console_status(&a->con, &st, re_io_now_ns(), 0);
 		retry_log(a, &next_retry);
 		key = re_console_key(&a->con);
+		trace_tick(a, key);
 		if (key == 'q' || key == 'Q' || key < 0)
 			break;
 		key = 0;
@@ -468,6 +576,7 @@ static int cleanup(struct app *a)
 	int latched = a->sup && a->sup->latched;
 
 	power_off(a, latched);
+	close_recorder(a);
 	re_lock_release(&a->lock_relay);
 	re_lock_release(&a->lock_ctl);
 	re_console_close(&a->con);
@@ -497,6 +606,11 @@ static int supervise(struct app *a)
 	re_lock_init(&a->lock_relay);
 	re_io_bind(&a->io, &a->real);
 	install_signals();
+	if (open_recorder(a) < 0) {
+		re_console_close(&a->con);
+		re_log_close(&a->log);
+		return EXIT_USAGE;
+	}
 	rc = re_start(a);
 	if ((rc == 0 || rc == EXIT_FAULT) && a->sup)
 		run(a);
