@@ -42,6 +42,8 @@ struct opts {
 	const char *relay;
 	const char *log;
 	const char *show_cal;
+	const char *show_trace; /* --show-trace FILE (issue 16) */
+	const char *window;	/* --window FROM:TO */
 	int config_searched;	/* no -c: find_config() chose it */
 	const char *commission; /* report directory */
 	int wait_s;	       /* commissioning: each wait for the technician */

@@ -54,6 +54,7 @@
 #include "re_rec.h"
 #include "re_relay.h"
 #include "re_start.h"
+#include "re_traceshow.h"
 #include "re_super.h"
 
 static void on_signal(int sig)
@@ -136,6 +137,10 @@ static void usage(FILE *f)
 	    "      --log FILE           failure log\n"
 	    "      --show-calibration FILE  print a calibration file (and "
 	    "plot it)\n"
+	    "      --show-trace FILE    check a flight-recorder trace and "
+	    "plot it (PNG pages)\n"
+	    "      --window FROM:TO     --show-trace: only t_s FROM..TO "
+	    "seconds (either may be empty)\n"
 	    "      --commission DIR     the commissioning run; report "
 	    "in DIR\n"
 	    "      --wait S             commissioning: each wait for the "
@@ -184,6 +189,8 @@ static int opt_value(struct opts *o, int c, const char *arg)
 	case 'r': o->relay = arg; return 0;
 	case 'l': o->log = arg; return 0;
 	case 's': o->show_cal = arg; return 0;
+	case 'T': o->show_trace = arg; return 0;
+	case 'w': o->window = arg; return 0;
 	case 'M': o->commission = arg; return 0;
 	case 'F': o->find_addr = arg; return 0;
 	case 'P':
@@ -232,6 +239,8 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 	    {"period", required_argument, NULL, 'p'},
 	    {"log", required_argument, NULL, 'l'},
 	    {"show-calibration", required_argument, NULL, 's'},
+	    {"show-trace", required_argument, NULL, 'T'},
+	    {"window", required_argument, NULL, 'w'},
 	    {"commission", required_argument, NULL, 'M'},
 	    {"wait", required_argument, NULL, 'W'},
 	    {"find-addr", required_argument, NULL, 'F'},
@@ -637,6 +646,22 @@ static int show_calibration(struct app *a)
 		   : EXIT_USAGE;
 }
 
+/* --show-trace: the trace checked, summarised and drawn (issue 16). */
+static int show_trace(struct app *a)
+{
+	struct re_traceshow_win w;
+
+	if (a->o.window && re_traceshow_window(a->o.window, &w) < 0) {
+		fprintf(stderr,
+			"roboelf: error: invalid window '%s': use FROM:TO in "
+			"seconds, FROM < TO, either may be empty\n",
+			a->o.window);
+		return EXIT_USAGE;
+	}
+	return re_traceshow_run(a->o.show_trace, a->o.window ? &w : NULL,
+				stdout, stderr);
+}
+
 /* ---- the commissioning run ------------------------------------------- */
 
 static void comm_say(void *ud, const char *line)
@@ -734,6 +759,8 @@ int main(int argc, char **argv)
 		return rc > 0 ? 0 : EXIT_USAGE;
 	if (a.o.show_cal)
 		return show_calibration(&a);
+	if (a.o.show_trace)
+		return show_trace(&a);
 	if (load_config(&a) < 0 || open_log(&a) < 0)
 		return EXIT_USAGE;
 	if (a.o.commission)
