@@ -67,7 +67,11 @@ int re_rec_init(struct re_rec *r, const struct re_rec_cfg *cfg)
 	    !(cfg->period_ms > 0) || !(cfg->seconds > 0) ||
 	    !(cfg->after_fault_s >= 0))
 		return GL_ERR_ARG;
-	n = ceil((cfg->seconds + cfg->after_fault_s) * 1000.0 / cfg->period_ms);
+	if (cfg->min_period_ms < 0 || cfg->min_period_ms > cfg->period_ms)
+		return GL_ERR_ARG;
+	n = ceil(
+	    (cfg->seconds + cfg->after_fault_s) * 1000.0 /
+	    (cfg->min_period_ms > 0 ? cfg->min_period_ms : cfg->period_ms));
 	if (n < 2)
 		n = 2;
 	if (n > RE_TRACE_MAX_RECORDS)
@@ -78,6 +82,7 @@ int re_rec_init(struct re_rec *r, const struct re_rec_cfg *cfg)
 	if (rc != GL_OK)
 		goto out_free;
 	r->after_ns = (int64_t)llround(cfg->after_fault_s * 1e9);
+	r->span_s = cfg->seconds + cfg->after_fault_s;
 	pthread_mutex_init(&r->mu, NULL);
 	pthread_cond_init(&r->cv, NULL);
 	if (pthread_create(&r->th, NULL, writer, r) != 0) {
@@ -291,18 +296,24 @@ static void *writer(void *arg)
 	return NULL;
 }
 
-/* Copy the ring, oldest first, and hand it to the writer. Caller holds mu
- * and the writer is idle. */
+/* Copy the ring's last span_s, oldest first, and hand it to the writer.
+ * Caller holds mu and the writer is idle. */
 static void queue(struct re_rec *r, const char *reason, const char *path)
 {
-	size_t first = (r->head + r->cap - r->count) % r->cap;
-	size_t n1 = r->cap - first < r->count ? r->cap - first : r->count;
+	size_t count = r->count, first, n1;
 	time_t now = time(NULL);
 	struct tm tm;
+	double newest =
+	    count ? r->ring[(r->head + r->cap - 1) % r->cap].t_s : 0;
 
+	while (count > 1 && r->ring[(r->head + r->cap - count) % r->cap].t_s <
+				newest - r->span_s - 1e-9)
+		count--;
+	first = (r->head + r->cap - count) % r->cap;
+	n1 = r->cap - first < count ? r->cap - first : count;
 	memcpy(r->snap, r->ring + first, n1 * sizeof(*r->snap));
-	memcpy(r->snap + n1, r->ring, (r->count - n1) * sizeof(*r->snap));
-	r->snap_n = r->count;
+	memcpy(r->snap + n1, r->ring, (count - n1) * sizeof(*r->snap));
+	r->snap_n = count;
 	r->job_hdr = r->hdr;
 	gmtime_r(&now, &tm);
 	strftime(r->job_hdr.created, sizeof(r->job_hdr.created),

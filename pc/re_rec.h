@@ -31,7 +31,10 @@
 struct re_rec_cfg {
 	double seconds;	      /* history before a fault, s */
 	double after_fault_s; /* and after it, s */
-	double period_ms;     /* the supervisor period (sizes the ring) */
+	double period_ms;     /* the supervisor period (the header's) */
+	double min_period_ms; /* the shortest period it runs at, which
+			       * sizes the ring (calibration samples faster
+			       * than the configured period); 0: period_ms */
 	const char *dir;      /* directory of the traces, "" or NULL: "." */
 	int n_axes;	      /* 1..RE_TRACE_AXES */
 	const char *axis_names[RE_TRACE_AXES];
@@ -49,6 +52,7 @@ struct re_rec {
 	struct re_trace_hdr hdr; /* the header's fixed part */
 	char dir[RE_REC_PATH / 2];
 	int64_t after_ns;
+	double span_s; /* a trace covers at most seconds + after_fault_s */
 	/* a fault whose trace is due (set in the cycle, dumped outside it) */
 	int fault_pending;
 	int64_t fault_ns, due_ns;
@@ -82,8 +86,9 @@ struct re_rec {
 
 /*
  * re_rec_init() - allocate the ring ((seconds + after_fault_s) x 1000 /
- * period_ms records, at least 2), the dump buffer and its text buffer,
- * and start the writer thread.
+ * min_period_ms records, at least 2), the dump buffer and its text buffer,
+ * and start the writer thread. A trace holds the cycles of the last
+ * seconds + after_fault_s (fewer records when the period is longer).
  * @r: [out]; @cfg: [in] copied (the names too).
  * Return: GL_OK; GL_ERR_ARG (bad sizes, axes, names, too many records);
  *         GL_ERR_NOMEM; GL_ERR_SYS (the thread could not start).

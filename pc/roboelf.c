@@ -435,7 +435,12 @@ static int open_recorder(struct app *a)
 	memset(&rc, 0, sizeof(rc));
 	rc.seconds = a->cfg.recorder.seconds;
 	rc.after_fault_s = a->cfg.recorder.after_fault_s;
+	/* calibration samples every RE_CALIB_SAMPLE_MS: the ring holds
+	 * seconds + after_fault_s at the shorter of the two periods */
 	rc.period_ms = a->cfg.period_ms;
+	rc.min_period_ms = a->cfg.period_ms < RE_CALIB_SAMPLE_MS
+			       ? a->cfg.period_ms
+			       : RE_CALIB_SAMPLE_MS;
 	rc.dir = dir;
 	rc.n_axes = RE_AXES;
 	for (int i = 0; i < RE_AXES; i++)

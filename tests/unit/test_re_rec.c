@@ -65,6 +65,14 @@ static void test_rec_sizes(void **state)
 	c.axis_names[1] = "B C";
 	assert_int_equal(re_rec_init(&r, &c), GL_ERR_ARG);
 	c.axis_names[1] = "B";
+	c.period_ms = 50;
+	c.min_period_ms = 10; /* calibration's samples: 3200 again */
+	assert_int_equal(re_rec_init(&r, &c), GL_OK);
+	assert_int_equal(r.cap, 3200);
+	re_rec_free(&r);
+	c.min_period_ms = 60; /* above the period */
+	assert_int_equal(re_rec_init(&r, &c), GL_ERR_ARG);
+	c.min_period_ms = 0;
 	c.period_ms = 0;
 	assert_int_equal(re_rec_init(&r, &c), GL_ERR_ARG);
 	c.period_ms = 0.001; /* 32e6 records */
