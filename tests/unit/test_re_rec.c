@@ -3,10 +3,12 @@
  * (pc/re_rec.c; the cycle itself is tested in test_re_super.c):
  * the ring's size and its refusals, the dump written atomically: a child
  * that writes a large trace over and over is SIGKILLed at 40 pseudo-random
- * moments; after each kill the trace under its final name parses as
- * complete and is never older than the one seen before, and a left
- * NAME.tmp either parses as complete (killed between the write and the
- * rename) or is refused - never a partial file accepted.
+ * moments (within three times one write's duration, measured first;
+ * every other one as soon as NAME.tmp exists, i.e. inside a write); after each
+ * kill the trace under its final name parses as complete and is never older
+ * than the one seen before, and a left NAME.tmp either parses as complete
+ * (killed between the write and the rename) or is refused - never a partial
+ * file accepted.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -119,6 +121,7 @@ static void test_rec_kill_while_writing(void **state)
 	char *text = malloc(cap);
 	int32_t last = 0, gen;
 	int partial = 0, complete_tmp = 0, no_tmp = 0;
+	long dump_ms;
 	uint64_t seed = 88172645463325252ULL;
 
 	(void)state;
@@ -131,6 +134,21 @@ static void test_rec_kill_while_writing(void **state)
 		recs[i].cycle = i;
 		recs[i].axis[0].pot_v = 2.5 + 1e-4 * i;
 	}
+	/* one write here first: the kills land within 3 of its durations,
+	 * so that some fall inside a write also when it is slow (ASan) */
+	{
+		struct re_trace_hdr h;
+		struct timespec t0, t1;
+
+		hdr(&h);
+		clock_gettime(CLOCK_MONOTONIC, &t0);
+		assert_int_equal(re_rec_dump_to(path, &h, recs, BIG, text, cap),
+				 GL_OK);
+		clock_gettime(CLOCK_MONOTONIC, &t1);
+		dump_ms = (t1.tv_sec - t0.tv_sec) * 1000 +
+			  (t1.tv_nsec - t0.tv_nsec) / 1000000;
+		unlink(path);
+	}
 	for (int k = 0; k < 40; k++) {
 		pid_t pid = fork();
 		struct timespec ts = {0, 0};
@@ -142,8 +160,13 @@ static void test_rec_kill_while_writing(void **state)
 		seed ^= seed << 13;
 		seed ^= seed >> 7;
 		seed ^= seed << 17;
-		ts.tv_nsec = (long)(seed % 150) * 1000000L; /* 0..149 ms */
+		ts.tv_sec = (time_t)(seed % (uint64_t)(3 * dump_ms + 1)) / 1000;
+		ts.tv_nsec = (long)(seed % (uint64_t)(3 * dump_ms + 1)) % 1000 *
+			     1000000L;
 		nanosleep(&ts, NULL);
+		/* every other kill waits for NAME.tmp: inside a write */
+		while (k % 2 && access(tmp, F_OK) != 0)
+			;
 		kill(pid, SIGKILL);
 		waitpid(pid, &st, 0);
 		assert_true(WIFSIGNALED(st));
@@ -160,12 +183,16 @@ static void test_rec_kill_while_writing(void **state)
 			complete_tmp++;
 		else
 			partial++;
+		unlink(tmp); /* the next wait is for the next write's */
 	}
-	print_message("[ MEASURE  ] 40 kills: %d left a partial NAME.tmp "
+	print_message("[ MEASURE  ] one write %ld ms; 40 kills: %d left a "
+		      "partial NAME.tmp "
 		      "(refused), %d a complete one, %d none; the trace always "
 		      "complete (last write %d)\n",
-		      partial, complete_tmp, no_tmp, (int)last);
-	assert_true(partial > 0); /* some kills did land inside a write */
+		      dump_ms, partial, complete_tmp, no_tmp, (int)last);
+	/* the 20 kills aimed at a write find NAME.tmp (a partial
+	 * one, or a complete one not yet renamed) */
+	assert_true(partial + complete_tmp >= 15);
 	unlink(tmp);
 	unlink(path);
 	rmdir(dir);
