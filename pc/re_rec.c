@@ -6,6 +6,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -57,6 +58,16 @@ static int fill_hdr(struct re_rec *r, const struct re_rec_cfg *cfg)
 	return GL_OK;
 }
 
+/* glibc reads the time zone on the first gmtime_r(): here, at start-up,
+ * not in a fault's reaction (re_rec_fault_note()). */
+static void warm_gmtime(void)
+{
+	time_t now = time(NULL);
+	struct tm tm;
+
+	gmtime_r(&now, &tm);
+}
+
 int re_rec_init(struct re_rec *r, const struct re_rec_cfg *cfg)
 {
 	double n;
@@ -81,6 +92,7 @@ int re_rec_init(struct re_rec *r, const struct re_rec_cfg *cfg)
 		rc = alloc_buffers(r, (size_t)n, cfg->n_axes);
 	if (rc != GL_OK)
 		goto out_free;
+	warm_gmtime();
 	r->after_ns = (int64_t)llround(cfg->after_fault_s * 1e9);
 	r->span_s = cfg->seconds + cfg->after_fault_s;
 	pthread_mutex_init(&r->mu, NULL);
@@ -263,7 +275,12 @@ int re_rec_dump_to(const char *path, const struct re_trace_hdr *h,
 static void *writer(void *arg)
 {
 	struct re_rec *r = arg;
+	sigset_t all;
 
+	/* signals are the main thread's (their handlers set flags): none
+	 * interrupts a write here */
+	sigfillset(&all);
+	pthread_sigmask(SIG_BLOCK, &all, NULL);
 	pthread_mutex_lock(&r->mu);
 	for (;;) {
 		int64_t t0;
@@ -324,12 +341,11 @@ static void queue(struct re_rec *r, const char *reason, const char *path)
 	pthread_cond_broadcast(&r->cv);
 }
 
-int re_rec_request(struct re_rec *r, int64_t now_ns)
+int re_rec_request(struct re_rec *r)
 {
 	char path[RE_REC_PATH];
 	int rc = GL_OK;
 
-	(void)now_ns;
 	pthread_mutex_lock(&r->mu);
 	if (r->job) {
 		rc = GL_ERR_BUSY;

@@ -117,11 +117,11 @@ void re_rec_take(struct re_rec *r, const struct re_super *s);
 const char *re_rec_fault_note(struct re_rec *r, const struct re_super *s);
 
 /*
- * re_rec_request() - a trace of the ring as it is now (SIGUSR1, a key):
- * queued at the next re_rec_poll().
+ * re_rec_request() - a trace of the ring as it is now (SIGUSR1, a key),
+ * outside the cycle: the ring is copied and handed to the writer at once.
  * Return: GL_OK, GL_ERR_BUSY when the writer is busy (try again later).
  */
-int re_rec_request(struct re_rec *r, int64_t now_ns);
+int re_rec_request(struct re_rec *r);
 
 /*
  * re_rec_poll() - outside the cycle: a fault's trace whose after_fault_s

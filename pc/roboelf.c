@@ -446,6 +446,13 @@ static int open_recorder(struct app *a)
 	for (int i = 0; i < RE_AXES; i++)
 		rc.axis_names[i] = a->names[i];
 	rc.config_hash = re_config_hash(&a->cfg);
+	if (access(dir, W_OK | X_OK) != 0) {
+		fprintf(stderr,
+			"roboelf: error: cannot write traces in '%s' "
+			"(recorder.dir, else the log's directory): %s\n",
+			dir, strerror(errno));
+		return -1;
+	}
 	err = re_rec_init(&rec, &rc);
 	if (err != GL_OK) {
 		fprintf(stderr,
@@ -492,7 +499,7 @@ static void trace_tick(struct app *a, int key)
 	if (!a->rec)
 		return;
 	if ((trace_asked || key == 't' || key == 'T') &&
-	    re_rec_request(a->rec, re_io_now_ns()) == GL_OK)
+	    re_rec_request(a->rec) == GL_OK)
 		trace_asked = 0;
 	re_rec_poll(a->rec, re_io_now_ns());
 	trace_report(a);

@@ -1,8 +1,9 @@
 /*
  * test_re_rec.c - the flight recorder's pieces that need no supervisor
  * (pc/re_rec.c; the cycle itself is tested in test_re_super.c):
- * the ring's size and its refusals, the dump written atomically: a child
- * that writes a large trace over and over is SIGKILLed at 40 pseudo-random
+ * the ring's size and its refusals; no system call in the cycle's copy
+ * nor in a fault's note (seccomp strict mode); the dump written atomically: a
+ * child that writes a 3 MB trace over and over is SIGKILLed at 40 pseudo-random
  * moments (within three times one write's duration, measured first;
  * every other one as soon as NAME.tmp exists, i.e. inside a write); after each
  * kill the trace under its final name parses as complete and is never older
@@ -20,17 +21,21 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <linux/seccomp.h>
+#include <sys/prctl.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 #include <cmocka.h>
 
+#include "base_clock.h"
 #include "base_file.h"
 #include "gl_err.h"
 #include "re_rec.h"
 #include "re_trace.h"
 
-#define BIG 20000 /* records: about 8 MB of text */
+#define BIG 8000 /* records: about 3 MB of text */
 
 static struct re_trace_rec recs[BIG];
 
@@ -199,10 +204,80 @@ static void test_rec_kill_while_writing(void **state)
 	free(text);
 }
 
+static int64_t f_now(void *ud)
+{
+	(void)ud;
+	return base_now_ns(); /* clock_gettime: the vDSO, no system call */
+}
+
+static enum re_relay_state f_relay(void *ud)
+{
+	(void)ud;
+	return RE_RELAY_ON;
+}
+
+static const struct re_io_ops f_ops = {.now_ns = f_now, .relay_state = f_relay};
+
+/* In a child under seccomp strict mode (any system call but read, write,
+ * exit and sigreturn kills it): 100000 cycles copied into the ring and a
+ * fault's note made. The child exiting by itself with 0 is the proof that
+ * neither makes a system call. */
+static void test_rec_no_syscall(void **state)
+{
+	static struct re_super s;
+	static struct re_rec r;
+	struct re_rec_cfg c = {.seconds = 30,
+			       .after_fault_s = 2,
+			       .period_ms = 10,
+			       .dir = "/tmp",
+			       .n_axes = 3,
+			       .axis_names = {"A", "B", "C"}};
+	pid_t pid;
+	int st;
+
+	(void)state;
+	memset(&s, 0, sizeof(s));
+	s.io.ops = &f_ops;
+	s.cfg.n_axes = 3;
+	s.have_record = s.have_za = s.link_ok = 1;
+	for (int i = 0; i < 3; i++)
+		s.have_encres[i] = 1;
+	snprintf(s.fault_line, sizeof(s.fault_line), "FAULT X: test");
+	assert_int_equal(re_rec_init(&r, &c), GL_OK);
+	re_rec_attach(&r, &s, "1");
+	pid = fork();
+	assert_true(pid >= 0);
+	if (pid == 0) {
+		const char *note;
+
+		if (prctl(PR_SET_SECCOMP, SECCOMP_MODE_STRICT) != 0)
+			syscall(SYS_exit, 2);
+		for (long i = 0; i < 100000; i++) {
+			s.cycles++;
+			s.rec.axis[0].ref_pos += 10;
+			re_rec_take(&r, &s);
+		}
+		s.latched = 1;
+		note = re_rec_fault_note(&r, &s);
+		syscall(SYS_exit, note && r.count == r.cap &&
+					  !strncmp(note, "trace /tmp/", 11)
+				      ? 0
+				      : 3);
+	}
+	assert_int_equal(waitpid(pid, &st, 0), pid);
+	if (WIFSIGNALED(st))
+		fail_msg("the child was killed by signal %d: a system call",
+			 WTERMSIG(st));
+	assert_true(WIFEXITED(st));
+	assert_int_equal(WEXITSTATUS(st), 0);
+	re_rec_free(&r);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_rec_sizes),
+	    cmocka_unit_test(test_rec_no_syscall),
 	    cmocka_unit_test(test_rec_kill_while_writing),
 	};
 
