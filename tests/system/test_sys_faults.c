@@ -238,8 +238,8 @@ static void check_trace(struct sys_case *c, const char *name)
 	while (f < h.n_records && r[f].phase != RE_TPH_FAULT)
 		f++;
 	if (f == h.n_records || f == 0 || r[f].fault == 0)
-		fail_msg("%s: trace '%s': fault cycle %zu of %u", name, path,
-			 f, h.n_records);
+		fail_msg("%s: trace '%s': fault cycle %zu of %u", name, path, f,
+			 h.n_records);
 	assert_int_equal(h.have_fault, 1);
 	free(r);
 }
