@@ -737,6 +737,13 @@ static const struct field log_fields[] = {
 	END,
 };
 
+static const struct field recorder_fields[] = {
+	D(struct re_config_recorder, seconds, 1, 120),
+	D(struct re_config_recorder, after_fault_s, 0, 60),
+	S(struct re_config_recorder, dir, 0),
+	END,
+};
+
 static int parse_axes(struct pctx *c, const struct field *f, yaml_node_t *v,
 		      void *base)
 {
@@ -766,6 +773,7 @@ static const struct field root_fields[] = {
 	{ "axes", FT_CUSTOM, 0, 0, 0, 0, NULL, parse_axes },
 	M(struct re_config, calibration, calibration_fields),
 	M(struct re_config, log, log_fields),
+	M(struct re_config, recorder, recorder_fields),
 	END,
 };
 /* clang-format on */
@@ -1118,6 +1126,17 @@ static int check_address(struct pctx *c, const struct re_config *cfg)
 		       TEXT_SHOWN, cfg->controller.address);
 }
 
+/* The time after a fault is recorded into the same ring: less than it. */
+static int check_recorder(struct pctx *c, const struct re_config_recorder *r)
+{
+	if (r->after_fault_s < r->seconds)
+		return GL_OK;
+	return fail_at(c, later_mark(c, &r->seconds, &r->after_fault_s),
+		       "'after_fault_s' (%g s) must be less than 'seconds' "
+		       "(%g s): both are in the one ring",
+		       r->after_fault_s, r->seconds);
+}
+
 static int check_all(struct pctx *c, const struct re_config *cfg)
 {
 	int i, rc = check_table(c, root_fields, cfg);
@@ -1138,6 +1157,8 @@ static int check_all(struct pctx *c, const struct re_config *cfg)
 		rc = check_relay(c, cfg);
 	if (!rc)
 		rc = check_clinical(c, cfg);
+	if (!rc)
+		rc = check_recorder(c, &cfg->recorder);
 	return rc;
 }
 
@@ -1240,6 +1261,8 @@ void re_config_defaults(struct re_config *out)
 	snprintf(out->log.path, sizeof(out->log.path), "%s", "roboelf.log");
 	out->log.max_bytes = 10L * 1024 * 1024;
 	out->log.keep = 5;
+	out->recorder.seconds = 30;
+	out->recorder.after_fault_s = 2;
 }
 
 /* ---- parse ---- */

@@ -137,6 +137,13 @@ struct re_config_log {
 	int keep;	/* rotated files kept: PATH.1 .. PATH.n */
 };
 
+/* The flight recorder (issue 16, docs/trace-format.md). */
+struct re_config_recorder {
+	double seconds;	       /* a trace holds this much before a fault, s */
+	double after_fault_s;  /* and this much after it, s (< seconds) */
+	char dir[RE_PATH_MAX]; /* where traces go; "": the log's directory */
+};
+
 struct re_config {
 	enum re_mode mode;
 	int period_ms; /* supervisor cycle, 2..100 */
@@ -147,6 +154,7 @@ struct re_config {
 	struct re_config_axis axes[RE_AXES];
 	struct re_config_calibration calibration;
 	struct re_config_log log;
+	struct re_config_recorder recorder;
 };
 
 /*

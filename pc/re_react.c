@@ -385,7 +385,13 @@ static void log_fault(struct re_super *s)
 	    s->verdict[0] ? " | " : "", s->verdict,
 	    (unsigned long long)s->cycles, ns_to_ms(s->age_last_ns));
 	if (n < cap)
-		snapshot(s, t + n, cap - n);
+		n += snapshot(s, t + n, cap - n);
+	if (n < cap && s->rec_fault) { /* flight recorder (issue 16) */
+		const char *note = s->rec_fault(s->rec_ud, s);
+
+		if (note)
+			snprintf(t + n, cap - n, " | %s", note);
+	}
 	log_keep(s, RE_LOG_FAULT, t);
 }
 

@@ -189,6 +189,12 @@ static int init_super(struct app *a)
 	a->sup = calloc(1, sizeof(*a->sup));
 	if (!a->sup || re_super_init(a->sup, &a->io, &sc, NULL, 0) != GL_OK)
 		return fail(a, "cannot set up the supervisor");
+	if (a->rec) { /* flight recorder (issue 16) */
+		char serial[24];
+
+		snprintf(serial, sizeof(serial), "%ld", a->info.serial);
+		re_rec_attach(a->rec, a->sup, serial);
+	}
 	return 0;
 }
 

@@ -24,6 +24,7 @@
 #include "re_lock.h"
 #include "re_log.h"
 #include "re_plan.h"
+#include "re_rec.h"
 #include "re_relay.h"
 #include "re_super.h"
 
@@ -41,6 +42,8 @@ struct opts {
 	const char *relay;
 	const char *log;
 	const char *show_cal;
+	const char *show_trace; /* --show-trace FILE (issue 16) */
+	const char *window;	/* --window FROM:TO */
 	int config_searched;	/* no -c: find_config() chose it */
 	const char *commission; /* report directory */
 	int wait_s;	       /* commissioning: each wait for the technician */
@@ -63,6 +66,7 @@ struct app {
 	struct re_plan plan;
 	struct re_calset *cal;
 	struct re_super *sup;
+	struct re_rec *rec; /* flight recorder (issue 16), NULL: none */
 	const char *names[RE_AXES];
 	long hbpc;
 	int calib;   /* the operator's choice: RE_CALIB_FULL / _FILE */

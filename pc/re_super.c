@@ -433,15 +433,30 @@ static int cycle_checks(struct re_super *s)
 	return warn ? RE_WARN : RE_OK;
 }
 
+/* flight recorder (issue 16): the hooks, and the one call per cycle */
+void re_super_recorder(struct re_super *s,
+		       void (*cycle)(void *ud, const struct re_super *s),
+		       const char *(*fault)(void *ud, const struct re_super *s),
+		       void *ud)
+{
+	s->rec_cycle = cycle;
+	s->rec_fault = fault;
+	s->rec_ud = ud;
+}
+
 int re_super_cycle(struct re_super *s)
 {
 	int v;
 
 	s->cycles++;
-	if (s->latched)
-		return latched_cycle(s);
-	v = cycle_checks(s);
-	s->last_end_ns = s->latched ? 0 : now_ns(s);
+	if (s->latched) {
+		v = latched_cycle(s);
+	} else {
+		v = cycle_checks(s);
+		s->last_end_ns = s->latched ? 0 : now_ns(s);
+	}
+	if (s->rec_cycle) /* flight recorder (issue 16): a copy, no I/O */
+		s->rec_cycle(s->rec_ud, s);
 	return v;
 }
 

@@ -177,6 +177,12 @@ struct re_super {
 	int log_failing;
 	enum re_log_level pending_lvl;
 	char pending[2048];
+	/* flight recorder (issue 16; re_super_recorder()): @rec_cycle at the
+	 * end of every cycle, @rec_fault when a fault latches (its text is
+	 * added to the FAULT log entry); NULL: none */
+	void (*rec_cycle)(void *ud, const struct re_super *s);
+	const char *(*rec_fault)(void *ud, const struct re_super *s);
+	void *rec_ud;
 	/* scratch, preallocated */
 	char prefix[32];
 	char resp[128];
@@ -243,6 +249,20 @@ void re_super_own(struct re_super *s, unsigned mask);
  * Return: the lateness of this wake-up in ns (>= 0).
  */
 int64_t re_super_wait(struct re_super *s);
+
+/*
+ * re_super_recorder() - the flight recorder's hooks (issue 16): @cycle is
+ * called at the end of every re_super_cycle() (also latched ones), after
+ * any fault reaction in it; @fault when a fault latches, after the stop,
+ * the relay and the motors were confirmed and before the FAULT log entry
+ * is written: the text it returns (NULL: none) ends that entry, e.g. the
+ * name of the trace that will hold the fault. Both run inside the cycle:
+ * they must not allocate, block or do I/O. NULL hooks: no recorder.
+ */
+void re_super_recorder(struct re_super *s,
+		       void (*cycle)(void *ud, const struct re_super *s),
+		       const char *(*fault)(void *ud, const struct re_super *s),
+		       void *ud);
 
 /*
  * re_super_cycle() - one cycle: round trip, checks, fault reaction.

@@ -51,13 +51,24 @@
 #include "re_lock.h"
 #include "re_log.h"
 #include "re_plan.h"
+#include "re_rec.h"
 #include "re_relay.h"
 #include "re_start.h"
+#include "re_traceshow.h"
 #include "re_super.h"
 
 static void on_signal(int sig)
 {
 	re_sig.quit = sig;
+}
+
+/* SIGUSR1: write a trace of the flight recorder now (issue 16). */
+static volatile sig_atomic_t trace_asked;
+
+static void on_usr1(int sig)
+{
+	(void)sig;
+	trace_asked = 1;
 }
 
 /* A stop (SIGSTOP, a debugger) during start-up: the cycle measures its own
@@ -93,6 +104,8 @@ static void install_signals(void)
 	sa.sa_handler = on_cont;
 	sa.sa_flags = SA_RESTART;
 	sigaction(SIGCONT, &sa, NULL);
+	sa.sa_handler = on_usr1;
+	sigaction(SIGUSR1, &sa, NULL);
 	sa.sa_flags = 0;
 	sa.sa_handler = SIG_IGN;
 	for (size_t i = 0; i < sizeof(ignore) / sizeof(ignore[0]); i++)
@@ -109,6 +122,7 @@ static void usage(FILE *f)
 	    "               [--calibration full|file] [--period MS] "
 	    "[--log FILE]\n"
 	    "       roboelf --show-calibration FILE\n"
+	    "       roboelf --show-trace FILE [--window FROM:TO]\n"
 	    "       roboelf --commission DIR [-c FILE] [--galil ...] "
 	    "[--wait S]\n"
 	    "\n"
@@ -123,6 +137,10 @@ static void usage(FILE *f)
 	    "      --log FILE           failure log\n"
 	    "      --show-calibration FILE  print a calibration file (and "
 	    "plot it)\n"
+	    "      --show-trace FILE    check a flight-recorder trace and "
+	    "plot it (PNG pages)\n"
+	    "      --window FROM:TO     --show-trace: only t_s FROM..TO "
+	    "seconds (either may be empty)\n"
 	    "      --commission DIR     the commissioning run; report "
 	    "in DIR\n"
 	    "      --wait S             commissioning: each wait for the "
@@ -171,6 +189,8 @@ static int opt_value(struct opts *o, int c, const char *arg)
 	case 'r': o->relay = arg; return 0;
 	case 'l': o->log = arg; return 0;
 	case 's': o->show_cal = arg; return 0;
+	case 'T': o->show_trace = arg; return 0;
+	case 'w': o->window = arg; return 0;
 	case 'M': o->commission = arg; return 0;
 	case 'F': o->find_addr = arg; return 0;
 	case 'P':
@@ -219,6 +239,8 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 	    {"period", required_argument, NULL, 'p'},
 	    {"log", required_argument, NULL, 'l'},
 	    {"show-calibration", required_argument, NULL, 's'},
+	    {"show-trace", required_argument, NULL, 'T'},
+	    {"window", required_argument, NULL, 'w'},
 	    {"commission", required_argument, NULL, 'M'},
 	    {"wait", required_argument, NULL, 'W'},
 	    {"find-addr", required_argument, NULL, 'F'},
@@ -388,6 +410,112 @@ static void retry_log(struct app *a, int64_t *next_ns)
 			       a->cfg.log.path, strerror(errno));
 }
 
+/* ---- the flight recorder (issue 16) -------------------------------------- */
+
+/* The ring sized from the configuration; traces next to the log unless
+ * recorder.dir says otherwise. */
+static int open_recorder(struct app *a)
+{
+	static struct re_rec rec;
+	struct re_rec_cfg rc;
+	char dir[RE_PATH_MAX];
+	char *slash;
+	int err;
+
+	snprintf(dir, sizeof(dir), "%s",
+		 a->cfg.recorder.dir[0] ? a->cfg.recorder.dir
+					: a->cfg.log.path);
+	slash = strrchr(dir, '/');
+	if (a->cfg.recorder.dir[0])
+		; /* as configured */
+	else if (!slash)
+		snprintf(dir, sizeof(dir), ".");
+	else
+		slash[slash == dir] = '\0'; /* "/x.log": "/" */
+	memset(&rc, 0, sizeof(rc));
+	rc.seconds = a->cfg.recorder.seconds;
+	rc.after_fault_s = a->cfg.recorder.after_fault_s;
+	/* calibration samples every RE_CALIB_SAMPLE_MS: the ring holds
+	 * seconds + after_fault_s at the shorter of the two periods */
+	rc.period_ms = a->cfg.period_ms;
+	rc.min_period_ms = a->cfg.period_ms < RE_CALIB_SAMPLE_MS
+			       ? a->cfg.period_ms
+			       : RE_CALIB_SAMPLE_MS;
+	rc.dir = dir;
+	rc.n_axes = RE_AXES;
+	for (int i = 0; i < RE_AXES; i++)
+		rc.axis_names[i] = a->names[i];
+	rc.config_hash = re_config_hash(&a->cfg);
+	if (access(dir, W_OK | X_OK) != 0) {
+		fprintf(stderr,
+			"roboelf: error: cannot write traces in '%s' "
+			"(recorder.dir, else the log's directory): %s\n",
+			dir, strerror(errno));
+		return -1;
+	}
+	err = re_rec_init(&rec, &rc);
+	if (err != GL_OK) {
+		fprintf(stderr,
+			"roboelf: error: cannot set up the flight recorder: "
+			"%s\n",
+			gl_strerror(err));
+		return -1;
+	}
+	a->rec = &rec;
+	return 0;
+}
+
+/* Say what the recorder's writer finished: on the console and in the log. */
+static void trace_report(struct app *a)
+{
+	char path[RE_REC_PATH], err[RE_REC_ERR];
+	size_t n = 0;
+	double ms = 0;
+	int v;
+
+	while ((v = re_rec_done(a->rec, path, sizeof(path), err, sizeof(err),
+				&n, &ms)) != 0) {
+		if (v < 0) {
+			re_console_msg(&a->con,
+				       "roboelf: WARNING: cannot write the "
+				       "trace '%s': %s",
+				       path, err);
+			re_log_msg(&a->log, RE_LOG_WARN,
+				   "trace: cannot write '%s': %s", path, err);
+			continue;
+		}
+		re_console_msg(
+		    &a->con, "roboelf: trace %s written (%zu cycles)", path, n);
+		re_log_msg(&a->log, RE_LOG_INFO,
+			   "trace: %s written (%zu cycles, %.1f ms)", path, n,
+			   ms);
+	}
+}
+
+/* Between cycles: a trace asked for (SIGUSR1, key t), a fault's trace
+ * once after_fault_s has passed, what the writer finished. */
+static void trace_tick(struct app *a, int key)
+{
+	if (!a->rec)
+		return;
+	if ((trace_asked || key == 't' || key == 'T') &&
+	    re_rec_request(a->rec) == GL_OK)
+		trace_asked = 0;
+	re_rec_poll(a->rec, re_io_now_ns());
+	trace_report(a);
+}
+
+/* Quitting: a fault's trace still due is written now. */
+static void close_recorder(struct app *a)
+{
+	if (!a->rec)
+		return;
+	re_rec_finish(a->rec);
+	trace_report(a);
+	re_rec_free(a->rec);
+	a->rec = NULL;
+}
+
 /* Every period until the operator quits; a latched fault keeps the status
  * board running. A terminal that went away (end of input) quits. */
 static void run(struct app *a)
@@ -406,6 +534,7 @@ static void run(struct app *a)
 		re_console_status(&a->con, &st, re_io_now_ns(), 0);
 		retry_log(a, &next_retry);
 		key = re_console_key(&a->con);
+		trace_tick(a, key);
 		if (key == 'q' || key == 'Q' || key < 0)
 			break;
 		key = 0;
@@ -468,6 +597,7 @@ static int cleanup(struct app *a)
 	int latched = a->sup && a->sup->latched;
 
 	power_off(a, latched);
+	close_recorder(a);
 	re_lock_release(&a->lock_relay);
 	re_lock_release(&a->lock_ctl);
 	re_console_close(&a->con);
@@ -497,6 +627,11 @@ static int supervise(struct app *a)
 	re_lock_init(&a->lock_relay);
 	re_io_bind(&a->io, &a->real);
 	install_signals();
+	if (open_recorder(a) < 0) {
+		re_console_close(&a->con);
+		re_log_close(&a->log);
+		return EXIT_USAGE;
+	}
 	rc = re_start(a);
 	if ((rc == 0 || rc == EXIT_FAULT) && a->sup)
 		run(a);
@@ -521,6 +656,22 @@ static int show_calibration(struct app *a)
 				stderr) == GL_OK
 		   ? 0
 		   : EXIT_USAGE;
+}
+
+/* --show-trace: the trace checked, summarised and drawn (issue 16). */
+static int show_trace(struct app *a)
+{
+	struct re_traceshow_win w;
+
+	if (a->o.window && re_traceshow_window(a->o.window, &w) < 0) {
+		fprintf(stderr,
+			"roboelf: error: invalid window '%s': use FROM:TO in "
+			"seconds, FROM < TO, either may be empty\n",
+			a->o.window);
+		return EXIT_USAGE;
+	}
+	return re_traceshow_run(a->o.show_trace, a->o.window ? &w : NULL,
+				stdout, stderr);
 }
 
 /* ---- the commissioning run ------------------------------------------- */
@@ -620,6 +771,8 @@ int main(int argc, char **argv)
 		return rc > 0 ? 0 : EXIT_USAGE;
 	if (a.o.show_cal)
 		return show_calibration(&a);
+	if (a.o.show_trace)
+		return show_trace(&a);
 	if (load_config(&a) < 0 || open_log(&a) < 0)
 		return EXIT_USAGE;
 	if (a.o.commission)

@@ -6,7 +6,9 @@
 # calibration, "RoboELF Ready for Use"), then drives a scripted joystick tour
 # through the simulator's control port: each axis forward and back, a brief
 # invalid switch state that must not trip, and finally a potentiometer fault
-# that must trip the E-stop. Every process it starts is stopped on exit,
+# that must trip the E-stop. It ends by naming the flight recorder's trace
+# of that fault (kept in $BUILD/demo/) and the PNG pages roboelf
+# --show-trace drew from it. Every process it starts is stopped on exit,
 # whatever happens.
 #
 # INTERACTIVE=1: no script; drive the joysticks and inject faults from the
@@ -131,6 +133,20 @@ ctl "pot B offset 0.5" >/dev/null
 wait_line "$TMP/roboelf.out" 'FAULT ENCODER:' 5 || die "the potentiometer fault did not trip"
 [ "$(ctl relay)" = off ] || die "the relay is still on after the fault"
 say "relay: $(ctl relay); $(grep -o -m1 'FAULT ENCODER:.*' "$TMP/roboelf.out" | tr -d '\r')"
-sleep 2
+
+# The flight recorder (issue 16): the fault's trace is written
+# recorder.after_fault_s (2 s) after the fault; kept in $BUILD/demo and drawn.
+say "waiting for the flight recorder's trace of the fault (written 2 s after it)"
+wait_line "$TMP/roboelf.log" 'trace: .* written' 10 || die "no trace of the fault was written"
+trace=$(sed -n 's/.* trace: \(.*\) written (.*/\1/p' "$TMP/roboelf.log" | head -n 1)
+OUT="$TOP/$BUILD/demo"
+mkdir -p "$OUT" && cp "$trace" "$OUT/" || die "cannot keep the trace in $OUT"
+trace="$OUT/$(basename "$trace")"
+"$BIN/roboelf" --show-trace "$trace" >"$TMP/show.out" 2>"$TMP/show.err" ||
+	die "roboelf --show-trace failed: $(cat "$TMP/show.err")"
 say "demo finished: stopping roboelf and galil-sim"
+stop "$RE_PID"; RE_PID=""
+stop "$SIM_PID"; SIM_PID=""
+say "the fault's trace: $trace"
+say "its plots: $(sed -n 's/^wrote //p' "$TMP/show.out" | tr '\n' ' ')"
 exit 0

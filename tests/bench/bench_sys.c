@@ -18,7 +18,12 @@
  *  3. galil-sim's virtual-time speed (galil-sim --bench 10: 8 busy
  *     program threads, in-process sim_advance_ms());
  *  4. fault reaction times: test_sys_faults run with ROBOELF_REPEAT=N,
- *     median / p99 / max per fault in ms and in supervisor periods.
+ *     median / p99 / max per fault in ms and in supervisor periods;
+ *  5. the flight recorder (issue 16): its cost per cycle (re_rec_take()
+ *     on a filled supervisor, 10^6 times in-process), its system calls
+ *     per cycle (strace -c of this program run with --rec-loop N against
+ *     --rec-loop 0), and the dump of a full 30 s ring at 10 ms (text and
+ *     durable write, ms and bytes).
  * Beside each figure: the original system's value where it has one
  * (roboelf-software-description.txt: 50 ms loop, 75/125 ms watchdog,
  * 0.5 s invalid input, one controller command per value read).
@@ -35,6 +40,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "base_clock.h"
+#include "re_rec.h"
 #include "sys_h.h"
 
 #define MAX_ROWS    512
@@ -662,12 +669,160 @@ static void print_table(void)
 		       rows[i].value, rows[i].unit, rows[i].original);
 }
 
+/* ---- the flight recorder (issue 16) ------------------------------------- */
+
+static int64_t rb_now(void *ud)
+{
+	(void)ud;
+	return base_now_ns();
+}
+
+static enum re_relay_state rb_relay(void *ud)
+{
+	(void)ud;
+	return RE_RELAY_ON;
+}
+
+static const struct re_io_ops rb_ops = {.now_ns = rb_now,
+					.relay_state = rb_relay};
+static struct re_super rb_sup;
+static struct re_rec rb_rec;
+
+/* A supervisor as after an armed cycle with tables, and a 30 s ring at
+ * 10 ms attached to it. */
+static int rec_setup(void)
+{
+	struct re_rec_cfg rc = {.seconds = 30,
+				.after_fault_s = 2,
+				.period_ms = 10,
+				.dir = "/tmp",
+				.n_axes = 3,
+				.axis_names = {"A", "B", "C"}};
+	struct re_super *s = &rb_sup;
+
+	memset(s, 0, sizeof(*s));
+	s->io.ops = &rb_ops;
+	s->cfg.n_axes = 3;
+	s->have_record = s->have_za = s->link_ok = 1;
+	s->expect = RE_DMC_ARMED;
+	for (int i = 0; i < 3; i++) {
+		s->cfg.pot_input[i] = i + 1;
+		s->have_encres[i] = 1;
+		s->encres[i].exp.pot_v = 2.5;
+		s->encres[i].tol_v = 0.06;
+		s->encres[i].margin_v = 0.05;
+		s->rec.axis[i].analog_in = 16384;
+		s->rec.axis[i].velocity = 64 * 1000;
+	}
+	if (re_rec_init(&rb_rec, &rc) != 0)
+		return -1;
+	re_rec_attach(&rb_rec, s, "1");
+	return 0;
+}
+
+/* @n cycles copied; ns per copy. */
+static double rec_loop(long n)
+{
+	int64_t t0 = base_now_ns();
+
+	for (long i = 0; i < n; i++) {
+		rb_sup.cycles++;
+		rb_sup.rec.sample++;
+		rb_sup.rec.axis[0].ref_pos += 10;
+		rb_sup.rec.axis[0].motor_pos += 10;
+		re_rec_take(&rb_rec, &rb_sup);
+	}
+	return n ? (double)(base_now_ns() - t0) / (double)n : 0;
+}
+
+/* System calls made by "@self --rec-loop @n" (strace -f -c), or -1. */
+static long rec_syscalls(const char *self, long n)
+{
+	char cmd[SYS_PATH_MAX * 2], line[256];
+	long calls = -1;
+	FILE *f;
+
+	snprintf(cmd, sizeof(cmd),
+		 "strace -f -c -o /dev/stdout '%s' --rec-loop %ld "
+		 "2>/dev/null",
+		 self, n);
+	f = popen(cmd, "r");
+	while (f && fgets(line, sizeof(line), f)) {
+		double pct, secs;
+		long usecs, c;
+
+		if (strstr(line, " total") &&
+		    sscanf(line, "%lf %lf %ld %ld", &pct, &secs, &usecs, &c) ==
+			4)
+			calls = c;
+	}
+	if (f && pclose(f) != 0)
+		calls = -1;
+	return calls;
+}
+
+static void recorder_cost(const char *self)
+{
+	char path[] = "/tmp/bench-trace-XXXXXX";
+	long a, b, n = 200000;
+	double ns, ms = -1;
+	int64_t t0;
+	int fd;
+
+	if (rec_setup() < 0) {
+		add("recorder", "copy of one cycle", "time", "ns/cycle", "",
+		    "n/a");
+		return;
+	}
+	rec_loop(3200); /* the ring full, as after 32 s */
+	ns = rec_loop(1000000);
+	add("recorder", "copy of one cycle into the ring (re_rec_take)", "time",
+	    "ns/cycle", "none (no recorder)", "%.0f", ns);
+	a = rec_syscalls(self, 0);
+	b = rec_syscalls(self, n);
+	if (a < 0 || b < 0)
+		add("recorder", "system calls per cycle (strace -c)", "count",
+		    "1/cycle", "", "n/a (no strace)");
+	else
+		add("recorder", "system calls per cycle (strace -c)", "count",
+		    "1/cycle", "", "%.4f (%ld over %ld cycles)",
+		    (double)(b - a) / (double)n, b - a, n);
+	fd = mkstemp(path);
+	if (fd >= 0) {
+		struct re_trace_hdr h = rb_rec.hdr;
+
+		close(fd);
+		snprintf(h.created, sizeof(h.created), "2026-01-01T00:00:00Z");
+		snprintf(h.reason, sizeof(h.reason), "request");
+		t0 = base_now_ns();
+		if (re_rec_dump_to(path, &h, rb_rec.ring, rb_rec.count,
+				   rb_rec.text, rb_rec.text_cap) == 0)
+			ms = (double)(base_now_ns() - t0) / 1e6;
+		unlink(path);
+	}
+	add("recorder", "trace of a full ring (3200 cycles): text + write",
+	    "time", "ms", "", ms < 0 ? "n/a" : "%.1f", ms);
+	add("recorder", "ring of 30 s at 10 ms (+2 s after a fault)", "memory",
+	    "MB", "", "%.1f",
+	    (double)(rb_rec.cap * 2 * sizeof(struct re_trace_rec) +
+		     rb_rec.text_cap) /
+		1e6);
+	re_rec_free(&rb_rec);
+}
+
 int main(int argc, char **argv)
 {
 	static const int periods[] = {50, 10, 2};
 	static struct sys_env env;
 	struct opts o;
 
+	if (argc == 3 && !strcmp(argv[1], "--rec-loop")) { /* for strace */
+		if (rec_setup() < 0)
+			return 1;
+		rec_loop(atol(argv[2]));
+		re_rec_free(&rb_rec);
+		return 0;
+	}
 	if (parse_opts(argc, argv, &o) < 0)
 		return 2;
 	if (sys_env_init(&env) < 0 || sys_env_calibrate(&env, 150000) < 0) {
@@ -692,6 +847,7 @@ int main(int argc, char **argv)
 		add_loop(&f);
 	}
 	sim_speed(&env);
+	recorder_cost(argv[0]);
 	reactions(&env, &o);
 	print_table();
 	printf("\nbench: written to %s (work files in %s)\n", o.csv, env.dir);

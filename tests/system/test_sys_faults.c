@@ -17,7 +17,9 @@
  *    the deadline of docs/safety.md ("Deadlines") plus SLACK_MS;
  *  - that the controller obeyed the supervisor's stop command (the log
  *    entry does not say "rejected"), where the controller is reachable;
- *  - roboelf exits 4 (fault latched) on SIGTERM afterwards.
+ *  - roboelf exits 4 (fault latched) on SIGTERM afterwards, and the FAULT
+ *    entry names a flight-recorder trace (issue 16) that parses and holds
+ *    the cycles before the fault and the fault cycle.
  *
  * Environment: ROBOELF_REPEAT=N repeats each case N times (make bench);
  * ROBOELF_REACTION_CSV=FILE appends one line per measurement to FILE;
@@ -36,7 +38,10 @@
 
 #include <cmocka.h>
 
+#include "base_file.h"
+#include "gl_err.h"
 #include "re_calfile.h"
+#include "re_trace.h"
 #include "sys_h.h"
 
 #define SLACK_MS      25   /* scheduling allowance on a busy 2-core box */
@@ -210,6 +215,35 @@ static void expect_fault(struct sys_case *c, const struct expect *x,
 }
 
 /* After a fault: the operator quits; a latched fault exits 4. */
+/* The flight recorder (issue 16): the FAULT entry names a trace, written
+ * at the latest when roboelf quit; it parses strictly and holds cycles
+ * before the fault and the fault cycle (phase FAULT, the fault's id). */
+static void check_trace(struct sys_case *c, const char *name)
+{
+	char line[4096], path[SYS_PATH_MAX], err[512], *buf;
+	const char *p;
+	struct re_trace_hdr h;
+	struct re_trace_rec *r;
+	size_t len, f = 0;
+
+	if (sys_log_find(c, " FAULT ", "| trace ", line, sizeof(line)) < 0)
+		fail_msg("%s: %s", name, c->err);
+	p = strstr(line, "| trace ") + 8;
+	snprintf(path, sizeof(path), "%.*s", (int)strcspn(p, " |"), p);
+	if (base_file_read(path, RE_TRACE_MAX_BYTES, &buf, &len) < 0)
+		fail_msg("%s: no trace '%s'", name, path);
+	if (re_trace_parse(buf, len, &h, &r, err, sizeof(err)) != GL_OK)
+		fail_msg("%s: trace '%s' refused: %s", name, path, err);
+	free(buf);
+	while (f < h.n_records && r[f].phase != RE_TPH_FAULT)
+		f++;
+	if (f == h.n_records || f == 0 || r[f].fault == 0)
+		fail_msg("%s: trace '%s': fault cycle %zu of %u", name, path, f,
+			 h.n_records);
+	assert_int_equal(h.have_fault, 1);
+	free(r);
+}
+
 static void quit_latched(struct sys_case *c, const char *name)
 {
 	int status;
@@ -219,6 +253,7 @@ static void quit_latched(struct sys_case *c, const char *name)
 		fail_msg("%s: roboelf did not exit within %d ms of SIGTERM",
 			 name, EXIT_WAIT_MS);
 	assert_int_equal(proc_exit_code(&c->re), 4);
+	check_trace(c, name);
 }
 
 /* ---- fixtures ----------------------------------------------------------- */

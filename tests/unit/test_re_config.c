@@ -109,6 +109,11 @@ static const struct bad_case bad_cases[] = {
     {"bad_key_not_scalar.yaml", 2, 3, "expected a key name, got a list"},
     {"bad_log_keep.yaml", 3, 9, "'keep' must be between 1 and 9, got 10"},
     {"bad_log_path_empty.yaml", 3, 9, "'path' must not be empty"},
+    {"bad_recorder_seconds.yaml", 3, 12,
+     "'seconds' must be between 1 and 120, got 500"},
+    {"bad_recorder_after.yaml", 4, 18,
+     "'after_fault_s' (5 s) must be less than 'seconds' (5 s): both are in "
+     "the one ring"},
     {"bad_map_for_number.yaml", 2, 12,
      "expected an integer for 'period_ms', got a mapping"},
     {"bad_missing_value.yaml", 2, 11, "missing value for 'period_ms'"},
@@ -280,6 +285,9 @@ static void test_defaults_documented(void **state)
 	assert_string_equal(c.log.path, "roboelf.log");
 	assert_int_equal(c.log.max_bytes, 10485760);
 	assert_int_equal(c.log.keep, 5);
+	assert_float_equal(c.recorder.seconds, 30, 0);
+	assert_float_equal(c.recorder.after_fault_s, 2, 0);
+	assert_string_equal(c.recorder.dir, "");
 }
 
 /* The built-in defaults are clinical without a relay port: refused. */
@@ -442,6 +450,9 @@ static void emit(struct sbuf *b, const struct re_config *c)
 	    c->calibration.backoff_counts, c->calibration.move_timeout_ms);
 	put(b, "log:\n  path: \"%s\"\n  max_bytes: %ld\n  keep: %d\n",
 	    c->log.path, c->log.max_bytes, c->log.keep);
+	put(b, "recorder:\n  seconds: %.17g\n  after_fault_s: %.17g\n",
+	    c->recorder.seconds, c->recorder.after_fault_s);
+	put(b, "  dir: \"%s\"\n", c->recorder.dir);
 }
 
 /* A configuration with every field away from its default. */
@@ -514,6 +525,9 @@ static void changed(struct re_config *c)
 	strcpy(c->log.path, "/var/log/roboelf/roboelf.log");
 	c->log.max_bytes = 65536;
 	c->log.keep = 3;
+	c->recorder.seconds = 12.5;
+	c->recorder.after_fault_s = 0.5;
+	strcpy(c->recorder.dir, "/var/log/roboelf/traces");
 }
 
 /* Every field written as YAML reads back to the same struct. */

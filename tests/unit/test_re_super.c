@@ -14,11 +14,15 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <cmocka.h>
 
+#include "base_file.h"
 #include "gl_err.h"
+#include "re_rec.h"
 #include "re_super.h"
+#include "re_trace.h"
 
 #define MS	  1000000LL
 #define PERIOD_MS 50
@@ -75,7 +79,7 @@ struct fake {
 	int motors_on_after_stop; /* "MG _MOx" answers 0 (motor still on) */
 	int fhnew;		  /* "MG fhnew": another program's handles */
 	int faxis;		  /* "MG faxis" */
-	char logs[16][1024];
+	char logs[16][2560];
 	int log_level[16];
 	int n_logs;
 	char seq[512]; /* order of reactions */
@@ -780,6 +784,103 @@ static void test_super_no_alloc(void **state)
 	assert_int_equal(after.uordblks, before.uordblks);
 }
 
+static int find_log(const char *a)
+{
+	for (int i = 0; i < fk.n_logs; i++)
+		if (strstr(fk.logs[i], a))
+			return i;
+	return -1;
+}
+
+/* Read the trace at @path (strictly) into @h and @r. */
+static void read_trace(const char *path, struct re_trace_hdr *h,
+		       struct re_trace_rec **r)
+{
+	char *buf, err[256];
+	size_t len;
+
+	assert_int_equal(base_file_read(path, RE_TRACE_MAX_BYTES, &buf, &len),
+			 0);
+	if (re_trace_parse(buf, len, h, r, err, sizeof(err)) != GL_OK)
+		fail_msg("%s: %s", path, err);
+	free(buf);
+}
+
+/* The flight recorder on the cycle (issue 16): no allocation in any cycle
+ * (the ring is allocated at start-up), the FAULT log entry names the
+ * trace, which is written only once after_fault_s has passed, and holds
+ * the cycles before the fault, the fault cycle and those after it, with
+ * the potentiometer step in the cycle that first saw it. */
+static void test_super_recorder(void **state)
+{
+	static struct re_rec rec;
+	struct re_rec_cfg rc = {.seconds = 2,
+				.after_fault_s = 0.5,
+				.period_ms = PERIOD_MS,
+				.n_axes = 3,
+				.axis_names = {"A", "B", "C"},
+				.config_hash = 0x1234};
+	char dir[] = "/tmp/test_re_rec.XXXXXX", path[RE_REC_PATH], err[256];
+	char want[RE_REC_PATH + 8];
+	struct re_trace_hdr h;
+	struct re_trace_rec *r;
+	size_t n;
+	double ms;
+	long n0;
+	int i;
+
+	(void)state;
+	assert_non_null(mkdtemp(dir));
+	rc.dir = dir;
+	assert_int_equal(re_rec_init(&rec, &rc), GL_OK);
+	assert_int_equal(rec.cap, 50); /* (2 + 0.5) s / 50 ms */
+	re_rec_attach(&rec, &sup, "12345");
+	assert_int_equal(run(2), RE_OK);
+	n0 = n_allocs;
+	assert_int_equal(run(100), RE_OK);
+	set_pot(0, 3.0);
+	assert_int_equal(run(5), RE_FAULT);
+	i = find_log("| trace ");
+	assert_true(i >= 0);
+	assert_int_equal(fk.log_level[i], RE_LOG_FAULT);
+	snprintf(want, sizeof(want), "| trace %s", rec.fault_path);
+	assert_non_null(strstr(fk.logs[i], want));
+	assert_int_equal(strncmp(rec.fault_path, dir, strlen(dir)), 0);
+	assert_int_equal(run(9), RE_OK); /* 0.45 s: not yet due */
+	assert_int_equal(re_rec_poll(&rec, fk.now), 0);
+	assert_int_equal(run(11), RE_OK);
+	assert_int_equal(n_allocs, n0);
+	assert_int_equal(re_rec_poll(&rec, fk.now), 1);
+	re_rec_finish(&rec);
+	assert_int_equal(
+	    re_rec_done(&rec, path, sizeof(path), err, sizeof(err), &n, &ms),
+	    1);
+	assert_string_equal(path, rec.fault_path);
+	assert_int_equal(n, 50);
+	read_trace(path, &h, &r);
+	re_rec_free(&rec);
+	assert_int_equal(h.n_records, 50);
+	assert_string_equal(h.serial, "12345");
+	assert_string_equal(h.reason, "fault");
+	assert_int_equal(h.have_fault, 1);
+	assert_int_equal(strncmp(h.fault_text, "FAULT ", 6), 0);
+	assert_int_equal(r[49].cycle, (int32_t)sup.cycles);
+	/* 20 latched cycles after the fault cycle, 29 before it */
+	assert_int_equal(r[29].phase, RE_TPH_FAULT);
+	assert_int_equal(r[28].phase, RE_TPH_ARMED);
+	assert_true(r[29].fault != 0);
+	assert_float_equal(r[29].t_s, h.fault_t_s, 1e-6);
+	/* the step: first seen one cycle before the fault (persistence 1) */
+	assert_float_equal(r[27].axis[0].pot_v, 2.5, 1e-3);
+	assert_float_equal(r[28].axis[0].pot_v, 3.0, 1e-3);
+	assert_true(r[28].axis[0].margin_v < 0);
+	assert_true(r[27].axis[0].margin_v > 0);
+	assert_float_equal(r[28].t_s - r[27].t_s, PERIOD_MS / 1000.0, 1e-3);
+	free(r);
+	unlink(path);
+	rmdir(dir);
+}
+
 /* The lateness percentiles of the exit statistics: upper bin edges, the
  * worst value for 100 %, 0 with no cycle. */
 static void test_super_late_percentiles(void **state)
@@ -834,6 +935,7 @@ int main(void)
 	    cmocka_unit_test_setup(test_super_status, setup),
 	    cmocka_unit_test_setup(test_super_messages_logged, setup),
 	    cmocka_unit_test_setup(test_super_no_alloc, setup),
+	    cmocka_unit_test_setup(test_super_recorder, setup),
 	    cmocka_unit_test(test_super_late_percentiles),
 	};
 
