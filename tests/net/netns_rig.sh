@@ -18,7 +18,9 @@
 #                                      (iptables statistic match)
 #   netns_rig.sh delay ID MS BIN       hold every packet the controller sends
 #                                      MS ms (BIN/nfq-delay, NFQUEUE 0)
-#   netns_rig.sh rto ID MS             rto_min MS on the data route, both ends
+#   netns_rig.sh rto ID MS             rto_min MS on the data route, both ends;
+#                                      the namespace's TCP (the controller's)
+#                                      with linear retransmission timeouts
 #   netns_rig.sh clear ID              no loss, no delay, no rto_min
 #   netns_rig.sh teardown ID           remove it all
 #   netns_rig.sh addr ID               print "<data addr> <mgmt addr>" (.2)
@@ -83,6 +85,7 @@ clear_rules() {
 	inns iptables -F OUTPUT 2>/dev/null
 	ip route del "$DNA/32" dev "$DH" 2>/dev/null
 	inns ip route del "$DHA/32" dev "$DN" 2>/dev/null
+	inns sysctl -qw net.ipv4.tcp_thin_linear_timeouts=0 2>/dev/null
 	return 0
 }
 
@@ -112,6 +115,7 @@ rto() {
 	ms=$1
 	ip route replace "$DNA/32" dev "$DH" rto_min "${ms}ms" || die "host route"
 	inns ip route replace "$DHA/32" dev "$DN" rto_min "${ms}ms" || die "namespace route"
+	inns sysctl -qw net.ipv4.tcp_thin_linear_timeouts=1 || die "namespace sysctl"
 }
 
 teardown() {

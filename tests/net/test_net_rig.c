@@ -25,6 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -39,7 +40,7 @@
 #define FAULT_WAIT_MS 8000 /* FAULT line, beyond the deadline */
 #define EXIT_WAIT_MS  8000
 #define RIG_WAIT_MS   10000
-#define RTO_MIN_MS    20 /* the installed route's rto_min (docs/link.md) */
+#define RTO_MIN_MS    10 /* the installed route's rto_min (docs/link.md) */
 
 static struct sys_env env;
 static int env_ok, rig_ok;
@@ -61,7 +62,7 @@ static int rig(const char *fmt, ...)
 	va_start(ap, fmt);
 	vsnprintf(args, sizeof(args), fmt, ap);
 	va_end(ap);
-	argv[n++] = (char *)"bash";
+	argv[n++] = (char *)"/bin/bash";
 	argv[n++] = rig_sh;
 	for (char *t = strtok_r(args, " ", &save); t && n < 15;
 	     t = strtok_r(NULL, " ", &save))
@@ -214,6 +215,10 @@ static void expect_no_trip(struct sys_case *c, const char *name, double t0,
 	proc_find_line(&c->re, PROC_STDOUT, "FAULT ", o.line, sizeof(o.line));
 	o.warnings = count_warnings(c);
 	record(name, expected, &o);
+	if (o.line[0] && strstr(o.line, "this supervisor did not run"))
+		fail_msg("%s: inconclusive: the PC stalled (machine overloaded), "
+			 "not the link: %s",
+			 name, o.line);
 	if (o.line[0])
 		fail_msg("%s: tripped within %.0f s: %s", name, secs, o.line);
 	if (sys_state(c, st, sizeof(st)) < 0)
@@ -240,9 +245,12 @@ static void quit_latched(struct sys_case *c, const char *name)
 
 /* ---- cases -------------------------------------------------------------- */
 
-static void start(struct sys_case *c, const char *calibration)
+/* A case on the rig as installed (rto_min RTO_MIN_MS) or, with @rto 0,
+ * as before docs/link.md (the kernel's default minimum). */
+static void start_rto(struct sys_case *c, const char *calibration, int rto)
 {
-	char *wrap[] = {(char *)"ip", (char *)"netns", (char *)"exec", ns,
+	/* the script exec's ip, which exec's galil-sim: the pid is its */
+	char *wrap[] = {(char *)"/bin/bash", rig_sh, (char *)"exec", rig_id,
 			NULL};
 	struct sys_opts o = {.sim_wrap = wrap,
 			     .sim_addr = data_addr,
@@ -253,10 +261,19 @@ static void start(struct sys_case *c, const char *calibration)
 	if (!env_ok || !rig_ok)
 		fail_msg("no environment (calibration or rig failed)");
 	if (rig("clear %s", rig_id) || rig("up %s", rig_id) ||
-	    rig("rto %s %d", rig_id, RTO_MIN_MS))
+	    (rto && rig("rto %s %d", rig_id, rto)))
 		fail_msg("rig reset failed");
 	if (sys_case_start(c, &env, &o) < 0)
 		fail_msg("case start: %s", c->err);
+	/* the rig measures the link, not a CPU shared with builds and
+	 * fuzzers: roboelf and galil-sim run at nice -10 (root is given) */
+	setpriority(PRIO_PROCESS, (id_t)c->re.pid, -10);
+	setpriority(PRIO_PROCESS, (id_t)c->sim.p.pid, -10);
+}
+
+static void start(struct sys_case *c, const char *calibration)
+{
+	start_rto(c, calibration, RTO_MIN_MS);
 }
 
 static void stop(struct sys_case *c)
@@ -284,6 +301,12 @@ static void test_pull_armed(void **state)
 
 	(void)state;
 	start(&cs, NULL);
+	/* roboelf checked the route at start-up (docs/link.md) */
+	assert_int_equal(proc_find_line(&cs.re, PROC_STDOUT,
+					"roboelf: route to the controller: "
+					"rto_min 10 ms (limit 25 ms)",
+					NULL, 0),
+			 0);
 	jog(&cs);
 	t = rig_inject(&cs, "down");
 	expect_trip(&cs, "cable pull, armed", t, C() + P(), W_stop(), &o);
@@ -414,9 +437,14 @@ static void loss_case(const char *name, const char *pct, int trip,
 	struct outcome o = {0};
 	double t;
 
-	start(&cs, NULL);
-	if (!rto && rig("clear %s", rig_id))
-		fail_msg("rig clear failed");
+	start_rto(&cs, NULL, rto ? RTO_MIN_MS : 0);
+	if (!rto)
+		assert_int_equal(
+		    proc_find_line(&cs.re, PROC_STDOUT,
+				   "roboelf: warning: the route to the "
+				   "controller '10.231.",
+				   NULL, 0),
+		    0);
 	t = sys_sim_time(&cs);
 	if (rig("loss %s %s", rig_id, pct))
 		fail_msg("%s: rig loss failed", name);
@@ -494,7 +522,7 @@ static int group_teardown(void **state)
 /* The rig's precondition: 0, or prints the SKIP line and returns 77. */
 static int rig_check(void)
 {
-	char *argv[] = {(char *)"bash", rig_sh, (char *)"check", NULL};
+	char *argv[] = {(char *)"/bin/bash", rig_sh, (char *)"check", NULL};
 	struct proc p;
 	int status, rc;
 
