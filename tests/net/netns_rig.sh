@@ -101,11 +101,14 @@ delay() {
 	[ -x "$bin/nfq-delay" ] || die "no '$bin/nfq-delay' (libnetfilter-queue-dev missing at build time?)"
 	kill_delay
 	fifo=$(mktemp -u /tmp/roboelf-nfq.XXXXXX); mkfifo "$fifo" || die "mkfifo"
-	inns "$bin/nfq-delay" 0 "$ms" >"$fifo" 2>&1 &
+	# not through a shell function: $! must be the pid that becomes
+	# nfq-delay (ip netns exec exec's it)
+	ip netns exec "$NS" "$bin/nfq-delay" 0 "$ms" >"$fifo" 2>&1 &
 	echo $! >"$PIDF"
 	# wait for its ready line (it ends at once on failure)
-	if ! timeout 5 head -1 "$fifo" | grep -q '^nfq-delay: ready'; then
-		rm -f "$fifo"; kill_delay; die "nfq-delay did not start"
+	line=$(timeout 5 head -1 "$fifo")
+	if [ "${line#nfq-delay: ready}" = "$line" ]; then
+		rm -f "$fifo"; kill_delay; die "nfq-delay did not start: $line"
 	fi
 	rm -f "$fifo"
 	inns iptables -A OUTPUT -o "$DN" -j NFQUEUE --queue-num 0 || { kill_delay; die "iptables NFQUEUE"; }

@@ -25,7 +25,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include <signal.h>
+#include <net/if.h>
+#include <sys/ioctl.h>
 #include <sys/resource.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -45,7 +48,7 @@
 static struct sys_env env;
 static int env_ok, rig_ok;
 static char rig_sh[SYS_PATH_MAX + 32], rig_id[16], ns[32];
-static char data_addr[16], mgmt_addr[16];
+static char data_addr[16], mgmt_addr[16], data_if[IFNAMSIZ];
 static struct sys_case cs;
 
 /* ---- the rig script --------------------------------------------------- */
@@ -83,15 +86,51 @@ static int rig(const char *fmt, ...)
 	return n;
 }
 
-/* The simulated time just before the rig command @what (the injection). */
-static double rig_inject(struct sys_case *c, const char *what)
+/* The host's end of the data pair up or down (SIOCSIFFLAGS: no process
+ * to start, so the injection time is exact even on a loaded machine). */
+static int link_set(int up)
+{
+	struct ifreq ifr;
+	int fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0), rc = -1;
+
+	memset(&ifr, 0, sizeof(ifr));
+	snprintf(ifr.ifr_name, sizeof(ifr.ifr_name), "%s", data_if);
+	if (fd >= 0 && ioctl(fd, SIOCGIFFLAGS, &ifr) == 0) {
+		if (up)
+			ifr.ifr_flags |= IFF_UP;
+		else
+			ifr.ifr_flags &= ~IFF_UP;
+		rc = ioctl(fd, SIOCSIFFLAGS, &ifr);
+	}
+	if (fd >= 0)
+		close(fd);
+	return rc;
+}
+
+/* Pull the cable: the simulated time just before it (the injection). */
+static double pull_cable(struct sys_case *c)
 {
 	double t = sys_sim_time(c);
 
 	if (t < 0)
 		fail_msg("sim time: %s", c->err);
-	if (rig("%s %s", what, rig_id) != 0)
-		fail_msg("rig '%s' failed", what);
+	if (link_set(0) < 0)
+		fail_msg("cannot set '%s' down", data_if);
+	return t;
+}
+
+/* A rig command that takes effect as it returns (delay, loss): the
+ * simulated time just after it; the measured reaction is from the moment
+ * the rule was in place at the latest. */
+static double rig_after(struct sys_case *c, const char *what, const char *arg)
+{
+	double t;
+
+	if (rig("%s %s %s", what, rig_id, arg) != 0)
+		fail_msg("rig '%s %s' failed", what, arg);
+	t = sys_sim_time(c);
+	if (t < 0)
+		fail_msg("sim time: %s", c->err);
 	return t;
 }
 
@@ -308,7 +347,7 @@ static void test_pull_armed(void **state)
 					NULL, 0),
 			 0);
 	jog(&cs);
-	t = rig_inject(&cs, "down");
+	t = pull_cable(&cs);
 	expect_trip(&cs, "cable pull, armed", t, C() + P(), W_stop(), &o);
 	quit_latched(&cs, "cable pull, armed");
 	stop(&cs);
@@ -324,7 +363,7 @@ static void test_pull_calibrating(void **state)
 	start(&cs, "full");
 	if (sys_wait_moving(&cs, 'A', 200, 60000) < 0)
 		fail_msg("no calibration motion: %s", cs.err);
-	t = rig_inject(&cs, "down");
+	t = pull_cable(&cs);
 	expect_trip(&cs, "cable pull, calibrating", t, C() + P(), W_stop(),
 		    &o);
 	quit_latched(&cs, "cable pull, calibrating");
@@ -344,7 +383,7 @@ static void test_pull_latched(void **state)
 	    sys_wait_fault(&cs, FAULT_WAIT_MS, line, sizeof(line)) < 0 ||
 	    sys_check_safe(&cs, 0, HOLD_MS) < 0)
 		fail_msg("latch: %s", cs.err);
-	t = rig_inject(&cs, "down");
+	t = pull_cable(&cs);
 	if (sys_check_safe(&cs, 0, 1000) < 0)
 		fail_msg("cable pull, latched: %s", cs.err);
 	if (sys_events(&cs) < 0)
@@ -367,8 +406,8 @@ static void test_pull_back_200ms(void **state)
 	(void)state;
 	start(&cs, NULL);
 	jog(&cs);
-	t = rig_inject(&cs, "down");
-	if (sys_wait_sim(&cs, t + 200, 3000) < 0 || rig("up %s", rig_id))
+	t = pull_cable(&cs);
+	if (sys_wait_sim(&cs, t + 200, 3000) < 0 || link_set(1) < 0)
 		fail_msg("cable back: %s", cs.err);
 	expect_trip(&cs, "cable back after 200 ms", t, C() + P(), W_stop(),
 		    &o);
@@ -392,15 +431,13 @@ static void test_pull_back_200ms(void **state)
 /* One-way delay @ms on every frame the controller sends. */
 static void delay_case(const char *name, int ms, int trip, double secs)
 {
-	char bin[SYS_PATH_MAX];
+	char arg[SYS_PATH_MAX + 16];
 	struct outcome o = {0};
 	double t;
 
 	start(&cs, NULL);
-	snprintf(bin, sizeof(bin), "%s", env.bin);
-	t = sys_sim_time(&cs);
-	if (rig("delay %s %d %s", rig_id, ms, bin))
-		fail_msg("%s: rig delay failed", name);
+	snprintf(arg, sizeof(arg), "%d %s", ms, env.bin);
+	t = rig_after(&cs, "delay", arg);
 	if (trip) {
 		expect_trip(&cs, name, t, C() + P() + ms, W_stop() + ms, &o);
 		quit_latched(&cs, name);
@@ -445,9 +482,7 @@ static void loss_case(const char *name, const char *pct, int trip,
 				   "controller '10.231.",
 				   NULL, 0),
 		    0);
-	t = sys_sim_time(&cs);
-	if (rig("loss %s %s", rig_id, pct))
-		fail_msg("%s: rig loss failed", name);
+	t = rig_after(&cs, "loss", pct);
 	if (trip) {
 		/* the burst that trips comes at a random time: no deadline
 		 * from the injection; the reply age and the controller's
@@ -577,6 +612,7 @@ int main(void)
 	snprintf(ns, sizeof(ns), "roboelf-net-%u", id);
 	snprintf(data_addr, sizeof(data_addr), "10.231.%u.2", id % 250 + 1);
 	snprintf(mgmt_addr, sizeof(mgmt_addr), "10.232.%u.2", id % 250 + 1);
+	snprintf(data_if, sizeof(data_if), "rd%uh", id);
 	if (filter && *filter)
 		cmocka_set_test_filter(filter);
 	if (mode && !strcmp(mode, "long"))
