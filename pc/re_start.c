@@ -121,15 +121,17 @@ static int check_route(struct app *a)
 		snprintf(host, sizeof(host), "%s", a->cfg.controller.address);
 	rc = gl_route_rto_min_ms(fd, 1000, &ms);
 	if (rc == GL_OK && ms > 0 && ms <= limit) {
-		progress(a, "route to the controller: rto_min %d ms (limit %d "
-			    "ms)", ms, limit);
+		progress(a,
+			 "route to the controller: rto_min %d ms (limit %d "
+			 "ms)",
+			 ms, limit);
 		return 0;
 	}
 	if (rc != GL_OK)
 		snprintf(what, sizeof(what),
 			 "cannot read the route to the controller '%s': %s",
-			 host, rc == GL_ERR_SYS ? strerror(errno)
-						: gl_strerror(rc));
+			 host,
+			 rc == GL_ERR_SYS ? strerror(errno) : gl_strerror(rc));
 	else
 		snprintf(what, sizeof(what),
 			 "the route to the controller '%s' has rto_min %d ms "
@@ -137,7 +139,7 @@ static int check_route(struct app *a)
 			 "run 'ip route replace %s dev <interface> rto_min "
 			 "%dms' (docs/link.md)",
 			 host, ms ? ms : GL_ROUTE_DEFAULT_RTO_MIN_MS, limit,
-			 host, limit < 20 ? limit : 20);
+			 host, limit < 5 ? limit : 5);
 	if (a->cfg.mode == RE_MODE_CLINICAL)
 		return fail(a, what);
 	progress(a, "warning: %s", what);

@@ -135,7 +135,7 @@ static int ask(const struct route_req *r, int timeout_ms, int *out)
 	n = recv(pfd.fd, buf, sizeof(buf), 0);
 	if (n > 0)
 		rc = gl_route_parse(buf, (size_t)n, out);
-out_close: {
+out_close : {
 	int keep = errno;
 
 	close(pfd.fd);

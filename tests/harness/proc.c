@@ -338,8 +338,8 @@ static int sim_parse_ready(struct proc_sim *s, const char *line)
 int proc_sim_start(struct proc_sim *s, const char *bin_dir,
 		   const char *relay_link, char *const extra[], int timeout_ms)
 {
-	return proc_sim_start_wrapped(s, NULL, bin_dir, relay_link, NULL,
-				      extra, timeout_ms);
+	return proc_sim_start_wrapped(s, NULL, bin_dir, relay_link, NULL, extra,
+				      timeout_ms);
 }
 
 int proc_sim_start_wrapped(struct proc_sim *s, char *const wrap[],

@@ -494,8 +494,8 @@ int sys_case_start(struct sys_case *c, struct sys_env *e,
 		goto fail;
 	}
 	c->sim_up = 1;
-	c->ctl = proc_ctl_connect_at(o->ctl_addr, c->sim.ctl_port,
-				     CTL_TIMEOUT_MS);
+	c->ctl =
+	    proc_ctl_connect_at(o->ctl_addr, c->sim.ctl_port, CTL_TIMEOUT_MS);
 	if (c->ctl < 0) {
 		seterr(c->err, "cannot connect to the control port %d",
 		       c->sim.ctl_port);

@@ -105,8 +105,7 @@ static int run(struct nfq_handle *h, struct nfq_q_handle *qh)
 
 			if (len > 0)
 				nfq_handle_packet(h, buf, (int)len);
-			else if (len < 0 && errno != EINTR &&
-				 errno != ENOBUFS)
+			else if (len < 0 && errno != EINTR && errno != ENOBUFS)
 				return -1;
 		}
 		release(qh, 0);

@@ -43,7 +43,7 @@
 #define FAULT_WAIT_MS 8000 /* FAULT line, beyond the deadline */
 #define EXIT_WAIT_MS  8000
 #define RIG_WAIT_MS   10000
-#define RTO_MIN_MS    10 /* the installed route's rto_min (docs/link.md) */
+#define RTO_MIN_MS    5 /* the installed route's rto_min (docs/link.md) */
 
 static struct sys_env env;
 static int env_ok, rig_ok;
@@ -136,11 +136,20 @@ static double rig_after(struct sys_case *c, const char *what, const char *arg)
 
 /* ---- expectations ----------------------------------------------------- */
 
-static double P(void) { return env.period_ms; }
-static double C(void) { return env.crit_factor * env.period_ms; }
+static double P(void)
+{
+	return env.period_ms;
+}
+static double C(void)
+{
+	return env.crit_factor * env.period_ms;
+}
 /* the controller's own watchdog: the last heartbeat got through before the
  * injection at the latest; then wdto, one main loop and one sample */
-static double W_stop(void) { return env.wdto_ms + SYS_MAINMS + 1; }
+static double W_stop(void)
+{
+	return env.wdto_ms + SYS_MAINMS + 1;
+}
 
 struct outcome {
 	double relay_ms;  /* relay off after the injection, -1 none */
@@ -156,10 +165,11 @@ static void record(const char *name, const char *expected,
 	const char *csv = getenv("ROBOELF_REACTION_CSV");
 	FILE *f;
 
-	print_message("[ MEASURE  ] %s: expected %s; relay off %.0f ms, "
-		      "motors off %.0f ms, reply age %.0f ms, %ld warnings%s%s\n",
-		      name, expected, o->relay_ms, o->motors_ms, o->age_ms,
-		      o->warnings, o->line[0] ? "; " : "", o->line);
+	print_message(
+	    "[ MEASURE  ] %s: expected %s; relay off %.0f ms, "
+	    "motors off %.0f ms, reply age %.0f ms, %ld warnings%s%s\n",
+	    name, expected, o->relay_ms, o->motors_ms, o->age_ms, o->warnings,
+	    o->line[0] ? "; " : "", o->line);
 	if (!csv || !*csv || !(f = fopen(csv, "a")))
 		return;
 	fprintf(f, "%s,%s,%.1f,%.1f,%.1f,%ld\n", name, expected, o->relay_ms,
@@ -255,9 +265,10 @@ static void expect_no_trip(struct sys_case *c, const char *name, double t0,
 	o.warnings = count_warnings(c);
 	record(name, expected, &o);
 	if (o.line[0] && strstr(o.line, "this supervisor did not run"))
-		fail_msg("%s: inconclusive: the PC stalled (machine overloaded), "
-			 "not the link: %s",
-			 name, o.line);
+		fail_msg(
+		    "%s: inconclusive: the PC stalled (machine overloaded), "
+		    "not the link: %s",
+		    name, o.line);
 	if (o.line[0])
 		fail_msg("%s: tripped within %.0f s: %s", name, secs, o.line);
 	if (sys_state(c, st, sizeof(st)) < 0)
@@ -343,7 +354,7 @@ static void test_pull_armed(void **state)
 	/* roboelf checked the route at start-up (docs/link.md) */
 	assert_int_equal(proc_find_line(&cs.re, PROC_STDOUT,
 					"roboelf: route to the controller: "
-					"rto_min 10 ms (limit 25 ms)",
+					"rto_min 5 ms (limit 25 ms)",
 					NULL, 0),
 			 0);
 	jog(&cs);
@@ -364,8 +375,7 @@ static void test_pull_calibrating(void **state)
 	if (sys_wait_moving(&cs, 'A', 200, 60000) < 0)
 		fail_msg("no calibration motion: %s", cs.err);
 	t = pull_cable(&cs);
-	expect_trip(&cs, "cable pull, calibrating", t, C() + P(), W_stop(),
-		    &o);
+	expect_trip(&cs, "cable pull, calibrating", t, C() + P(), W_stop(), &o);
 	quit_latched(&cs, "cable pull, calibrating");
 	stop(&cs);
 }
@@ -409,8 +419,7 @@ static void test_pull_back_200ms(void **state)
 	t = pull_cable(&cs);
 	if (sys_wait_sim(&cs, t + 200, 3000) < 0 || link_set(1) < 0)
 		fail_msg("cable back: %s", cs.err);
-	expect_trip(&cs, "cable back after 200 ms", t, C() + P(), W_stop(),
-		    &o);
+	expect_trip(&cs, "cable back after 200 ms", t, C() + P(), W_stop(), &o);
 	if (sys_check_safe(&cs, 0, 1000) < 0 || sys_events(&cs) < 0)
 		fail_msg("cable back after 200 ms: %s", cs.err);
 	for (int a = 0; a < 3; a++) {
@@ -468,8 +477,8 @@ static void test_delay_150(void **state)
 /* Random loss @pct % each way for @secs; a trip is the reply-age fault
  * with the reply age within C + P. @rto: with the installed rto_min (else
  * the kernel's default 200 ms minimum, the state before docs/link.md). */
-static void loss_case(const char *name, const char *pct, int trip,
-		      double secs, int rto)
+static void loss_case(const char *name, const char *pct, int trip, double secs,
+		      int rto)
 {
 	struct outcome o = {0};
 	double t;
@@ -489,8 +498,8 @@ static void loss_case(const char *name, const char *pct, int trip,
 		 * stop are asserted */
 		expect_trip(&cs, name, t, -1, -1, &o);
 		if (o.motors_ms > o.relay_ms + W_stop() + SLACK_MS)
-			fail_msg("%s: motors off %.0f ms after the relay",
-				 name, o.motors_ms - o.relay_ms);
+			fail_msg("%s: motors off %.0f ms after the relay", name,
+				 o.motors_ms - o.relay_ms);
 		quit_latched(&cs, name);
 	} else {
 		expect_no_trip(&cs, name, t, secs, "no trip", -1);
@@ -598,7 +607,8 @@ int main(void)
 	    cmocka_unit_test(test_loss_5_60s),
 	    cmocka_unit_test(test_loss_5_no_rto),
 	};
-	const char *top = getenv("ROBOELF_TOP"), *mode = getenv("ROBOELF_NETRIG");
+	const char *top = getenv("ROBOELF_TOP"),
+		   *mode = getenv("ROBOELF_NETRIG");
 	const char *filter = getenv("ROBOELF_SYS_FILTER");
 	unsigned id = (unsigned)getpid() % 100000;
 	int rc;
@@ -618,6 +628,5 @@ int main(void)
 	if (mode && !strcmp(mode, "long"))
 		return cmocka_run_group_tests(long_tests, group_setup,
 					      group_teardown);
-	return cmocka_run_group_tests(short_tests, group_setup,
-				      group_teardown);
+	return cmocka_run_group_tests(short_tests, group_setup, group_teardown);
 }

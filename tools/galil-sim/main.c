@@ -306,15 +306,13 @@ static int serve(struct sim *s, const struct opts *o)
 	int rc;
 
 	if (sim_net_open(&net, s, o->listen_addr, o->port, o->control_port, err,
-			 sizeof(err)) <
-	    0) {
+			 sizeof(err)) < 0) {
 		fprintf(stderr, "galil-sim: %s\n", err);
 		return 1;
 	}
 	printf("galil-sim: listening on %s:%d control %d relay %s\n",
-	       o->listen_addr ? o->listen_addr : "127.0.0.1",
-	       sim_net_port(net), sim_net_control_port(net),
-	       sim_relay_tty(sim_get_relay(s)));
+	       o->listen_addr ? o->listen_addr : "127.0.0.1", sim_net_port(net),
+	       sim_net_control_port(net), sim_relay_tty(sim_get_relay(s)));
 	fflush(stdout);
 	rc = sim_net_run(net, &stop, err, sizeof(err));
 	if (rc < 0)

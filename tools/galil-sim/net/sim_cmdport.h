@@ -90,8 +90,8 @@ void sim_cmdport_init(struct sim_cmdport *cp, struct sim *s);
  * @err: [out] the reason on failure; @errlen its size.
  * Return: 0 or GL_ERR_SYS.
  */
-int sim_cmdport_listen(struct sim_cmdport *cp, const char *addr, int port, char *err,
-		       size_t errlen);
+int sim_cmdport_listen(struct sim_cmdport *cp, const char *addr, int port,
+		       char *err, size_t errlen);
 
 /*
  * sim_cmdport_shutdown() - close every connection (no event, the

@@ -50,8 +50,8 @@ void sim_ctlport_init(struct sim_ctlport *cp, struct sim *s);
  * @err: [out] the reason on failure; @errlen its size.
  * Return: 0 or GL_ERR_SYS.
  */
-int sim_ctlport_listen(struct sim_ctlport *cp, const char *addr, int port, char *err,
-		       size_t errlen);
+int sim_ctlport_listen(struct sim_ctlport *cp, const char *addr, int port,
+		       char *err, size_t errlen);
 
 /* sim_ctlport_shutdown() - close every client (freeing its answer buffer)
  * and the listener. */
