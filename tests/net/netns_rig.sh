@@ -58,7 +58,18 @@ check() {
 	exit 0
 }
 
+# Namespaces of earlier runs that were killed before their teardown: the
+# id is the test's pid (mod 100000); remove those whose process is gone.
+sweep() {
+	for old in $(ip netns list 2>/dev/null | sed -n 's/^roboelf-net-\([0-9][0-9]*\).*/\1/p'); do
+		[ "$old" = "$ID" ] && continue
+		kill -0 "$old" 2>/dev/null && continue
+		(ids "$old"; teardown)
+	done
+}
+
 setup() {
+	sweep
 	ip netns add "$NS" || die "cannot create namespace $NS"
 	ip link add "$DH" type veth peer name "$DN" || die "cannot create veth $DH"
 	ip link add "$MH" type veth peer name "$MN" || die "cannot create veth $MH"
