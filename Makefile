@@ -6,6 +6,7 @@
 #   make asan     the full check built with -fsanitize=address,undefined
 #   make demo     the whole system on the simulator
 #   make bench    performance figures (printed and written as CSV)
+#   make soak     the randomised soak (SOAK_SECONDS, default 600; SOAK_SEED)
 #   make lint     clang-format dry run and cppcheck
 #   make install / uninstall   (PREFIX, DESTDIR)
 #
@@ -84,7 +85,7 @@ BINS := $(if $(wildcard pc/roboelf.c),$(BUILD)/bin/roboelf) \
         $(if $(STUB_SRC),$(BUILD)/bin/galil-stub)
 TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 
-.PHONY: all check test asan demo bench lint install uninstall clean deps tests
+.PHONY: all check test asan demo bench soak lint install uninstall clean deps tests
 .SUFFIXES:
 .DELETE_ON_ERROR:
 
@@ -146,6 +147,16 @@ demo: deps
 bench: deps
 	@$(MAKE) --no-print-directory tests
 	@BUILD=$(BUILD) tests/bench.sh
+
+# The soak: seeded random joystick use with pot noise and transient invalid
+# states (tests/system/test_sys_soak.c); make check runs it for 60 s.
+SOAK_SECONDS ?= 600
+SOAK_SEED ?= 20261125
+soak: deps
+	@$(MAKE) --no-print-directory tests
+	@BUILD=$(BUILD) ROBOELF_BIN=$(CURDIR)/$(BUILD)/bin ROBOELF_TOP=$(CURDIR) \
+		ROBOELF_SOAK_S=$(SOAK_SECONDS) ROBOELF_SOAK_SEED=$(SOAK_SEED) \
+		$(BUILD)/tests/system/test_sys_soak
 
 lint:
 	clang-format --dry-run --Werror $(shell git ls-files '*.c' '*.h' 2>/dev/null)
