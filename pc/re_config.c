@@ -12,6 +12,7 @@
  * struct copied out only on success.
  */
 #include "re_config.h"
+#include "re_rt.h"
 
 #include <errno.h>
 #include <inttypes.h>
@@ -744,6 +745,13 @@ static const struct field recorder_fields[] = {
 	END,
 };
 
+static const struct field realtime_fields[] = {
+	I(struct re_config_realtime, priority, 0, 99),
+	I(struct re_config_realtime, cpu, -1, 1023),
+	B(struct re_config_realtime, lock_memory),
+	END,
+};
+
 static int parse_axes(struct pctx *c, const struct field *f, yaml_node_t *v,
 		      void *base)
 {
@@ -774,6 +782,7 @@ static const struct field root_fields[] = {
 	M(struct re_config, calibration, calibration_fields),
 	M(struct re_config, log, log_fields),
 	M(struct re_config, recorder, recorder_fields),
+	M(struct re_config, realtime, realtime_fields),
 	END,
 };
 /* clang-format on */
@@ -1137,6 +1146,19 @@ static int check_recorder(struct pctx *c, const struct re_config_recorder *r)
 		       r->after_fault_s, r->seconds);
 }
 
+/* A period under RE_RT_MIN_MS_WITHOUT needs SCHED_FIFO asked for. */
+static int check_realtime(struct pctx *c, const struct re_config *cfg)
+{
+	if (cfg->period_ms >= RE_RT_MIN_MS_WITHOUT ||
+	    cfg->realtime.priority > 0)
+		return GL_OK;
+	return fail_at(c,
+		       later_mark(c, &cfg->period_ms, &cfg->realtime.priority),
+		       "'period_ms' %d needs real-time scheduling: set "
+		       "'realtime.priority' 1..99 or a period of %d ms or more",
+		       cfg->period_ms, RE_RT_MIN_MS_WITHOUT);
+}
+
 static int check_all(struct pctx *c, const struct re_config *cfg)
 {
 	int i, rc = check_table(c, root_fields, cfg);
@@ -1159,6 +1181,8 @@ static int check_all(struct pctx *c, const struct re_config *cfg)
 		rc = check_clinical(c, cfg);
 	if (!rc)
 		rc = check_recorder(c, &cfg->recorder);
+	if (!rc)
+		rc = check_realtime(c, cfg);
 	return rc;
 }
 
@@ -1263,6 +1287,9 @@ void re_config_defaults(struct re_config *out)
 	out->log.keep = 5;
 	out->recorder.seconds = 30;
 	out->recorder.after_fault_s = 2;
+	out->realtime.priority = 50;
+	out->realtime.cpu = -1;
+	out->realtime.lock_memory = true;
 }
 
 /* ---- parse ---- */

@@ -26,6 +26,7 @@
  */
 #include <errno.h>
 #include <getopt.h>
+#include <sched.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -53,6 +54,7 @@
 #include "re_plan.h"
 #include "re_rec.h"
 #include "re_relay.h"
+#include "re_rt.h"
 #include "re_start.h"
 #include "re_traceshow.h"
 #include "re_super.h"
@@ -125,6 +127,7 @@ static void usage(FILE *f)
 	    "       roboelf --show-trace FILE [--window FROM:TO]\n"
 	    "       roboelf --commission DIR [-c FILE] [--galil ...] "
 	    "[--wait S]\n"
+	    "       roboelf --check-host[=SECONDS] [-c FILE]\n"
 	    "\n"
 	    "  -c, --config FILE        configuration (default %s, else "
 	    "%s)\n"
@@ -148,12 +151,16 @@ static void usage(FILE *f)
 	    "      --find-addr A, --find-port P  commissioning: where the "
 	    "discovery probe goes\n"
 	    "                           (255.255.255.255, 50000)\n"
+	    "      --check-host[=S]     measure this host's wake-up "
+	    "lateness for S s (10) and\n"
+	    "                           name the shortest safe period\n"
 	    "  -h, --help               this text\n"
 	    "      --version            the release and the DMC interface "
 	    "it expects\n"
 	    "\n"
 	    "exit: 0 quit, 2 usage/config, 3 no relay/controller, "
-	    "4 fault latched, 5 commissioning found a fault\n",
+	    "4 fault latched, 5 commissioning found a fault,\n"
+	    "      6 --check-host: the configured period is not safe here\n",
 	    DEFAULT_CONFIG, SYSTEM_CONFIG);
 }
 
@@ -208,6 +215,15 @@ static int opt_value(struct opts *o, int c, const char *arg)
 			"s\n",
 			arg);
 		return -1;
+	case 'H':
+		o->check_host_s = arg ? atoi(arg) : 10;
+		if (o->check_host_s >= 1 && o->check_host_s <= 3600)
+			return 0;
+		fprintf(stderr,
+			"roboelf: error: invalid --check-host '%s': must be "
+			"1..3600 s\n",
+			arg);
+		return -1;
 	case 'p':
 		if (parse_period(arg, &o->period_ms) == 0)
 			return 0;
@@ -245,6 +261,7 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 	    {"wait", required_argument, NULL, 'W'},
 	    {"find-addr", required_argument, NULL, 'F'},
 	    {"find-port", required_argument, NULL, 'P'},
+	    {"check-host", optional_argument, NULL, 'H'},
 	    {"help", no_argument, NULL, 'h'},
 	    {"version", no_argument, NULL, 'V'},
 	    {NULL, 0, NULL, 0},
@@ -591,6 +608,99 @@ static void power_off(struct app *a, int latched)
 		   "stop: %s%s", what, latched ? " (fault latched)" : "");
 }
 
+/* ---- real time (issue 17) ------------------------------------------------ */
+
+/* SCHED_FIFO, locked memory and a CPU as configured, for this thread only
+ * (the recorder's writer thread, started before, keeps the normal policy);
+ * what is in force is read back from the kernel and logged. A period the
+ * result cannot hold is refused. Return: 0, or -1 (said on stderr). */
+static int rt_setup(struct app *a)
+{
+	const struct re_config_realtime *r = &a->cfg.realtime;
+	struct re_rt_cfg rc = {r->priority, r->cpu, r->lock_memory};
+	char d[RE_RT_DESCRIBE_MAX];
+	int refused = re_rt_setup(&rc, &a->rt) < 0, pol = -1, prio = 0;
+	long kb = -1;
+
+	re_rt_describe(&a->rt, d, sizeof(d));
+	re_rt_readback(&pol, &prio, &kb);
+	re_log_msg(&a->log, refused ? RE_LOG_WARN : RE_LOG_INFO,
+		   "real time: %s; read back: policy %s priority %d, "
+		   "VmLck %ld kB",
+		   d, pol == SCHED_FIFO ? "SCHED_FIFO" : "normal", prio, kb);
+	if (a->cfg.period_ms < re_rt_min_period_ms(&a->rt)) {
+		fprintf(stderr,
+			"roboelf: error: a %d ms period needs real-time "
+			"scheduling, and this host gave %s: run as root or "
+			"give roboelf CAP_SYS_NICE (docs/supervisor.md, "
+			"\"Real time\"), or use a period of %d ms or more\n",
+			a->cfg.period_ms, d, re_rt_min_period_ms(&a->rt));
+		return -1;
+	}
+	if (refused && a->rt.err_fifo)
+		re_console_msg(&a->con,
+			       "roboelf: note: real time: %s; periods under "
+			       "%d ms are refused",
+			       d, RE_RT_MIN_MS_WITHOUT);
+	return 0;
+}
+
+/* --check-host: this host's wake-up lateness under the configured real-
+ * time set-up, and the verdict per period. Return: 0, EXIT_HOST when the
+ * configured period is not safe, EXIT_USAGE when the probe failed. */
+static int check_host(struct app *a)
+{
+	static const int cand[] = {2, 3, 5, 10, 20, 50, 100};
+	const struct re_config_realtime *r = &a->cfg.realtime;
+	const struct re_config_watchdog *w = &a->cfg.watchdog;
+	struct re_rt_cfg rc = {r->priority, r->cpu, r->lock_memory};
+	struct re_rt_probe p;
+	struct re_rt_verdict v;
+	char d[RE_RT_DESCRIBE_MAX];
+	int best = 0, own_safe;
+
+	install_signals();
+	re_rt_setup(&rc, &a->rt);
+	printf("host check: %s\n", re_rt_describe(&a->rt, d, sizeof(d)));
+	printf("host check: sleeping to 1 ms deadlines for %d s ...\n",
+	       a->o.check_host_s);
+	fflush(stdout);
+	if (re_rt_probe_run(1000000, a->o.check_host_s * 1000000000LL,
+			    &re_sig.quit, &p) < 0 ||
+	    p.wakes == 0) {
+		fprintf(stderr, "roboelf: error: host check: %s\n",
+			strerror(errno));
+		return EXIT_USAGE;
+	}
+	printf("host check: %llu wake-ups, late p50 %.3f p99 %.3f p99.9 %.3f "
+	       "max %.3f ms; %llu later than 1 ms, %llu later than 5 ms\n",
+	       (unsigned long long)p.wakes, p.p50_ms, p.p99_ms, p.p999_ms,
+	       p.max_ms, (unsigned long long)p.over_1ms,
+	       (unsigned long long)p.over_5ms);
+	printf("period  lateness allowed  verdict (watchdog %.1f/%.1f x P)\n",
+	       w->noncritical_factor, w->critical_factor);
+	for (size_t i = 0; i < sizeof(cand) / sizeof(cand[0]); i++) {
+		re_rt_verdict(&p, cand[i], w->noncritical_factor,
+			      w->critical_factor, &v);
+		if (v.safe && cand[i] >= re_rt_min_period_ms(&a->rt) && !best)
+			best = cand[i];
+		printf("%4d ms  %8.1f ms        %s\n", cand[i], v.margin_ms,
+		       cand[i] < re_rt_min_period_ms(&a->rt)
+			   ? "refused without real-time scheduling"
+		       : !v.safe ? "NOT SAFE: would trip WATCHDOG"
+		       : v.quiet ? "safe"
+				 : "safe, with occasional watchdog warnings");
+	}
+	re_rt_verdict(&p, a->cfg.period_ms, w->noncritical_factor,
+		      w->critical_factor, &v);
+	own_safe = v.safe && a->cfg.period_ms >= re_rt_min_period_ms(&a->rt);
+	printf("host check: shortest safe period on this host: %s%d ms; the "
+	       "configured %d ms (%s) is %s\n",
+	       best ? "" : "none of these; more than ", best ? best : 100,
+	       a->cfg.period_ms, a->o.config, own_safe ? "safe" : "NOT SAFE");
+	return own_safe ? 0 : EXIT_HOST;
+}
+
 /* Return: 1 when a fault was latched. */
 static int cleanup(struct app *a)
 {
@@ -627,7 +737,7 @@ static int supervise(struct app *a)
 	re_lock_init(&a->lock_relay);
 	re_io_bind(&a->io, &a->real);
 	install_signals();
-	if (open_recorder(a) < 0) {
+	if (open_recorder(a) < 0 || rt_setup(a) < 0) {
 		re_console_close(&a->con);
 		re_log_close(&a->log);
 		return EXIT_USAGE;
@@ -773,7 +883,11 @@ int main(int argc, char **argv)
 		return show_calibration(&a);
 	if (a.o.show_trace)
 		return show_trace(&a);
-	if (load_config(&a) < 0 || open_log(&a) < 0)
+	if (load_config(&a) < 0)
+		return EXIT_USAGE;
+	if (a.o.check_host_s)
+		return check_host(&a);
+	if (open_log(&a) < 0)
 		return EXIT_USAGE;
 	if (a.o.commission)
 		return commission(&a);

@@ -263,7 +263,8 @@ static void quit_and_report(const struct soak_fig *f, double sim_s)
 
 static void test_soak(void **state)
 {
-	unsigned long long seed = env_ull("ROBOELF_SOAK_SEED", SOAK_SEED_DEFAULT);
+	unsigned long long seed =
+	    env_ull("ROBOELF_SOAK_SEED", SOAK_SEED_DEFAULT);
 	unsigned long long rng = seed;
 	long secs = (long)env_ull("ROBOELF_SOAK_S", SOAK_S_DEFAULT);
 	struct soak_fig f = {0};
