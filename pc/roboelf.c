@@ -539,16 +539,20 @@ static void run(struct app *a)
 {
 	struct re_status st;
 	int64_t next_retry = 0;
-	int key = 0;
+	int key = 0, v;
 
 	re_console_raw(&a->con);
 	while (!re_sig.quit) {
 		re_super_wait(a->sup);
-		if (re_super_cycle(a->sup) == RE_FAULT)
+		a->real.defer_log = 1; /* no file write in the cycle */
+		v = re_super_cycle(a->sup);
+		a->real.defer_log = 0;
+		if (v == RE_FAULT)
 			re_console_fault(&a->con, re_super_fault_line(a->sup));
 		re_super_status(a->sup, &st);
 		re_start_show_foreign(a, st.foreign);
 		re_console_status(&a->con, &st, re_io_now_ns(), 0);
+		re_io_flush_log(&a->real); /* after the cycle (issue 17) */
 		retry_log(a, &next_retry);
 		key = re_console_key(&a->con);
 		trace_tick(a, key);
@@ -706,6 +710,7 @@ static int cleanup(struct app *a)
 {
 	int latched = a->sup && a->sup->latched;
 
+	re_io_flush_log(&a->real);
 	power_off(a, latched);
 	close_recorder(a);
 	re_lock_release(&a->lock_relay);
