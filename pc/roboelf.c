@@ -533,12 +533,14 @@ static void close_recorder(struct app *a)
 	a->rec = NULL;
 }
 
+#define KEY_POLL_MS 100 /* the keyboard is read this often, ms */
+
 /* Every period until the operator quits; a latched fault keeps the status
  * board running. A terminal that went away (end of input) quits. */
 static void run(struct app *a)
 {
 	struct re_status st;
-	int64_t next_retry = 0;
+	int64_t next_retry = 0, next_key = 0;
 	int key = 0, v;
 
 	re_console_raw(&a->con);
@@ -554,7 +556,11 @@ static void run(struct app *a)
 		re_console_status(&a->con, &st, re_io_now_ns(), 0);
 		re_io_flush_log(&a->real); /* after the cycle (issue 17) */
 		retry_log(a, &next_retry);
-		key = re_console_key(&a->con);
+		/* the keyboard every KEY_POLL_MS, not every cycle (issue 17) */
+		if (re_io_now_ns() >= next_key) {
+			next_key = re_io_now_ns() + KEY_POLL_MS * 1000000LL;
+			key = re_console_key(&a->con);
+		}
 		trace_tick(a, key);
 		if (key == 'q' || key == 'Q' || key < 0)
 			break;
