@@ -44,6 +44,8 @@
 #include <unistd.h>
 
 #include "base_clock.h"
+#include "gl_err.h"
+#include "re_config.h"
 #include "re_rec.h"
 #include "sys_h.h"
 
@@ -740,6 +742,37 @@ static void print_table(void)
 		       rows[i].value, rows[i].unit, rows[i].original);
 }
 
+/* ---- calibration against its physical bounds (issue 17) ----------------- */
+
+/* The sweep (travel / vmax of the slowest axis: the axes move together)
+ * and the least a calibration from the centre can take at vmax: half the
+ * travel to the reverse switch, the sweep, half back to the centre. */
+static void calib_bounds(const struct sys_env *e)
+{
+	static struct re_config cfg;
+	char err[RE_CONFIG_ERR_MAX];
+	double sweep = 0;
+
+	if (re_config_load_file(e->cfg, &cfg, err, sizeof(err)) != GL_OK) {
+		add("calibration", "sweep time (travel / vmax)", "time", "s",
+		    "", "n/a (%s)", err);
+		return;
+	}
+	for (int i = 0; i < RE_AXES; i++) {
+		double t =
+		    (double)cfg.axes[i].travel_counts / cfg.axes[i].vmax_cps;
+
+		if (t > sweep)
+			sweep = t;
+	}
+	add("calibration", "sweep time (travel / vmax, slowest axis)", "time",
+	    "s", "", "%.1f", sweep);
+	add("calibration", "least from the centre (1/2 + sweep + 1/2 at vmax)",
+	    "time", "s", "", "%.1f", 2 * sweep);
+	add("calibration", "full calibration / sweep time", "ratio", "", "",
+	    "%.2f", e->calib_s / sweep);
+}
+
 /* ---- the flight recorder (issue 16) ------------------------------------- */
 
 static int64_t rb_now(void *ud)
@@ -905,9 +938,11 @@ int main(int argc, char **argv)
 	if (getenv("ROBOELF_SYS_CAL") && *getenv("ROBOELF_SYS_CAL"))
 		add("calibration", "full calibration, default robot", "time",
 		    "s", "", "n/a (reused from ROBOELF_SYS_CAL)");
-	else
+	else {
 		add("calibration", "full calibration, default robot", "time",
 		    "s", "", "%.1f", env.calib_s);
+		calib_bounds(&env);
+	}
 	for (size_t i = 0; i < sizeof(periods) / sizeof(periods[0]); i++) {
 		struct loop_fig f;
 
