@@ -151,6 +151,12 @@ static const struct bad_case bad_cases[] = {
     {"bad_realtime_period.yaml", 4, 13,
      "'period_ms' 5 needs real-time scheduling: set 'realtime.priority' "
      "1..99 or a period of 10 ms or more"},
+    {"bad_quote_single.yaml", 3, 10,
+     "this quote is not closed on its line (the parser then stopped at "
+     "line 5 column 1: found unexpected end of stream)"},
+    {"bad_quote_unclosed.yaml", 3, 12,
+     "this quote is not closed on its line (the parser then stopped at "
+     "line 8 column 1: found unexpected end of stream)"},
     {"bad_readback_protocol.yaml", 4, 13,
      "'readback' needs the devantech protocol"},
     {"bad_root_list.yaml", 1, 1,
