@@ -401,6 +401,13 @@ static int load_config(struct app *a)
 		return -1;
 	}
 	apply_overrides(a);
+	if (a->cfg.mode == RE_MODE_CLINICAL && base_paths_root()) {
+		fprintf(stderr,
+			"roboelf: error: %s is set: refused in clinical mode "
+			"(it is for testing a staged installation); unset it\n",
+			BASE_PATHS_ROOT_ENV);
+		return -1;
+	}
 	if (re_config_validate(&a->cfg, a->err, sizeof(a->err)) != GL_OK ||
 	    check_analog(&a->cfg, a->err, sizeof(a->err)) != GL_OK) {
 		fprintf(stderr, "roboelf: error: %s\n", a->err);

@@ -78,6 +78,17 @@ out=$(re --calibration file 2>&1)
 rc=$?
 [ $rc -eq 2 ] || fail "edited configuration: exit $rc: $out"
 printf '%s\n' "$out" | grep -q "^$cfg:$line:" || fail "edited configuration not read: $out"
+# ROBOELF_ROOT is refused in clinical mode, before anything is opened
+cp "$cfg" "$tmp/edited.yaml"
+sed -i -e 's/^period_ms: 1$/period_ms: 50/' -e 's/^mode: development$/mode: clinical/' \
+	-e 's|^  port_clinical: ""$|  port_clinical: /dev/roboelf-relay|' \
+	-e 's|^  address: "127.0.0.1:23023"$|  address: "192.0.2.1"|' "$cfg"
+out=$(re --calibration file 2>&1)
+rc=$?
+want="roboelf: ROBOELF_ROOT=$root: the installed files are looked for under it
+roboelf: error: ROBOELF_ROOT is set: refused in clinical mode (it is for testing a staged installation); unset it"
+[ $rc -eq 2 ] && [ "$out" = "$want" ] || fail "clinical with ROBOELF_ROOT: exit $rc: '$out'"
+cp "$tmp/edited.yaml" "$cfg"
 # -c wins
 printf 'period_ms: 0\n' >"$tmp/mine.yaml"
 out=$(re -c "$tmp/mine.yaml" --calibration file 2>&1)
