@@ -9,7 +9,7 @@
 # installed with PREFIX=/usr into $BUILD/deb/root, stripped; the man pages
 # and the changelog compressed; the copyright, the udev rule of the relay
 # (RELAY_USB_VENDOR, RELAY_USB_PRODUCT, optional RELAY_USB_SERIAL), the
-# conffile list and the postinst added; then dpkg-deb builds the package
+# group's real-time limits, the conffile list and the postinst added; then dpkg-deb builds the package
 # (root-owned files, no fakeroot needed).
 set -eu
 cd "$(dirname "$0")/.."
@@ -67,6 +67,9 @@ mkdir -p "$root/lib/udev/rules.d"
 sed -e "s/@VENDOR@/$VENDOR/g" -e "s/@PRODUCT@/$PRODUCT/g" \
 	-e "s/@SERIAL_MATCH@/$serial_match/" -e "s/@SERIAL_NOTE@/$serial_note/" \
 	"$PKG/60-roboelf-relay.rules.in" >"$root/lib/udev/rules.d/60-roboelf-relay.rules"
+
+# the operators' real-time limits (pam_limits)
+install -D -m 644 "$PKG/limits.conf" "$root/etc/security/limits.d/roboelf.conf"
 
 # the control files
 printf 'Source: roboelf\n\nPackage: roboelf\nArchitecture: any\n' >"$DEB/shlibs/debian/control"

@@ -1,8 +1,9 @@
 #!/bin/sh
 # deb.sh - the Debian package (issue 17): `make deb` builds
 # $BUILD/roboelf_<version>_<arch>.deb; `dpkg -c` lists the programs, the man
-# pages, the conffile /etc/roboelf/roboelf.yaml, the DMC programs, the docs
-# tree and the relay's udev rule, all owned by root; the packaged galil-load
+# pages, the conffiles /etc/roboelf/roboelf.yaml and the group's real-time
+# limits, the DMC programs, the docs tree and the relay's udev rule, all
+# owned by root; the packaged galil-load
 # finds the packaged DMC programs; the postinst creates the group roboelf
 # once (run twice against stand-in commands, never on this machine's
 # groups); lintian reports no error. lintian comes from `make deps`: a
@@ -28,7 +29,8 @@ awk '{print $6}' "$tmp/list" >"$tmp/paths"
 for p in ./usr/bin/roboelf ./usr/bin/galil-load ./usr/bin/galil-sim \
 	./usr/share/man/man1/roboelf.1.gz ./usr/share/man/man1/galil-load.1.gz \
 	./usr/share/man/man1/galil-sim.1.gz ./usr/share/man/man5/roboelf.yaml.5.gz \
-	./etc/roboelf/roboelf.yaml ./usr/share/roboelf/dmc/MANIFEST \
+	./etc/roboelf/roboelf.yaml ./etc/security/limits.d/roboelf.conf \
+	./usr/share/roboelf/dmc/MANIFEST \
 	./usr/share/roboelf/dmc/constants.dmc ./usr/share/roboelf/dmc/roboelf.dmc \
 	./usr/share/roboelf/config/plant.yaml ./lib/udev/rules.d/60-roboelf-relay.rules \
 	./usr/share/doc/roboelf/copyright ./usr/share/doc/roboelf/changelog.gz \
@@ -42,12 +44,15 @@ grep -q '^-rwxr-xr-x .*\./usr/bin/roboelf$' "$tmp/list" || fail "roboelf is not 
 [ "$(dpkg-deb -f "$deb" Package)" = roboelf ] || fail "Package"
 [ "$(dpkg-deb -f "$deb" Version)" = "$version" ] || fail "Version"
 dpkg-deb -e "$deb" "$tmp/ctl" || fail "dpkg-deb -e"
-[ "$(cat "$tmp/ctl/conffiles")" = /etc/roboelf/roboelf.yaml ] || fail "conffiles: $(cat "$tmp/ctl/conffiles")"
+[ "$(cat "$tmp/ctl/conffiles")" = "/etc/roboelf/roboelf.yaml
+/etc/security/limits.d/roboelf.conf" ] || fail "conffiles: $(cat "$tmp/ctl/conffiles")"
 
 dpkg-deb -x "$deb" "$tmp/x" || fail "dpkg-deb -x"
 want='SUBSYSTEM=="tty", ATTRS{idVendor}=="0403", ATTRS{idProduct}=="6001", SYMLINK+="roboelf-relay", GROUP="roboelf", MODE="0660"'
 grep -v '^#' "$tmp/x/lib/udev/rules.d/60-roboelf-relay.rules" | grep -qxF "$want" ||
 	fail "udev rule: $(grep -v '^#' "$tmp/x/lib/udev/rules.d/60-roboelf-relay.rules")"
+[ "$(grep -v '^#' "$tmp/x/etc/security/limits.d/roboelf.conf")" = "$(printf '@roboelf\t-\trtprio\t60\n@roboelf\t-\tmemlock\tunlimited')" ] ||
+	fail "limits: $(cat "$tmp/x/etc/security/limits.d/roboelf.conf")"
 cmp -s "$tmp/x/etc/roboelf/roboelf.yaml" config/roboelf.yaml || fail "the conffile is not config/roboelf.yaml"
 # built for /usr: the packaged galil-load finds the packaged DMC programs
 out=$(cd "$tmp" && ROBOELF_ROOT=$tmp/x "$tmp/x/usr/bin/galil-load" --version 2>/dev/null | sed -n 2p)
