@@ -36,7 +36,8 @@
 #define EXIT_COMMISSION 5 /* the commissioning run found a fault */
 #define EXIT_HOST	6 /* --check-host: the configured period is not safe */
 #define DEFAULT_CONFIG	"config/roboelf.yaml"
-#define SYSTEM_CONFIG	"/etc/roboelf/roboelf.yaml" /* the installed one */
+/* the installed one, under SYSCONFDIR (base_paths.h) */
+#define SYSTEM_CONFIG "roboelf/roboelf.yaml"
 
 struct opts {
 	const char *config; /* -c, or the one found (roboelf.1, FILES) */
@@ -47,6 +48,8 @@ struct opts {
 	const char *show_trace; /* --show-trace FILE (issue 16) */
 	const char *window;	/* --window FROM:TO */
 	int config_searched;	/* no -c: find_config() chose it */
+	const char *dmc;	/* --dmc DIR: the DMC programs (--version) */
+	int version;		/* --version asked */
 	const char *commission; /* report directory */
 	int wait_s;	       /* commissioning: each wait for the technician */
 	const char *find_addr; /* commissioning: discovery probe address */

@@ -36,6 +36,7 @@
 #include <unistd.h>
 
 #include "base_clock.h"
+#include "base_paths.h"
 #include "base_version.h"
 #include "gl_err.h"
 #include "gl_link.h"
@@ -116,6 +117,17 @@ static void install_signals(void)
 
 /* ---- options ----------------------------------------------------------- */
 
+/* The installed configuration: SYSCONFDIR/roboelf/roboelf.yaml, under
+ * ROBOELF_ROOT when that is set (base_paths.h); "" when it does not fit. */
+static const char *system_config(void)
+{
+	static char path[RE_PATH_MAX];
+
+	if (!path[0])
+		base_paths_sysconf(SYSTEM_CONFIG, path, sizeof(path));
+	return path;
+}
+
 static void usage(FILE *f)
 {
 	fprintf(
@@ -154,14 +166,16 @@ static void usage(FILE *f)
 	    "      --check-host[=S]     measure this host's wake-up "
 	    "lateness for S s (10) and\n"
 	    "                           name the shortest safe period\n"
+	    "      --dmc DIR            the DMC programs --version names "
+	    "(default ./dmc, else the installed ones)\n"
 	    "  -h, --help               this text\n"
-	    "      --version            the release and the DMC interface "
-	    "it expects\n"
+	    "      --version            the release, the DMC interface it "
+	    "expects, the files it uses\n"
 	    "\n"
 	    "exit: 0 quit, 2 usage/config, 3 no relay/controller, "
 	    "4 fault latched, 5 commissioning found a fault,\n"
 	    "      6 --check-host: the configured period is not safe here\n",
-	    DEFAULT_CONFIG, SYSTEM_CONFIG);
+	    DEFAULT_CONFIG, system_config());
 }
 
 static int parse_period(const char *s, int *out)
@@ -200,6 +214,7 @@ static int opt_value(struct opts *o, int c, const char *arg)
 	case 'w': o->window = arg; return 0;
 	case 'M': o->commission = arg; return 0;
 	case 'F': o->find_addr = arg; return 0;
+	case 'D': o->dmc = arg; return 0;
 	case 'P':
 		o->find_port = atoi(arg);
 		if (o->find_port >= 1 && o->find_port <= 65535)
@@ -262,6 +277,7 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 	    {"find-addr", required_argument, NULL, 'F'},
 	    {"find-port", required_argument, NULL, 'P'},
 	    {"check-host", optional_argument, NULL, 'H'},
+	    {"dmc", required_argument, NULL, 'D'},
 	    {"help", no_argument, NULL, 'h'},
 	    {"version", no_argument, NULL, 'V'},
 	    {NULL, 0, NULL, 0},
@@ -276,10 +292,8 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 			return 1;
 		}
 		if (c == 'V') {
-			printf("roboelf %s (controller program interface %s, "
-			       "dmc/constants.dmc vers)\n",
-			       ROBOELF_VERSION, ROBOELF_DMC_VERSION);
-			return 1;
+			o->version = 1;
+			continue;
 		}
 		if (opt_value(o, c, optarg) < 0)
 			return -1;
@@ -327,16 +341,49 @@ static int check_analog(const struct re_config *c, char *err, size_t len)
 }
 
 /* Without -c: ./config/roboelf.yaml (the source tree), then the
- * installed /etc/roboelf/roboelf.yaml; the first that exists. */
+ * installed SYSCONFDIR/roboelf/roboelf.yaml; the first that exists. */
 static void find_config(struct opts *o)
 {
 	if (o->config)
 		return;
 	o->config_searched = 1;
 	o->config = access(DEFAULT_CONFIG, F_OK) == 0 ||
-			    access(SYSTEM_CONFIG, F_OK) != 0
+			    access(system_config(), F_OK) != 0
 			? DEFAULT_CONFIG
-			: SYSTEM_CONFIG;
+			: system_config();
+}
+
+/* --version: the release, the DMC interface, and the files this roboelf
+ * would use from here: its configuration and the DMC programs that go
+ * with it (--dmc, else ./dmc, else the installed ones). */
+static int print_version(struct opts *o)
+{
+	char dir[RE_PATH_MAX], manifest[RE_PATH_MAX + 16];
+
+	printf("roboelf %s (controller program interface %s, "
+	       "dmc/constants.dmc vers)\n",
+	       ROBOELF_VERSION, ROBOELF_DMC_VERSION);
+	find_config(o);
+	if (!o->config_searched)
+		printf("configuration: %s (-c)\n", o->config);
+	else if (access(o->config, F_OK) == 0)
+		printf("configuration: %s\n", o->config);
+	else
+		printf("configuration: none (neither %s here nor %s)\n",
+		       DEFAULT_CONFIG, system_config());
+	if (o->dmc) {
+		snprintf(manifest, sizeof(manifest), "%s/MANIFEST", o->dmc);
+		printf("DMC programs: %s (--dmc%s)\n", o->dmc,
+		       access(manifest, F_OK) == 0 ? ""
+						   : "; it has no MANIFEST");
+	} else if (base_paths_dmc_dir(dir, sizeof(dir)) == 0) {
+		printf("DMC programs: %s\n", dir);
+	} else {
+		printf("DMC programs: none (neither dmc/MANIFEST here nor "
+		       "%s/MANIFEST)\n",
+		       dir);
+	}
+	return 0;
 }
 
 static int load_config(struct app *a)
@@ -350,10 +397,17 @@ static int load_config(struct app *a)
 				"roboelf: no configuration: neither '%s' (in "
 				"this directory) nor '%s' exists; give one "
 				"with -c FILE\n",
-				DEFAULT_CONFIG, SYSTEM_CONFIG);
+				DEFAULT_CONFIG, system_config());
 		return -1;
 	}
 	apply_overrides(a);
+	if (a->cfg.mode == RE_MODE_CLINICAL && base_paths_root()) {
+		fprintf(stderr,
+			"roboelf: error: %s is set: refused in clinical mode "
+			"(it is for testing a staged installation); unset it\n",
+			BASE_PATHS_ROOT_ENV);
+		return -1;
+	}
 	if (re_config_validate(&a->cfg, a->err, sizeof(a->err)) != GL_OK ||
 	    check_analog(&a->cfg, a->err, sizeof(a->err)) != GL_OK) {
 		fprintf(stderr, "roboelf: error: %s\n", a->err);
@@ -890,6 +944,13 @@ int main(int argc, char **argv)
 
 	if (rc)
 		return rc > 0 ? 0 : EXIT_USAGE;
+	if (base_paths_root())
+		fprintf(stderr,
+			"roboelf: %s=%s: the installed files are looked for "
+			"under it\n",
+			BASE_PATHS_ROOT_ENV, base_paths_root());
+	if (a.o.version)
+		return print_version(&a.o);
 	if (a.o.show_cal)
 		return show_calibration(&a);
 	if (a.o.show_trace)
