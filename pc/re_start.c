@@ -433,10 +433,13 @@ static int sample_cb(void *ud, const struct gl_record **rec)
 	if (re_sig.quit)
 		return GL_ERR_AGAIN;
 	re_super_wait(a->sup);
+	a->real.defer_log = 1; /* no file write in the cycle (issue 17) */
 	v = re_super_cycle(a->sup);
+	a->real.defer_log = 0;
 	re_super_status(a->sup, &st);
 	re_start_show_foreign(a, st.foreign);
 	re_console_status(&a->con, &st, re_io_now_ns(), 0);
+	re_io_flush_log(&a->real); /* after the cycle (issue 17) */
 	if (v == RE_FAULT) {
 		re_console_fault(&a->con, re_super_fault_line(a->sup));
 		return RE_FAULT;

@@ -165,6 +165,23 @@ static int check_stall(struct re_super *s, struct re_fault *f)
 	return RE_FAULT;
 }
 
+/* "hbpc=N" into @buf (32 bytes; N < RE_HBPC_WRAP, 10 digits at most)
+ * without snprintf: the one command text built every cycle (issue 17). */
+static void hb_prefix(char *buf, long hb)
+{
+	char dig[16];
+	int n = 0;
+
+	memcpy(buf, "hbpc=", 5);
+	do {
+		dig[n++] = (char)('0' + hb % 10);
+		hb /= 10;
+	} while (hb > 0 && n < (int)sizeof(dig));
+	for (int i = 0; i < n; i++)
+		buf[5 + i] = dig[n - 1 - i];
+	buf[5 + n] = '\0';
+}
+
 /* The round trip and the PC-side watchdog verdict on it. */
 static int exchange(struct re_super *s, struct re_fault *f)
 {
@@ -172,7 +189,7 @@ static int exchange(struct re_super *s, struct re_fault *f)
 	int rc, v, tmo = reply_timeout_ms(s);
 
 	s->hbpc = (s->hbpc + 1) % RE_HBPC_WRAP;
-	snprintf(s->prefix, sizeof(s->prefix), "hbpc=%ld", s->hbpc);
+	hb_prefix(s->prefix, s->hbpc);
 	rc = s->io.ops->record(s->io.ud, s->prefix, &s->rec, tmo);
 	now = now_ns(s);
 	s->link_ok = rc == GL_OK;

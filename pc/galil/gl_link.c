@@ -315,6 +315,9 @@ static int chan_write(gl_link *l, struct gl_chan *ch, const void *buf,
 
 /*
  * Read what is there (one recv) into the parser. @deadline < 0: do not wait.
+ * When waiting is allowed the socket is polled first: a reply awaited is
+ * rarely there yet, and poll + recv is one system call fewer than a recv
+ * that finds nothing, then poll, then recv (issue 17: the lean cycle).
  * Return: GL_OK (bytes fed), GL_ERR_AGAIN (nothing without waiting),
  *         GL_ERR_TIMEOUT, GL_ERR_CLOSED, GL_ERR_SYS.
  */
@@ -329,6 +332,11 @@ static int chan_read(gl_link *l, struct gl_chan *ch, int64_t deadline)
 		want = sizeof(buf);
 	if (want == 0)
 		return GL_ERR_PROTO; /* cannot happen: next() drains input */
+	if (deadline >= 0) {
+		rc = wait_fd(ch->fd, POLLIN, deadline);
+		if (rc < 0)
+			return rc;
+	}
 	for (;;) {
 		n = recv(ch->fd, buf, want, 0);
 		if (n > 0)

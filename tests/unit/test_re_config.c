@@ -146,6 +146,17 @@ static const struct bad_case bad_cases[] = {
      "'on' must list 1 to 16 bytes, got 17"},
     {"bad_quoted_number.yaml", 2, 12,
      "expected an integer for 'period_ms', got a quoted string"},
+    {"bad_realtime_cpu.yaml", 3, 8,
+     "'cpu' must be between -1 and 1023, got -2"},
+    {"bad_realtime_period.yaml", 4, 13,
+     "'period_ms' 5 needs real-time scheduling: set 'realtime.priority' "
+     "1..99 or a period of 10 ms or more"},
+    {"bad_quote_single.yaml", 3, 10,
+     "this quote is not closed on its line (the parser then stopped at "
+     "line 5 column 1: found unexpected end of stream)"},
+    {"bad_quote_unclosed.yaml", 3, 12,
+     "this quote is not closed on its line (the parser then stopped at "
+     "line 8 column 1: found unexpected end of stream)"},
     {"bad_readback_protocol.yaml", 4, 13,
      "'readback' needs the devantech protocol"},
     {"bad_root_list.yaml", 1, 1,
@@ -453,6 +464,8 @@ static void emit(struct sbuf *b, const struct re_config *c)
 	put(b, "recorder:\n  seconds: %.17g\n  after_fault_s: %.17g\n",
 	    c->recorder.seconds, c->recorder.after_fault_s);
 	put(b, "  dir: \"%s\"\n", c->recorder.dir);
+	put(b, "realtime:\n  priority: %d\n  cpu: %d\n  lock_memory: %s\n",
+	    c->realtime.priority, c->realtime.cpu, tf(c->realtime.lock_memory));
 }
 
 /* A configuration with every field away from its default. */
@@ -465,6 +478,9 @@ static void changed(struct re_config *c)
 	re_config_defaults(c);
 	c->mode = RE_MODE_CLINICAL;
 	c->period_ms = 20;
+	c->realtime.priority = 70;
+	c->realtime.cpu = 1;
+	c->realtime.lock_memory = false;
 	strcpy(c->controller.address, "192.168.42.7:23");
 	strcpy(c->controller.model, "DMC4040");
 	c->controller.timeout_ms = 75;
