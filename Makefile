@@ -182,6 +182,23 @@ deps:
 		fi; \
 	fi
 
+# ---- network rig (tests/net, docs/link.md) ------------------------------------
+# nfq-delay (the rig's packet delayer) is built when libnetfilter-queue is
+# there; `make netrig` runs every network case (minutes), `make check` the
+# short ones. Skipped without root: reported SKIPPED, and netrig fails.
+DEB_PKGS += iptables libnetfilter-queue-dev
+NFQ_LIBS := $(shell pkg-config --libs libnetfilter_queue 2>/dev/null)
+ifneq ($(NFQ_LIBS),)
+tests: $(BUILD)/bin/nfq-delay
+$(BUILD)/bin/nfq-delay: tests/net/nfq_delay.c
+	@mkdir -p $(@D)
+	$(CC) $(WARN) $(CFLAGS) $(SAN) -D_DEFAULT_SOURCE $(ALL_LDFLAGS) -o $@ $< $(NFQ_LIBS)
+endif
+.PHONY: netrig
+netrig: deps
+	@$(MAKE) --no-print-directory tests
+	@BUILD=$(BUILD) ROBOELF_NETRIG=long ROBOELF_NO_SKIP=1 tests/run-all.sh net
+
 # ---- install -----------------------------------------------------------------
 # The installed places (issue 17): base_paths.c is built with DATADIR and
 # SYSCONFDIR (and rebuilt when they change); roboelf and galil-load look there

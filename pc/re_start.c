@@ -14,6 +14,7 @@
 #include "base_clock.h"
 #include "gl_err.h"
 #include "gl_link.h"
+#include "gl_route.h"
 #include "re_comm_find.h"
 
 struct re_signals re_sig;
@@ -101,6 +102,50 @@ static int start_relay(struct app *a)
 	return 0;
 }
 
+/* The route's minimum retransmission time (docs/link.md): a frame lost on
+ * the cable must be resent soon enough that the reply still comes within
+ * the critical reply-age limit. None, or one above the limit, refuses a
+ * clinical start and is a warning in development mode. A loopback
+ * controller (the simulator on this PC) has no cable: not checked. */
+static int check_route(struct app *a)
+{
+	int fd = gl_link_fd(a->real.link), ms = 0, rc;
+	int crit = (int)(a->cfg.watchdog.critical_factor * a->cfg.period_ms);
+	int limit = gl_route_rto_limit_ms(crit, a->cfg.period_ms);
+	char host[256], port[16], what[700];
+
+	if (gl_route_peer_loopback(fd) == 1)
+		return 0;
+	if (gl_link_addr_split(a->cfg.controller.address, host, sizeof(host),
+			       port, sizeof(port)) != GL_OK)
+		snprintf(host, sizeof(host), "%s", a->cfg.controller.address);
+	rc = gl_route_rto_min_ms(fd, 1000, &ms);
+	if (rc == GL_OK && ms > 0 && ms <= limit) {
+		progress(a,
+			 "route to the controller: rto_min %d ms (limit %d "
+			 "ms)",
+			 ms, limit);
+		return 0;
+	}
+	if (rc != GL_OK)
+		snprintf(what, sizeof(what),
+			 "cannot read the route to the controller '%s': %s",
+			 host,
+			 rc == GL_ERR_SYS ? strerror(errno) : gl_strerror(rc));
+	else
+		snprintf(what, sizeof(what),
+			 "the route to the controller '%s' has rto_min %d ms "
+			 "(limit %d ms): one lost frame would trip WATCHDOG; "
+			 "run 'ip route replace %s dev <interface> rto_min "
+			 "%dms' (docs/link.md)",
+			 host, ms ? ms : GL_ROUTE_DEFAULT_RTO_MIN_MS, limit,
+			 host, limit < 5 ? limit : 5);
+	if (a->cfg.mode == RE_MODE_CLINICAL)
+		return fail(a, what);
+	progress(a, "warning: %s", what);
+	return 0;
+}
+
 /* Connect, identify, refuse a controller another supervisor runs, close
  * the other connections, check the program's identity. */
 static int start_link(struct app *a)
@@ -118,6 +163,8 @@ static int start_link(struct app *a)
 	a->real.link = l;
 	a->real.address = a->cfg.controller.address;
 	a->real.cmd_timeout_ms = a->cfg.controller.timeout_ms;
+	if (check_route(a))
+		return EXIT_CONNECT;
 	if (re_ctl_identify(l, &a->cfg, &a->info, a->err, sizeof(a->err)) ||
 	    re_ctl_check_busy(&a->io, a->cfg.watchdog.controller_timeout_ms,
 			      a->err, sizeof(a->err)) ||
@@ -695,6 +742,8 @@ static int commission_link(struct app *a)
 	a->real.link = l;
 	a->real.address = a->cfg.controller.address;
 	a->real.cmd_timeout_ms = a->cfg.controller.timeout_ms;
+	if (check_route(a))
+		return EXIT_CONNECT;
 	if (re_ctl_identify(l, &a->cfg, &a->info, a->err, sizeof(a->err)) ||
 	    re_ctl_check_busy(&a->io, a->cfg.watchdog.controller_timeout_ms,
 			      a->err, sizeof(a->err)))

@@ -173,6 +173,13 @@ static void sock_options(int fd)
 
 	/* small command lines must leave at once, not wait for Nagle */
 	setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof(one));
+	/* a thin stream (one command in flight): a lost frame is resent
+	 * after the route's rto_min again, not after twice the last wait, for
+	 * the first retransmissions (docs/link.md); ignored where unknown */
+#ifdef TCP_THIN_LINEAR_TIMEOUTS
+	setsockopt(fd, IPPROTO_TCP, TCP_THIN_LINEAR_TIMEOUTS, &one,
+		   sizeof(one));
+#endif
 	/* a dead controller or cable surfaces even while the link is idle */
 	setsockopt(fd, SOL_SOCKET, SO_KEEPALIVE, &one, sizeof(one));
 #ifdef TCP_KEEPIDLE
