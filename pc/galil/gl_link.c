@@ -609,11 +609,16 @@ int gl_link_record(gl_link *l, const char *prefix, struct gl_record *rec,
 	if (l->layout == GL_LAYOUT_NONE && (rc = gl_link_query_layout(l)) < 0)
 		return rc;
 	ctrl_clear(l);
-	rc = snprintf(line, sizeof(line), "%s%sQR", prefix ? prefix : "",
-		      prefix ? ";" : "");
-	if (rc < 0 || (size_t)rc >= sizeof(line))
+	/* "PREFIX;QR" by hand: this is built every cycle (no snprintf) */
+	x.len = prefix ? strlen(prefix) : 0;
+	if (x.len + 3 >= sizeof(line))
 		return GL_ERR_ARG;
-	x.len = (size_t)rc;
+	if (prefix) {
+		memcpy(line, prefix, x.len);
+		line[x.len++] = ';';
+	}
+	memcpy(line + x.len, "QR", 3);
+	x.len += 2;
 	x.n_term = count_commands(line, x.len);
 	x.bin_len = gl_record_size(l->layout, l->n_axes);
 	if (x.n_term < 0)
