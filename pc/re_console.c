@@ -15,7 +15,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#define BAR_WIDTH   12
+#define BAR_WIDTH   16
 #define ANSI_RED    "\033[1;31m"
 #define ANSI_GREEN  "\033[32m"
 #define ANSI_YELLOW "\033[33m"
@@ -366,15 +366,32 @@ int re_console_format_line(const struct re_status *st, char *buf, size_t cap)
 
 /* ---- the board --------------------------------------------------------- */
 
-static void bar(char out[BAR_WIDTH + 3], double pct)
+/* A bar over the axis's travel: the soft limits '|' one place inside each
+ * end (so that an axis past one shows beyond it), the position '#'; '?'
+ * throughout when no calibration gives the soft limits. */
+static void soft_bar(char out[BAR_WIDTH + 3], const struct re_axis_status *a)
 {
-	int pos = pct < 0 ? -1 : (int)(pct / 100.0 * (BAR_WIDTH - 1) + 0.5);
+	double span = a->soft_fwd_counts - a->soft_rev_counts, x;
+	int pos;
 
 	out[0] = '[';
-	for (int i = 0; i < BAR_WIDTH; i++)
-		out[1 + i] = i == pos ? '#' : (pct >= 0 ? '-' : '?');
 	out[BAR_WIDTH + 1] = ']';
 	out[BAR_WIDTH + 2] = '\0';
+	if (!a->have_soft || span <= 0) {
+		memset(out + 1, '?', BAR_WIDTH);
+		return;
+	}
+	memset(out + 1, '-', BAR_WIDTH);
+	out[2] = '|';
+	out[BAR_WIDTH - 1] = '|';
+	x = 1 + (a->enc_counts - a->soft_rev_counts) / span * (BAR_WIDTH - 3);
+	if (a->enc_counts < a->soft_rev_counts)
+		pos = 0; /* past a soft limit: outside its mark */
+	else if (a->enc_counts > a->soft_fwd_counts)
+		pos = BAR_WIDTH - 1;
+	else
+		pos = (int)(x + 0.5);
+	out[1 + pos] = '#';
 }
 
 static const char *col(const struct re_console *c, const char *code)
@@ -428,23 +445,40 @@ static void board_printf(struct re_console *c, int width, const char *fmt, ...)
 	frame_line(c, line, width);
 }
 
+/* Counts in the axis's unit ("  -12.35 deg"), or as counts ("  -12345 cnt")
+ * when counts are asked for or the scale is not known: 12 characters; a
+ * speed (@per_s) in the same unit per second without its name: 8. */
+static void unit_text(const struct re_console *c, int i, double counts,
+		      int per_s, char *buf, size_t cap)
+{
+	const struct re_console_axis *u = &c->ax[i];
+
+	if (c->counts || u->per_unit <= 0)
+		snprintf(buf, cap, per_s ? "%6.0f/s" : "%8.0f cnt", counts);
+	else if (per_s)
+		snprintf(buf, cap, "%6.1f/s", counts / u->per_unit);
+	else
+		snprintf(buf, cap, "%8.2f %-3s", counts / u->per_unit, u->unit);
+}
+
 static void board_axis(struct re_console *c, const struct re_status *st, int i,
 		       int width)
 {
 	const struct re_axis_status *a = &st->axis[i];
-	char b[BAR_WIDTH + 3], exp[48] = "    -      -";
+	char b[BAR_WIDTH + 3], exp[48] = "    -      -", pos[40], vel[40];
 
-	bar(b, a->pos_pct);
+	soft_bar(b, a);
+	unit_text(c, i, a->enc_counts, 0, pos, sizeof(pos));
+	unit_text(c, i, a->vel_cps, 1, vel, sizeof(vel));
 	if (a->have_expect)
 		snprintf(exp, sizeof(exp), "%5.3f %s%+6.3f%s",
 			 a->pot_expected_v,
 			 col(c, a->margin_v < 0 ? ANSI_RED : ""), a->margin_v,
 			 col(c, a->margin_v < 0 ? ANSI_OFF : ""));
-	board_printf(
-	    c, width, "%-2.2s %7d %s %3.0f%% %5.3f %s %6.0f %-7s %-3s %s",
-	    st->axis_names[i], (int)a->enc_counts, b,
-	    a->pos_pct < 0 ? 0.0 : a->pos_pct, a->pot_v, exp, a->vel_cps,
-	    motion_text(a), limit_text(a), a->motor_off ? "off" : "on");
+	board_printf(c, width, "%-2.2s %s %s %5.3f %s %s %-7s %-3s %s",
+		     st->axis_names[i], pos, b, a->pot_v, exp, vel,
+		     st->link_ok ? motion_text(a) : "STALE", limit_text(a),
+		     a->motor_off ? "off" : "on");
 }
 
 /* The kept FAULT, wrapped at word boundaries into at most 5 lines, then
@@ -496,24 +530,24 @@ static void term_size(struct re_console *c, int *cols, int *rows)
 	}
 }
 
-static void board_draw(struct re_console *c, const struct re_status *st,
-		       int width)
+/* The board's lines for a terminal @width x @rows, added to the frame. */
+static void board_build(struct re_console *c, const struct re_status *st,
+			int width, int rows)
 {
 	char ctl[64];
 
-	if (c->board_lines > 0)
-		frame_add(c, "\033[%dA\r\033[J", c->board_lines);
+	(void)rows;
 	ctrl_text(st, ctl, sizeof(ctl));
 	board_printf(
 	    c, width, "RoboELF  mode %s  up %.1f s  relay %s%s%s  link %s",
 	    st->mode_name, st->uptime_s,
 	    col(c, st->relay == RE_RELAY_ON ? ANSI_GREEN : ANSI_YELLOW),
 	    relay_text(st->relay), col(c, ANSI_OFF),
-	    st->link_ok ? "ok" : "DOWN");
+	    st->link_ok ? "ok" : "DOWN (values below are stale)");
 	board_faults(c, width);
-	board_printf(c, width,
-		     "ax encoder position         pot V expect "
-		     "margin  vel/s state   lim mot");
+	board_printf(c, width, "%-2s %12s %-18s %5s %-12s %8s %-7s %-3s %s",
+		     "ax", "position", "  |soft  limits|", "pot V",
+		     "expect margin", "speed", "state", "lim", "mot");
 	for (int i = 0; i < st->n_axes; i++)
 		board_axis(c, st, i, width);
 	board_printf(c, width,
@@ -530,18 +564,27 @@ static void board_draw(struct re_console *c, const struct re_status *st,
 	board_printf(c, width, "%s",
 		     st->latched ? "LATCHED: every motor off; q quits"
 				 : "q: quit");
+}
+
+static void board_draw(struct re_console *c, const struct re_status *st,
+		       int width, int rows)
+{
+	if (c->board_lines > 0)
+		frame_add(c, "\033[%dA\r\033[J", c->board_lines);
+	board_build(c, st, width, rows);
 	/* the lines now on screen: the next frame moves up over them */
 	c->board_lines = frame_send(c);
 }
 
 /* Board or status lines for this terminal: too small a terminal gets the
  * lines (said once); a resize redraws the board from the top. */
-static int board_fits(struct re_console *c, int *width)
+static int board_fits(struct re_console *c, int *width, int *height)
 {
 	int cols, rows;
 
 	term_size(c, &cols, &rows);
 	*width = cols;
+	*height = rows;
 	if (cols < RE_CONSOLE_MIN_COLS || rows < RE_CONSOLE_MIN_ROWS) {
 		if (!c->small_said++)
 			re_console_msg(
@@ -569,13 +612,13 @@ void re_console_status(struct re_console *c, const struct re_status *st,
 {
 	char line[1024];
 	int64_t gap = c->tty_out ? RE_CONSOLE_BOARD_NS : RE_CONSOLE_LINE_NS;
-	int width = 80;
+	int width = 80, height = 24;
 
 	if (!force && c->last_draw_ns && now_ns - c->last_draw_ns < gap)
 		return;
 	c->last_draw_ns = now_ns;
-	if (c->tty_out && board_fits(c, &width)) {
-		board_draw(c, st, width);
+	if (c->tty_out && board_fits(c, &width, &height)) {
+		board_draw(c, st, width, height);
 		return;
 	}
 	re_console_format_line(st, line, sizeof(line));
@@ -584,6 +627,39 @@ void re_console_status(struct re_console *c, const struct re_status *st,
 	else
 		frame_add(c, "%s\n", line);
 	frame_send(c);
+}
+
+void re_console_units(struct re_console *c, int axis, const char *unit,
+		      double counts_per_unit)
+{
+	if (axis < 0 || axis >= RE_SUPER_AXES)
+		return;
+	snprintf(c->ax[axis].unit, sizeof(c->ax[axis].unit), "%s",
+		 unit ? unit : "");
+	c->ax[axis].per_unit = counts_per_unit > 0 ? counts_per_unit : 0;
+}
+
+void re_console_counts(struct re_console *c, int on)
+{
+	c->counts = !!on;
+}
+
+int re_console_render(struct re_console *c, const struct re_status *st,
+		      int cols, int rows, char *buf, size_t cap)
+{
+	int color = c->color, lines;
+
+	if (cols < RE_CONSOLE_MIN_COLS || rows < RE_CONSOLE_MIN_ROWS)
+		return -1;
+	c->color = 0;
+	c->frame_len = 0;
+	board_build(c, st, cols, rows);
+	lines = count_lines(c->frame, c->frame_len);
+	if (cap)
+		snprintf(buf, cap, "%.*s", (int)c->frame_len, c->frame);
+	c->frame_len = 0;
+	c->color = color;
+	return lines;
 }
 
 /* ---- questions ------------------------------------------------------------

@@ -4,10 +4,14 @@
  * calibration question.
  *
  * On a terminal: a status board redrawn in place at most 10 times a second
- * (per axis encoder counts, position as a 0-100 % bar, potentiometer volts
- * against the expected value and the margin left, velocity, motion state,
- * limit switches, motor on/off; relay state, watchdog latency last/worst,
- * loop period, lateness and overruns, controller fault, operating mode).
+ * (per axis the position in the robot's units - degrees for A and B, mm
+ * for C, from the configuration's counts_per_unit; encoder counts when
+ * asked for (re_console_counts(), key u) or when the scale is not known -
+ * a bar over the travel with the soft limits marked '|', potentiometer
+ * volts against the expected value and the margin left, velocity, motion
+ * state, limit switches, motor on/off; relay state, watchdog latency
+ * last/worst, loop period, lateness and overruns, controller fault,
+ * operating mode).
  * Messages (progress, warnings) scroll above the board. The first FAULT
  * line is also kept on the board, in a panel under the header, until the
  * program ends (later ones below it, newest first), so it cannot scroll
@@ -49,6 +53,13 @@
 #define RE_CONSOLE_MIN_COLS 60 /* narrower: status lines, no board */
 #define RE_CONSOLE_MIN_ROWS 16 /* lower: status lines, no board */
 
+/* How an axis is shown: @unit "deg"/"mm", @per_unit counts per unit (0:
+ * not known, counts shown). */
+struct re_console_axis {
+	char unit[8];
+	double per_unit;
+};
+
 struct re_console {
 	FILE *out; /* stdout */
 	int out_fd;
@@ -70,6 +81,8 @@ struct re_console {
 	char later[RE_CONSOLE_LATER][256]; /* later ones, newest first */
 	int nlater;
 	uint64_t nfaults; /* FAULT lines shown in all */
+	struct re_console_axis ax[RE_SUPER_AXES];
+	int counts; /* show encoder counts instead of units */
 };
 
 enum re_calib_choice {
@@ -113,6 +126,31 @@ void re_console_msg(struct re_console *c, const char *fmt, ...)
  * for good, later ones in the history (newest first).
  */
 void re_console_fault(struct re_console *c, const char *line);
+
+/*
+ * re_console_units() - show axis @axis (0-based, < RE_SUPER_AXES) in
+ * @unit ("deg", "mm"; cut to 7 bytes) with @counts_per_unit encoder
+ * counts per unit; 0 (or less): the scale is not known, counts are shown.
+ */
+void re_console_units(struct re_console *c, int axis, const char *unit,
+		      double counts_per_unit);
+
+/*
+ * re_console_counts() - @on: show encoder counts (and counts/s) on the
+ * board instead of the units; 0: the units again. The next frame shows it.
+ */
+void re_console_counts(struct re_console *c, int on);
+
+/*
+ * re_console_render() - the board for @st as it would be drawn on a
+ * terminal of @cols x @rows, without colour or cursor movements (pure
+ * apart from @c's kept faults and settings; for tests and snapshots).
+ * @buf: [out] NUL-terminated lines, each ending in '\n'.
+ * Return: the number of lines, or -1 when @cols x @rows is below the
+ *         board's minimum (the status line is used there).
+ */
+int re_console_render(struct re_console *c, const struct re_status *st,
+		      int cols, int rows, char *buf, size_t cap);
 
 /*
  * re_console_status() - show @st: redraw the board when at least

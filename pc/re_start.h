@@ -50,6 +50,7 @@ struct opts {
 	const char *find_addr; /* commissioning: discovery probe address */
 	int find_port;	       /* and its port (0: the defaults) */
 	int period_ms;	       /* 0: from the configuration */
+	int counts;	       /* --counts: the board in encoder counts */
 	enum re_calib_choice calib;
 };
 

@@ -482,6 +482,9 @@ static void axis_status(const struct re_super *s, int i,
 			   (t->soft_fwd - t->soft_rev) * 100.0;
 
 		out->pos_pct = p < 0 ? 0 : p > 100 ? 100 : p;
+		out->soft_rev_counts = t->soft_rev;
+		out->soft_fwd_counts = t->soft_fwd;
+		out->have_soft = 1;
 	}
 	out->have_expect = s->have_encres[i];
 	out->pot_expected_v = s->encres[i].exp.pot_v;

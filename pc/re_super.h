@@ -72,6 +72,9 @@ struct re_super_cfg {
 struct re_axis_status {
 	int32_t enc_counts;
 	double pos_pct; /* 0..100 between the soft limits; -1 unknown */
+	double soft_rev_counts; /* the soft limits (valid when have_soft) */
+	double soft_fwd_counts;
+	int have_soft;
 	double pot_v;
 	double pot_expected_v;
 	double margin_v; /* tolerance - |pot - expected|; < 0 outside */

@@ -181,10 +181,96 @@ static void test_status_words(void **state)
 				     "9)\""));
 }
 
+/* Line @n (0-based) of @text into @out (without its newline). */
+static void line_of(const char *text, int n, char *out, size_t cap)
+{
+	const char *e;
+
+	while (n-- > 0 && (text = strchr(text, '\n')) != NULL)
+		text++;
+	assert_non_null(text);
+	e = strchr(text, '\n');
+	assert_non_null(e);
+	snprintf(out, cap, "%.*s", (int)(e - text), text);
+}
+
+/* Three calibrated axes, soft limits -49000..49000 counts, shown in deg
+ * (A, B) and mm (C) at 1000 counts per unit. */
+static void calibrated(struct re_console *c, struct re_status *st)
+{
+	status_of(st);
+	for (int i = 0; i < 3; i++) {
+		struct re_axis_status *a = &st->axis[i];
+
+		a->have_soft = 1;
+		a->soft_rev_counts = -49000;
+		a->soft_fwd_counts = 49000;
+		a->pos_pct = 50;
+		a->pot_v = 2.5;
+	}
+	re_console_units(c, 0, "deg", 1000);
+	re_console_units(c, 1, "deg", 1000);
+	re_console_units(c, 2, "mm", 1000);
+}
+
+/* Positions in the robot's units, the bar with the soft limits '|' and the
+ * position '#' (beyond a soft limit past its mark), counts on request and
+ * where the scale is not known, '?' without a calibration. */
+static void test_units_and_bar(void **state)
+{
+	static struct re_console c;
+	static char buf[RE_CONSOLE_FRAME];
+	struct re_status st;
+	char l[256];
+
+	(void)state;
+	re_console_open(&c, stdout, -1);
+	calibrated(&c, &st);
+	st.axis[0].enc_counts = -12345;
+	st.axis[0].vel_cps = -1500;
+	st.axis[1].enc_counts = 49000;
+	st.axis[1].pos_pct = 100;
+	st.axis[2].enc_counts = -52000; /* past the reverse soft limit */
+	st.axis[2].pos_pct = 0;
+	assert_int_equal(re_console_render(&c, &st, 80, 24, buf, sizeof(buf)),
+			 8);
+	line_of(buf, 1, l, sizeof(l));
+	assert_string_equal(l, "ax     position   |soft  limits|   pot V expect "
+			       "margin    speed state   lim mot");
+	line_of(buf, 2, l, sizeof(l));
+	assert_string_equal(l, "A    -12.35 deg [-|----#-------|-] 2.500     -"
+			       "      -   -1.5/s stopped -   on");
+	line_of(buf, 3, l, sizeof(l));
+	assert_string_equal(l, "B     49.00 deg [-|------------#-] 2.500     -"
+			       "      -    0.0/s at-lim  sF  on");
+	line_of(buf, 4, l, sizeof(l));
+	assert_string_equal(l, "C    -52.00 mm  [#|------------|-] 2.500     -"
+			       "      -    0.0/s at-lim  sR  on");
+	re_console_counts(&c, 1);
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 2, l, sizeof(l));
+	assert_string_equal(l, "A    -12345 cnt [-|----#-------|-] 2.500     -"
+			       "      -  -1500/s stopped -   on");
+	re_console_counts(&c, 0);
+	re_console_units(&c, 0, "deg", 0); /* scale not known: counts */
+	st.axis[0].have_soft = 0;	     /* not calibrated: '?' */
+	st.axis[0].pos_pct = -1;
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 2, l, sizeof(l));
+	assert_string_equal(l, "A    -12345 cnt [????????????????] 2.500     -"
+			       "      -  -1500/s stopped -   on");
+	st.link_ok = 0; /* the last values, marked */
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 3, l, sizeof(l));
+	assert_string_equal(l, "B     49.00 deg [-|------------#-] 2.500     -"
+			       "      -    0.0/s STALE   sF  on");
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_status_words),
+	    cmocka_unit_test(test_units_and_bar),
 	    cmocka_unit_test(test_stalled_reader_never_blocks),
 	    cmocka_unit_test(test_regular_file_appends),
 	};
