@@ -197,19 +197,58 @@ void re_console_msg(struct re_console *c, const char *fmt, ...)
 	fflush(c->out);
 }
 
-/* Keep @line for the board: the first for good, later ones newest first. */
+static void hist_add(struct re_console *c, const struct re_event *ev)
+{
+	struct re_console_event *h = &c->hist[0];
+
+	if (c->nhist > 0 && h->kind == ev->kind && ev->kind != RE_EV_OTHER &&
+	    h->level == ev->level) {
+		h->count++;
+	} else {
+		memmove(&c->hist[1], &c->hist[0],
+			sizeof(c->hist[0]) * (RE_CONSOLE_HIST - 1));
+		if (c->nhist < RE_CONSOLE_HIST)
+			c->nhist++;
+		h->count = 1;
+	}
+	h->t_s = ev->t_s;
+	h->level = ev->level;
+	h->kind = ev->kind;
+	snprintf(h->text, sizeof(h->text), "%s", ev->text);
+}
+
+/* Keep @line for the board: the first for good, later ones in the
+ * history. */
 static void fault_keep(struct re_console *c, const char *line)
 {
+	struct re_event ev;
+
 	c->nfaults++;
 	if (!c->fault[0]) {
 		snprintf(c->fault, sizeof(c->fault), "%s", line);
 		return;
 	}
-	for (int i = RE_CONSOLE_LATER - 1; i > 0; i--)
-		memcpy(c->later[i], c->later[i - 1], sizeof(c->later[i]));
-	snprintf(c->later[0], sizeof(c->later[0]), "%s", line);
-	if (c->nlater < RE_CONSOLE_LATER)
-		c->nlater++;
+	memset(&ev, 0, sizeof(ev));
+	ev.t_s = c->last_t_s;
+	ev.level = RE_LOG_FAULT;
+	ev.kind = RE_EV_OTHER;
+	snprintf(ev.text, sizeof(ev.text), "%s", line);
+	hist_add(c, &ev);
+}
+
+void re_console_event(struct re_console *c, const struct re_event *ev)
+{
+	hist_add(c, ev);
+	if (c->tty_out)
+		return; /* on the board */
+	fprintf(c->out, "roboelf: %s %s\n",
+		ev->level == RE_LOG_FAULT ? "later FAULT" : "WARNING", ev->text);
+	fflush(c->out);
+}
+
+void re_console_log_path(struct re_console *c, const char *path)
+{
+	snprintf(c->log_path, sizeof(c->log_path), "%s", path ? path : "");
 }
 
 void re_console_fault(struct re_console *c, const char *line)
@@ -481,16 +520,14 @@ static void board_axis(struct re_console *c, const struct re_status *st, int i,
 		     a->motor_off ? "off" : "on");
 }
 
-/* The kept FAULT, wrapped at word boundaries into at most 5 lines, then
- * the later ones, one line each, newest first. */
-static void board_faults(struct re_console *c, int width)
+/* The kept FAULT, wrapped at word boundaries into at most 5 lines.
+ * Return: the lines added. */
+static int board_faults(struct re_console *c, int width)
 {
 	const char *p = c->fault;
 	int w = width - 1, k = 0;
 
-	if (!c->fault[0])
-		return;
-	while (*p && k++ < 5) {
+	while (*p && k < 5) {
 		int n = (int)strlen(p);
 
 		if (n > w) {
@@ -500,12 +537,42 @@ static void board_faults(struct re_console *c, int width)
 		}
 		board_printf(c, width, "%s%.*s%s", col(c, ANSI_RED), n, p,
 			     col(c, ANSI_OFF));
+		k++;
 		p += n;
 		while (*p == ' ')
 			p++;
 	}
-	for (int i = 0; i < c->nlater; i++)
-		board_printf(c, width, "later: %s", c->later[i]);
+	return k;
+}
+
+/* The later faults and warnings, newest first, at most @room lines
+ * (the last of them the log's path). */
+static void board_history(struct re_console *c, int width, int room)
+{
+	int n = c->nhist < room - 1 ? c->nhist : room - 1;
+
+	if (room < 1 || (!c->nhist && !c->fault[0]))
+		return;
+	for (int i = 0; i < n; i++) {
+		const struct re_console_event *h = &c->hist[i];
+		char times[16] = "";
+
+		if (h->count > 1)
+			snprintf(times, sizeof(times), " (x%u)", h->count);
+		board_printf(c, width, "%7.1f s %s%s%s%s: %s", h->t_s,
+			     col(c, h->level == RE_LOG_FAULT ? ANSI_RED
+							     : ANSI_YELLOW),
+			     h->level == RE_LOG_FAULT ? "later FAULT" : "WARN",
+			     col(c, ANSI_OFF), times, h->text);
+	}
+	if (!c->log_path[0])
+		return;
+	if (c->nhist > n)
+		board_printf(c, width, "%d older not shown; all in the log %s",
+			     c->nhist - n, c->log_path);
+	else
+		board_printf(c, width, "every fault and warning is in the log %s",
+			     c->log_path);
 }
 
 static int any_motor_on(const struct re_status *st)
@@ -535,8 +602,9 @@ static void board_build(struct re_console *c, const struct re_status *st,
 			int width, int rows)
 {
 	char ctl[64];
+	int lines;
 
-	(void)rows;
+	c->last_t_s = st->uptime_s;
 	ctrl_text(st, ctl, sizeof(ctl));
 	board_printf(
 	    c, width, "RoboELF  mode %s  up %.1f s  relay %s%s%s  link %s",
@@ -544,7 +612,10 @@ static void board_build(struct re_console *c, const struct re_status *st,
 	    col(c, st->relay == RE_RELAY_ON ? ANSI_GREEN : ANSI_YELLOW),
 	    relay_text(st->relay), col(c, ANSI_OFF),
 	    st->link_ok ? "ok" : "DOWN (values below are stale)");
-	board_faults(c, width);
+	lines = 1 + board_faults(c, width);
+	/* the rest of the board: column header, axes, three lines */
+	lines += 1 + st->n_axes + 3;
+	board_history(c, width, rows - 1 - RE_CONSOLE_ROOM - lines);
 	board_printf(c, width, "%-2s %12s %-18s %5s %-12s %8s %-7s %-3s %s",
 		     "ax", "position", "  |soft  limits|", "pot V",
 		     "expect margin", "speed", "state", "lim", "mot");

@@ -14,8 +14,10 @@
  * operating mode).
  * Messages (progress, warnings) scroll above the board. The first FAULT
  * line is also kept on the board, in a panel under the header, until the
- * program ends (later ones below it, newest first), so it cannot scroll
- * away. Every board line is cut to the terminal's width (never wraps); a
+ * program ends, so it cannot scroll away; below it the history of later
+ * faults and warnings (re_console_event()), newest first, as many as fit
+ * (repeats of one kind folded into one line with a count), and the log
+ * file's path (re_console_log_path()). Every board line is cut to the terminal's width (never wraps); a
  * terminal narrower than RE_CONSOLE_MIN_COLS or lower than
  * RE_CONSOLE_MIN_ROWS gets the status lines instead, said once; a resize
  * redraws the board from the top of the screen.
@@ -49,7 +51,9 @@
 #define RE_CONSOLE_LINE_NS  1000000000LL /* 1 s between status lines */
 #define RE_CONSOLE_FRAME    4096	 /* one status frame, bytes */
 #define RE_CONSOLE_FAULT    512		 /* the first FAULT line kept, bytes */
-#define RE_CONSOLE_LATER    3  /* later FAULT lines kept on the board */
+#define RE_CONSOLE_HIST	    16 /* later faults and warnings kept */
+#define RE_CONSOLE_ROOM	    4  /* screen lines left above the board for
+				* messages (the demo's narration) */
 #define RE_CONSOLE_MIN_COLS 60 /* narrower: status lines, no board */
 #define RE_CONSOLE_MIN_ROWS 16 /* lower: status lines, no board */
 
@@ -78,8 +82,16 @@ struct re_console {
 	int cols, rows;		      /* the terminal at the last board */
 	int small_said;		      /* "terminal too small" was said */
 	char fault[RE_CONSOLE_FAULT]; /* the first FAULT, kept on the board */
-	char later[RE_CONSOLE_LATER][256]; /* later ones, newest first */
-	int nlater;
+	struct re_console_event {
+		double t_s;
+		enum re_log_level level;
+		enum re_event_kind kind;
+		unsigned count; /* folded repeats of this kind */
+		char text[RE_SUPER_EVENT_LEN];
+	} hist[RE_CONSOLE_HIST]; /* newest first */
+	int nhist;
+	char log_path[256]; /* shown under the history; "" none */
+	double last_t_s;    /* uptime of the last board */
 	uint64_t nfaults; /* FAULT lines shown in all */
 	struct re_console_axis ax[RE_SUPER_AXES];
 	int counts; /* show encoder counts instead of units */
@@ -126,6 +138,17 @@ void re_console_msg(struct re_console *c, const char *fmt, ...)
  * for good, later ones in the history (newest first).
  */
 void re_console_fault(struct re_console *c, const char *line);
+
+/*
+ * re_console_event() - a later fault or a warning (@ev) for the board's
+ * history, newest first; one of the same kind as the newest folds into it
+ * (its text replaced, a count kept). Without a terminal it is printed as
+ * one line ("roboelf: WARNING ..." / "roboelf: later FAULT ...").
+ */
+void re_console_event(struct re_console *c, const struct re_event *ev);
+
+/* re_console_log_path() - the log file named under the history. */
+void re_console_log_path(struct re_console *c, const char *path);
 
 /*
  * re_console_units() - show axis @axis (0-based, < RE_SUPER_AXES) in

@@ -419,6 +419,7 @@ int re_super_fault(struct re_super *s, const struct re_fault *f)
 	if (s->latched) {
 		re_fault_format(f, s->cfg.axis_names, s->msg, sizeof(s->msg));
 		re_io_logf(&s->io, RE_LOG_WARN, "while latched: %s", s->msg);
+		re_super_note(s, RE_LOG_FAULT, RE_EV_LATER, s->msg);
 		return RE_OK;
 	}
 	s->verdict[0] = '\0';

@@ -376,6 +376,16 @@ void re_start_show_foreign(struct app *a, unsigned mask)
 		       hs);
 }
 
+void re_start_show_events(struct app *a)
+{
+	struct re_event ev;
+
+	while (a->sup && re_super_event(a->sup, a->ev_seen, &ev)) {
+		a->ev_seen = ev.seq;
+		re_console_event(&a->con, &ev);
+	}
+}
+
 /* The calibration's sampler: one supervised cycle per sample. */
 static int sample_cb(void *ud, const struct gl_record **rec)
 {
@@ -389,6 +399,7 @@ static int sample_cb(void *ud, const struct gl_record **rec)
 	v = re_super_cycle(a->sup);
 	re_super_status(a->sup, &st);
 	re_start_show_foreign(a, st.foreign);
+	re_start_show_events(a);
 	re_console_status(&a->con, &st, re_io_now_ns(), 0);
 	if (v == RE_FAULT) {
 		re_console_fault(&a->con, re_super_fault_line(a->sup));

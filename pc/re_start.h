@@ -73,6 +73,7 @@ struct app {
 	int calib;   /* the operator's choice: RE_CALIB_FULL / _FILE */
 	int powered; /* the relay was switched on at some point */
 	unsigned foreign_shown; /* other programs' handles already shown */
+	uint64_t ev_seen;	/* the supervisor's events already shown */
 	int ctl_ours; /* the controller was taken over: ours to stop */
 	char err[RE_CONFIG_ERR_MAX];
 };
@@ -122,5 +123,12 @@ int64_t re_start_stall_limit_ms(const struct app *a);
  * but the operator is told once per handle, on the console and in the log.
  */
 void re_start_show_foreign(struct app *a, unsigned mask);
+
+/*
+ * re_start_show_events() - the supervisor's later faults and warnings not
+ * shown yet go to the console's history (re_super_event(), in order).
+ * No-op before the supervisor exists.
+ */
+void re_start_show_events(struct app *a);
 
 #endif /* RE_START_H */

@@ -218,11 +218,39 @@ static int exchange(struct re_super *s, struct re_fault *f)
 static void warn_watchdog(struct re_super *s)
 {
 	s->wd_warnings++;
-	re_io_logf(&s->io, RE_LOG_WARN,
-		   "watchdog: reply after %.1f ms "
-		   "(non-critical limit %.1f ms, critical %.1f ms)",
-		   ns_to_ms(s->age_last_ns), ns_to_ms(s->noncrit_ns),
-		   ns_to_ms(s->crit_ns));
+	snprintf(s->text, sizeof(s->text),
+		 "watchdog: reply after %.1f ms "
+		 "(non-critical limit %.1f ms, critical %.1f ms)",
+		 ns_to_ms(s->age_last_ns), ns_to_ms(s->noncrit_ns),
+		 ns_to_ms(s->crit_ns));
+	re_io_logf(&s->io, RE_LOG_WARN, "%s", s->text);
+	re_super_note(s, RE_LOG_WARN, RE_EV_WATCHDOG, s->text);
+}
+
+void re_super_note(struct re_super *s, enum re_log_level lvl,
+		   enum re_event_kind kind, const char *text)
+{
+	struct re_event *e = &s->events[s->event_seq % RE_SUPER_EVENTS];
+
+	e->seq = ++s->event_seq;
+	e->t_s = (double)(now_ns(s) - s->t0_ns) / 1e9;
+	e->level = lvl;
+	e->kind = kind;
+	snprintf(e->text, sizeof(e->text), "%s", text);
+}
+
+int re_super_event(const struct re_super *s, uint64_t after,
+		   struct re_event *out)
+{
+	uint64_t oldest = s->event_seq > RE_SUPER_EVENTS
+			      ? s->event_seq - RE_SUPER_EVENTS + 1
+			      : 1;
+	uint64_t next = after + 1 > oldest ? after + 1 : oldest;
+
+	if (next > s->event_seq)
+		return 0;
+	*out = s->events[(next - 1) % RE_SUPER_EVENTS];
+	return 1;
 }
 
 static int check_relay(struct re_super *s, struct re_fault *f)
@@ -336,9 +364,10 @@ static void watch_handles(struct re_super *s)
 		if (fresh >> h & 1)
 			hs[n++] = (char)('A' + h);
 	hs[n] = '\0';
-	re_io_logf(&s->io, RE_LOG_WARN,
-		   "another program connected to the controller (handle %s)",
-		   hs);
+	snprintf(s->text, sizeof(s->text),
+		 "another program connected to the controller (handle %s)", hs);
+	re_io_logf(&s->io, RE_LOG_WARN, "%s", s->text);
+	re_super_note(s, RE_LOG_WARN, RE_EV_FOREIGN, s->text);
 }
 
 static void drain_messages(struct re_super *s)
@@ -402,6 +431,7 @@ static int latched_cycle(struct re_super *s)
 		re_fault_format(&scratch, s->cfg.axis_names, s->text,
 				sizeof(s->text));
 		re_io_logf(&s->io, RE_LOG_WARN, "while latched: %s", s->text);
+		re_super_note(s, RE_LOG_FAULT, RE_EV_RELAY, s->text);
 	}
 	drain_messages(s);
 	return RE_OK;

@@ -26,6 +26,7 @@
  * re_super_fault(). Power-off is the reverse (re_super_shutdown()).
  */
 #include <errno.h>
+#include <limits.h>
 #include <getopt.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -540,6 +541,7 @@ static void run(struct app *a)
 			re_console_fault(&a->con, re_super_fault_line(a->sup));
 		re_super_status(a->sup, &st);
 		re_start_show_foreign(a, st.foreign);
+		re_start_show_events(a);
 		re_console_status(&a->con, &st, re_io_now_ns(), 0);
 		retry_log(a, &next_retry);
 		key = re_console_key(&a->con);
@@ -625,7 +627,12 @@ static int cleanup(struct app *a)
 /* The console: the board in each axis's unit (or counts, --counts). */
 static void open_console(struct app *a)
 {
+	char abs[PATH_MAX];
+
 	re_console_open(&a->con, stdout, STDIN_FILENO);
+	re_console_log_path(&a->con, realpath(a->cfg.log.path, abs)
+					 ? abs
+					 : a->cfg.log.path);
 	for (int i = 0; i < RE_AXES; i++)
 		re_console_units(&a->con, i, re_unit_name(a->cfg.axes[i].unit),
 				 a->cfg.axes[i].counts_per_unit);

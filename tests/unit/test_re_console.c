@@ -266,11 +266,76 @@ static void test_units_and_bar(void **state)
 			       "      -    0.0/s STALE   sF  on");
 }
 
+static void event(struct re_console *c, double t, enum re_log_level lvl,
+		  enum re_event_kind kind, const char *text)
+{
+	struct re_event ev;
+
+	memset(&ev, 0, sizeof(ev));
+	ev.t_s = t;
+	ev.level = lvl;
+	ev.kind = kind;
+	snprintf(ev.text, sizeof(ev.text), "%s", text);
+	re_console_event(c, &ev);
+}
+
+/* The first FAULT stays under the header; below it the later faults and
+ * warnings newest first (repeats of one kind folded, with a count), as
+ * many as fit, and the log's path. */
+static void test_history(void **state)
+{
+	static struct re_console c;
+	static char buf[RE_CONSOLE_FRAME];
+	struct re_status st;
+	char l[256];
+	int n;
+
+	(void)state;
+	re_console_open(&c, stdout, -1);
+	c.tty_out = 1; /* the board's history, not printed lines */
+	calibrated(&c, &st);
+	re_console_log_path(&c, "/var/log/roboelf.log");
+	event(&c, 1.5, RE_LOG_WARN, RE_EV_WATCHDOG, "watchdog: reply after 80 ms");
+	event(&c, 1.6, RE_LOG_WARN, RE_EV_WATCHDOG, "watchdog: reply after 90 ms");
+	c.fault[0] = '\0';
+	snprintf(c.fault, sizeof(c.fault), "FAULT COMM: the link is gone. "
+					   "Recovery: restart roboelf");
+	event(&c, 4.25, RE_LOG_FAULT, RE_EV_LATER, "FAULT ESTOP: relay lost");
+	n = re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	assert_int_equal(n, 12);
+	line_of(buf, 1, l, sizeof(l));
+	assert_string_equal(l, "FAULT COMM: the link is gone. Recovery: restart "
+			       "roboelf");
+	line_of(buf, 2, l, sizeof(l));
+	assert_string_equal(l, "    4.2 s later FAULT: FAULT ESTOP: relay lost");
+	line_of(buf, 3, l, sizeof(l));
+	assert_string_equal(l, "    1.6 s WARN (x2): watchdog: reply after 90 "
+			       "ms");
+	line_of(buf, 4, l, sizeof(l));
+	assert_string_equal(l, "every fault and warning is in the log "
+			       "/var/log/roboelf.log");
+	for (int i = 0; i < 10; i++)
+		event(&c, 5 + i, RE_LOG_WARN, RE_EV_OTHER, "x");
+	/* 24 rows: 4 kept for messages and 1 spare; header, the fault's one
+	 * line, column header, 3 axes and 3 lines: 9; the history gets 10:
+	 * the 9 newest (of 12) and the log line */
+	n = re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	assert_int_equal(n, 19);
+	line_of(buf, 2, l, sizeof(l));
+	assert_string_equal(l, "   14.0 s WARN: x");
+	line_of(buf, 10, l, sizeof(l));
+	assert_string_equal(l, "    6.0 s WARN: x");
+	line_of(buf, 11, l, sizeof(l));
+	assert_string_equal(l, "3 older not shown; all in the log "
+			       "/var/log/roboelf.log");
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_status_words),
 	    cmocka_unit_test(test_units_and_bar),
+	    cmocka_unit_test(test_history),
 	    cmocka_unit_test(test_stalled_reader_never_blocks),
 	    cmocka_unit_test(test_regular_file_appends),
 	};
