@@ -94,11 +94,11 @@ struct re_config_encoder_failure {
 };
 
 struct re_config_analog {
-	int input;		 /* analog input 1..8 (AN[n]) */
-	double expected_range_v; /* pot span over the full travel, V */
-	double range_tolerance;	 /* fraction of expected_range_v */
-	double reverse_v;	 /* pot at the reverse limit switch, V */
-	double forward_v;	 /* pot at the forward limit switch, V */
+	int input;		     /* analog input 1..8 (AN[n]) */
+	double expected_range_v;     /* pot span over the full travel, V */
+	double range_tolerance;	     /* fraction of expected_range_v */
+	double reverse_v;	     /* pot at the reverse limit switch, V */
+	double forward_v;	     /* pot at the forward limit switch, V */
 	double absolute_tolerance_v; /* how far a real pot may read from
 				      * reverse_v / forward_v there, V */
 };
@@ -233,8 +233,8 @@ const char *re_config_relay_port(const struct re_config *cfg);
 void re_config_relay_cfg(const struct re_config *cfg, struct re_relay_cfg *out);
 
 /*
- * re_config_hash() - FNV-1a 64 (pc/galil/gl_hash.h) over the fields a calibration
- * table depends on: per axis its name, step_counts, travel_counts,
+ * re_config_hash() - FNV-1a 64 (pc/galil/gl_hash.h) over the fields a
+ * calibration table depends on: per axis its name, step_counts, travel_counts,
  * travel_tolerance, analog input, expected_range_v, range_tolerance,
  * allowed_error and monotonic_margin_v. A calibration file whose hash
  * differs was made for another configuration.

@@ -69,8 +69,16 @@ void re_console_raw(struct re_console *c)
 	t.c_iflag &= ~(tcflag_t)IXON; /* Ctrl-S must not freeze the board */
 	t.c_cc[VMIN] = 0;
 	t.c_cc[VTIME] = 0;
-	if (tcsetattr(c->in_fd, TCSANOW, &t) == 0)
+	/* TCSAFLUSH: what was typed before (during the calibration) is
+	 * dropped, never read as a key of the run */
+	if (tcsetattr(c->in_fd, TCSAFLUSH, &t) == 0)
 		c->raw = 1;
+}
+
+void re_console_flush_keys(struct re_console *c)
+{
+	if (c->tty_in)
+		tcflush(c->in_fd, TCIFLUSH);
 }
 
 void re_console_restore(struct re_console *c)
@@ -242,7 +250,8 @@ void re_console_event(struct re_console *c, const struct re_event *ev)
 	if (c->tty_out)
 		return; /* on the board */
 	fprintf(c->out, "roboelf: %s %s\n",
-		ev->level == RE_LOG_FAULT ? "later FAULT" : "WARNING", ev->text);
+		ev->level == RE_LOG_FAULT ? "later FAULT" : "WARNING",
+		ev->text);
 	fflush(c->out);
 }
 
@@ -281,7 +290,7 @@ static const char *relay_text(enum re_relay_state r)
 {
 	switch (r) {
 	case RE_RELAY_ON: return "ON";
-	case RE_RELAY_OFF: return "OFF (motor power cut)";
+	case RE_RELAY_OFF: return "OFF (power cut)";
 	default: return "UNKNOWN";
 	}
 }
@@ -520,6 +529,47 @@ static void board_axis(struct re_console *c, const struct re_status *st, int i,
 		     a->motor_off ? "off" : "on");
 }
 
+/* During a calibration: the axis's phase, a bar of its position over the
+ * travel (0 % at the reverse switch), where it is, and its time left. */
+static void board_cal_axis(struct re_console *c, const struct re_status *st,
+			   int i, int width)
+{
+	const struct re_calib_axis_progress *p = &c->cal.axis[i];
+	const struct re_axis_status *a = &st->axis[i];
+	char b[BAR_WIDTH + 3], pos[40];
+	int k = p->pct < 0 ? -1 : (int)(p->pct / 100 * (BAR_WIDTH - 1) + 0.5);
+
+	b[0] = '[';
+	for (int j = 0; j < BAR_WIDTH; j++)
+		b[1 + j] = j == k ? '#' : k < 0 ? '?' : '-';
+	b[BAR_WIDTH + 1] = ']';
+	b[BAR_WIDTH + 2] = '\0';
+	unit_text(c, i, a->enc_counts, 0, pos, sizeof(pos));
+	board_printf(c, width, "%-2.2s %-15s %s %3.0f%% %s %5.3f %4.0f s %s",
+		     st->axis_names[i], p->phase ? p->phase : "-", b,
+		     p->pct < 0 ? 0 : p->pct, pos, a->pot_v, p->left_s,
+		     st->link_ok ? motion_text(a) : "STALE");
+}
+
+static void board_axes(struct re_console *c, const struct re_status *st,
+		       int width)
+{
+	if (!c->cal.active) {
+		board_printf(c, width,
+			     "%-2s %12s %-18s %5s %-12s %8s %-7s %-3s %s", "ax",
+			     "position", "  |soft  limits|", "pot V",
+			     "expect margin", "speed", "state", "lim", "mot");
+		for (int i = 0; i < st->n_axes; i++)
+			board_axis(c, st, i, width);
+		return;
+	}
+	board_printf(c, width, "%-2s %-15s %-18s %4s %12s %5s %6s %s", "ax",
+		     "calibration", "[rev  travel  fwd]", "", "position",
+		     "pot V", "left", "state");
+	for (int i = 0; i < st->n_axes; i++)
+		board_cal_axis(c, st, i, width);
+}
+
 /* The kept FAULT, wrapped at word boundaries into at most 5 lines.
  * Return: the lines added. */
 static int board_faults(struct re_console *c, int width)
@@ -559,11 +609,16 @@ static void board_history(struct re_console *c, int width, int room)
 
 		if (h->count > 1)
 			snprintf(times, sizeof(times), " (x%u)", h->count);
-		board_printf(c, width, "%7.1f s %s%s%s%s: %s", h->t_s,
-			     col(c, h->level == RE_LOG_FAULT ? ANSI_RED
-							     : ANSI_YELLOW),
-			     h->level == RE_LOG_FAULT ? "later FAULT" : "WARN",
-			     col(c, ANSI_OFF), times, h->text);
+		const char *text = h->text;
+
+		/* "FAULT COMM: ..." is shown as "later FAULT COMM: ..." */
+		if (h->level == RE_LOG_FAULT && !strncmp(text, "FAULT ", 6))
+			text += 6;
+		board_printf(
+		    c, width, "%7.1f s %s%s%s%s%s %s", h->t_s,
+		    col(c, h->level == RE_LOG_FAULT ? ANSI_RED : ANSI_YELLOW),
+		    h->level == RE_LOG_FAULT ? "later FAULT" : "WARN",
+		    col(c, ANSI_OFF), times, text == h->text ? ":" : "", text);
 	}
 	if (!c->log_path[0])
 		return;
@@ -571,7 +626,8 @@ static void board_history(struct re_console *c, int width, int room)
 		board_printf(c, width, "%d older not shown; all in the log %s",
 			     c->nhist - n, c->log_path);
 	else
-		board_printf(c, width, "every fault and warning is in the log %s",
+		board_printf(c, width,
+			     "every fault and warning is in the log %s",
 			     c->log_path);
 }
 
@@ -597,6 +653,30 @@ static void term_size(struct re_console *c, int *cols, int *rows)
 	}
 }
 
+/* The last line: what the operator can do now. During a calibration
+ * only Ctrl-C is read (as a signal); the keys once the board runs, and
+ * only from a terminal. */
+static void board_keys(struct re_console *c, const struct re_status *st,
+		       int width)
+{
+	const char *other = c->counts ? "units" : "counts";
+
+	if (c->cal.active)
+		board_printf(c, width,
+			     "%s %.0f s, about %.0f s left; Ctrl-C stops it%s",
+			     c->cal.full ? "calibrating" : "checking the file",
+			     c->cal.elapsed_s, c->cal.left_s,
+			     c->cal.full ? " (old table kept)" : "");
+	else if (!c->tty_in)
+		board_printf(c, width,
+			     "%sno keyboard here: Ctrl-C or SIGTERM quits",
+			     st->latched ? "LATCHED: every motor off; " : "");
+	else
+		board_printf(c, width, "%skeys: q quit  t trace  u %s",
+			     st->latched ? "LATCHED: every motor off; " : "",
+			     other);
+}
+
 /* The board's lines for a terminal @width x @rows, added to the frame. */
 static void board_build(struct re_console *c, const struct re_status *st,
 			int width, int rows)
@@ -607,20 +687,16 @@ static void board_build(struct re_console *c, const struct re_status *st,
 	c->last_t_s = st->uptime_s;
 	ctrl_text(st, ctl, sizeof(ctl));
 	board_printf(
-	    c, width, "RoboELF  mode %s  up %.1f s  relay %s%s%s  link %s",
+	    c, width, "RoboELF  mode %s  up %.0f s  relay %s%s%s  link %s",
 	    st->mode_name, st->uptime_s,
 	    col(c, st->relay == RE_RELAY_ON ? ANSI_GREEN : ANSI_YELLOW),
 	    relay_text(st->relay), col(c, ANSI_OFF),
-	    st->link_ok ? "ok" : "DOWN (values below are stale)");
+	    st->link_ok ? "ok" : "DOWN (stale)");
 	lines = 1 + board_faults(c, width);
 	/* the rest of the board: column header, axes, three lines */
 	lines += 1 + st->n_axes + 3;
 	board_history(c, width, rows - 1 - RE_CONSOLE_ROOM - lines);
-	board_printf(c, width, "%-2s %12s %-18s %5s %-12s %8s %-7s %-3s %s",
-		     "ax", "position", "  |soft  limits|", "pot V",
-		     "expect margin", "speed", "state", "lim", "mot");
-	for (int i = 0; i < st->n_axes; i++)
-		board_axis(c, st, i, width);
+	board_axes(c, st, width);
 	board_printf(c, width,
 		     "watchdog %.1f ms (worst %.1f, warn %llu) period %.0f ms "
 		     "late %.1f/%.1f ms overruns %llu",
@@ -632,9 +708,7 @@ static void board_build(struct re_console *c, const struct re_status *st,
 		     st->have_za ? cmd_text(st->za.jcmd) : "-",
 		     st->have_za && any_motor_on(st) ? cmd_text(st->za.mcmd)
 						     : "-");
-	board_printf(c, width, "%s",
-		     st->latched ? "LATCHED: every motor off; q quits"
-				 : "q: quit");
+	board_keys(c, st, width);
 }
 
 static void board_draw(struct re_console *c, const struct re_status *st,
@@ -710,6 +784,14 @@ void re_console_units(struct re_console *c, int axis, const char *unit,
 	c->ax[axis].per_unit = counts_per_unit > 0 ? counts_per_unit : 0;
 }
 
+void re_console_calib(struct re_console *c, const struct re_calib_progress *p)
+{
+	if (p && p->active)
+		c->cal = *p;
+	else
+		memset(&c->cal, 0, sizeof(c->cal));
+}
+
 void re_console_counts(struct re_console *c, int on)
 {
 	c->counts = !!on;
@@ -763,6 +845,7 @@ enum re_calib_choice re_console_ask_calibration(struct re_console *c)
 
 	if (!c->tty_in)
 		return RE_CALIB_ASK;
+	re_console_flush_keys(c);
 	for (;;) {
 		re_console_msg(c, "Calibration: [f]ull (move every axis "
 				  "end to end) or [l]oad from file?");
@@ -782,6 +865,7 @@ int re_console_ask_yes(struct re_console *c, const char *question)
 
 	if (!c->tty_in)
 		return 0;
+	re_console_flush_keys(c);
 	for (;;) {
 		re_console_msg(c, "%s [y/n]", question);
 		if (read_answer(c, a, sizeof(a)) < 0)

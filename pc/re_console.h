@@ -17,13 +17,13 @@
  * program ends, so it cannot scroll away; below it the history of later
  * faults and warnings (re_console_event()), newest first, as many as fit
  * (repeats of one kind folded into one line with a count), and the log
- * file's path (re_console_log_path()). Every board line is cut to the terminal's width (never wraps); a
- * terminal narrower than RE_CONSOLE_MIN_COLS or lower than
- * RE_CONSOLE_MIN_ROWS gets the status lines instead, said once; a resize
- * redraws the board from the top of the screen.
- * Colour only on a terminal and only when NO_COLOR is unset (no-color.org)
- * and TERM is not "dumb". The keyboard is in raw mode (no echo, no line
- * buffering) between re_console_open() and re_console_close().
+ * file's path (re_console_log_path()). Every board line is cut to the
+ * terminal's width (never wraps); a terminal narrower than RE_CONSOLE_MIN_COLS
+ * or lower than RE_CONSOLE_MIN_ROWS gets the status lines instead, said once; a
+ * resize redraws the board from the top of the screen. Colour only on a
+ * terminal and only when NO_COLOR is unset (no-color.org) and TERM is not
+ * "dumb". The keyboard is in raw mode (no echo, no line buffering) between
+ * re_console_open() and re_console_close().
  *
  * Not on a terminal: one "status ..." line per second, no escape codes.
  *
@@ -45,14 +45,16 @@
 #include <stdio.h>
 #include <termios.h>
 
+#include "re_calib.h"
 #include "re_super.h"
 
 #define RE_CONSOLE_BOARD_NS 100000000LL	 /* >= 100 ms between redraws */
 #define RE_CONSOLE_LINE_NS  1000000000LL /* 1 s between status lines */
 #define RE_CONSOLE_FRAME    4096	 /* one status frame, bytes */
 #define RE_CONSOLE_FAULT    512		 /* the first FAULT line kept, bytes */
-#define RE_CONSOLE_HIST	    16 /* later faults and warnings kept */
-#define RE_CONSOLE_ROOM	    4  /* screen lines left above the board for
+#define RE_CONSOLE_HIST	    16		 /* later faults and warnings kept */
+#define RE_CONSOLE_ROOM                                                        \
+	4		       /* screen lines left above the board for        \
 				* messages (the demo's narration) */
 #define RE_CONSOLE_MIN_COLS 60 /* narrower: status lines, no board */
 #define RE_CONSOLE_MIN_ROWS 16 /* lower: status lines, no board */
@@ -92,9 +94,10 @@ struct re_console {
 	int nhist;
 	char log_path[256]; /* shown under the history; "" none */
 	double last_t_s;    /* uptime of the last board */
-	uint64_t nfaults; /* FAULT lines shown in all */
+	uint64_t nfaults;   /* FAULT lines shown in all */
 	struct re_console_axis ax[RE_SUPER_AXES];
-	int counts; /* show encoder counts instead of units */
+	int counts;		      /* show encoder counts instead of units */
+	struct re_calib_progress cal; /* cal.active: calibration lines */
 };
 
 enum re_calib_choice {
@@ -116,6 +119,14 @@ int re_console_open(struct re_console *c, FILE *out, int in_fd);
  * re_console_restore(). No-op without a terminal.
  */
 void re_console_raw(struct re_console *c);
+
+/*
+ * re_console_flush_keys() - drop every key typed but not read yet, so that
+ * nothing typed in one phase acts in the next (keys typed during the
+ * calibration, before a question, before a fault). No-op without a
+ * terminal. Called by re_console_raw() and before each question.
+ */
+void re_console_flush_keys(struct re_console *c);
 
 /* re_console_restore() - give the terminal back its settings (idempotent;
  * async-signal-safe enough to call on the way out). */
@@ -149,6 +160,14 @@ void re_console_event(struct re_console *c, const struct re_event *ev);
 
 /* re_console_log_path() - the log file named under the history. */
 void re_console_log_path(struct re_console *c, const char *path);
+
+/*
+ * re_console_calib() - while a calibration (or the check of a file and
+ * the move to the centre) runs, the board shows per axis its phase, a bar
+ * of its position over the travel and the time left, instead of the axis
+ * lines; @p copied. NULL (or @p->active 0): the axis lines again.
+ */
+void re_console_calib(struct re_console *c, const struct re_calib_progress *p);
 
 /*
  * re_console_units() - show axis @axis (0-based, < RE_SUPER_AXES) in

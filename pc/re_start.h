@@ -72,8 +72,10 @@ struct app {
 	long hbpc;
 	int calib;   /* the operator's choice: RE_CALIB_FULL / _FILE */
 	int powered; /* the relay was switched on at some point */
-	unsigned foreign_shown; /* other programs' handles already shown */
-	uint64_t ev_seen;	/* the supervisor's events already shown */
+	unsigned foreign_shown;	 /* other programs' handles already shown */
+	uint64_t ev_seen;	 /* the supervisor's events already shown */
+	struct re_calib *calrun; /* the calibration running, or NULL */
+	const struct re_calib_cfg *calcfg; /* its settings */
 	int ctl_ours; /* the controller was taken over: ours to stop */
 	char err[RE_CONFIG_ERR_MAX];
 };

@@ -227,32 +227,6 @@ static void warn_watchdog(struct re_super *s)
 	re_super_note(s, RE_LOG_WARN, RE_EV_WATCHDOG, s->text);
 }
 
-void re_super_note(struct re_super *s, enum re_log_level lvl,
-		   enum re_event_kind kind, const char *text)
-{
-	struct re_event *e = &s->events[s->event_seq % RE_SUPER_EVENTS];
-
-	e->seq = ++s->event_seq;
-	e->t_s = (double)(now_ns(s) - s->t0_ns) / 1e9;
-	e->level = lvl;
-	e->kind = kind;
-	snprintf(e->text, sizeof(e->text), "%s", text);
-}
-
-int re_super_event(const struct re_super *s, uint64_t after,
-		   struct re_event *out)
-{
-	uint64_t oldest = s->event_seq > RE_SUPER_EVENTS
-			      ? s->event_seq - RE_SUPER_EVENTS + 1
-			      : 1;
-	uint64_t next = after + 1 > oldest ? after + 1 : oldest;
-
-	if (next > s->event_seq)
-		return 0;
-	*out = s->events[(next - 1) % RE_SUPER_EVENTS];
-	return 1;
-}
-
 static int check_relay(struct re_super *s, struct re_fault *f)
 {
 	char why[sizeof(f->s)];

@@ -39,9 +39,9 @@
 #include "re_io.h"
 #include "re_pot.h"
 
-#define RE_SUPER_AXES 3
-#define RE_SUPER_LINE 768 /* FAULT line, bytes incl. NUL */
-#define RE_SUPER_MSGS 8	  /* unsolicited lines drained per cycle */
+#define RE_SUPER_AXES	   3
+#define RE_SUPER_LINE	   768 /* FAULT line, bytes incl. NUL */
+#define RE_SUPER_MSGS	   8   /* unsolicited lines drained per cycle */
 #define RE_SUPER_EVENTS	   16  /* later faults and warnings kept */
 #define RE_SUPER_EVENT_LEN 240 /* one of them, bytes incl. NUL */
 
@@ -91,7 +91,7 @@ struct re_super_cfg {
 /* Per-axis view for the status board. */
 struct re_axis_status {
 	int32_t enc_counts;
-	double pos_pct; /* 0..100 between the soft limits; -1 unknown */
+	double pos_pct;		/* 0..100 between the soft limits; -1 unknown */
 	double soft_rev_counts; /* the soft limits (valid when have_soft) */
 	double soft_fwd_counts;
 	int have_soft;
@@ -132,8 +132,8 @@ struct re_status {
 	uint64_t overruns;
 	uint64_t wd_warnings; /* non-critical watchdog events */
 	int armed;
-	int expect; /* program state expected: RE_DMC_ARMED, _SERVICE, 0 */
-	int link_ok; /* last round trip succeeded */
+	int expect;	 /* program state expected: RE_DMC_ARMED, _SERVICE, 0 */
+	int link_ok;	 /* last round trip succeeded */
 	struct re_za za; /* program fields (valid when have_za) */
 	int have_za;
 	const char *mode_name;

@@ -537,8 +537,11 @@ static void run(struct app *a)
 	re_console_raw(&a->con);
 	while (!re_sig.quit) {
 		re_super_wait(a->sup);
-		if (re_super_cycle(a->sup) == RE_FAULT)
+		if (re_super_cycle(a->sup) == RE_FAULT) {
 			re_console_fault(&a->con, re_super_fault_line(a->sup));
+			/* keys typed before the fault do not act after it */
+			re_console_flush_keys(&a->con);
+		}
 		re_super_status(a->sup, &st);
 		re_start_show_foreign(a, st.foreign);
 		re_start_show_events(a);
@@ -630,9 +633,8 @@ static void open_console(struct app *a)
 	char abs[PATH_MAX];
 
 	re_console_open(&a->con, stdout, STDIN_FILENO);
-	re_console_log_path(&a->con, realpath(a->cfg.log.path, abs)
-					 ? abs
-					 : a->cfg.log.path);
+	re_console_log_path(
+	    &a->con, realpath(a->cfg.log.path, abs) ? abs : a->cfg.log.path);
 	for (int i = 0; i < RE_AXES; i++)
 		re_console_units(&a->con, i, re_unit_name(a->cfg.axes[i].unit),
 				 a->cfg.axes[i].counts_per_unit);

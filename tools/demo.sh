@@ -62,6 +62,17 @@ ctl() {
 	printf '%s\n' "$ans"
 }
 
+# latch AXIS DIR: a key holds a joystick (both switches) until space
+latch() {
+	ctl "joy $1 $2" >/dev/null
+	say "key $key: joystick $1 $2 LATCHED (stays pressed until space); another joystick as well is two commands: an INPUT fault"
+}
+# inject KEY REQUEST WHAT: a fault injected in galil-sim
+inject() {
+	ctl "$2" >/dev/null
+	say "key $1: injected: $3"
+}
+
 say "starting galil-sim (default robot)"
 "$BIN/galil-sim" --port 0 --control-port 0 --relay-link "$TMP/relay" \
 	>"$TMP/sim.out" 2>"$TMP/sim.err" &
@@ -99,15 +110,19 @@ if [ "${INTERACTIVE:-}" = 1 ]; then
 	say "keys are read now"
 	while IFS= read -r -s -n 1 key <&3; do
 		case "$key" in
-		a) ctl "joy A fwd" ;; z) ctl "joy A rev" ;;
-		s) ctl "joy B fwd" ;; x) ctl "joy B rev" ;;
-		d) ctl "joy C fwd" ;; c) ctl "joy C rev" ;;
-		" ") for ax in A B C; do ctl "joy $ax neutral"; done ;;
-		i) ctl "joy A fwd a" ;;
-		p) ctl "pot B offset 0.5" ;; e) ctl "enc A stuck" ;;
-		j) ctl "block C 1" ;; r) ctl "relayfault unplug" ;;
+		a) latch A fwd ;; z) latch A rev ;;
+		s) latch B fwd ;; x) latch B rev ;;
+		d) latch C fwd ;; c) latch C rev ;;
+		" ") for ax in A B C; do ctl "joy $ax neutral" >/dev/null; done
+		     say "key space: every joystick RELEASED (neutral)" ;;
+		i) ctl "joy A fwd a" >/dev/null
+		   say "key i: axis A fwd switch a only: LATCHED (an invalid state: held 0.5 s it is an INPUT fault; space releases)" ;;
+		p) inject p "pot B offset 0.5" "potentiometer B +0.5 V" ;;
+		e) inject e "enc A stuck" "encoder A stuck" ;;
+		j) inject j "block C 1" "axis C jammed" ;;
+		r) inject r "relayfault unplug" "relay unplugged" ;;
 		q) break ;;
-		esac >/dev/null
+		esac
 	done
 	exit 0
 fi
