@@ -91,6 +91,14 @@ void re_console_restore(struct re_console *c)
 
 void re_console_close(struct re_console *c)
 {
+	/* the board stays on the screen, under the last messages; the whole
+	 * screen scrolls again, the cursor under the board */
+	if (c->tty_out && (c->board_lines || c->half)) {
+		fprintf(c->out, "%s\033[r\033[%d;1H\n", c->half ? "\0338" : "",
+			c->rows);
+		c->board_lines = 0;
+		c->half = 0;
+	}
 	re_console_restore(c);
 	fflush(c->out);
 	if (c->nb_fd >= 0)
@@ -126,8 +134,8 @@ static int count_lines(const char *buf, size_t len)
 }
 
 /* Write the frame; a short or refused write drops the rest of it. Return
- * the number of complete lines that reached the output. */
-static int frame_send(struct re_console *c)
+ * the number of bytes that reached the output. */
+static size_t frame_send(struct re_console *c)
 {
 	size_t len = c->frame_len;
 	ssize_t n;
@@ -137,22 +145,24 @@ static int frame_send(struct re_console *c)
 	if (c->nb_fd < 0) {
 		fwrite(c->frame, 1, len, c->out);
 		fflush(c->out);
-		return count_lines(c->frame, len);
+		return len;
 	}
 	do
 		n = write(c->nb_fd, c->frame, len);
 	while (n < 0 && errno == EINTR);
 	if (n < (ssize_t)len)
 		c->dropped++;
-	return n > 0 ? count_lines(c->frame, (size_t)n) : 0;
+	return n > 0 ? (size_t)n : 0;
 }
 
-/* Take the board off the screen so that a message can scroll above it. */
+/* Before a message: the cursor back where the text flows (in the scroll
+ * region above the board) if a frame was cut short after saving it. */
 static void board_erase(struct re_console *c)
 {
-	if (c->tty_out && c->board_lines > 0)
-		fprintf(c->out, "\033[%dA\r\033[J", c->board_lines);
-	c->board_lines = 0;
+	if (c->tty_out && c->half) {
+		fputs("\0338", c->out);
+		c->half = 0;
+	}
 }
 
 static void term_size(struct re_console *c, int *cols, int *rows);
@@ -505,6 +515,8 @@ static void unit_text(const struct re_console *c, int i, double counts,
 		snprintf(buf, cap, per_s ? "%6.0f/s" : "%8.0f cnt", counts);
 	else if (per_s)
 		snprintf(buf, cap, "%6.1f/s", counts / u->per_unit);
+	else if (counts / u->per_unit > -0.005 && counts / u->per_unit < 0)
+		snprintf(buf, cap, "%8.2f %-3s", 0.0, u->unit); /* not -0.00 */
 	else
 		snprintf(buf, cap, "%8.2f %-3s", counts / u->per_unit, u->unit);
 }
@@ -711,14 +723,71 @@ static void board_build(struct re_console *c, const struct re_status *st,
 	board_keys(c, st, width);
 }
 
+/* The board of @n lines (@text) on the bottom of a screen of @rows, the
+ * lines above it the scroll region. A taller board first scrolls the
+ * text up by the lines it takes (LFs from the text cursor, then back up),
+ * so that nothing written there is overwritten; a shorter one clears the
+ * lines it gives back. The text cursor is saved and restored around it. */
+static void board_place(struct re_console *c, const char *text, int n, int rows)
+{
+	int old = c->board_lines, top = rows - n + 1;
+
+	if (c->half)
+		frame_add(c, "\0338");
+	for (int k = old; k < n; k++)
+		frame_add(c, "\n");
+	if (n > old)
+		frame_add(c, "\033[%dA", n - old);
+	frame_add(c, "\0337");
+	if (n != old || c->redo)
+		frame_add(c, "\033[1;%dr", top - 1);
+	for (int r = rows - old + 1; r < top; r++)
+		frame_add(c, "\033[%d;1H\033[2K", r);
+	for (int i = 0; i < n; i++) {
+		const char *e = strchr(text, '\n');
+
+		frame_add(c, "\033[%d;1H\033[2K%.*s", top + i, (int)(e - text),
+			  text);
+		text = e + 1;
+	}
+	frame_add(c, "\0338");
+}
+
 static void board_draw(struct re_console *c, const struct re_status *st,
 		       int width, int rows)
 {
-	if (c->board_lines > 0)
-		frame_add(c, "\033[%dA\r\033[J", c->board_lines);
+	size_t start = c->frame_len, len, sent; /* a resize's reset first */
+	int n;
+
 	board_build(c, st, width, rows);
-	/* the lines now on screen: the next frame moves up over them */
-	c->board_lines = frame_send(c);
+	len = c->frame_len - start;
+	n = count_lines(c->frame + start, len);
+	memcpy(c->lines, c->frame + start, len);
+	c->lines[len] = '\0';
+	c->frame_len = start;
+	board_place(c, c->lines, n, rows);
+	len = c->frame_len;
+	sent = frame_send(c);
+	/* cut short: the saved cursor is restored first next time, and the
+	 * scroll region set again */
+	c->half = sent > 0 && sent < len;
+	c->redo = sent < len;
+	c->board_lines = sent > 0 ? n : c->board_lines;
+}
+
+/* The board off the screen for good (too small a terminal, quitting):
+ * the scroll region back to the whole screen, the board's lines cleared,
+ * the cursor where the text flows. */
+static void board_remove(struct re_console *c, FILE *out)
+{
+	if (!c->board_lines && !c->half)
+		return;
+	fprintf(out, "%s\0337\033[r\033[%d;1H\033[J\0338",
+		c->half ? "\0338" : "", c->rows - c->board_lines + 1);
+	fflush(out);
+	c->board_lines = 0;
+	c->half = 0;
+	c->redo = 0;
 }
 
 /* Board or status lines for this terminal: too small a terminal gets the
@@ -739,12 +808,14 @@ static int board_fits(struct re_console *c, int *width, int *height)
 			    "lines",
 			    cols, rows, RE_CONSOLE_MIN_COLS,
 			    RE_CONSOLE_MIN_ROWS);
-		c->board_lines = 0;
+		board_remove(c, c->out);
 		return 0;
 	}
-	if ((cols != c->cols || rows != c->rows) && c->board_lines > 0) {
-		frame_add(c, "\033[H\033[2J");
+	if ((cols != c->cols || rows != c->rows) && c->board_lines) {
+		/* a resize: the whole screen again, the board from scratch */
+		frame_add(c, "%s\033[r\033[H\033[2J", c->half ? "\0338" : "");
 		c->board_lines = 0;
+		c->half = 0;
 	}
 	c->cols = cols;
 	c->rows = rows;

@@ -12,8 +12,13 @@
  * state, limit switches, motor on/off; relay state, watchdog latency
  * last/worst, loop period, lateness and overruns, controller fault,
  * operating mode).
- * Messages (progress, warnings) scroll above the board. The first FAULT
- * line is also kept on the board, in a panel under the header, until the
+ * The board is drawn at absolute positions on the bottom lines of the
+ * screen, and the lines above it are made the terminal's scroll region:
+ * messages (progress, warnings), and the text of any other program
+ * writing to the same terminal (the demo's narration), scroll there above
+ * the board and are never erased by it. The cursor is saved before and
+ * restored after every frame, so it always stays in that region. The first
+ * FAULT line is also kept on the board, in a panel under the header, until the
  * program ends, so it cannot scroll away; below it the history of later
  * faults and warnings (re_console_event()), newest first, as many as fit
  * (repeats of one kind folded into one line with a count), and the log
@@ -74,13 +79,18 @@ struct re_console {
 	int tty_in;  /* @in_fd is a terminal: raw keys, questions */
 	int color;
 	int raw;	 /* termios changed; restore on close */
-	int board_lines; /* lines of the board now on screen */
+	int board_lines; /* lines of the board now on screen (at the bottom,
+			  * under the scroll region); 0: none */
+	int half;	 /* the last frame was cut short: its saved cursor
+			  * must be restored before anything else */
+	int redo;	 /* ... and the scroll region set again */
 	int64_t last_draw_ns;
 	struct termios saved; /* the terminal before raw mode */
 	int nb_fd;	      /* non-blocking description of @out, or -1 */
 	uint64_t dropped;     /* status frames not (fully) written */
 	size_t frame_len;
 	char frame[RE_CONSOLE_FRAME];
+	char lines[RE_CONSOLE_FRAME]; /* the board's text, before positioning */
 	int cols, rows;		      /* the terminal at the last board */
 	int small_said;		      /* "terminal too small" was said */
 	char fault[RE_CONSOLE_FAULT]; /* the first FAULT, kept on the board */
