@@ -256,12 +256,16 @@ static void fault_keep(struct re_console *c, const char *line)
 
 void re_console_event(struct re_console *c, const struct re_event *ev)
 {
+	int fault = ev->level == RE_LOG_FAULT;
+	const char *text = ev->text;
+
 	hist_add(c, ev);
 	if (c->tty_out)
 		return; /* on the board */
-	fprintf(c->out, "roboelf: %s %s\n",
-		ev->level == RE_LOG_FAULT ? "later FAULT" : "WARNING",
-		ev->text);
+	if (fault && !strncmp(text, "FAULT ", 6))
+		text += 6;
+	fprintf(c->out, "roboelf: %s%s\n",
+		fault ? "later FAULT " : "warning: ", text);
 	fflush(c->out);
 }
 

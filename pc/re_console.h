@@ -164,7 +164,7 @@ void re_console_fault(struct re_console *c, const char *line);
  * re_console_event() - a later fault or a warning (@ev) for the board's
  * history, newest first; one of the same kind as the newest folds into it
  * (its text replaced, a count kept). Without a terminal it is printed as
- * one line ("roboelf: WARNING ..." / "roboelf: later FAULT ...").
+ * one line ("roboelf: warning: ..." / "roboelf: later FAULT ESTOP: ...").
  */
 void re_console_event(struct re_console *c, const struct re_event *ev);
 

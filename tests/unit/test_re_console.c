@@ -336,6 +336,31 @@ static void test_history(void **state)
 			       "/var/log/roboelf.log");
 }
 
+/* Without a terminal, each later fault or warning is one line. */
+static void test_event_lines(void **state)
+{
+	static struct re_console c;
+	char buf[512];
+	FILE *f = tmpfile();
+	size_t n;
+
+	(void)state;
+	assert_non_null(f);
+	re_console_open(&c, f, -1);
+	assert_int_equal(c.tty_out, 0);
+	event(&c, 2.0, RE_LOG_WARN, RE_EV_FOREIGN,
+	      "another program connected to the controller (handle C)");
+	event(&c, 3.0, RE_LOG_FAULT, RE_EV_LATER, "FAULT ESTOP: relay lost");
+	rewind(f);
+	n = fread(buf, 1, sizeof(buf) - 1, f);
+	buf[n] = '\0';
+	fclose(f);
+	assert_string_equal(buf, "roboelf: warning: another program connected "
+				 "to the controller (handle C)\n"
+				 "roboelf: later FAULT ESTOP: relay lost\n");
+	assert_int_equal(c.nhist, 2);
+}
+
 /* ---- snapshots: the whole board at 80x24, exactly --------------------
  *
  * Each case renders the board (no colour) and compares it with
@@ -612,6 +637,7 @@ int main(void)
 	    cmocka_unit_test(test_status_words),
 	    cmocka_unit_test(test_units_and_bar),
 	    cmocka_unit_test(test_history),
+	    cmocka_unit_test(test_event_lines),
 	    cmocka_unit_test(test_snapshot_faults),
 	    cmocka_unit_test(test_snapshot_phases),
 	    cmocka_unit_test(test_stalled_reader_never_blocks),
