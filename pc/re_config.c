@@ -83,6 +83,7 @@ struct pctx {
 
 static const char *const mode_names[] = {"clinical", "development", NULL};
 static const char *const backend_names[] = {"auto", "serialport", "tty", NULL};
+static const char *const unit_names[] = {"deg", "mm", NULL};
 static const char *const proto_names[] = {"devantech", "icstation", "lcus",
 					  "kmtronic", NULL};
 static const int bauds[] = {1200,  2400,  4800,	 9600,
@@ -717,6 +718,8 @@ static const struct field axis_fields[] = {
 	D(struct re_config_axis, allowed_error, 0.0, 10.0),
 	I(struct re_config_axis, persistence_cycles, 1, 1000),
 	D(struct re_config_axis, monotonic_margin_v, 0.0, 1.0),
+	E(struct re_config_axis, unit, unit_names, 1),
+	D(struct re_config_axis, counts_per_unit, 0.0, 10000000.0),
 	END,
 };
 
@@ -1233,6 +1236,13 @@ static void axis_defaults(struct re_config_axis *a, int i)
 	a->allowed_error = 0.5;
 	a->persistence_cycles = 1;
 	a->monotonic_margin_v = 0.005;
+	a->unit = i == 2 ? RE_UNIT_MM : RE_UNIT_DEG;
+	a->counts_per_unit = 0; /* not known: the console shows counts */
+}
+
+const char *re_unit_name(enum re_unit u)
+{
+	return u == RE_UNIT_MM ? "mm" : "deg";
 }
 
 static void relay_defaults(struct re_config_relay *r)

@@ -78,6 +78,15 @@ struct re_config_joystick {
 	int invalid_timeout_ms; /* DMC jto */
 };
 
+/* The unit an axis is shown in on the console. */
+enum re_unit {
+	RE_UNIT_DEG = 0, /* a rotary axis, degrees */
+	RE_UNIT_MM,	 /* a linear axis, millimetres */
+};
+
+/* re_unit_name() - "deg" or "mm". */
+const char *re_unit_name(enum re_unit u);
+
 struct re_config_encoder_failure {
 	bool enabled;	  /* OA */
 	int time_samples; /* OT, servo samples, 2..32000 */
@@ -115,6 +124,11 @@ struct re_config_axis {
 	int persistence_cycles;	   /* cycles an ENCODER mismatch must
 				    * last before it is a fault, >= 1 */
 	double monotonic_margin_v; /* calibration noise margin, V */
+	/* How the console shows this axis (display only: no check, no
+	 * calibration depends on it): @unit "deg" or "mm", @counts_per_unit
+	 * encoder counts per degree or mm; 0: not known, counts are shown. */
+	enum re_unit unit;
+	double counts_per_unit;
 };
 
 struct re_config_calibration {

@@ -423,10 +423,21 @@ void re_start_show_foreign(struct app *a, unsigned mask)
 		       hs);
 }
 
+void re_start_show_events(struct app *a)
+{
+	struct re_event ev;
+
+	while (a->sup && re_super_event(a->sup, a->ev_seen, &ev)) {
+		a->ev_seen = ev.seq;
+		re_console_event(&a->con, &ev);
+	}
+}
+
 /* The calibration's sampler: one supervised cycle per sample. */
 static int sample_cb(void *ud, const struct gl_record **rec)
 {
 	struct app *a = ud;
+	struct re_calib_progress prog;
 	struct re_status st;
 	int v;
 
@@ -438,6 +449,10 @@ static int sample_cb(void *ud, const struct gl_record **rec)
 	a->real.defer_log = 0;
 	re_super_status(a->sup, &st);
 	re_start_show_foreign(a, st.foreign);
+	re_start_show_events(a);
+	re_calib_progress(a->calrun, a->calcfg, &a->sup->rec, re_io_now_ns(),
+			  &prog);
+	re_console_calib(&a->con, &prog);
 	re_console_status(&a->con, &st, re_io_now_ns(), 0);
 	re_io_flush_log(&a->real); /* after the cycle (issue 17) */
 	if (v == RE_FAULT) {
@@ -567,6 +582,50 @@ static void save_calibration(struct app *a)
 	drop_backup(a);
 }
 
+/* An interrupted calibration: which table is in force now - the one of
+ * the file (kept, unchanged), or none (the next start needs a full
+ * calibration) - on the console and in the log. */
+static void say_table_in_force(struct app *a, const struct re_calib_cfg *cc)
+{
+	const char *file = a->cfg.calibration.file;
+	struct re_calfile_expect e;
+	struct re_calset *old;
+	char serial[32];
+	int rc;
+
+	if (a->calib != RE_CALIB_FULL) {
+		progress(a,
+			 "calibration interrupted: the table in force is "
+			 "still the one loaded from '%s' (made %s), "
+			 "unchanged",
+			 file, a->cal->date);
+		return;
+	}
+	old = calloc(1, sizeof(*old));
+	fill_expect(a, cc, &e, serial);
+	rc = old ? re_calfile_load(file, &e, old, a->err, sizeof(a->err))
+		 : GL_ERR_NOMEM;
+	if (rc == GL_OK)
+		progress(a,
+			 "calibration interrupted: no new table; the table "
+			 "in force is still the one in '%s' (made %s), "
+			 "kept unchanged: the next start can load it",
+			 file, old->date);
+	else if (rc == GL_ERR_NOENT)
+		progress(a,
+			 "calibration interrupted: no table is in force "
+			 "('%s' does not exist): the next start needs a "
+			 "full calibration",
+			 file);
+	else
+		progress(a,
+			 "calibration interrupted: no table is in force "
+			 "('%s' was not changed but cannot be used: %s): "
+			 "the next start needs a full calibration",
+			 file, a->err);
+	free(old);
+}
+
 /* The chosen procedure in the service state. Return: 0, EXIT_FAULT, or
  * 0 with re_sig.quit set (interrupted). */
 static int run_calibration(struct app *a, struct re_calib *c,
@@ -587,8 +646,7 @@ static int run_calibration(struct app *a, struct re_calib *c,
 	if (rc == RE_FAULT)
 		return latch(a, &f);
 	if (rc == GL_ERR_AGAIN) {
-		progress(a, "calibration interrupted: '%s' was not changed",
-			 a->cfg.calibration.file);
+		say_table_in_force(a, cc);
 		return 0;
 	}
 	if (rc != GL_OK) {
@@ -612,7 +670,12 @@ static int calibrate(struct app *a)
 	re_calib_cfg_from(&a->cfg, &a->plan, a->names, &cc);
 	cc.stop = &re_sig.quit;
 	cc.sampler = (struct re_calib_sampler){sample_cb, own_cb, tables_cb, a};
+	a->calrun = c;
+	a->calcfg = &cc;
 	rc = run_calibration(a, c, &cc);
+	a->calrun = NULL;
+	a->calcfg = NULL;
+	re_console_calib(&a->con, NULL);
 	re_calib_free(c);
 	return rc;
 }

@@ -55,6 +55,7 @@ struct opts {
 	const char *find_addr; /* commissioning: discovery probe address */
 	int find_port;	       /* and its port (0: the defaults) */
 	int period_ms;	       /* 0: from the configuration */
+	int counts;	       /* --counts: the board in encoder counts */
 	enum re_calib_choice calib;
 	int check_host_s; /* --check-host[=S]: seconds of the probe, 0: no */
 };
@@ -78,7 +79,10 @@ struct app {
 	long hbpc;
 	int calib;   /* the operator's choice: RE_CALIB_FULL / _FILE */
 	int powered; /* the relay was switched on at some point */
-	unsigned foreign_shown; /* other programs' handles already shown */
+	unsigned foreign_shown;	 /* other programs' handles already shown */
+	uint64_t ev_seen;	 /* the supervisor's events already shown */
+	struct re_calib *calrun; /* the calibration running, or NULL */
+	const struct re_calib_cfg *calcfg; /* its settings */
 	int ctl_ours; /* the controller was taken over: ours to stop */
 	char err[RE_CONFIG_ERR_MAX];
 };
@@ -128,5 +132,12 @@ int64_t re_start_stall_limit_ms(const struct app *a);
  * but the operator is told once per handle, on the console and in the log.
  */
 void re_start_show_foreign(struct app *a, unsigned mask);
+
+/*
+ * re_start_show_events() - the supervisor's later faults and warnings not
+ * shown yet go to the console's history (re_super_event(), in order).
+ * No-op before the supervisor exists.
+ */
+void re_start_show_events(struct app *a);
 
 #endif /* RE_START_H */

@@ -5,6 +5,7 @@
  *
  *   roboelf [-c FILE] [--galil HOST[:PORT]] [--relay PORT]
  *           [--calibration full|file] [--period MS] [--log FILE]
+ *           [--counts]
  *   roboelf --show-calibration FILE
  *
  * Exit codes: 0 normal quit; 2 configuration or usage error (also: a
@@ -25,6 +26,7 @@
  * re_super_fault(). Power-off is the reverse (re_super_shutdown()).
  */
 #include <errno.h>
+#include <limits.h>
 #include <getopt.h>
 #include <sched.h>
 #include <signal.h>
@@ -135,6 +137,7 @@ static void usage(FILE *f)
 	    "usage: roboelf [-c FILE] [--galil HOST[:PORT]] [--relay PORT]\n"
 	    "               [--calibration full|file] [--period MS] "
 	    "[--log FILE]\n"
+	    "               [--counts]\n"
 	    "       roboelf --show-calibration FILE\n"
 	    "       roboelf --show-trace FILE [--window FROM:TO]\n"
 	    "       roboelf --commission DIR [-c FILE] [--galil ...] "
@@ -150,6 +153,8 @@ static void usage(FILE *f)
 	    "the tables\n"
 	    "      --period MS          supervisor period, 2..100 ms\n"
 	    "      --log FILE           failure log\n"
+	    "      --counts             the board in encoder counts, not "
+	    "deg/mm (key u toggles)\n"
 	    "      --show-calibration FILE  print a calibration file (and "
 	    "plot it)\n"
 	    "      --show-trace FILE    check a flight-recorder trace and "
@@ -280,6 +285,7 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 	    {"dmc", required_argument, NULL, 'D'},
 	    {"help", no_argument, NULL, 'h'},
 	    {"version", no_argument, NULL, 'V'},
+	    {"counts", no_argument, NULL, 'U'},
 	    {NULL, 0, NULL, 0},
 	};
 	int c;
@@ -290,6 +296,10 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 		if (c == 'h') {
 			usage(stdout);
 			return 1;
+		}
+		if (c == 'U') {
+			o->counts = 1;
+			continue;
 		}
 		if (c == 'V') {
 			o->version = 1;
@@ -603,10 +613,14 @@ static void run(struct app *a)
 		a->real.defer_log = 1; /* no file write in the cycle */
 		v = re_super_cycle(a->sup);
 		a->real.defer_log = 0;
-		if (v == RE_FAULT)
+		if (v == RE_FAULT) {
 			re_console_fault(&a->con, re_super_fault_line(a->sup));
+			/* keys typed before the fault do not act after it */
+			re_console_flush_keys(&a->con);
+		}
 		re_super_status(a->sup, &st);
 		re_start_show_foreign(a, st.foreign);
+		re_start_show_events(a);
 		re_console_status(&a->con, &st, re_io_now_ns(), 0);
 		re_io_flush_log(&a->real); /* after the cycle (issue 17) */
 		retry_log(a, &next_retry);
@@ -616,6 +630,10 @@ static void run(struct app *a)
 			key = re_console_key(&a->con);
 		}
 		trace_tick(a, key);
+		if (key == 'u' || key == 'U') {
+			re_console_counts(&a->con, !a->con.counts);
+			re_console_status(&a->con, &st, re_io_now_ns(), 1);
+		}
 		if (key == 'q' || key == 'Q' || key < 0)
 			break;
 		key = 0;
@@ -784,11 +802,25 @@ static int cleanup(struct app *a)
 	return latched;
 }
 
+/* The console: the board in each axis's unit (or counts, --counts). */
+static void open_console(struct app *a)
+{
+	char abs[PATH_MAX];
+
+	re_console_open(&a->con, stdout, STDIN_FILENO);
+	re_console_log_path(
+	    &a->con, realpath(a->cfg.log.path, abs) ? abs : a->cfg.log.path);
+	for (int i = 0; i < RE_AXES; i++)
+		re_console_units(&a->con, i, re_unit_name(a->cfg.axes[i].unit),
+				 a->cfg.axes[i].counts_per_unit);
+	re_console_counts(&a->con, a->o.counts);
+}
+
 static int supervise(struct app *a)
 {
 	int rc;
 
-	re_console_open(&a->con, stdout, STDIN_FILENO);
+	open_console(a);
 	if (a->o.calib == RE_CALIB_ASK && !a->con.tty_in) {
 		fprintf(stderr, "roboelf: error: no terminal to ask full or "
 				"file calibration: use --calibration full or "

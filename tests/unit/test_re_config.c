@@ -47,6 +47,9 @@ static const struct bad_case bad_cases[] = {
      "got 9601"},
     {"bad_bool.yaml", 3, 15,
      "expected true or false for 'active_low', got 'yes'"},
+    {"bad_unit.yaml", 5, 11, "'unit' must be deg or mm, got 'inch'"},
+    {"bad_counts_per_unit.yaml", 6, 22,
+     "'counts_per_unit' must be between 0 and 10000000, got -5"},
     {"bad_channel.yaml", 3, 12, "'channel' must be between 1 and 8, got 9"},
     {"bad_clinical_loopback.yaml", 5, 12,
      "'address' 127.0.0.1:23023 is a loopback address; clinical mode needs the "
@@ -288,6 +291,8 @@ static void test_defaults_documented(void **state)
 		assert_true(a->allowed_error == 0.5);
 		assert_int_equal(a->persistence_cycles, 1);
 		assert_true(a->monotonic_margin_v == 0.005);
+		assert_int_equal(a->unit, i == 2 ? RE_UNIT_MM : RE_UNIT_DEG);
+		assert_true(a->counts_per_unit == 0); /* counts shown */
 	}
 	assert_string_equal(c.calibration.file, "roboelf-calibration.txt");
 	assert_true(c.calibration.backup);
@@ -317,7 +322,8 @@ static void test_defaults_refused_clinical(void **state)
 	assert_int_equal(re_config_validate(&c, err, sizeof(err)), GL_OK);
 }
 
-/* config/roboelf.yaml loads and is exactly the defaults in development. */
+/* config/roboelf.yaml: the defaults in development mode, with galil-sim's
+ * scale for the console. */
 static void test_default_file_loads(void **state)
 {
 	struct re_config c, d;
@@ -330,6 +336,9 @@ static void test_default_file_loads(void **state)
 	assert_string_equal(err, "");
 	re_config_defaults(&d);
 	d.mode = RE_MODE_DEVELOPMENT;
+	/* the scale of galil-sim's robot (the default is 0: counts shown) */
+	for (int i = 0; i < RE_AXES; i++)
+		d.axes[i].counts_per_unit = 1000;
 	assert_memory_equal(&c, &d, sizeof(c));
 }
 
@@ -412,6 +421,8 @@ static void emit_axis(struct sbuf *b, const struct re_config_axis *a)
 	put(b, "    allowed_error: %.17g\n    persistence_cycles: %d\n",
 	    a->allowed_error, a->persistence_cycles);
 	put(b, "    monotonic_margin_v: %.17g\n", a->monotonic_margin_v);
+	put(b, "    unit: %s\n    counts_per_unit: %.17g\n",
+	    re_unit_name(a->unit), a->counts_per_unit);
 }
 
 /* emit() - every field of @c as YAML. */
@@ -533,6 +544,8 @@ static void changed(struct re_config *c)
 		a->allowed_error = 0.3;
 		a->persistence_cycles = 2 + i;
 		a->monotonic_margin_v = 0.01;
+		a->unit = i == 0 ? RE_UNIT_MM : RE_UNIT_DEG;
+		a->counts_per_unit = 123.25 + i;
 	}
 	strcpy(c->calibration.file, "/var/lib/roboelf/cal.txt");
 	c->calibration.backup = false;
