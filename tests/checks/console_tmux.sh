@@ -95,6 +95,12 @@ check_screen() { # WIDTH WHAT
 	[ -z "$long" ] || fail "$2: a line longer than $1: '$long'"
 }
 
+# A session that lives as long as the check: killing the last session
+# ends the tmux server, and a new-session racing with that ending fails
+# ("server exited unexpectedly").
+tmux -S "$sock" new-session -d -s keep -x 80 -y 24 "sleep 100000" ||
+	fail "tmux: cannot start a server"
+
 # no calibration file yet: interrupted, none is in force
 interrupt 80x24 "sweep fwd" "calibration interrupted: no table is in force ('$tmp/cal.txt' does not exist): the next start needs a full calibration"
 
@@ -132,6 +138,9 @@ for size in 80x24 100x30 200x60; do
 	[ -n "${SHOW:-}" ] && { echo "--- $size"; cat "$tmp/screen"; }
 	cp "$tmp/screen" "$tmp/screen-$size.txt"
 	tmux -S "$sock" send-keys -t re q
+	# roboelf has quit (its locks released) before the next one starts
+	wait_for 20 sh -c "! pgrep -f '^$BIN/roboelf -c $tmp/roboelf.yaml' >/dev/null" ||
+		fail "$size: roboelf did not quit within 20 s of q"
 	tmux -S "$sock" kill-session -t re 2>/dev/null
 	ctlreq 'pot B ok' >/dev/null
 done
