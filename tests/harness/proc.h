@@ -138,7 +138,7 @@ int proc_sim_start_wrapped(struct proc_sim *s, char *const wrap[],
 int proc_ctl_connect(int port, int timeout_ms);
 
 /*
- * proc_ctl_connect_at() - connect to @addr (dotted IPv4, NULL: 127.0.0.1)
+ * proc_ctl_connect_at() - connect to @addr (dotted IPv4; NULL or "": 127.0.0.1)
  * port @port within @timeout_ms. Return: the socket, or -1.
  */
 int proc_ctl_connect_at(const char *addr, int port, int timeout_ms);

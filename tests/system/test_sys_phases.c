@@ -412,6 +412,7 @@ static int ph_start(struct sys_case *c, const struct ph_opts *o)
 	memset(c, 0, sizeof(*c));
 	c->ctl = -1;
 	c->env = &env;
+	snprintf(c->sim_addr, sizeof(c->sim_addr), "127.0.0.1");
 	c->id = ++env.ncase;
 	snprintf(c->relay_link, sizeof(c->relay_link), "%s/relay-%d", env.dir,
 		 c->id);
