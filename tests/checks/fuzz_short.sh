@@ -21,7 +21,9 @@ if ! command -v "${FUZZ_CC:-clang}" >/dev/null; then
 	echo "fuzz_short.sh: FAILED: ${FUZZ_CC:-clang} not found (make deps installs it)"
 	exit 1
 fi
-make --no-print-directory -s BUILD="$BUILD" FUZZ_BUILD="$FUZZ_BUILD" fuzz-build ||
+# a make of its own: run-all.sh has no jobserver to share (make check)
+unset MAKEFLAGS MFLAGS MAKELEVEL
+make --no-print-directory -s -j2 BUILD="$BUILD" FUZZ_BUILD="$FUZZ_BUILD" fuzz-build ||
 	{ echo "fuzz_short.sh: FAILED: make fuzz-build"; exit 1; }
 tmp=$(mktemp -d) || exit 1
 trap 'rm -rf "$tmp"' EXIT

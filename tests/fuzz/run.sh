@@ -13,7 +13,8 @@
 #                 The repository's corpus is never written.
 #   FUZZ_ARGS     extra libFuzzer options
 # Each target replays its whole corpus (regression inputs included) first,
-# then fuzzes; the dictionary tests/fuzz/NAME.dict is used when present.
+# then fuzzes; the dictionary tests/fuzz/NAME.dict and the libFuzzer options
+# in tests/fuzz/NAME.options (one line) are used when present.
 # Prints one line per target: NAME: ok|FAILED, execs, exec/s, cov, ft, and
 # for a failure the reproducer path and the command that replays it. Logs go
 # to WORK/log/NAME.log. Exits 1 when a target failed (crash, leak, timeout,
@@ -41,10 +42,12 @@ for name in "$@"; do
 	done
 	dict=
 	[ -f "tests/fuzz/$name.dict" ] && dict=-dict=tests/fuzz/$name.dict
+	opts=
+	[ -f "tests/fuzz/$name.options" ] && opts=$(cat "tests/fuzz/$name.options")
 	# -timeout: one input taking longer is a hang (a failure);
 	# -rss_limit_mb: a memory blow-up is a failure too.
 	"$bin" -max_total_time="$FUZZ_SECONDS" -timeout=20 -rss_limit_mb=2048 \
-		-print_final_stats=1 -artifact_prefix="$crash/" $dict \
+		-print_final_stats=1 -artifact_prefix="$crash/" $dict $opts \
 		${FUZZ_ARGS:-} "$corpus" >"$log" 2>&1
 	rc=$?
 	done_line=$(grep -E '^#[0-9]+[[:space:]]+DONE' "$log" | tail -1)
