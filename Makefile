@@ -6,9 +6,11 @@
 #   make asan     the full check built with -fsanitize=address,undefined
 #   make demo     the whole system on the simulator
 #   make bench    performance figures (printed and written as CSV)
+#   make soak     the randomised soak (SOAK_SECONDS, default 600; SOAK_SEED)
 #   make lint     clang-format dry run and cppcheck
 #   make fuzz     every libFuzzer target for FUZZ_SECONDS (default 600) each
 #   make install / uninstall   (PREFIX, DESTDIR)
+#   make deb      the Debian package build/roboelf_<version>_<arch>.deb
 #
 # Source layout conventions (so that adding a file needs no Makefile edit):
 #   pc/base/*.c          shared base: clock, files, YAML -> $(BUILD)/lib/libbase.a
@@ -85,7 +87,7 @@ BINS := $(if $(wildcard pc/roboelf.c),$(BUILD)/bin/roboelf) \
         $(if $(STUB_SRC),$(BUILD)/bin/galil-stub)
 TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 
-.PHONY: all check test asan demo bench lint install uninstall clean deps tests
+.PHONY: all check test asan demo bench soak lint install uninstall clean deps tests
 .SUFFIXES:
 .DELETE_ON_ERROR:
 
@@ -93,7 +95,7 @@ all: $(BINS)
 
 tests: $(BINS) $(TESTS)
 
-$(BUILD)/obj/%.o: %.c
+$(BUILD)/obj/%.o: %.c | have-deps
 	@mkdir -p $(@D)
 	$(CC) $(ALL_CFLAGS) -c $< -o $@
 
@@ -148,9 +150,19 @@ bench: deps
 	@$(MAKE) --no-print-directory tests
 	@BUILD=$(BUILD) tests/bench.sh
 
-lint:
-	clang-format --dry-run --Werror $(shell git ls-files '*.c' '*.h' 2>/dev/null)
-	cppcheck --quiet --error-exitcode=1 --std=c11 --enable=warning,portability \
+# The soak: seeded random joystick use with pot noise and transient invalid
+# states (tests/system/test_sys_soak.c); make check runs it for 60 s.
+SOAK_SECONDS ?= 600
+SOAK_SEED ?= 20261125
+soak: deps
+	@$(MAKE) --no-print-directory tests
+	@BUILD=$(BUILD) ROBOELF_BIN=$(CURDIR)/$(BUILD)/bin ROBOELF_TOP=$(CURDIR) \
+		ROBOELF_SOAK_S=$(SOAK_SECONDS) ROBOELF_SOAK_SEED=$(SOAK_SEED) \
+		$(BUILD)/tests/system/test_sys_soak
+
+lint: have-lint-deps
+	$(CLANG_FORMAT) --dry-run --Werror $(shell git ls-files '*.c' '*.h' 2>/dev/null)
+	$(CPPCHECK) --quiet --error-exitcode=1 --std=c11 --enable=warning,portability \
 		--suppress=missingIncludeSystem $(addprefix -I,$(INC_DIRS)) \
 		pc tools tests
 
@@ -203,30 +215,88 @@ deps:
 		fi; \
 	fi
 
+# ---- network rig (tests/net, docs/link.md) ------------------------------------
+# nfq-delay (the rig's packet delayer) is built when libnetfilter-queue is
+# there; `make netrig` runs every network case (minutes), `make check` the
+# short ones. Skipped without root: reported SKIPPED, and netrig fails.
+DEB_PKGS += iptables libnetfilter-queue-dev
+NFQ_LIBS := $(shell pkg-config --libs libnetfilter_queue 2>/dev/null)
+ifneq ($(NFQ_LIBS),)
+tests: $(BUILD)/bin/nfq-delay
+$(BUILD)/bin/nfq-delay: tests/net/nfq_delay.c
+	@mkdir -p $(@D)
+	$(CC) $(WARN) $(CFLAGS) $(SAN) -D_DEFAULT_SOURCE $(ALL_LDFLAGS) -o $@ $< $(NFQ_LIBS)
+endif
+.PHONY: netrig
+netrig: deps
+	@$(MAKE) --no-print-directory tests
+	@BUILD=$(BUILD) ROBOELF_NETRIG=long ROBOELF_NO_SKIP=1 tests/run-all.sh net
+
 # ---- install -----------------------------------------------------------------
+# The installed places (issue 17): base_paths.c is built with DATADIR and
+# SYSCONFDIR (and rebuilt when they change); roboelf and galil-load look there
+# for what is not in the directory they are started in (docs/technician.md,
+# "Installation"). The docs tree is installed as it is, links intact.
+DATADIR = $(PREFIX)/share/roboelf
+DOCDIR = $(PREFIX)/share/doc/roboelf
 MAN1 := $(wildcard docs/*.1)
 MAN5 := $(wildcard docs/*.5)
+DOC_FILES := $(shell find docs -type f ! -name '.*' 2>/dev/null | LC_ALL=C sort)
+PATHS_STAMP := $(BUILD)/gen/paths
+$(call obj,pc/base/base_paths.c): ALL_CFLAGS += -DROBOELF_DATADIR='"$(DATADIR)"' \
+	-DROBOELF_SYSCONFDIR='"$(SYSCONFDIR)"'
+$(call obj,pc/base/base_paths.c): $(PATHS_STAMP)
+$(PATHS_STAMP): paths-force
+	@mkdir -p $(@D); echo '$(DATADIR) $(SYSCONFDIR)' >$@.new; \
+	if cmp -s $@.new $@; then rm $@.new; else mv $@.new $@; fi
+.PHONY: paths-force
+
 install: all
 	$(INSTALL) -d "$(DESTDIR)$(PREFIX)/bin" "$(DESTDIR)$(PREFIX)/share/man/man1" \
-		"$(DESTDIR)$(PREFIX)/share/man/man5" "$(DESTDIR)$(PREFIX)/share/roboelf/dmc" \
-		"$(DESTDIR)$(PREFIX)/share/roboelf/config" "$(DESTDIR)$(PREFIX)/share/doc/roboelf"
+		"$(DESTDIR)$(PREFIX)/share/man/man5" "$(DESTDIR)$(DATADIR)/dmc" \
+		"$(DESTDIR)$(DATADIR)/config" "$(DESTDIR)$(DOCDIR)"
 	$(INSTALL) -m 755 $(BINS:$(BUILD)/bin/galil-stub=) "$(DESTDIR)$(PREFIX)/bin/"
 	$(if $(MAN1),$(INSTALL) -m 644 $(MAN1) "$(DESTDIR)$(PREFIX)/share/man/man1/")
 	$(if $(MAN5),$(INSTALL) -m 644 $(MAN5) "$(DESTDIR)$(PREFIX)/share/man/man5/")
-	$(INSTALL) -m 644 $(wildcard dmc/*.dmc dmc/MANIFEST) "$(DESTDIR)$(PREFIX)/share/roboelf/dmc/"
-	$(INSTALL) -m 644 $(wildcard config/*.yaml) "$(DESTDIR)$(PREFIX)/share/roboelf/config/"
+	$(INSTALL) -m 644 $(wildcard dmc/*.dmc dmc/MANIFEST) "$(DESTDIR)$(DATADIR)/dmc/"
+	$(INSTALL) -m 644 $(wildcard config/*.yaml) "$(DESTDIR)$(DATADIR)/config/"
 	@# the operator's configuration roboelf finds without -c; an existing
 	@# (edited) one is kept
 	$(INSTALL) -d "$(DESTDIR)$(SYSCONFDIR)/roboelf"
 	[ -e "$(DESTDIR)$(SYSCONFDIR)/roboelf/roboelf.yaml" ] || \
 		$(INSTALL) -m 644 config/roboelf.yaml "$(DESTDIR)$(SYSCONFDIR)/roboelf/roboelf.yaml"
-	$(INSTALL) -m 644 README.md $(wildcard docs/*.md) "$(DESTDIR)$(PREFIX)/share/doc/roboelf/"
+	$(INSTALL) -m 644 README.md "$(DESTDIR)$(DOCDIR)/"
+	@for f in $(DOC_FILES); do \
+		$(INSTALL) -D -m 644 "$$f" "$(DESTDIR)$(DOCDIR)/$$f" || exit 1; done
 
 uninstall:
 	rm -f $(addprefix "$(DESTDIR)$(PREFIX)/bin/",roboelf galil-load galil-sim)
 	rm -f $(addprefix "$(DESTDIR)$(PREFIX)/share/man/man1/",$(notdir $(MAN1)))
 	rm -f $(addprefix "$(DESTDIR)$(PREFIX)/share/man/man5/",$(notdir $(MAN5)))
-	rm -rf "$(DESTDIR)$(PREFIX)/share/roboelf" "$(DESTDIR)$(PREFIX)/share/doc/roboelf"
+	rm -rf "$(DESTDIR)$(DATADIR)" "$(DESTDIR)$(DOCDIR)"
+
+# ---- missing packages and the Debian package (issue 17) ---------------------
+# have-deps: before compiling, name the missing Debian packages and `make deps`
+# (tools/have-deps.sh) instead of a raw compiler error; have-lint-deps: the
+# same for make lint. make deb: the programs built again with the Debian build
+# flags into $(BUILD)/deb, installed there with PREFIX=/usr, packaged by
+# dpkg-deb with packaging/deb/ (tools/mkdeb.sh): $(BUILD)/roboelf_V_ARCH.deb.
+PKG_CONFIG ?= pkg-config
+CLANG_FORMAT ?= clang-format
+CPPCHECK ?= cppcheck
+DEB_PKGS += dpkg-dev lintian
+RELAY_USB_VENDOR ?= 0403
+RELAY_USB_PRODUCT ?= 6001
+RELAY_USB_SERIAL ?=
+.PHONY: have-deps have-lint-deps deb
+have-deps:
+	@CC="$(CC)" PKG_CONFIG="$(PKG_CONFIG)" sh tools/have-deps.sh build
+have-lint-deps:
+	@CLANG_FORMAT="$(CLANG_FORMAT)" CPPCHECK="$(CPPCHECK)" sh tools/have-deps.sh lint
+deb: have-deps
+	@BUILD="$(BUILD)" MAKE="$(MAKE)" RELAY_USB_VENDOR="$(RELAY_USB_VENDOR)" \
+		RELAY_USB_PRODUCT="$(RELAY_USB_PRODUCT)" RELAY_USB_SERIAL="$(RELAY_USB_SERIAL)" \
+		sh tools/mkdeb.sh
 
 clean:
 	rm -rf $(BUILD)

@@ -16,8 +16,8 @@
 #include "re_pot.h"
 
 #define AXES	  "ABC"
-#define ACFACT	  10	/* dmc/constants.dmc: DC = 10 x speed */
-#define GUARD_CNT 200	/* extra counts before a slow zone */
+#define ACFACT	  10  /* dmc/constants.dmc: DC = 10 x speed */
+#define GUARD_CNT 200 /* extra counts before a slow zone */
 
 enum phase {
 	PH_START,    /* nothing sent yet */
@@ -28,6 +28,8 @@ enum phase {
 	PH_SLOW_FWD, /* still sweeping, slowly onto the forward switch */
 	PH_BACK_FWD, /* backing off it: the forward soft limit */
 	PH_DONE,
+	PH_CHECK,  /* a loaded file checked against the robot */
+	PH_CENTRE, /* to the centre of the new (or loaded) table */
 };
 
 /* Least-squares sums of one table point's samples, dx = enc - point. */
@@ -44,6 +46,7 @@ struct cal_axis {
 	double start; /* table point 0 = reverse soft limit */
 	double soft_fwd;
 	double seek_len; /* length of the bounded slow move, counts */
+	double centre;	 /* PH_CENTRE: the target, counts */
 	struct acc acc[RE_CAL_MAX_POINTS];
 };
 
@@ -58,12 +61,14 @@ struct re_calib {
 	struct cal_axis ax[RE_AXES];
 	const struct gl_record *rec;
 	struct re_encpot_state encpot[RE_AXES];
-	struct batch b;	  /* queued, not sent yet */
-	unsigned pending; /* sent, not taken yet (mvreq still 1) */
+	struct batch b;	    /* queued, not sent yet */
+	unsigned pending;   /* sent, not taken yet (mvreq still 1) */
 	unsigned taken_now; /* taken after this sample's record was read:
 			       that record does not show the move yet */
 	int64_t sent_ns;
 	int64_t t0_ns;
+	int running; /* a procedure runs (for re_calib_progress()) */
+	int full;
 	int filled;
 	char line[GL_LINE_MAX + 1];
 	char resp[128];
@@ -115,7 +120,8 @@ static void axis_cfg_from(const struct re_config *cfg,
 	 * leaves points with samples at one edge only */
 	o->check.step_tol_counts = a->step_counts - 1.0;
 	/* the table ends are a back-off inside the switches */
-	o->check.abs_first_v = a->analog.reverse_v + back * pa->gain_v_per_count;
+	o->check.abs_first_v =
+	    a->analog.reverse_v + back * pa->gain_v_per_count;
 	o->check.abs_last_v = a->analog.forward_v - back * pa->gain_v_per_count;
 	o->check.abs_tol_v = a->analog.absolute_tolerance_v;
 	o->encpot.allowed_error = a->allowed_error;
@@ -280,9 +286,10 @@ static int send_batch(struct re_calib *c, const struct re_io *io,
 	}
 	if (rc == GL_OK && c->line[0])
 		rc = send(c, io, cfg, f);
-	snprintf(c->line, sizeof(c->line), "mvax[0]=%u;mvax[1]=%u;mvax[2]=%u;"
-		 "mvreq=1", c->b.mask & 1, c->b.mask >> 1 & 1,
-		 c->b.mask >> 2 & 1);
+	snprintf(c->line, sizeof(c->line),
+		 "mvax[0]=%u;mvax[1]=%u;mvax[2]=%u;"
+		 "mvreq=1",
+		 c->b.mask & 1, c->b.mask >> 1 & 1, c->b.mask >> 2 & 1);
 	if (rc == GL_OK)
 		rc = send(c, io, cfg, f);
 	c->pending = c->b.mask;
@@ -433,8 +440,8 @@ static int check_at_switch(const struct re_calib *c,
 {
 	const struct re_calib_axis_cfg *a = &cfg->axis[i];
 	double shift = a->backoff_counts * a->gain_v;
-	double want = fwd ? a->check.abs_last_v + shift
-			  : a->check.abs_first_v - shift;
+	double want =
+	    fwd ? a->check.abs_last_v + shift : a->check.abs_first_v - shift;
 	double pot = pot_of(c, cfg, i);
 
 	if (!(a->check.abs_tol_v > 0) || fabs(pot - want) <= a->check.abs_tol_v)
@@ -724,9 +731,12 @@ static int to_centre(struct re_calib *c, const struct re_io *io,
 	int64_t deadline = now_ns(io) + cfg->move_timeout_ms * BASE_NS_PER_MS;
 	int rc;
 
-	for (int i = 0; i < RE_AXES; i++)
-		move_to(c, i, (set->axis[i].soft_rev + set->axis[i].soft_fwd) / 2,
-			cfg->axis[i].travel_cps);
+	for (int i = 0; i < RE_AXES; i++) {
+		c->ax[i].centre =
+		    (set->axis[i].soft_rev + set->axis[i].soft_fwd) / 2;
+		move_to(c, i, c->ax[i].centre, cfg->axis[i].travel_cps);
+		enter(c, io, i, PH_CENTRE);
+	}
 	rc = send_batch(c, io, cfg, f);
 	do {
 		if (rc == GL_OK)
@@ -798,6 +808,8 @@ int re_calib_full(struct re_calib *c, const struct re_io *io,
 	for (int i = 0; i < RE_AXES; i++)
 		enter(c, io, i, PH_START);
 	c->t0_ns = now_ns(io);
+	c->running = 1;
+	c->full = 1;
 	own(cfg, 7);
 	rc = sweep_all(c, io, cfg, fault);
 	for (int i = 0; rc == GL_OK && i < RE_AXES; i++)
@@ -811,6 +823,7 @@ int re_calib_full(struct re_calib *c, const struct re_io *io,
 		rc = to_centre(c, io, cfg, set, fault);
 	}
 	own(cfg, 0);
+	c->running = 0;
 	if (seconds)
 		*seconds = (double)(now_ns(io) - c->t0_ns) / 1e9;
 	if (filled)
@@ -838,8 +851,10 @@ static int check_position(struct re_calib *c, const struct re_calib_cfg *cfg,
 		if (v == RE_OK)
 			continue;
 		if (v < 0)
-			return abort_axis(f, i, "the table cannot be used "
-						"(%s)", gl_strerror(v));
+			return abort_axis(f, i,
+					  "the table cannot be used "
+					  "(%s)",
+					  gl_strerror(v));
 		if (r.exp.where == RE_TPOS_OUTSIDE)
 			return abort_axis(f, i,
 					  "encoder %.0f is outside the "
@@ -867,6 +882,10 @@ int re_calib_check_robot(struct re_calib *c, const struct re_io *io,
 	c->pending = 0;
 	c->taken_now = 0;
 	c->t0_ns = now_ns(io);
+	c->running = 1;
+	c->full = 0;
+	for (int i = 0; i < RE_AXES; i++)
+		enter(c, io, i, PH_CHECK);
 	rc = sample(c, cfg, fault);
 	if (rc == GL_OK)
 		rc = check_position(c, cfg, set, fault);
@@ -876,5 +895,108 @@ int re_calib_check_robot(struct re_calib *c, const struct re_io *io,
 	if (rc == GL_OK)
 		rc = to_centre(c, io, cfg, set, fault);
 	own(cfg, 0);
+	c->running = 0;
 	return rc;
+}
+
+/* ---- progress, for the console ----------------------------------------- */
+
+static const char *const phase_names[] = {
+    [PH_START] = "starting",	      [PH_FAST_REV] = "to rev switch",
+    [PH_TO_REV] = "onto rev switch",  [PH_BACK_REV] = "off rev switch",
+    [PH_SWEEP] = "sweep fwd",	      [PH_SLOW_FWD] = "onto fwd switch",
+    [PH_BACK_FWD] = "off fwd switch", [PH_DONE] = "table built",
+    [PH_CHECK] = "checking file",     [PH_CENTRE] = "to centre",
+};
+
+/* The pot at the reverse and forward switches, and the slow zones'
+ * lengths in counts. */
+struct span {
+	double rev_v, fwd_v, zone_rev, zone_fwd;
+};
+
+static struct span span_of(const struct re_calib_axis_cfg *a)
+{
+	struct span sp;
+	double g = a->gain_v > 0 ? a->gain_v : 1;
+
+	sp.rev_v = a->check.abs_first_v - a->backoff_counts * a->gain_v;
+	sp.fwd_v = a->check.abs_last_v + a->backoff_counts * a->gain_v;
+	sp.zone_rev = fmax(0, (a->pnlo_v - sp.rev_v) / g);
+	sp.zone_fwd = fmax(0, (sp.fwd_v - a->pnhi_v) / g);
+	return sp;
+}
+
+static double secs(double counts, int cps)
+{
+	return cps > 0 ? fmax(0, counts) / cps : 0;
+}
+
+/* Seconds left for axis @i in phase @ph at encoder @enc, pot @pot. */
+static double axis_left_s(const struct re_calib *c,
+			  const struct re_calib_axis_cfg *a, int i, double enc,
+			  double pot)
+{
+	struct span sp = span_of(a);
+	double g = a->gain_v > 0 ? a->gain_v : 1, t = a->travel_counts;
+	double d_rev = fmax(0, (pot - sp.rev_v) / g);
+	double d_fwd = fmax(0, (sp.fwd_v - pot) / g);
+	double centre = secs(t / 2, a->travel_cps);
+	double back = secs(a->backoff_counts, a->seek_cps);
+	double sweep = secs(t - sp.zone_fwd, a->vmax_cps) +
+		       secs(sp.zone_fwd, a->seek_cps) + back + centre;
+
+	switch (c->ax[i].ph) {
+	case PH_START:
+	case PH_FAST_REV:
+	case PH_TO_REV:
+		return secs(d_rev - sp.zone_rev, a->travel_cps) +
+		       secs(fmin(d_rev, sp.zone_rev), a->seek_cps) + back +
+		       sweep;
+	case PH_BACK_REV: return back + sweep;
+	case PH_SWEEP:
+		return secs(d_fwd - sp.zone_fwd, a->vmax_cps) +
+		       secs(fmin(d_fwd, sp.zone_fwd), a->seek_cps) + back +
+		       centre;
+	case PH_SLOW_FWD: return secs(d_fwd, a->seek_cps) + back + centre;
+	case PH_BACK_FWD:
+	case PH_DONE: return centre;
+	case PH_CHECK:
+		return secs(fabs(pot - (sp.rev_v + sp.fwd_v) / 2) / g,
+			    a->travel_cps);
+	case PH_CENTRE: return secs(fabs(enc - c->ax[i].centre), a->travel_cps);
+	}
+	return 0;
+}
+
+void re_calib_progress(const struct re_calib *c, const struct re_calib_cfg *cfg,
+		       const struct gl_record *rec, int64_t now_ns,
+		       struct re_calib_progress *out)
+{
+	memset(out, 0, sizeof(*out));
+	if (!c || !c->running)
+		return;
+	rec = rec ? rec : c->rec;
+	out->active = 1;
+	out->full = c->full;
+	out->elapsed_s = (double)(now_ns - c->t0_ns) / 1e9;
+	for (int i = 0; i < cfg->n_axes && i < RE_AXES; i++) {
+		const struct re_calib_axis_cfg *a = &cfg->axis[i];
+		struct re_calib_axis_progress *p = &out->axis[i];
+		struct span sp = span_of(a);
+		double pot, enc;
+
+		p->phase = phase_names[c->ax[i].ph];
+		p->pct = -1;
+		if (!rec || rec->n_axes <= i)
+			continue;
+		pot = re_pot_of(rec, i, a->pot_input);
+		enc = rec->axis[i].motor_pos;
+		if (sp.fwd_v > sp.rev_v)
+			p->pct =
+			    fmin(100, fmax(0, (pot - sp.rev_v) /
+						  (sp.fwd_v - sp.rev_v) * 100));
+		p->left_s = axis_left_s(c, a, i, enc, pot);
+		out->left_s = fmax(out->left_s, p->left_s);
+	}
 }

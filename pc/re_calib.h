@@ -109,6 +109,23 @@ void re_calib_cfg_from(const struct re_config *cfg, const struct re_plan *plan,
 
 struct re_calib;
 
+/* What a calibration is doing now, for the console (re_calib_progress()). */
+struct re_calib_axis_progress {
+	const char *phase; /* "to rev switch", "sweep fwd", "to centre" ... */
+	double pct;	   /* position over the travel from the potentiometer
+			    * (0 at the reverse switch, 100 at the forward
+			    * one), clamped to 0..100; -1 unknown */
+	double left_s;	   /* estimated time left for this axis, s */
+};
+
+struct re_calib_progress {
+	int active; /* a procedure runs */
+	int full;   /* 1: full calibration; 0: the check of the file */
+	double elapsed_s;
+	double left_s; /* the longest of the axes', s (they run together) */
+	struct re_calib_axis_progress axis[RE_AXES];
+};
+
 /* re_calib_new() - allocate the working state. Return: GL_OK/GL_ERR_NOMEM. */
 int re_calib_new(struct re_calib **out);
 void re_calib_free(struct re_calib *c);
@@ -128,6 +145,19 @@ void re_calib_free(struct re_calib *c);
 int re_calib_full(struct re_calib *c, const struct re_io *io,
 		  const struct re_calib_cfg *cfg, struct re_calset *set,
 		  struct re_fault *fault, double *seconds, int *filled);
+
+/*
+ * re_calib_progress() - where the running procedure of @c is, per axis:
+ * its phase, its position over the travel and an estimate of the time
+ * left (the remaining distances of this and the following phases at the
+ * speeds configured for them, without acceleration), read from @rec (the
+ * sample just taken, e.g. in the sampler; NULL: the procedure's last).
+ * Pure: no I/O. @out->active is 0 when no procedure runs.
+ * @now_ns: the io's clock.
+ */
+void re_calib_progress(const struct re_calib *c, const struct re_calib_cfg *cfg,
+		       const struct gl_record *rec, int64_t now_ns,
+		       struct re_calib_progress *out);
 
 /*
  * re_calib_check_robot() - for tables loaded from a file: the

@@ -12,6 +12,7 @@
  * struct copied out only on success.
  */
 #include "re_config.h"
+#include "re_rt.h"
 
 #include <errno.h>
 #include <inttypes.h>
@@ -82,6 +83,7 @@ struct pctx {
 
 static const char *const mode_names[] = {"clinical", "development", NULL};
 static const char *const backend_names[] = {"auto", "serialport", "tty", NULL};
+static const char *const unit_names[] = {"deg", "mm", NULL};
 static const char *const proto_names[] = {"devantech", "icstation", "lcus",
 					  "kmtronic", NULL};
 static const int bauds[] = {1200,  2400,  4800,	 9600,
@@ -716,6 +718,8 @@ static const struct field axis_fields[] = {
 	D(struct re_config_axis, allowed_error, 0.0, 10.0),
 	I(struct re_config_axis, persistence_cycles, 1, 1000),
 	D(struct re_config_axis, monotonic_margin_v, 0.0, 1.0),
+	E(struct re_config_axis, unit, unit_names, 1),
+	D(struct re_config_axis, counts_per_unit, 0.0, 10000000.0),
 	END,
 };
 
@@ -741,6 +745,13 @@ static const struct field recorder_fields[] = {
 	D(struct re_config_recorder, seconds, 1, 120),
 	D(struct re_config_recorder, after_fault_s, 0, 60),
 	S(struct re_config_recorder, dir, 0),
+	END,
+};
+
+static const struct field realtime_fields[] = {
+	I(struct re_config_realtime, priority, 0, 99),
+	I(struct re_config_realtime, cpu, -1, 1023),
+	B(struct re_config_realtime, lock_memory),
 	END,
 };
 
@@ -774,6 +785,7 @@ static const struct field root_fields[] = {
 	M(struct re_config, calibration, calibration_fields),
 	M(struct re_config, log, log_fields),
 	M(struct re_config, recorder, recorder_fields),
+	M(struct re_config, realtime, realtime_fields),
 	END,
 };
 /* clang-format on */
@@ -1137,6 +1149,19 @@ static int check_recorder(struct pctx *c, const struct re_config_recorder *r)
 		       r->after_fault_s, r->seconds);
 }
 
+/* A period under RE_RT_MIN_MS_WITHOUT needs SCHED_FIFO asked for. */
+static int check_realtime(struct pctx *c, const struct re_config *cfg)
+{
+	if (cfg->period_ms >= RE_RT_MIN_MS_WITHOUT ||
+	    cfg->realtime.priority > 0)
+		return GL_OK;
+	return fail_at(c,
+		       later_mark(c, &cfg->period_ms, &cfg->realtime.priority),
+		       "'period_ms' %d needs real-time scheduling: set "
+		       "'realtime.priority' 1..99 or a period of %d ms or more",
+		       cfg->period_ms, RE_RT_MIN_MS_WITHOUT);
+}
+
 static int check_all(struct pctx *c, const struct re_config *cfg)
 {
 	int i, rc = check_table(c, root_fields, cfg);
@@ -1159,6 +1184,8 @@ static int check_all(struct pctx *c, const struct re_config *cfg)
 		rc = check_clinical(c, cfg);
 	if (!rc)
 		rc = check_recorder(c, &cfg->recorder);
+	if (!rc)
+		rc = check_realtime(c, cfg);
 	return rc;
 }
 
@@ -1209,6 +1236,13 @@ static void axis_defaults(struct re_config_axis *a, int i)
 	a->allowed_error = 0.5;
 	a->persistence_cycles = 1;
 	a->monotonic_margin_v = 0.005;
+	a->unit = i == 2 ? RE_UNIT_MM : RE_UNIT_DEG;
+	a->counts_per_unit = 0; /* not known: the console shows counts */
+}
+
+const char *re_unit_name(enum re_unit u)
+{
+	return u == RE_UNIT_MM ? "mm" : "deg";
 }
 
 static void relay_defaults(struct re_config_relay *r)
@@ -1263,17 +1297,93 @@ void re_config_defaults(struct re_config *out)
 	out->log.keep = 5;
 	out->recorder.seconds = 30;
 	out->recorder.after_fault_s = 2;
+	out->realtime.priority = 50;
+	out->realtime.cpu = -1;
+	out->realtime.lock_memory = true;
 }
 
 /* ---- parse ---- */
 
 /* Say why base_yaml_load() failed, at the place libyaml gives. */
-static int syntax_error(struct pctx *c, int rc, const struct base_yaml_error *e)
+/* Where a quoted value of line @ln (@p .. @end) opens without closing on
+ * that line: its 0-based column, or -1. A quote opens a value after ": ",
+ * "- ", "[" or "," (a quote inside a plain value, as in don't, opens
+ * nothing); '' and \" do not close. */
+static long open_quote_col(const char *p, const char *end)
 {
+	const char *b = p;
+
+	for (const char *q = p; q < end; q++) {
+		const char *v = q;
+		char quote;
+
+		if (*q == '#' && (q == b || q[-1] == ' ' || q[-1] == '\t'))
+			return -1; /* a comment */
+		if (*q != ':' && *q != '-' && *q != '[' && *q != ',')
+			continue;
+		v = q + 1;
+		if (*q != '[' && *q != ',' && (v >= end || *v != ' '))
+			continue;
+		while (v < end && *v == ' ')
+			v++;
+		if (v >= end || (*v != '"' && *v != '\''))
+			continue;
+		quote = *v;
+		for (q = v + 1; q < end; q++) {
+			if (quote == '"' && *q == '\\' && q + 1 < end)
+				q++;
+			else if (quote == '\'' && *q == '\'' && q + 1 < end &&
+				 q[1] == '\'')
+				q++;
+			else if (*q == quote)
+				break;
+		}
+		if (q >= end)
+			return v - b;
+	}
+	return -1;
+}
+
+/* The first line up to @last (0-based) with a quote that is not closed on
+ * it: a double-quoted YAML value may span lines, so libyaml reports the
+ * error where the quote finally closes, often many lines later. */
+static int unclosed_quote(const char *buf, size_t len, size_t last,
+			  yaml_mark_t *at)
+{
+	const char *p = buf, *end = buf + len;
+
+	for (size_t ln = 0; p < end && ln <= last; ln++) {
+		const char *nl = memchr(p, '\n', (size_t)(end - p));
+		const char *le = nl ? nl : end;
+		long col = open_quote_col(p, le);
+
+		if (col >= 0) {
+			at->line = ln;
+			at->column = (size_t)col;
+			return 1;
+		}
+		p = le + 1;
+	}
+	return 0;
+}
+
+static int syntax_error(struct pctx *c, int rc, const struct base_yaml_error *e,
+			const char *buf, size_t len)
+{
+	yaml_mark_t q;
+
 	if (rc == -ENOMEM) {
 		fail_at(c, NULL, "out of memory");
 		return GL_ERR_NOMEM;
 	}
+	if (e->type != YAML_READER_ERROR &&
+	    unclosed_quote(buf, len, e->mark.line, &q))
+		return fail_at(c, &q,
+			       "this quote is not closed on its line (the "
+			       "parser then stopped at line %zu column %zu: "
+			       "%s)",
+			       e->mark.line + 1, e->mark.column + 1,
+			       e->problem ? e->problem : "syntax error");
 	if (e->context)
 		return fail_at(c, &e->mark, "%s (%s at line %zu column %zu)",
 			       e->problem ? e->problem : "syntax error",
@@ -1290,7 +1400,7 @@ static int load_document(struct pctx *c, const char *buf, size_t len,
 	struct base_yaml_error e;
 	int rc = base_yaml_load(buf, len, BASE_YAML_ONE_DOC, doc, &e);
 
-	return rc ? syntax_error(c, rc, &e) : GL_OK;
+	return rc ? syntax_error(c, rc, &e, buf, len) : GL_OK;
 }
 
 /* Defaults derived from other fields; they are in range (check_table()). */

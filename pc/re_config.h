@@ -78,6 +78,15 @@ struct re_config_joystick {
 	int invalid_timeout_ms; /* DMC jto */
 };
 
+/* The unit an axis is shown in on the console. */
+enum re_unit {
+	RE_UNIT_DEG = 0, /* a rotary axis, degrees */
+	RE_UNIT_MM,	 /* a linear axis, millimetres */
+};
+
+/* re_unit_name() - "deg" or "mm". */
+const char *re_unit_name(enum re_unit u);
+
 struct re_config_encoder_failure {
 	bool enabled;	  /* OA */
 	int time_samples; /* OT, servo samples, 2..32000 */
@@ -85,11 +94,11 @@ struct re_config_encoder_failure {
 };
 
 struct re_config_analog {
-	int input;		 /* analog input 1..8 (AN[n]) */
-	double expected_range_v; /* pot span over the full travel, V */
-	double range_tolerance;	 /* fraction of expected_range_v */
-	double reverse_v;	 /* pot at the reverse limit switch, V */
-	double forward_v;	 /* pot at the forward limit switch, V */
+	int input;		     /* analog input 1..8 (AN[n]) */
+	double expected_range_v;     /* pot span over the full travel, V */
+	double range_tolerance;	     /* fraction of expected_range_v */
+	double reverse_v;	     /* pot at the reverse limit switch, V */
+	double forward_v;	     /* pot at the forward limit switch, V */
 	double absolute_tolerance_v; /* how far a real pot may read from
 				      * reverse_v / forward_v there, V */
 };
@@ -115,6 +124,11 @@ struct re_config_axis {
 	int persistence_cycles;	   /* cycles an ENCODER mismatch must
 				    * last before it is a fault, >= 1 */
 	double monotonic_margin_v; /* calibration noise margin, V */
+	/* How the console shows this axis (display only: no check, no
+	 * calibration depends on it): @unit "deg" or "mm", @counts_per_unit
+	 * encoder counts per degree or mm; 0: not known, counts are shown. */
+	enum re_unit unit;
+	double counts_per_unit;
 };
 
 struct re_config_calibration {
@@ -144,6 +158,13 @@ struct re_config_recorder {
 	char dir[RE_PATH_MAX]; /* where traces go; "": the log's directory */
 };
 
+/* Real-time set-up of the supervisor's thread (issue 17, pc/re_rt.h). */
+struct re_config_realtime {
+	int priority;	  /* SCHED_FIFO 1..99; 0: not requested */
+	int cpu;	  /* pin the cycle to this CPU; -1: not pinned */
+	bool lock_memory; /* mlockall before the first cycle */
+};
+
 struct re_config {
 	enum re_mode mode;
 	int period_ms; /* supervisor cycle, 2..100 */
@@ -155,6 +176,7 @@ struct re_config {
 	struct re_config_calibration calibration;
 	struct re_config_log log;
 	struct re_config_recorder recorder;
+	struct re_config_realtime realtime;
 };
 
 /*
@@ -219,8 +241,8 @@ const char *re_config_relay_port(const struct re_config *cfg);
 void re_config_relay_cfg(const struct re_config *cfg, struct re_relay_cfg *out);
 
 /*
- * re_config_hash() - FNV-1a 64 (pc/galil/gl_hash.h) over the fields a calibration
- * table depends on: per axis its name, step_counts, travel_counts,
+ * re_config_hash() - FNV-1a 64 (pc/galil/gl_hash.h) over the fields a
+ * calibration table depends on: per axis its name, step_counts, travel_counts,
  * travel_tolerance, analog input, expected_range_v, range_tolerance,
  * allowed_error and monotonic_margin_v. A calibration file whose hash
  * differs was made for another configuration.

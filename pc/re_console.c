@@ -15,7 +15,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#define BAR_WIDTH   12
+#define BAR_WIDTH   16
 #define ANSI_RED    "\033[1;31m"
 #define ANSI_GREEN  "\033[32m"
 #define ANSI_YELLOW "\033[33m"
@@ -69,8 +69,16 @@ void re_console_raw(struct re_console *c)
 	t.c_iflag &= ~(tcflag_t)IXON; /* Ctrl-S must not freeze the board */
 	t.c_cc[VMIN] = 0;
 	t.c_cc[VTIME] = 0;
-	if (tcsetattr(c->in_fd, TCSANOW, &t) == 0)
+	/* TCSAFLUSH: what was typed before (during the calibration) is
+	 * dropped, never read as a key of the run */
+	if (tcsetattr(c->in_fd, TCSAFLUSH, &t) == 0)
 		c->raw = 1;
+}
+
+void re_console_flush_keys(struct re_console *c)
+{
+	if (c->tty_in)
+		tcflush(c->in_fd, TCIFLUSH);
 }
 
 void re_console_restore(struct re_console *c)
@@ -83,6 +91,14 @@ void re_console_restore(struct re_console *c)
 
 void re_console_close(struct re_console *c)
 {
+	/* the board stays on the screen, under the last messages; the whole
+	 * screen scrolls again, the cursor under the board */
+	if (c->tty_out && (c->board_lines || c->half)) {
+		fprintf(c->out, "%s\033[r\033[%d;1H\n", c->half ? "\0338" : "",
+			c->rows);
+		c->board_lines = 0;
+		c->half = 0;
+	}
 	re_console_restore(c);
 	fflush(c->out);
 	if (c->nb_fd >= 0)
@@ -118,8 +134,8 @@ static int count_lines(const char *buf, size_t len)
 }
 
 /* Write the frame; a short or refused write drops the rest of it. Return
- * the number of complete lines that reached the output. */
-static int frame_send(struct re_console *c)
+ * the number of bytes that reached the output. */
+static size_t frame_send(struct re_console *c)
 {
 	size_t len = c->frame_len;
 	ssize_t n;
@@ -129,22 +145,24 @@ static int frame_send(struct re_console *c)
 	if (c->nb_fd < 0) {
 		fwrite(c->frame, 1, len, c->out);
 		fflush(c->out);
-		return count_lines(c->frame, len);
+		return len;
 	}
 	do
 		n = write(c->nb_fd, c->frame, len);
 	while (n < 0 && errno == EINTR);
 	if (n < (ssize_t)len)
 		c->dropped++;
-	return n > 0 ? count_lines(c->frame, (size_t)n) : 0;
+	return n > 0 ? (size_t)n : 0;
 }
 
-/* Take the board off the screen so that a message can scroll above it. */
+/* Before a message: the cursor back where the text flows (in the scroll
+ * region above the board) if a frame was cut short after saving it. */
 static void board_erase(struct re_console *c)
 {
-	if (c->tty_out && c->board_lines > 0)
-		fprintf(c->out, "\033[%dA\r\033[J", c->board_lines);
-	c->board_lines = 0;
+	if (c->tty_out && c->half) {
+		fputs("\0338", c->out);
+		c->half = 0;
+	}
 }
 
 static void term_size(struct re_console *c, int *cols, int *rows);
@@ -197,19 +215,63 @@ void re_console_msg(struct re_console *c, const char *fmt, ...)
 	fflush(c->out);
 }
 
-/* Keep @line for the board: the first for good, later ones newest first. */
+static void hist_add(struct re_console *c, const struct re_event *ev)
+{
+	struct re_console_event *h = &c->hist[0];
+
+	if (c->nhist > 0 && h->kind == ev->kind && ev->kind != RE_EV_OTHER &&
+	    h->level == ev->level) {
+		h->count++;
+	} else {
+		memmove(&c->hist[1], &c->hist[0],
+			sizeof(c->hist[0]) * (RE_CONSOLE_HIST - 1));
+		if (c->nhist < RE_CONSOLE_HIST)
+			c->nhist++;
+		h->count = 1;
+	}
+	h->t_s = ev->t_s;
+	h->level = ev->level;
+	h->kind = ev->kind;
+	snprintf(h->text, sizeof(h->text), "%s", ev->text);
+}
+
+/* Keep @line for the board: the first for good, later ones in the
+ * history. */
 static void fault_keep(struct re_console *c, const char *line)
 {
+	struct re_event ev;
+
 	c->nfaults++;
 	if (!c->fault[0]) {
 		snprintf(c->fault, sizeof(c->fault), "%s", line);
 		return;
 	}
-	for (int i = RE_CONSOLE_LATER - 1; i > 0; i--)
-		memcpy(c->later[i], c->later[i - 1], sizeof(c->later[i]));
-	snprintf(c->later[0], sizeof(c->later[0]), "%s", line);
-	if (c->nlater < RE_CONSOLE_LATER)
-		c->nlater++;
+	memset(&ev, 0, sizeof(ev));
+	ev.t_s = c->last_t_s;
+	ev.level = RE_LOG_FAULT;
+	ev.kind = RE_EV_OTHER;
+	snprintf(ev.text, sizeof(ev.text), "%s", line);
+	hist_add(c, &ev);
+}
+
+void re_console_event(struct re_console *c, const struct re_event *ev)
+{
+	int fault = ev->level == RE_LOG_FAULT;
+	const char *text = ev->text;
+
+	hist_add(c, ev);
+	if (c->tty_out)
+		return; /* on the board */
+	if (fault && !strncmp(text, "FAULT ", 6))
+		text += 6;
+	fprintf(c->out, "roboelf: %s%s\n",
+		fault ? "later FAULT " : "warning: ", text);
+	fflush(c->out);
+}
+
+void re_console_log_path(struct re_console *c, const char *path)
+{
+	snprintf(c->log_path, sizeof(c->log_path), "%s", path ? path : "");
 }
 
 void re_console_fault(struct re_console *c, const char *line)
@@ -242,7 +304,7 @@ static const char *relay_text(enum re_relay_state r)
 {
 	switch (r) {
 	case RE_RELAY_ON: return "ON";
-	case RE_RELAY_OFF: return "OFF (motor power cut)";
+	case RE_RELAY_OFF: return "OFF (power cut)";
 	default: return "UNKNOWN";
 	}
 }
@@ -366,15 +428,32 @@ int re_console_format_line(const struct re_status *st, char *buf, size_t cap)
 
 /* ---- the board --------------------------------------------------------- */
 
-static void bar(char out[BAR_WIDTH + 3], double pct)
+/* A bar over the axis's travel: the soft limits '|' one place inside each
+ * end (so that an axis past one shows beyond it), the position '#'; '?'
+ * throughout when no calibration gives the soft limits. */
+static void soft_bar(char out[BAR_WIDTH + 3], const struct re_axis_status *a)
 {
-	int pos = pct < 0 ? -1 : (int)(pct / 100.0 * (BAR_WIDTH - 1) + 0.5);
+	double span = a->soft_fwd_counts - a->soft_rev_counts, x;
+	int pos;
 
 	out[0] = '[';
-	for (int i = 0; i < BAR_WIDTH; i++)
-		out[1 + i] = i == pos ? '#' : (pct >= 0 ? '-' : '?');
 	out[BAR_WIDTH + 1] = ']';
 	out[BAR_WIDTH + 2] = '\0';
+	if (!a->have_soft || span <= 0) {
+		memset(out + 1, '?', BAR_WIDTH);
+		return;
+	}
+	memset(out + 1, '-', BAR_WIDTH);
+	out[2] = '|';
+	out[BAR_WIDTH - 1] = '|';
+	x = 1 + (a->enc_counts - a->soft_rev_counts) / span * (BAR_WIDTH - 3);
+	if (a->enc_counts < a->soft_rev_counts)
+		pos = 0; /* past a soft limit: outside its mark */
+	else if (a->enc_counts > a->soft_fwd_counts)
+		pos = BAR_WIDTH - 1;
+	else
+		pos = (int)(x + 0.5);
+	out[1 + pos] = '#';
 }
 
 static const char *col(const struct re_console *c, const char *code)
@@ -428,35 +507,93 @@ static void board_printf(struct re_console *c, int width, const char *fmt, ...)
 	frame_line(c, line, width);
 }
 
+/* Counts in the axis's unit ("  -12.35 deg"), or as counts ("  -12345 cnt")
+ * when counts are asked for or the scale is not known: 12 characters; a
+ * speed (@per_s) in the same unit per second without its name: 8. */
+static void unit_text(const struct re_console *c, int i, double counts,
+		      int per_s, char *buf, size_t cap)
+{
+	const struct re_console_axis *u = &c->ax[i];
+
+	if (c->counts || u->per_unit <= 0)
+		snprintf(buf, cap, per_s ? "%6.0f/s" : "%8.0f cnt", counts);
+	else if (per_s)
+		snprintf(buf, cap, "%6.1f/s", counts / u->per_unit);
+	else if (counts / u->per_unit > -0.005 && counts / u->per_unit < 0)
+		snprintf(buf, cap, "%8.2f %-3s", 0.0, u->unit); /* not -0.00 */
+	else
+		snprintf(buf, cap, "%8.2f %-3s", counts / u->per_unit, u->unit);
+}
+
 static void board_axis(struct re_console *c, const struct re_status *st, int i,
 		       int width)
 {
 	const struct re_axis_status *a = &st->axis[i];
-	char b[BAR_WIDTH + 3], exp[48] = "    -      -";
+	char b[BAR_WIDTH + 3], exp[48] = "    -      -", pos[40], vel[40];
 
-	bar(b, a->pos_pct);
+	soft_bar(b, a);
+	unit_text(c, i, a->enc_counts, 0, pos, sizeof(pos));
+	unit_text(c, i, a->vel_cps, 1, vel, sizeof(vel));
 	if (a->have_expect)
 		snprintf(exp, sizeof(exp), "%5.3f %s%+6.3f%s",
 			 a->pot_expected_v,
 			 col(c, a->margin_v < 0 ? ANSI_RED : ""), a->margin_v,
 			 col(c, a->margin_v < 0 ? ANSI_OFF : ""));
-	board_printf(
-	    c, width, "%-2.2s %7d %s %3.0f%% %5.3f %s %6.0f %-7s %-3s %s",
-	    st->axis_names[i], (int)a->enc_counts, b,
-	    a->pos_pct < 0 ? 0.0 : a->pos_pct, a->pot_v, exp, a->vel_cps,
-	    motion_text(a), limit_text(a), a->motor_off ? "off" : "on");
+	board_printf(c, width, "%-2.2s %s %s %5.3f %s %s %-7s %-3s %s",
+		     st->axis_names[i], pos, b, a->pot_v, exp, vel,
+		     st->link_ok ? motion_text(a) : "STALE", limit_text(a),
+		     a->motor_off ? "off" : "on");
 }
 
-/* The kept FAULT, wrapped at word boundaries into at most 5 lines, then
- * the later ones, one line each, newest first. */
-static void board_faults(struct re_console *c, int width)
+/* During a calibration: the axis's phase, a bar of its position over the
+ * travel (0 % at the reverse switch), where it is, and its time left. */
+static void board_cal_axis(struct re_console *c, const struct re_status *st,
+			   int i, int width)
+{
+	const struct re_calib_axis_progress *p = &c->cal.axis[i];
+	const struct re_axis_status *a = &st->axis[i];
+	char b[BAR_WIDTH + 3], pos[40];
+	int k = p->pct < 0 ? -1 : (int)(p->pct / 100 * (BAR_WIDTH - 1) + 0.5);
+
+	b[0] = '[';
+	for (int j = 0; j < BAR_WIDTH; j++)
+		b[1 + j] = j == k ? '#' : k < 0 ? '?' : '-';
+	b[BAR_WIDTH + 1] = ']';
+	b[BAR_WIDTH + 2] = '\0';
+	unit_text(c, i, a->enc_counts, 0, pos, sizeof(pos));
+	board_printf(c, width, "%-2.2s %-15s %s %3.0f%% %s %5.3f %4.0f s %s",
+		     st->axis_names[i], p->phase ? p->phase : "-", b,
+		     p->pct < 0 ? 0 : p->pct, pos, a->pot_v, p->left_s,
+		     st->link_ok ? motion_text(a) : "STALE");
+}
+
+static void board_axes(struct re_console *c, const struct re_status *st,
+		       int width)
+{
+	if (!c->cal.active) {
+		board_printf(c, width,
+			     "%-2s %12s %-18s %5s %-12s %8s %-7s %-3s %s", "ax",
+			     "position", "  |soft  limits|", "pot V",
+			     "expect margin", "speed", "state", "lim", "mot");
+		for (int i = 0; i < st->n_axes; i++)
+			board_axis(c, st, i, width);
+		return;
+	}
+	board_printf(c, width, "%-2s %-15s %-18s %4s %12s %5s %6s %s", "ax",
+		     "calibration", "[rev  travel  fwd]", "", "position",
+		     "pot V", "left", "state");
+	for (int i = 0; i < st->n_axes; i++)
+		board_cal_axis(c, st, i, width);
+}
+
+/* The kept FAULT, wrapped at word boundaries into at most 5 lines.
+ * Return: the lines added. */
+static int board_faults(struct re_console *c, int width)
 {
 	const char *p = c->fault;
 	int w = width - 1, k = 0;
 
-	if (!c->fault[0])
-		return;
-	while (*p && k++ < 5) {
+	while (*p && k < 5) {
 		int n = (int)strlen(p);
 
 		if (n > w) {
@@ -466,12 +603,48 @@ static void board_faults(struct re_console *c, int width)
 		}
 		board_printf(c, width, "%s%.*s%s", col(c, ANSI_RED), n, p,
 			     col(c, ANSI_OFF));
+		k++;
 		p += n;
 		while (*p == ' ')
 			p++;
 	}
-	for (int i = 0; i < c->nlater; i++)
-		board_printf(c, width, "later: %s", c->later[i]);
+	return k;
+}
+
+/* The later faults and warnings, newest first, at most @room lines
+ * (the last of them the log's path). */
+static void board_history(struct re_console *c, int width, int room)
+{
+	int n = c->nhist < room - 1 ? c->nhist : room - 1;
+
+	if (room < 1 || (!c->nhist && !c->fault[0]))
+		return;
+	for (int i = 0; i < n; i++) {
+		const struct re_console_event *h = &c->hist[i];
+		char times[16] = "";
+
+		if (h->count > 1)
+			snprintf(times, sizeof(times), " (x%u)", h->count);
+		const char *text = h->text;
+
+		/* "FAULT COMM: ..." is shown as "later FAULT COMM: ..." */
+		if (h->level == RE_LOG_FAULT && !strncmp(text, "FAULT ", 6))
+			text += 6;
+		board_printf(
+		    c, width, "%7.1f s %s%s%s%s%s %s", h->t_s,
+		    col(c, h->level == RE_LOG_FAULT ? ANSI_RED : ANSI_YELLOW),
+		    h->level == RE_LOG_FAULT ? "later FAULT" : "WARN",
+		    col(c, ANSI_OFF), times, text == h->text ? ":" : "", text);
+	}
+	if (!c->log_path[0])
+		return;
+	if (c->nhist > n)
+		board_printf(c, width, "%d older not shown; all in the log %s",
+			     c->nhist - n, c->log_path);
+	else
+		board_printf(c, width,
+			     "every fault and warning is in the log %s",
+			     c->log_path);
 }
 
 static int any_motor_on(const struct re_status *st)
@@ -496,26 +669,50 @@ static void term_size(struct re_console *c, int *cols, int *rows)
 	}
 }
 
-static void board_draw(struct re_console *c, const struct re_status *st,
+/* The last line: what the operator can do now. During a calibration
+ * only Ctrl-C is read (as a signal); the keys once the board runs, and
+ * only from a terminal. */
+static void board_keys(struct re_console *c, const struct re_status *st,
 		       int width)
 {
-	char ctl[64];
+	const char *other = c->counts ? "units" : "counts";
 
-	if (c->board_lines > 0)
-		frame_add(c, "\033[%dA\r\033[J", c->board_lines);
+	if (c->cal.active)
+		board_printf(c, width,
+			     "%s %.0f s, about %.0f s left; Ctrl-C stops it%s",
+			     c->cal.full ? "calibrating" : "checking the file",
+			     c->cal.elapsed_s, c->cal.left_s,
+			     c->cal.full ? " (old table kept)" : "");
+	else if (!c->tty_in)
+		board_printf(c, width,
+			     "%sno keyboard here: Ctrl-C or SIGTERM quits",
+			     st->latched ? "LATCHED: every motor off; " : "");
+	else
+		board_printf(c, width, "%skeys: q quit  t trace  u %s",
+			     st->latched ? "LATCHED: every motor off; " : "",
+			     other);
+}
+
+/* The board's lines for a terminal @width x @rows, added to the frame. */
+static void board_build(struct re_console *c, const struct re_status *st,
+			int width, int rows)
+{
+	char ctl[64];
+	int lines;
+
+	c->last_t_s = st->uptime_s;
 	ctrl_text(st, ctl, sizeof(ctl));
 	board_printf(
-	    c, width, "RoboELF  mode %s  up %.1f s  relay %s%s%s  link %s",
+	    c, width, "RoboELF  mode %s  up %.0f s  relay %s%s%s  link %s",
 	    st->mode_name, st->uptime_s,
 	    col(c, st->relay == RE_RELAY_ON ? ANSI_GREEN : ANSI_YELLOW),
 	    relay_text(st->relay), col(c, ANSI_OFF),
-	    st->link_ok ? "ok" : "DOWN");
-	board_faults(c, width);
-	board_printf(c, width,
-		     "ax encoder position         pot V expect "
-		     "margin  vel/s state   lim mot");
-	for (int i = 0; i < st->n_axes; i++)
-		board_axis(c, st, i, width);
+	    st->link_ok ? "ok" : "DOWN (stale)");
+	lines = 1 + board_faults(c, width);
+	/* the rest of the board: column header, axes, three lines */
+	lines += 1 + st->n_axes + 3;
+	board_history(c, width, rows - 1 - RE_CONSOLE_ROOM - lines);
+	board_axes(c, st, width);
 	board_printf(c, width,
 		     "watchdog %.1f ms (worst %.1f, warn %llu) period %.0f ms "
 		     "late %.1f/%.1f ms overruns %llu",
@@ -527,21 +724,85 @@ static void board_draw(struct re_console *c, const struct re_status *st,
 		     st->have_za ? cmd_text(st->za.jcmd) : "-",
 		     st->have_za && any_motor_on(st) ? cmd_text(st->za.mcmd)
 						     : "-");
-	board_printf(c, width, "%s",
-		     st->latched ? "LATCHED: every motor off; q quits"
-				 : "q: quit");
-	/* the lines now on screen: the next frame moves up over them */
-	c->board_lines = frame_send(c);
+	board_keys(c, st, width);
+}
+
+/* The board of @n lines (@text) on the bottom of a screen of @rows, the
+ * lines above it the scroll region. A taller board first scrolls the
+ * text up by the lines it takes (LFs from the text cursor, then back up),
+ * so that nothing written there is overwritten; a shorter one clears the
+ * lines it gives back. The text cursor is saved and restored around it. */
+static void board_place(struct re_console *c, const char *text, int n, int rows)
+{
+	int old = c->board_lines, top = rows - n + 1;
+
+	if (c->half)
+		frame_add(c, "\0338");
+	for (int k = old; k < n; k++)
+		frame_add(c, "\n");
+	if (n > old)
+		frame_add(c, "\033[%dA", n - old);
+	frame_add(c, "\0337");
+	if (n != old || c->redo)
+		frame_add(c, "\033[1;%dr", top - 1);
+	for (int r = rows - old + 1; r < top; r++)
+		frame_add(c, "\033[%d;1H\033[2K", r);
+	for (int i = 0; i < n; i++) {
+		const char *e = strchr(text, '\n');
+
+		frame_add(c, "\033[%d;1H\033[2K%.*s", top + i, (int)(e - text),
+			  text);
+		text = e + 1;
+	}
+	frame_add(c, "\0338");
+}
+
+static void board_draw(struct re_console *c, const struct re_status *st,
+		       int width, int rows)
+{
+	size_t start = c->frame_len, len, sent; /* a resize's reset first */
+	int n;
+
+	board_build(c, st, width, rows);
+	len = c->frame_len - start;
+	n = count_lines(c->frame + start, len);
+	memcpy(c->lines, c->frame + start, len);
+	c->lines[len] = '\0';
+	c->frame_len = start;
+	board_place(c, c->lines, n, rows);
+	len = c->frame_len;
+	sent = frame_send(c);
+	/* cut short: the saved cursor is restored first next time, and the
+	 * scroll region set again */
+	c->half = sent > 0 && sent < len;
+	c->redo = sent < len;
+	c->board_lines = sent > 0 ? n : c->board_lines;
+}
+
+/* The board off the screen for good (too small a terminal, quitting):
+ * the scroll region back to the whole screen, the board's lines cleared,
+ * the cursor where the text flows. */
+static void board_remove(struct re_console *c, FILE *out)
+{
+	if (!c->board_lines && !c->half)
+		return;
+	fprintf(out, "%s\0337\033[r\033[%d;1H\033[J\0338",
+		c->half ? "\0338" : "", c->rows - c->board_lines + 1);
+	fflush(out);
+	c->board_lines = 0;
+	c->half = 0;
+	c->redo = 0;
 }
 
 /* Board or status lines for this terminal: too small a terminal gets the
  * lines (said once); a resize redraws the board from the top. */
-static int board_fits(struct re_console *c, int *width)
+static int board_fits(struct re_console *c, int *width, int *height)
 {
 	int cols, rows;
 
 	term_size(c, &cols, &rows);
 	*width = cols;
+	*height = rows;
 	if (cols < RE_CONSOLE_MIN_COLS || rows < RE_CONSOLE_MIN_ROWS) {
 		if (!c->small_said++)
 			re_console_msg(
@@ -551,12 +812,14 @@ static int board_fits(struct re_console *c, int *width)
 			    "lines",
 			    cols, rows, RE_CONSOLE_MIN_COLS,
 			    RE_CONSOLE_MIN_ROWS);
-		c->board_lines = 0;
+		board_remove(c, c->out);
 		return 0;
 	}
-	if ((cols != c->cols || rows != c->rows) && c->board_lines > 0) {
-		frame_add(c, "\033[H\033[2J");
+	if ((cols != c->cols || rows != c->rows) && c->board_lines) {
+		/* a resize: the whole screen again, the board from scratch */
+		frame_add(c, "%s\033[r\033[H\033[2J", c->half ? "\0338" : "");
 		c->board_lines = 0;
+		c->half = 0;
 	}
 	c->cols = cols;
 	c->rows = rows;
@@ -569,13 +832,13 @@ void re_console_status(struct re_console *c, const struct re_status *st,
 {
 	char line[1024];
 	int64_t gap = c->tty_out ? RE_CONSOLE_BOARD_NS : RE_CONSOLE_LINE_NS;
-	int width = 80;
+	int width = 80, height = 24;
 
 	if (!force && c->last_draw_ns && now_ns - c->last_draw_ns < gap)
 		return;
 	c->last_draw_ns = now_ns;
-	if (c->tty_out && board_fits(c, &width)) {
-		board_draw(c, st, width);
+	if (c->tty_out && board_fits(c, &width, &height)) {
+		board_draw(c, st, width, height);
 		return;
 	}
 	re_console_format_line(st, line, sizeof(line));
@@ -584,6 +847,47 @@ void re_console_status(struct re_console *c, const struct re_status *st,
 	else
 		frame_add(c, "%s\n", line);
 	frame_send(c);
+}
+
+void re_console_units(struct re_console *c, int axis, const char *unit,
+		      double counts_per_unit)
+{
+	if (axis < 0 || axis >= RE_SUPER_AXES)
+		return;
+	snprintf(c->ax[axis].unit, sizeof(c->ax[axis].unit), "%s",
+		 unit ? unit : "");
+	c->ax[axis].per_unit = counts_per_unit > 0 ? counts_per_unit : 0;
+}
+
+void re_console_calib(struct re_console *c, const struct re_calib_progress *p)
+{
+	if (p && p->active)
+		c->cal = *p;
+	else
+		memset(&c->cal, 0, sizeof(c->cal));
+}
+
+void re_console_counts(struct re_console *c, int on)
+{
+	c->counts = !!on;
+}
+
+int re_console_render(struct re_console *c, const struct re_status *st,
+		      int cols, int rows, char *buf, size_t cap)
+{
+	int color = c->color, lines;
+
+	if (cols < RE_CONSOLE_MIN_COLS || rows < RE_CONSOLE_MIN_ROWS)
+		return -1;
+	c->color = 0;
+	c->frame_len = 0;
+	board_build(c, st, cols, rows);
+	lines = count_lines(c->frame, c->frame_len);
+	if (cap)
+		snprintf(buf, cap, "%.*s", (int)c->frame_len, c->frame);
+	c->frame_len = 0;
+	c->color = color;
+	return lines;
 }
 
 /* ---- questions ------------------------------------------------------------
@@ -616,6 +920,7 @@ enum re_calib_choice re_console_ask_calibration(struct re_console *c)
 
 	if (!c->tty_in)
 		return RE_CALIB_ASK;
+	re_console_flush_keys(c);
 	for (;;) {
 		re_console_msg(c, "Calibration: [f]ull (move every axis "
 				  "end to end) or [l]oad from file?");
@@ -635,6 +940,7 @@ int re_console_ask_yes(struct re_console *c, const char *question)
 
 	if (!c->tty_in)
 		return 0;
+	re_console_flush_keys(c);
 	for (;;) {
 		re_console_msg(c, "%s [y/n]", question);
 		if (read_answer(c, a, sizeof(a)) < 0)

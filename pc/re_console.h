@@ -4,20 +4,31 @@
  * calibration question.
  *
  * On a terminal: a status board redrawn in place at most 10 times a second
- * (per axis encoder counts, position as a 0-100 % bar, potentiometer volts
- * against the expected value and the margin left, velocity, motion state,
- * limit switches, motor on/off; relay state, watchdog latency last/worst,
- * loop period, lateness and overruns, controller fault, operating mode).
- * Messages (progress, warnings) scroll above the board. The first FAULT
- * line is also kept on the board, in a panel under the header, until the
- * program ends (later ones below it, newest first), so it cannot scroll
- * away. Every board line is cut to the terminal's width (never wraps); a
- * terminal narrower than RE_CONSOLE_MIN_COLS or lower than
- * RE_CONSOLE_MIN_ROWS gets the status lines instead, said once; a resize
- * redraws the board from the top of the screen.
- * Colour only on a terminal and only when NO_COLOR is unset (no-color.org)
- * and TERM is not "dumb". The keyboard is in raw mode (no echo, no line
- * buffering) between re_console_open() and re_console_close().
+ * (per axis the position in the robot's units - degrees for A and B, mm
+ * for C, from the configuration's counts_per_unit; encoder counts when
+ * asked for (re_console_counts(), key u) or when the scale is not known -
+ * a bar over the travel with the soft limits marked '|', potentiometer
+ * volts against the expected value and the margin left, velocity, motion
+ * state, limit switches, motor on/off; relay state, watchdog latency
+ * last/worst, loop period, lateness and overruns, controller fault,
+ * operating mode).
+ * The board is drawn at absolute positions on the bottom lines of the
+ * screen, and the lines above it are made the terminal's scroll region:
+ * messages (progress, warnings), and the text of any other program
+ * writing to the same terminal (the demo's narration), scroll there above
+ * the board and are never erased by it. The cursor is saved before and
+ * restored after every frame, so it always stays in that region. The first
+ * FAULT line is also kept on the board, in a panel under the header, until the
+ * program ends, so it cannot scroll away; below it the history of later
+ * faults and warnings (re_console_event()), newest first, as many as fit
+ * (repeats of one kind folded into one line with a count), and the log
+ * file's path (re_console_log_path()). Every board line is cut to the
+ * terminal's width (never wraps); a terminal narrower than RE_CONSOLE_MIN_COLS
+ * or lower than RE_CONSOLE_MIN_ROWS gets the status lines instead, said once; a
+ * resize redraws the board from the top of the screen. Colour only on a
+ * terminal and only when NO_COLOR is unset (no-color.org) and TERM is not
+ * "dumb". The keyboard is in raw mode (no echo, no line buffering) between
+ * re_console_open() and re_console_close().
  *
  * Not on a terminal: one "status ..." line per second, no escape codes.
  *
@@ -39,15 +50,26 @@
 #include <stdio.h>
 #include <termios.h>
 
+#include "re_calib.h"
 #include "re_super.h"
 
 #define RE_CONSOLE_BOARD_NS 100000000LL	 /* >= 100 ms between redraws */
 #define RE_CONSOLE_LINE_NS  1000000000LL /* 1 s between status lines */
 #define RE_CONSOLE_FRAME    4096	 /* one status frame, bytes */
 #define RE_CONSOLE_FAULT    512		 /* the first FAULT line kept, bytes */
-#define RE_CONSOLE_LATER    3  /* later FAULT lines kept on the board */
+#define RE_CONSOLE_HIST	    16		 /* later faults and warnings kept */
+#define RE_CONSOLE_ROOM                                                        \
+	4		       /* screen lines left above the board for        \
+				* messages (the demo's narration) */
 #define RE_CONSOLE_MIN_COLS 60 /* narrower: status lines, no board */
 #define RE_CONSOLE_MIN_ROWS 16 /* lower: status lines, no board */
+
+/* How an axis is shown: @unit "deg"/"mm", @per_unit counts per unit (0:
+ * not known, counts shown). */
+struct re_console_axis {
+	char unit[8];
+	double per_unit;
+};
 
 struct re_console {
 	FILE *out; /* stdout */
@@ -57,19 +79,35 @@ struct re_console {
 	int tty_in;  /* @in_fd is a terminal: raw keys, questions */
 	int color;
 	int raw;	 /* termios changed; restore on close */
-	int board_lines; /* lines of the board now on screen */
+	int board_lines; /* lines of the board now on screen (at the bottom,
+			  * under the scroll region); 0: none */
+	int half;	 /* the last frame was cut short: its saved cursor
+			  * must be restored before anything else */
+	int redo;	 /* ... and the scroll region set again */
 	int64_t last_draw_ns;
 	struct termios saved; /* the terminal before raw mode */
 	int nb_fd;	      /* non-blocking description of @out, or -1 */
 	uint64_t dropped;     /* status frames not (fully) written */
 	size_t frame_len;
 	char frame[RE_CONSOLE_FRAME];
+	char lines[RE_CONSOLE_FRAME]; /* the board's text, before positioning */
 	int cols, rows;		      /* the terminal at the last board */
 	int small_said;		      /* "terminal too small" was said */
 	char fault[RE_CONSOLE_FAULT]; /* the first FAULT, kept on the board */
-	char later[RE_CONSOLE_LATER][256]; /* later ones, newest first */
-	int nlater;
-	uint64_t nfaults; /* FAULT lines shown in all */
+	struct re_console_event {
+		double t_s;
+		enum re_log_level level;
+		enum re_event_kind kind;
+		unsigned count; /* folded repeats of this kind */
+		char text[RE_SUPER_EVENT_LEN];
+	} hist[RE_CONSOLE_HIST]; /* newest first */
+	int nhist;
+	char log_path[256]; /* shown under the history; "" none */
+	double last_t_s;    /* uptime of the last board */
+	uint64_t nfaults;   /* FAULT lines shown in all */
+	struct re_console_axis ax[RE_SUPER_AXES];
+	int counts;		      /* show encoder counts instead of units */
+	struct re_calib_progress cal; /* cal.active: calibration lines */
 };
 
 enum re_calib_choice {
@@ -92,6 +130,14 @@ int re_console_open(struct re_console *c, FILE *out, int in_fd);
  */
 void re_console_raw(struct re_console *c);
 
+/*
+ * re_console_flush_keys() - drop every key typed but not read yet, so that
+ * nothing typed in one phase acts in the next (keys typed during the
+ * calibration, before a question, before a fault). No-op without a
+ * terminal. Called by re_console_raw() and before each question.
+ */
+void re_console_flush_keys(struct re_console *c);
+
 /* re_console_restore() - give the terminal back its settings (idempotent;
  * async-signal-safe enough to call on the way out). */
 void re_console_restore(struct re_console *c);
@@ -113,6 +159,50 @@ void re_console_msg(struct re_console *c, const char *fmt, ...)
  * for good, later ones in the history (newest first).
  */
 void re_console_fault(struct re_console *c, const char *line);
+
+/*
+ * re_console_event() - a later fault or a warning (@ev) for the board's
+ * history, newest first; one of the same kind as the newest folds into it
+ * (its text replaced, a count kept). Without a terminal it is printed as
+ * one line ("roboelf: warning: ..." / "roboelf: later FAULT ESTOP: ...").
+ */
+void re_console_event(struct re_console *c, const struct re_event *ev);
+
+/* re_console_log_path() - the log file named under the history. */
+void re_console_log_path(struct re_console *c, const char *path);
+
+/*
+ * re_console_calib() - while a calibration (or the check of a file and
+ * the move to the centre) runs, the board shows per axis its phase, a bar
+ * of its position over the travel and the time left, instead of the axis
+ * lines; @p copied. NULL (or @p->active 0): the axis lines again.
+ */
+void re_console_calib(struct re_console *c, const struct re_calib_progress *p);
+
+/*
+ * re_console_units() - show axis @axis (0-based, < RE_SUPER_AXES) in
+ * @unit ("deg", "mm"; cut to 7 bytes) with @counts_per_unit encoder
+ * counts per unit; 0 (or less): the scale is not known, counts are shown.
+ */
+void re_console_units(struct re_console *c, int axis, const char *unit,
+		      double counts_per_unit);
+
+/*
+ * re_console_counts() - @on: show encoder counts (and counts/s) on the
+ * board instead of the units; 0: the units again. The next frame shows it.
+ */
+void re_console_counts(struct re_console *c, int on);
+
+/*
+ * re_console_render() - the board for @st as it would be drawn on a
+ * terminal of @cols x @rows, without colour or cursor movements (pure
+ * apart from @c's kept faults and settings; for tests and snapshots).
+ * @buf: [out] NUL-terminated lines, each ending in '\n'.
+ * Return: the number of lines, or -1 when @cols x @rows is below the
+ *         board's minimum (the status line is used there).
+ */
+int re_console_render(struct re_console *c, const struct re_status *st,
+		      int cols, int rows, char *buf, size_t cap);
 
 /*
  * re_console_status() - show @st: redraw the board when at least

@@ -28,7 +28,7 @@ struct re_fault_msg {
 /* clang-format off */
 static const struct re_fault_msg re_fault_table[] = {
 	{RE_F_ENCPOT, RE_FC_ENCODER,
-	 "axis {a}: potentiometer reads {f0} V but {f1} V is expected at encoder position {i0} counts (difference {f2} V above the tolerance {f3} V for {i1} cycles)",
+	 "axis {a}: potentiometer reads {f0} V but {f1} V is expected at encoder position {i0} counts (they differ by {f2} V, more than the {f3} V allowed, for {i1} cycles)",
 	 "keep the E-stop pressed, check the encoder and potentiometer cables of axis {a}, restart roboelf and recalibrate"},
 	{RE_F_ENC_OUTSIDE, RE_FC_ENCODER,
 	 "axis {a}: encoder position {i0} counts is outside the calibrated travel {i1} to {i2} counts",

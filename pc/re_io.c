@@ -169,14 +169,62 @@ static enum re_relay_state real_relay_state(void *ud)
 	return r->relay ? re_relay_state(r->relay) : RE_RELAY_UNKNOWN;
 }
 
+/* Inside a cycle: copy the event into the queue (no system call). */
+static void logq_put(struct re_io_real *r, enum re_log_level lvl,
+		     const char *text)
+{
+	struct re_io_logq_ent *e;
+
+	if (r->logq_n >= RE_IO_LOGQ) {
+		r->logq_dropped++;
+		return;
+	}
+	e = &r->logq[r->logq_n++];
+	e->lvl = lvl;
+	clock_gettime(CLOCK_REALTIME, &e->wall);
+	e->mono_ns = re_io_now_ns();
+	snprintf(e->text, sizeof(e->text), "%s", text);
+}
+
+int re_io_flush_log(struct re_io_real *r)
+{
+	int rc = GL_OK, e;
+
+	for (unsigned i = 0; i < r->logq_n; i++) {
+		const struct re_io_logq_ent *q = &r->logq[i];
+
+		if (!r->log || !r->log->is_open)
+			break;
+		e = re_log_write_at(r->log, q->lvl, &q->wall, q->mono_ns,
+				    q->text);
+		rc = rc ? rc : e;
+	}
+	r->logq_n = 0;
+	if (r->logq_dropped && r->log && r->log->is_open) {
+		e = re_log_msg(r->log, RE_LOG_WARN,
+			       "log: %lu events dropped (more than %d "
+			       "in one cycle)",
+			       r->logq_dropped, RE_IO_LOGQ);
+		rc = rc ? rc : e;
+	}
+	r->logq_dropped = 0;
+	return rc;
+}
+
 static int real_log(void *ud, enum re_log_level lvl, const char *text)
 {
 	struct re_io_real *r = ud;
 
 	if (!r->log || !r->log->is_open)
 		return GL_OK;
-	if (lvl == RE_LOG_FAULT)
+	if (lvl == RE_LOG_FAULT) { /* the fault path: in order, on disk */
+		re_io_flush_log(r);
 		return re_log_fault(r->log, "%s", text);
+	}
+	if (r->defer_log) {
+		logq_put(r, lvl, text);
+		return GL_OK;
+	}
 	return re_log_msg(r->log, lvl, "%s", text);
 }
 

@@ -17,6 +17,8 @@
 #include "gl_link.h"
 #include "gl_record.h"
 #include "re_log.h"
+
+#include <time.h>
 #include "re_relay.h"
 
 /*
@@ -78,6 +80,18 @@ struct re_io {
 	void *ud;
 };
 
+#define RE_IO_LOGQ     16  /* log events queued between two flushes */
+#define RE_IO_LOGQ_LEN 512 /* longer queued texts are cut */
+
+/* One INFO/WARN event queued inside a cycle (issue 17: no file write in
+ * the cycle), with the times it happened at. */
+struct re_io_logq_ent {
+	enum re_log_level lvl;
+	struct timespec wall; /* CLOCK_REALTIME (vDSO: no system call) */
+	int64_t mono_ns;
+	char text[RE_IO_LOGQ_LEN];
+};
+
 /* The real world: any member may be NULL (then its calls fail safely). */
 struct re_io_real {
 	gl_link *link;
@@ -89,6 +103,12 @@ struct re_io_real {
 	 * command: a moment this process is known to have run (roboelf's
 	 * SIGCONT handler reads it to measure a stop) */
 	volatile int64_t last_run_ns;
+	/* defer_log: INFO/WARN events are queued (FAULT ones flush the queue
+	 * and go to disk at once) until re_io_flush_log() */
+	int defer_log;
+	unsigned logq_n;
+	unsigned long logq_dropped;
+	struct re_io_logq_ent logq[RE_IO_LOGQ];
 };
 
 /*
@@ -97,6 +117,15 @@ struct re_io_real {
  * NULL relay GL_ERR_RELAY; log calls on a NULL or closed log do nothing.
  */
 void re_io_bind(struct re_io *io, struct re_io_real *real);
+
+/*
+ * re_io_flush_log() - write the INFO/WARN events queued while
+ * @real->defer_log was set, in order, with the times they happened at;
+ * then, if the queue overflowed, one WARN saying how many were dropped.
+ * Called between cycles (after the cycle's work), never inside one.
+ * Return: GL_OK, or the first error of re_log_write_at().
+ */
+int re_io_flush_log(struct re_io_real *real);
 
 /* re_io_now_ns() - CLOCK_MONOTONIC in ns (for callers without an io). */
 int64_t re_io_now_ns(void);

@@ -48,6 +48,34 @@ static void log_keep(struct re_super *s, enum re_log_level lvl,
 	snprintf(s->pending, sizeof(s->pending), "%s", text);
 }
 
+/* ---- later faults and warnings, for the console ------------------------ */
+
+void re_super_note(struct re_super *s, enum re_log_level lvl,
+		   enum re_event_kind kind, const char *text)
+{
+	struct re_event *e = &s->events[s->event_seq % RE_SUPER_EVENTS];
+
+	e->seq = ++s->event_seq;
+	e->t_s = (double)(now_ns(s) - s->t0_ns) / 1e9;
+	e->level = lvl;
+	e->kind = kind;
+	snprintf(e->text, sizeof(e->text), "%s", text);
+}
+
+int re_super_event(const struct re_super *s, uint64_t after,
+		   struct re_event *out)
+{
+	uint64_t oldest = s->event_seq > RE_SUPER_EVENTS
+			      ? s->event_seq - RE_SUPER_EVENTS + 1
+			      : 1;
+	uint64_t next = after + 1 > oldest ? after + 1 : oldest;
+
+	if (next > s->event_seq)
+		return 0;
+	*out = s->events[(next - 1) % RE_SUPER_EVENTS];
+	return 1;
+}
+
 int re_super_retry(struct re_super *s)
 {
 	int rc;
@@ -99,17 +127,16 @@ static void ctrl_fault_detail(struct re_super *s, struct re_fault *f)
 static int may_settle(const struct re_super *s, enum re_fault_id id)
 {
 	return s->cfg.settle_ms > 0 &&
-	       (id == RE_F_MOTOR_OFF || id == RE_F_THREAD ||
-		id == RE_F_STATE || id == RE_F_CTRL_STATE ||
-		id == RE_F_UNCMD);
+	       (id == RE_F_MOTOR_OFF || id == RE_F_THREAD || id == RE_F_STATE ||
+		id == RE_F_CTRL_STATE || id == RE_F_UNCMD);
 }
 
 /* The program's latched fault (code 0: none), read over the link. */
 static int program_fault(struct re_super *s, struct re_za *za, double *det)
 {
 	double code = 0, axis = 0;
-	int rc = re_io_read(&s->io, "fcode", &code,
-			    s->cfg.fault_cmd_timeout_ms);
+	int rc =
+	    re_io_read(&s->io, "fcode", &code, s->cfg.fault_cmd_timeout_ms);
 
 	memset(za, 0, sizeof(*za));
 	*det = RE_VAL_UNKNOWN;
@@ -173,7 +200,8 @@ static int stop_controller(struct re_super *s, struct re_fault *f)
 	if (rc >= 0) {
 		program_verdict(s, f);
 		s->io.ops->command(s->io.ud, "pcflt=1", s->resp,
-				   sizeof(s->resp), s->cfg.fault_cmd_timeout_ms);
+				   sizeof(s->resp),
+				   s->cfg.fault_cmd_timeout_ms);
 	}
 	return rc;
 }
@@ -257,9 +285,8 @@ static void consequences(struct re_super *s, const struct re_fault *f)
 	s->then[0] = '\0';
 	/* RELAY_POWER is the program's power loss, named with its cause */
 	if (s->confirm.stop_rc < 0 || re_fault_is_ctrl(f->id) ||
-	    f->id == RE_F_RELAY_POWER ||
-	    program_fault(s, &za, &det) != GL_OK || !za.fcode ||
-	    own_doing(&za, det))
+	    f->id == RE_F_RELAY_POWER || program_fault(s, &za, &det) != GL_OK ||
+	    !za.fcode || own_doing(&za, det))
 		return;
 	re_ctrl_fault(&za, (long long)det, &c);
 	if (re_fault_what(&c, s->cfg.axis_names, s->then, sizeof(s->then)) ==
@@ -267,7 +294,8 @@ static void consequences(struct re_super *s, const struct re_fault *f)
 		s->then[0] = '\0';
 }
 
-/* ---- the FAULT line ------------------------------------------------------- */
+/* ---- the FAULT line -------------------------------------------------------
+ */
 
 /* " Safe state confirmed: ..." or " NOT CONFIRMED: ... PRESS THE HARDWARE
  * E-STOP NOW." - inserted before the recovery text. */
@@ -281,11 +309,10 @@ static size_t confirm_text(const struct re_super *s, char *buf, size_t cap)
 		    " Safe state confirmed: motor power off (relay open), "
 		    "motors off.");
 	return (size_t)snprintf(
-	    buf, cap,
-	    " NOT CONFIRMED:%s%s%s PRESS THE HARDWARE E-STOP NOW.",
+	    buf, cap, " NOT CONFIRMED:%s%s%s PRESS THE HARDWARE E-STOP NOW.",
 	    c->relay_rc == GL_OK ? " motor power off (relay open) confirmed;"
 				 : " relay open not confirmed;",
-	    c->stop_rc < 0	   ? " stop command not delivered;"
+	    c->stop_rc < 0	    ? " stop command not delivered;"
 	    : c->motors_rc == GL_OK ? " motors off confirmed;"
 				    : " motors off not confirmed;",
 	    c->stop_rc < 0 ? " the controller did not answer." : "");
@@ -327,8 +354,7 @@ static void compose_line(struct re_super *s)
 	snprintf(tail, sizeof(tail), "%s", rec + 2);
 	n = (size_t)(rec - line) + 1;
 	if (s->then[0] && n < cap)
-		n += (size_t)snprintf(line + n, cap - n, " Then: %s.",
-				      s->then);
+		n += (size_t)snprintf(line + n, cap - n, " Then: %s.", s->then);
 	if (s->foreign && n < cap)
 		n += foreign_text(s->foreign, line + n, cap - n);
 	if (n < cap)
@@ -419,6 +445,7 @@ int re_super_fault(struct re_super *s, const struct re_fault *f)
 	if (s->latched) {
 		re_fault_format(f, s->cfg.axis_names, s->msg, sizeof(s->msg));
 		re_io_logf(&s->io, RE_LOG_WARN, "while latched: %s", s->msg);
+		re_super_note(s, RE_LOG_FAULT, RE_EV_LATER, s->msg);
 		return RE_OK;
 	}
 	s->verdict[0] = '\0';
@@ -455,9 +482,9 @@ int re_super_shutdown(struct re_super *s, char *what, size_t cap)
 
 	/* the program back to its safe state, so that the motors off is not
 	 * a fault to it; then the stop itself, whatever the program did */
-	off_rc = s->io.ops->command(s->io.ud, "offreq=1", s->resp,
-				   sizeof(s->resp),
-				   s->cfg.fault_cmd_timeout_ms);
+	off_rc =
+	    s->io.ops->command(s->io.ud, "offreq=1", s->resp, sizeof(s->resp),
+			       s->cfg.fault_cmd_timeout_ms);
 	if (off_rc >= 0)
 		s->io.ops->sleep_until(s->io.ud,
 				       now_ns(s) + 25 * BASE_NS_PER_MS);
@@ -467,10 +494,12 @@ int re_super_shutdown(struct re_super *s, char *what, size_t cap)
 	s->armed = 0;
 	s->expect = 0;
 	if (what)
-		snprintf(what, cap, "motors off: %s; motor power off (relay): %s",
-			 mo_rc == GL_OK ? "confirmed" : rc_text(mo_rc, "NOT confirmed"),
-			 relay_rc == GL_OK ? "confirmed"
-					   : rc_text(relay_rc, "NOT confirmed"));
+		snprintf(
+		    what, cap, "motors off: %s; motor power off (relay): %s",
+		    mo_rc == GL_OK ? "confirmed"
+				   : rc_text(mo_rc, "NOT confirmed"),
+		    relay_rc == GL_OK ? "confirmed"
+				      : rc_text(relay_rc, "NOT confirmed"));
 	if (mo_rc != GL_OK)
 		return mo_rc < 0 ? mo_rc : GL_ERR_MISMATCH;
 	return relay_rc;

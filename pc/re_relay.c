@@ -98,7 +98,7 @@ struct re_relay {
 	bool reopen;		  /* "off" could not be written */
 	int rb_due;		  /* state queries sent, not answered */
 	bool rb_discard;	  /* the answers due predate a write */
-	int64_t rb_sent_ns;	  /* the oldest query due was sent (base_now_ns) */
+	int64_t rb_sent_ns; /* the oldest query due was sent (base_now_ns) */
 	char err[RE_RELAY_ERR_MAX];
 };
 
@@ -464,12 +464,12 @@ static int send_wait(struct re_relay *r, const uint8_t *msg, size_t len,
 
 /* The device node by stat(): after a watch event, once a second, and in
  * every call while it fails. */
-static int node_check(struct re_relay *r)
+static int node_check(struct re_relay *r, int events)
 {
 	int64_t now = base_now_ns();
 	struct stat st;
 
-	if (!re_pathwatch_changed(&r->pw) && !r->node_suspect &&
+	if (!(events && re_pathwatch_changed(&r->pw)) && !r->node_suspect &&
 	    now < r->next_full_ns)
 		return GL_OK;
 	r->next_full_ns = now + FULL_CHECK_NS;
@@ -484,27 +484,36 @@ static int node_check(struct re_relay *r)
 	return GL_OK;
 }
 
-/* Descriptor, hang-up and device node; no byte written. */
+/* Descriptor, hang-up and device node; no byte written. One poll() with
+ * timeout 0 looks at the descriptor (POLLNVAL: it is gone) and at the
+ * inotify watch of the path together (issue 17: one system call per cycle
+ * when nothing happened). */
 static int link_check(struct re_relay *r)
 {
-	struct pollfd p = {.events = POLLIN};
-	int fd;
+	struct pollfd p[2] = {{.events = POLLIN}, {.events = POLLIN}};
+	int fd, np;
 
 	if (!r->linked)
 		return set_err(r, GL_ERR_RELAY, "port not open");
 	fd = r->ops->fd(&r->io);
-	if (fd < 0 || fcntl(fd, F_GETFD) < 0)
+	if (fd < 0)
 		return set_err(r, GL_ERR_RELAY, "descriptor lost: %s",
-			       strerror(fd < 0 ? EBADF : errno));
-	p.fd = fd;
-	if (poll(&p, 1, 0) < 0 && errno != EINTR)
+			       strerror(EBADF));
+	p[0].fd = fd;
+	p[1].fd = r->pw.fd;
+	np = r->pw.fd >= 0 ? 2 : 1;
+	if (poll(p, (nfds_t)np, 0) < 0 && errno != EINTR)
 		return set_err(r, GL_ERR_RELAY, "poll failed: %s",
 			       strerror(errno));
-	if (p.revents & POLLHUP)
+	if (p[0].revents & POLLNVAL)
+		return set_err(r, GL_ERR_RELAY, "descriptor lost: %s",
+			       strerror(EBADF));
+	if (p[0].revents & POLLHUP)
 		return set_err(r, GL_ERR_RELAY, "link lost (hang-up)");
-	if (p.revents & (POLLERR | POLLNVAL))
+	if (p[0].revents & POLLERR)
 		return set_err(r, GL_ERR_RELAY, "link error");
-	return node_check(r);
+	/* no watch: re_pathwatch_changed() answers 1 (stat every call) */
+	return node_check(r, np < 2 || p[1].revents != 0);
 }
 
 /*
@@ -612,8 +621,8 @@ static int ics_record(struct re_relay *r, const char *id, uint8_t model)
 	n = snprintf(text, sizeof(text), "%s model=0x%02X\n", id, model);
 	if (n < 0 || (size_t)n >= sizeof(text))
 		n = (int)strlen(text);
-	if (base_durable_write(r->cfg.icstation_state, text, (size_t)n,
-			       0644) == 0)
+	if (base_durable_write(r->cfg.icstation_state, text, (size_t)n, 0644) ==
+	    0)
 		return GL_OK;
 	return set_err(r, GL_ERR_RELAY,
 		       "cannot record the icstation "

@@ -14,6 +14,7 @@
 #include "base_clock.h"
 #include "gl_err.h"
 #include "gl_link.h"
+#include "gl_route.h"
 #include "re_comm_find.h"
 
 struct re_signals re_sig;
@@ -101,6 +102,50 @@ static int start_relay(struct app *a)
 	return 0;
 }
 
+/* The route's minimum retransmission time (docs/link.md): a frame lost on
+ * the cable must be resent soon enough that the reply still comes within
+ * the critical reply-age limit. None, or one above the limit, refuses a
+ * clinical start and is a warning in development mode. A loopback
+ * controller (the simulator on this PC) has no cable: not checked. */
+static int check_route(struct app *a)
+{
+	int fd = gl_link_fd(a->real.link), ms = 0, rc;
+	int crit = (int)(a->cfg.watchdog.critical_factor * a->cfg.period_ms);
+	int limit = gl_route_rto_limit_ms(crit, a->cfg.period_ms);
+	char host[256], port[16], what[700];
+
+	if (gl_route_peer_loopback(fd) == 1)
+		return 0;
+	if (gl_link_addr_split(a->cfg.controller.address, host, sizeof(host),
+			       port, sizeof(port)) != GL_OK)
+		snprintf(host, sizeof(host), "%s", a->cfg.controller.address);
+	rc = gl_route_rto_min_ms(fd, 1000, &ms);
+	if (rc == GL_OK && ms > 0 && ms <= limit) {
+		progress(a,
+			 "route to the controller: rto_min %d ms (limit %d "
+			 "ms)",
+			 ms, limit);
+		return 0;
+	}
+	if (rc != GL_OK)
+		snprintf(what, sizeof(what),
+			 "cannot read the route to the controller '%s': %s",
+			 host,
+			 rc == GL_ERR_SYS ? strerror(errno) : gl_strerror(rc));
+	else
+		snprintf(what, sizeof(what),
+			 "the route to the controller '%s' has rto_min %d ms "
+			 "(limit %d ms): one lost frame would trip WATCHDOG; "
+			 "run 'ip route replace %s dev <interface> rto_min "
+			 "%dms' (docs/link.md)",
+			 host, ms ? ms : GL_ROUTE_DEFAULT_RTO_MIN_MS, limit,
+			 host, limit < 5 ? limit : 5);
+	if (a->cfg.mode == RE_MODE_CLINICAL)
+		return fail(a, what);
+	progress(a, "warning: %s", what);
+	return 0;
+}
+
 /* Connect, identify, refuse a controller another supervisor runs, close
  * the other connections, check the program's identity. */
 static int start_link(struct app *a)
@@ -118,6 +163,8 @@ static int start_link(struct app *a)
 	a->real.link = l;
 	a->real.address = a->cfg.controller.address;
 	a->real.cmd_timeout_ms = a->cfg.controller.timeout_ms;
+	if (check_route(a))
+		return EXIT_CONNECT;
 	if (re_ctl_identify(l, &a->cfg, &a->info, a->err, sizeof(a->err)) ||
 	    re_ctl_check_busy(&a->io, a->cfg.watchdog.controller_timeout_ms,
 			      a->err, sizeof(a->err)) ||
@@ -376,20 +423,38 @@ void re_start_show_foreign(struct app *a, unsigned mask)
 		       hs);
 }
 
+void re_start_show_events(struct app *a)
+{
+	struct re_event ev;
+
+	while (a->sup && re_super_event(a->sup, a->ev_seen, &ev)) {
+		a->ev_seen = ev.seq;
+		re_console_event(&a->con, &ev);
+	}
+}
+
 /* The calibration's sampler: one supervised cycle per sample. */
 static int sample_cb(void *ud, const struct gl_record **rec)
 {
 	struct app *a = ud;
+	struct re_calib_progress prog;
 	struct re_status st;
 	int v;
 
 	if (re_sig.quit)
 		return GL_ERR_AGAIN;
 	re_super_wait(a->sup);
+	a->real.defer_log = 1; /* no file write in the cycle (issue 17) */
 	v = re_super_cycle(a->sup);
+	a->real.defer_log = 0;
 	re_super_status(a->sup, &st);
 	re_start_show_foreign(a, st.foreign);
+	re_start_show_events(a);
+	re_calib_progress(a->calrun, a->calcfg, &a->sup->rec, re_io_now_ns(),
+			  &prog);
+	re_console_calib(&a->con, &prog);
 	re_console_status(&a->con, &st, re_io_now_ns(), 0);
+	re_io_flush_log(&a->real); /* after the cycle (issue 17) */
 	if (v == RE_FAULT) {
 		re_console_fault(&a->con, re_super_fault_line(a->sup));
 		return RE_FAULT;
@@ -517,6 +582,50 @@ static void save_calibration(struct app *a)
 	drop_backup(a);
 }
 
+/* An interrupted calibration: which table is in force now - the one of
+ * the file (kept, unchanged), or none (the next start needs a full
+ * calibration) - on the console and in the log. */
+static void say_table_in_force(struct app *a, const struct re_calib_cfg *cc)
+{
+	const char *file = a->cfg.calibration.file;
+	struct re_calfile_expect e;
+	struct re_calset *old;
+	char serial[32];
+	int rc;
+
+	if (a->calib != RE_CALIB_FULL) {
+		progress(a,
+			 "calibration interrupted: the table in force is "
+			 "still the one loaded from '%s' (made %s), "
+			 "unchanged",
+			 file, a->cal->date);
+		return;
+	}
+	old = calloc(1, sizeof(*old));
+	fill_expect(a, cc, &e, serial);
+	rc = old ? re_calfile_load(file, &e, old, a->err, sizeof(a->err))
+		 : GL_ERR_NOMEM;
+	if (rc == GL_OK)
+		progress(a,
+			 "calibration interrupted: no new table; the table "
+			 "in force is still the one in '%s' (made %s), "
+			 "kept unchanged: the next start can load it",
+			 file, old->date);
+	else if (rc == GL_ERR_NOENT)
+		progress(a,
+			 "calibration interrupted: no table is in force "
+			 "('%s' does not exist): the next start needs a "
+			 "full calibration",
+			 file);
+	else
+		progress(a,
+			 "calibration interrupted: no table is in force "
+			 "('%s' was not changed but cannot be used: %s): "
+			 "the next start needs a full calibration",
+			 file, a->err);
+	free(old);
+}
+
 /* The chosen procedure in the service state. Return: 0, EXIT_FAULT, or
  * 0 with re_sig.quit set (interrupted). */
 static int run_calibration(struct app *a, struct re_calib *c,
@@ -537,8 +646,7 @@ static int run_calibration(struct app *a, struct re_calib *c,
 	if (rc == RE_FAULT)
 		return latch(a, &f);
 	if (rc == GL_ERR_AGAIN) {
-		progress(a, "calibration interrupted: '%s' was not changed",
-			 a->cfg.calibration.file);
+		say_table_in_force(a, cc);
 		return 0;
 	}
 	if (rc != GL_OK) {
@@ -562,7 +670,12 @@ static int calibrate(struct app *a)
 	re_calib_cfg_from(&a->cfg, &a->plan, a->names, &cc);
 	cc.stop = &re_sig.quit;
 	cc.sampler = (struct re_calib_sampler){sample_cb, own_cb, tables_cb, a};
+	a->calrun = c;
+	a->calcfg = &cc;
 	rc = run_calibration(a, c, &cc);
+	a->calrun = NULL;
+	a->calcfg = NULL;
+	re_console_calib(&a->con, NULL);
 	re_calib_free(c);
 	return rc;
 }
@@ -692,6 +805,8 @@ static int commission_link(struct app *a)
 	a->real.link = l;
 	a->real.address = a->cfg.controller.address;
 	a->real.cmd_timeout_ms = a->cfg.controller.timeout_ms;
+	if (check_route(a))
+		return EXIT_CONNECT;
 	if (re_ctl_identify(l, &a->cfg, &a->info, a->err, sizeof(a->err)) ||
 	    re_ctl_check_busy(&a->io, a->cfg.watchdog.controller_timeout_ms,
 			      a->err, sizeof(a->err)))

@@ -26,6 +26,7 @@
 #include "re_plan.h"
 #include "re_rec.h"
 #include "re_relay.h"
+#include "re_rt.h"
 #include "re_super.h"
 
 /* roboelf's exit codes (roboelf.1). */
@@ -33,8 +34,10 @@
 #define EXIT_CONNECT	3
 #define EXIT_FAULT	4
 #define EXIT_COMMISSION 5 /* the commissioning run found a fault */
+#define EXIT_HOST	6 /* --check-host: the configured period is not safe */
 #define DEFAULT_CONFIG	"config/roboelf.yaml"
-#define SYSTEM_CONFIG	"/etc/roboelf/roboelf.yaml" /* the installed one */
+/* the installed one, under SYSCONFDIR (base_paths.h) */
+#define SYSTEM_CONFIG "roboelf/roboelf.yaml"
 
 struct opts {
 	const char *config; /* -c, or the one found (roboelf.1, FILES) */
@@ -45,12 +48,16 @@ struct opts {
 	const char *show_trace; /* --show-trace FILE (issue 16) */
 	const char *window;	/* --window FROM:TO */
 	int config_searched;	/* no -c: find_config() chose it */
+	const char *dmc;	/* --dmc DIR: the DMC programs (--version) */
+	int version;		/* --version asked */
 	const char *commission; /* report directory */
 	int wait_s;	       /* commissioning: each wait for the technician */
 	const char *find_addr; /* commissioning: discovery probe address */
 	int find_port;	       /* and its port (0: the defaults) */
 	int period_ms;	       /* 0: from the configuration */
+	int counts;	       /* --counts: the board in encoder counts */
 	enum re_calib_choice calib;
+	int check_host_s; /* --check-host[=S]: seconds of the probe, 0: no */
 };
 
 struct app {
@@ -66,12 +73,16 @@ struct app {
 	struct re_plan plan;
 	struct re_calset *cal;
 	struct re_super *sup;
-	struct re_rec *rec; /* flight recorder (issue 16), NULL: none */
+	struct re_rec *rec;    /* flight recorder (issue 16), NULL: none */
+	struct re_rt_state rt; /* real time in force (issue 17) */
 	const char *names[RE_AXES];
 	long hbpc;
 	int calib;   /* the operator's choice: RE_CALIB_FULL / _FILE */
 	int powered; /* the relay was switched on at some point */
-	unsigned foreign_shown; /* other programs' handles already shown */
+	unsigned foreign_shown;	 /* other programs' handles already shown */
+	uint64_t ev_seen;	 /* the supervisor's events already shown */
+	struct re_calib *calrun; /* the calibration running, or NULL */
+	const struct re_calib_cfg *calcfg; /* its settings */
 	int ctl_ours; /* the controller was taken over: ours to stop */
 	char err[RE_CONFIG_ERR_MAX];
 };
@@ -121,5 +132,12 @@ int64_t re_start_stall_limit_ms(const struct app *a);
  * but the operator is told once per handle, on the console and in the log.
  */
 void re_start_show_foreign(struct app *a, unsigned mask);
+
+/*
+ * re_start_show_events() - the supervisor's later faults and warnings not
+ * shown yet go to the console's history (re_super_event(), in order).
+ * No-op before the supervisor exists.
+ */
+void re_start_show_events(struct app *a);
 
 #endif /* RE_START_H */

@@ -165,6 +165,23 @@ static int check_stall(struct re_super *s, struct re_fault *f)
 	return RE_FAULT;
 }
 
+/* "hbpc=N" into @buf (32 bytes; N < RE_HBPC_WRAP, 10 digits at most)
+ * without snprintf: the one command text built every cycle (issue 17). */
+static void hb_prefix(char *buf, long hb)
+{
+	char dig[16];
+	int n = 0;
+
+	memcpy(buf, "hbpc=", 5);
+	do {
+		dig[n++] = (char)('0' + hb % 10);
+		hb /= 10;
+	} while (hb > 0 && n < (int)sizeof(dig));
+	for (int i = 0; i < n; i++)
+		buf[5 + i] = dig[n - 1 - i];
+	buf[5 + n] = '\0';
+}
+
 /* The round trip and the PC-side watchdog verdict on it. */
 static int exchange(struct re_super *s, struct re_fault *f)
 {
@@ -172,7 +189,7 @@ static int exchange(struct re_super *s, struct re_fault *f)
 	int rc, v, tmo = reply_timeout_ms(s);
 
 	s->hbpc = (s->hbpc + 1) % RE_HBPC_WRAP;
-	snprintf(s->prefix, sizeof(s->prefix), "hbpc=%ld", s->hbpc);
+	hb_prefix(s->prefix, s->hbpc);
 	rc = s->io.ops->record(s->io.ud, s->prefix, &s->rec, tmo);
 	now = now_ns(s);
 	s->link_ok = rc == GL_OK;
@@ -218,11 +235,13 @@ static int exchange(struct re_super *s, struct re_fault *f)
 static void warn_watchdog(struct re_super *s)
 {
 	s->wd_warnings++;
-	re_io_logf(&s->io, RE_LOG_WARN,
-		   "watchdog: reply after %.1f ms "
-		   "(non-critical limit %.1f ms, critical %.1f ms)",
-		   ns_to_ms(s->age_last_ns), ns_to_ms(s->noncrit_ns),
-		   ns_to_ms(s->crit_ns));
+	snprintf(s->text, sizeof(s->text),
+		 "watchdog: reply after %.1f ms "
+		 "(non-critical limit %.1f ms, critical %.1f ms)",
+		 ns_to_ms(s->age_last_ns), ns_to_ms(s->noncrit_ns),
+		 ns_to_ms(s->crit_ns));
+	re_io_logf(&s->io, RE_LOG_WARN, "%s", s->text);
+	re_super_note(s, RE_LOG_WARN, RE_EV_WATCHDOG, s->text);
 }
 
 static int check_relay(struct re_super *s, struct re_fault *f)
@@ -336,9 +355,10 @@ static void watch_handles(struct re_super *s)
 		if (fresh >> h & 1)
 			hs[n++] = (char)('A' + h);
 	hs[n] = '\0';
-	re_io_logf(&s->io, RE_LOG_WARN,
-		   "another program connected to the controller (handle %s)",
-		   hs);
+	snprintf(s->text, sizeof(s->text),
+		 "another program connected to the controller (handle %s)", hs);
+	re_io_logf(&s->io, RE_LOG_WARN, "%s", s->text);
+	re_super_note(s, RE_LOG_WARN, RE_EV_FOREIGN, s->text);
 }
 
 static void drain_messages(struct re_super *s)
@@ -402,6 +422,7 @@ static int latched_cycle(struct re_super *s)
 		re_fault_format(&scratch, s->cfg.axis_names, s->text,
 				sizeof(s->text));
 		re_io_logf(&s->io, RE_LOG_WARN, "while latched: %s", s->text);
+		re_super_note(s, RE_LOG_FAULT, RE_EV_RELAY, s->text);
 	}
 	drain_messages(s);
 	return RE_OK;
@@ -482,6 +503,9 @@ static void axis_status(const struct re_super *s, int i,
 			   (t->soft_fwd - t->soft_rev) * 100.0;
 
 		out->pos_pct = p < 0 ? 0 : p > 100 ? 100 : p;
+		out->soft_rev_counts = t->soft_rev;
+		out->soft_fwd_counts = t->soft_fwd;
+		out->have_soft = 1;
 	}
 	out->have_expect = s->have_encres[i];
 	out->pot_expected_v = s->encres[i].exp.pot_v;

@@ -39,9 +39,29 @@
 #include "re_io.h"
 #include "re_pot.h"
 
-#define RE_SUPER_AXES 3
-#define RE_SUPER_LINE 768 /* FAULT line, bytes incl. NUL */
-#define RE_SUPER_MSGS 8	  /* unsolicited lines drained per cycle */
+#define RE_SUPER_AXES	   3
+#define RE_SUPER_LINE	   768 /* FAULT line, bytes incl. NUL */
+#define RE_SUPER_MSGS	   8   /* unsolicited lines drained per cycle */
+#define RE_SUPER_EVENTS	   16  /* later faults and warnings kept */
+#define RE_SUPER_EVENT_LEN 240 /* one of them, bytes incl. NUL */
+
+/* What a kept event is about (the console folds repeats of one kind). */
+enum re_event_kind {
+	RE_EV_OTHER = 0,
+	RE_EV_WATCHDOG, /* a late reply (non-critical) */
+	RE_EV_FOREIGN,	/* another program at the controller */
+	RE_EV_LATER,	/* a fault while another is latched */
+	RE_EV_RELAY,	/* the relay failed while latched */
+};
+
+/* A warning or a later fault, for the console's history (also logged). */
+struct re_event {
+	uint64_t seq;		 /* 1, 2, ... in the order they happened */
+	double t_s;		 /* since the supervisor started, s */
+	enum re_log_level level; /* RE_LOG_WARN or RE_LOG_FAULT */
+	enum re_event_kind kind;
+	char text[RE_SUPER_EVENT_LEN];
+};
 
 struct re_super_cfg {
 	int n_axes;		   /* 1..RE_SUPER_AXES */
@@ -71,7 +91,10 @@ struct re_super_cfg {
 /* Per-axis view for the status board. */
 struct re_axis_status {
 	int32_t enc_counts;
-	double pos_pct; /* 0..100 between the soft limits; -1 unknown */
+	double pos_pct;		/* 0..100 between the soft limits; -1 unknown */
+	double soft_rev_counts; /* the soft limits (valid when have_soft) */
+	double soft_fwd_counts;
+	int have_soft;
 	double pot_v;
 	double pot_expected_v;
 	double margin_v; /* tolerance - |pot - expected|; < 0 outside */
@@ -109,8 +132,8 @@ struct re_status {
 	uint64_t overruns;
 	uint64_t wd_warnings; /* non-critical watchdog events */
 	int armed;
-	int expect; /* program state expected: RE_DMC_ARMED, _SERVICE, 0 */
-	int link_ok; /* last round trip succeeded */
+	int expect;	 /* program state expected: RE_DMC_ARMED, _SERVICE, 0 */
+	int link_ok;	 /* last round trip succeeded */
 	struct re_za za; /* program fields (valid when have_za) */
 	int have_za;
 	const char *mode_name;
@@ -173,6 +196,10 @@ struct re_super {
 	struct re_confirm confirm;
 	char fault_line[RE_SUPER_LINE];
 	int relay_lost_logged; /* relay failure while latched, logged once */
+	/* later faults and warnings for the console: a fixed ring (no
+	 * allocation in the cycle), read with re_super_event() */
+	struct re_event events[RE_SUPER_EVENTS];
+	uint64_t event_seq; /* the newest event's seq, 0: none yet */
 	/* a log entry that could not be written, kept for re_super_retry() */
 	int log_failing;
 	enum re_log_level pending_lvl;
@@ -287,6 +314,24 @@ int re_super_fault(struct re_super *s, const struct re_fault *f);
 
 /* re_super_fault_line() - the latched FAULT line, "" when not latched. */
 const char *re_super_fault_line(const struct re_super *s);
+
+/*
+ * re_super_note() - keep @text (cut to RE_SUPER_EVENT_LEN - 1 bytes) in the
+ * ring of later faults and warnings, as the newest, overwriting the oldest
+ * when full. Does not log (the caller does). No allocation, no I/O.
+ * @lvl: RE_LOG_WARN or RE_LOG_FAULT.
+ */
+void re_super_note(struct re_super *s, enum re_log_level lvl,
+		   enum re_event_kind kind, const char *text);
+
+/*
+ * re_super_event() - the oldest kept event newer than @after (a seq; 0 for
+ * the first). Events overwritten before they were read are skipped.
+ * @out: [out] a copy.
+ * Return: 1 when one was copied, 0 when none is newer.
+ */
+int re_super_event(const struct re_super *s, uint64_t after,
+		   struct re_event *out);
 
 /*
  * re_super_retry() - write a log entry that failed before (the FAULT entry

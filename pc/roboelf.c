@@ -5,6 +5,7 @@
  *
  *   roboelf [-c FILE] [--galil HOST[:PORT]] [--relay PORT]
  *           [--calibration full|file] [--period MS] [--log FILE]
+ *           [--counts]
  *   roboelf --show-calibration FILE
  *
  * Exit codes: 0 normal quit; 2 configuration or usage error (also: a
@@ -25,7 +26,9 @@
  * re_super_fault(). Power-off is the reverse (re_super_shutdown()).
  */
 #include <errno.h>
+#include <limits.h>
 #include <getopt.h>
+#include <sched.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -35,6 +38,7 @@
 #include <unistd.h>
 
 #include "base_clock.h"
+#include "base_paths.h"
 #include "base_version.h"
 #include "gl_err.h"
 #include "gl_link.h"
@@ -53,6 +57,7 @@
 #include "re_plan.h"
 #include "re_rec.h"
 #include "re_relay.h"
+#include "re_rt.h"
 #include "re_start.h"
 #include "re_traceshow.h"
 #include "re_super.h"
@@ -114,6 +119,17 @@ static void install_signals(void)
 
 /* ---- options ----------------------------------------------------------- */
 
+/* The installed configuration: SYSCONFDIR/roboelf/roboelf.yaml, under
+ * ROBOELF_ROOT when that is set (base_paths.h); "" when it does not fit. */
+static const char *system_config(void)
+{
+	static char path[RE_PATH_MAX];
+
+	if (!path[0])
+		base_paths_sysconf(SYSTEM_CONFIG, path, sizeof(path));
+	return path;
+}
+
 static void usage(FILE *f)
 {
 	fprintf(
@@ -121,10 +137,12 @@ static void usage(FILE *f)
 	    "usage: roboelf [-c FILE] [--galil HOST[:PORT]] [--relay PORT]\n"
 	    "               [--calibration full|file] [--period MS] "
 	    "[--log FILE]\n"
+	    "               [--counts]\n"
 	    "       roboelf --show-calibration FILE\n"
 	    "       roboelf --show-trace FILE [--window FROM:TO]\n"
 	    "       roboelf --commission DIR [-c FILE] [--galil ...] "
 	    "[--wait S]\n"
+	    "       roboelf --check-host[=SECONDS] [-c FILE]\n"
 	    "\n"
 	    "  -c, --config FILE        configuration (default %s, else "
 	    "%s)\n"
@@ -135,6 +153,8 @@ static void usage(FILE *f)
 	    "the tables\n"
 	    "      --period MS          supervisor period, 2..100 ms\n"
 	    "      --log FILE           failure log\n"
+	    "      --counts             the board in encoder counts, not "
+	    "deg/mm (key u toggles)\n"
 	    "      --show-calibration FILE  print a calibration file (and "
 	    "plot it)\n"
 	    "      --show-trace FILE    check a flight-recorder trace and "
@@ -148,13 +168,19 @@ static void usage(FILE *f)
 	    "      --find-addr A, --find-port P  commissioning: where the "
 	    "discovery probe goes\n"
 	    "                           (255.255.255.255, 50000)\n"
+	    "      --check-host[=S]     measure this host's wake-up "
+	    "lateness for S s (10) and\n"
+	    "                           name the shortest safe period\n"
+	    "      --dmc DIR            the DMC programs --version names "
+	    "(default ./dmc, else the installed ones)\n"
 	    "  -h, --help               this text\n"
-	    "      --version            the release and the DMC interface "
-	    "it expects\n"
+	    "      --version            the release, the DMC interface it "
+	    "expects, the files it uses\n"
 	    "\n"
 	    "exit: 0 quit, 2 usage/config, 3 no relay/controller, "
-	    "4 fault latched, 5 commissioning found a fault\n",
-	    DEFAULT_CONFIG, SYSTEM_CONFIG);
+	    "4 fault latched, 5 commissioning found a fault,\n"
+	    "      6 --check-host: the configured period is not safe here\n",
+	    DEFAULT_CONFIG, system_config());
 }
 
 static int parse_period(const char *s, int *out)
@@ -193,6 +219,7 @@ static int opt_value(struct opts *o, int c, const char *arg)
 	case 'w': o->window = arg; return 0;
 	case 'M': o->commission = arg; return 0;
 	case 'F': o->find_addr = arg; return 0;
+	case 'D': o->dmc = arg; return 0;
 	case 'P':
 		o->find_port = atoi(arg);
 		if (o->find_port >= 1 && o->find_port <= 65535)
@@ -206,6 +233,15 @@ static int opt_value(struct opts *o, int c, const char *arg)
 		fprintf(stderr,
 			"roboelf: error: invalid wait '%s': must be 1..3600 "
 			"s\n",
+			arg);
+		return -1;
+	case 'H':
+		o->check_host_s = arg ? atoi(arg) : 10;
+		if (o->check_host_s >= 1 && o->check_host_s <= 3600)
+			return 0;
+		fprintf(stderr,
+			"roboelf: error: invalid --check-host '%s': must be "
+			"1..3600 s\n",
 			arg);
 		return -1;
 	case 'p':
@@ -245,8 +281,11 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 	    {"wait", required_argument, NULL, 'W'},
 	    {"find-addr", required_argument, NULL, 'F'},
 	    {"find-port", required_argument, NULL, 'P'},
+	    {"check-host", optional_argument, NULL, 'H'},
+	    {"dmc", required_argument, NULL, 'D'},
 	    {"help", no_argument, NULL, 'h'},
 	    {"version", no_argument, NULL, 'V'},
+	    {"counts", no_argument, NULL, 'U'},
 	    {NULL, 0, NULL, 0},
 	};
 	int c;
@@ -258,11 +297,13 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 			usage(stdout);
 			return 1;
 		}
+		if (c == 'U') {
+			o->counts = 1;
+			continue;
+		}
 		if (c == 'V') {
-			printf("roboelf %s (controller program interface %s, "
-			       "dmc/constants.dmc vers)\n",
-			       ROBOELF_VERSION, ROBOELF_DMC_VERSION);
-			return 1;
+			o->version = 1;
+			continue;
 		}
 		if (opt_value(o, c, optarg) < 0)
 			return -1;
@@ -310,16 +351,49 @@ static int check_analog(const struct re_config *c, char *err, size_t len)
 }
 
 /* Without -c: ./config/roboelf.yaml (the source tree), then the
- * installed /etc/roboelf/roboelf.yaml; the first that exists. */
+ * installed SYSCONFDIR/roboelf/roboelf.yaml; the first that exists. */
 static void find_config(struct opts *o)
 {
 	if (o->config)
 		return;
 	o->config_searched = 1;
 	o->config = access(DEFAULT_CONFIG, F_OK) == 0 ||
-			    access(SYSTEM_CONFIG, F_OK) != 0
+			    access(system_config(), F_OK) != 0
 			? DEFAULT_CONFIG
-			: SYSTEM_CONFIG;
+			: system_config();
+}
+
+/* --version: the release, the DMC interface, and the files this roboelf
+ * would use from here: its configuration and the DMC programs that go
+ * with it (--dmc, else ./dmc, else the installed ones). */
+static int print_version(struct opts *o)
+{
+	char dir[RE_PATH_MAX], manifest[RE_PATH_MAX + 16];
+
+	printf("roboelf %s (controller program interface %s, "
+	       "dmc/constants.dmc vers)\n",
+	       ROBOELF_VERSION, ROBOELF_DMC_VERSION);
+	find_config(o);
+	if (!o->config_searched)
+		printf("configuration: %s (-c)\n", o->config);
+	else if (access(o->config, F_OK) == 0)
+		printf("configuration: %s\n", o->config);
+	else
+		printf("configuration: none (neither %s here nor %s)\n",
+		       DEFAULT_CONFIG, system_config());
+	if (o->dmc) {
+		snprintf(manifest, sizeof(manifest), "%s/MANIFEST", o->dmc);
+		printf("DMC programs: %s (--dmc%s)\n", o->dmc,
+		       access(manifest, F_OK) == 0 ? ""
+						   : "; it has no MANIFEST");
+	} else if (base_paths_dmc_dir(dir, sizeof(dir)) == 0) {
+		printf("DMC programs: %s\n", dir);
+	} else {
+		printf("DMC programs: none (neither dmc/MANIFEST here nor "
+		       "%s/MANIFEST)\n",
+		       dir);
+	}
+	return 0;
 }
 
 static int load_config(struct app *a)
@@ -333,10 +407,17 @@ static int load_config(struct app *a)
 				"roboelf: no configuration: neither '%s' (in "
 				"this directory) nor '%s' exists; give one "
 				"with -c FILE\n",
-				DEFAULT_CONFIG, SYSTEM_CONFIG);
+				DEFAULT_CONFIG, system_config());
 		return -1;
 	}
 	apply_overrides(a);
+	if (a->cfg.mode == RE_MODE_CLINICAL && base_paths_root()) {
+		fprintf(stderr,
+			"roboelf: error: %s is set: refused in clinical mode "
+			"(it is for testing a staged installation); unset it\n",
+			BASE_PATHS_ROOT_ENV);
+		return -1;
+	}
 	if (re_config_validate(&a->cfg, a->err, sizeof(a->err)) != GL_OK ||
 	    check_analog(&a->cfg, a->err, sizeof(a->err)) != GL_OK) {
 		fprintf(stderr, "roboelf: error: %s\n", a->err);
@@ -516,25 +597,43 @@ static void close_recorder(struct app *a)
 	a->rec = NULL;
 }
 
+#define KEY_POLL_MS 100 /* the keyboard is read this often, ms */
+
 /* Every period until the operator quits; a latched fault keeps the status
  * board running. A terminal that went away (end of input) quits. */
 static void run(struct app *a)
 {
 	struct re_status st;
-	int64_t next_retry = 0;
-	int key = 0;
+	int64_t next_retry = 0, next_key = 0;
+	int key = 0, v;
 
 	re_console_raw(&a->con);
 	while (!re_sig.quit) {
 		re_super_wait(a->sup);
-		if (re_super_cycle(a->sup) == RE_FAULT)
+		a->real.defer_log = 1; /* no file write in the cycle */
+		v = re_super_cycle(a->sup);
+		a->real.defer_log = 0;
+		if (v == RE_FAULT) {
 			re_console_fault(&a->con, re_super_fault_line(a->sup));
+			/* keys typed before the fault do not act after it */
+			re_console_flush_keys(&a->con);
+		}
 		re_super_status(a->sup, &st);
 		re_start_show_foreign(a, st.foreign);
+		re_start_show_events(a);
 		re_console_status(&a->con, &st, re_io_now_ns(), 0);
+		re_io_flush_log(&a->real); /* after the cycle (issue 17) */
 		retry_log(a, &next_retry);
-		key = re_console_key(&a->con);
+		/* the keyboard every KEY_POLL_MS, not every cycle (issue 17) */
+		if (re_io_now_ns() >= next_key) {
+			next_key = re_io_now_ns() + KEY_POLL_MS * 1000000LL;
+			key = re_console_key(&a->con);
+		}
 		trace_tick(a, key);
+		if (key == 'u' || key == 'U') {
+			re_console_counts(&a->con, !a->con.counts);
+			re_console_status(&a->con, &st, re_io_now_ns(), 1);
+		}
 		if (key == 'q' || key == 'Q' || key < 0)
 			break;
 		key = 0;
@@ -591,11 +690,105 @@ static void power_off(struct app *a, int latched)
 		   "stop: %s%s", what, latched ? " (fault latched)" : "");
 }
 
+/* ---- real time (issue 17) ------------------------------------------------ */
+
+/* SCHED_FIFO, locked memory and a CPU as configured, for this thread only
+ * (the recorder's writer thread, started before, keeps the normal policy);
+ * what is in force is read back from the kernel and logged. A period the
+ * result cannot hold is refused. Return: 0, or -1 (said on stderr). */
+static int rt_setup(struct app *a)
+{
+	const struct re_config_realtime *r = &a->cfg.realtime;
+	struct re_rt_cfg rc = {r->priority, r->cpu, r->lock_memory};
+	char d[RE_RT_DESCRIBE_MAX];
+	int refused = re_rt_setup(&rc, &a->rt) < 0, pol = -1, prio = 0;
+	long kb = -1;
+
+	re_rt_describe(&a->rt, d, sizeof(d));
+	re_rt_readback(&pol, &prio, &kb);
+	re_log_msg(&a->log, refused ? RE_LOG_WARN : RE_LOG_INFO,
+		   "real time: %s; read back: policy %s priority %d, "
+		   "VmLck %ld kB",
+		   d, pol == SCHED_FIFO ? "SCHED_FIFO" : "normal", prio, kb);
+	if (a->cfg.period_ms < re_rt_min_period_ms(&a->rt)) {
+		fprintf(stderr,
+			"roboelf: error: a %d ms period needs real-time "
+			"scheduling, and this host gave %s: run as root or "
+			"give roboelf CAP_SYS_NICE (docs/supervisor.md, "
+			"\"Real time\"), or use a period of %d ms or more\n",
+			a->cfg.period_ms, d, re_rt_min_period_ms(&a->rt));
+		return -1;
+	}
+	if (refused && a->rt.err_fifo)
+		re_console_msg(&a->con,
+			       "roboelf: note: real time: %s; periods under "
+			       "%d ms are refused",
+			       d, RE_RT_MIN_MS_WITHOUT);
+	return 0;
+}
+
+/* --check-host: this host's wake-up lateness under the configured real-
+ * time set-up, and the verdict per period. Return: 0, EXIT_HOST when the
+ * configured period is not safe, EXIT_USAGE when the probe failed. */
+static int check_host(struct app *a)
+{
+	static const int cand[] = {2, 3, 5, 10, 20, 50, 100};
+	const struct re_config_realtime *r = &a->cfg.realtime;
+	const struct re_config_watchdog *w = &a->cfg.watchdog;
+	struct re_rt_cfg rc = {r->priority, r->cpu, r->lock_memory};
+	struct re_rt_probe p;
+	struct re_rt_verdict v;
+	char d[RE_RT_DESCRIBE_MAX];
+	int best = 0, own_safe;
+
+	install_signals();
+	re_rt_setup(&rc, &a->rt);
+	printf("host check: %s\n", re_rt_describe(&a->rt, d, sizeof(d)));
+	printf("host check: sleeping to 1 ms deadlines for %d s ...\n",
+	       a->o.check_host_s);
+	fflush(stdout);
+	if (re_rt_probe_run(1000000, a->o.check_host_s * 1000000000LL,
+			    &re_sig.quit, &p) < 0 ||
+	    p.wakes == 0) {
+		fprintf(stderr, "roboelf: error: host check: %s\n",
+			strerror(errno));
+		return EXIT_USAGE;
+	}
+	printf("host check: %llu wake-ups, late p50 %.3f p99 %.3f p99.9 %.3f "
+	       "max %.3f ms; %llu later than 1 ms, %llu later than 5 ms\n",
+	       (unsigned long long)p.wakes, p.p50_ms, p.p99_ms, p.p999_ms,
+	       p.max_ms, (unsigned long long)p.over_1ms,
+	       (unsigned long long)p.over_5ms);
+	printf("period  lateness allowed  verdict (watchdog %.1f/%.1f x P)\n",
+	       w->noncritical_factor, w->critical_factor);
+	for (size_t i = 0; i < sizeof(cand) / sizeof(cand[0]); i++) {
+		re_rt_verdict(&p, cand[i], w->noncritical_factor,
+			      w->critical_factor, &v);
+		if (v.safe && cand[i] >= re_rt_min_period_ms(&a->rt) && !best)
+			best = cand[i];
+		printf("%4d ms  %8.1f ms        %s\n", cand[i], v.margin_ms,
+		       cand[i] < re_rt_min_period_ms(&a->rt)
+			   ? "refused without real-time scheduling"
+		       : !v.safe ? "NOT SAFE: would trip WATCHDOG"
+		       : v.quiet ? "safe"
+				 : "safe, with occasional watchdog warnings");
+	}
+	re_rt_verdict(&p, a->cfg.period_ms, w->noncritical_factor,
+		      w->critical_factor, &v);
+	own_safe = v.safe && a->cfg.period_ms >= re_rt_min_period_ms(&a->rt);
+	printf("host check: shortest safe period on this host: %s%d ms; the "
+	       "configured %d ms (%s) is %s\n",
+	       best ? "" : "none of these; more than ", best ? best : 100,
+	       a->cfg.period_ms, a->o.config, own_safe ? "safe" : "NOT SAFE");
+	return own_safe ? 0 : EXIT_HOST;
+}
+
 /* Return: 1 when a fault was latched. */
 static int cleanup(struct app *a)
 {
 	int latched = a->sup && a->sup->latched;
 
+	re_io_flush_log(&a->real);
 	power_off(a, latched);
 	close_recorder(a);
 	re_lock_release(&a->lock_relay);
@@ -609,11 +802,25 @@ static int cleanup(struct app *a)
 	return latched;
 }
 
+/* The console: the board in each axis's unit (or counts, --counts). */
+static void open_console(struct app *a)
+{
+	char abs[PATH_MAX];
+
+	re_console_open(&a->con, stdout, STDIN_FILENO);
+	re_console_log_path(
+	    &a->con, realpath(a->cfg.log.path, abs) ? abs : a->cfg.log.path);
+	for (int i = 0; i < RE_AXES; i++)
+		re_console_units(&a->con, i, re_unit_name(a->cfg.axes[i].unit),
+				 a->cfg.axes[i].counts_per_unit);
+	re_console_counts(&a->con, a->o.counts);
+}
+
 static int supervise(struct app *a)
 {
 	int rc;
 
-	re_console_open(&a->con, stdout, STDIN_FILENO);
+	open_console(a);
 	if (a->o.calib == RE_CALIB_ASK && !a->con.tty_in) {
 		fprintf(stderr, "roboelf: error: no terminal to ask full or "
 				"file calibration: use --calibration full or "
@@ -627,7 +834,7 @@ static int supervise(struct app *a)
 	re_lock_init(&a->lock_relay);
 	re_io_bind(&a->io, &a->real);
 	install_signals();
-	if (open_recorder(a) < 0) {
+	if (open_recorder(a) < 0 || rt_setup(a) < 0) {
 		re_console_close(&a->con);
 		re_log_close(&a->log);
 		return EXIT_USAGE;
@@ -769,11 +976,22 @@ int main(int argc, char **argv)
 
 	if (rc)
 		return rc > 0 ? 0 : EXIT_USAGE;
+	if (base_paths_root())
+		fprintf(stderr,
+			"roboelf: %s=%s: the installed files are looked for "
+			"under it\n",
+			BASE_PATHS_ROOT_ENV, base_paths_root());
+	if (a.o.version)
+		return print_version(&a.o);
 	if (a.o.show_cal)
 		return show_calibration(&a);
 	if (a.o.show_trace)
 		return show_trace(&a);
-	if (load_config(&a) < 0 || open_log(&a) < 0)
+	if (load_config(&a) < 0)
+		return EXIT_USAGE;
+	if (a.o.check_host_s)
+		return check_host(&a);
+	if (open_log(&a) < 0)
 		return EXIT_USAGE;
 	if (a.o.commission)
 		return commission(&a);

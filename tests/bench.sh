@@ -34,6 +34,13 @@ $CC -O2 -Wall -Wextra -shared -fPIC -o "$BUILD/bench/alloc_count.so" \
 	--alloc-lib "$TOP/$BUILD/bench/alloc_count.so" \
 	--faults-bin "$TOP/$BUILD/tests/system/test_sys_faults"
 
+# The host latency self-test (roboelf --check-host): this machine's wake-up
+# lateness under the configured real-time set-up and the shortest safe period.
+echo
+echo "bench: host self-test (roboelf --check-host=${ROBOELF_BENCH_HOST_S:-10})"
+"$BUILD/bin/roboelf" -c config/roboelf.yaml \
+	--check-host="${ROBOELF_BENCH_HOST_S:-10}" || true
+
 # The loops again with real-time scheduling (SCHED_FIFO 50, inherited by
 # galil-sim and roboelf), where this user may use it: the 2 ms period needs
 # it on an ordinary Linux (docs/supervisor.md). The fault matrix is not

@@ -1,7 +1,12 @@
 #!/bin/sh
 # run-all.sh - run every test binary under $BUILD/tests, then the script checks
 # in tests/checks/*.sh. Each cmocka binary prints its own summary; this script
-# ends with one line "N passed, N failed" counting test programs.
+# ends with one line "N passed, N failed, N skipped" counting test programs.
+# With arguments (e.g. "net"), only those test directories run, no checks.
+#
+# A program that exits 77 was SKIPPED (e.g. tests/net without root): it is
+# reported as such, never counted as passed; with ROBOELF_NO_SKIP=1 a skip
+# counts as a failure (make netrig).
 #
 # A test program counts as passed only if it exits 0 AND its output has no
 # cmocka "[  FAILED  ]" or "[  ERROR   ]" line (cmocka 1.1.5 returns 0 when a
@@ -15,12 +20,12 @@ export BUILD ROBOELF_BIN ROBOELF_TOP
 cd "$ROBOELF_TOP" || exit 1
 LOGDIR=$BUILD/test-logs
 mkdir -p "$LOGDIR"
-passed=0; failed=0; failures=""
+passed=0; failed=0; skipped=0; failures=""
 # Per-program deadline (s): a hung test fails with exit 124 instead of hanging
 # the run; system tests get more (ROBOELF_TEST_TIMEOUT overrides both).
 deadline() {
 	case $1 in
-	system/*) echo "${ROBOELF_TEST_TIMEOUT:-600}" ;;
+	system/* | net/*) echo "${ROBOELF_TEST_TIMEOUT:-600}" ;;
 	*) echo "${ROBOELF_TEST_TIMEOUT:-180}" ;;
 	esac
 }
@@ -33,7 +38,9 @@ run() { # run NAME KIND CMD... ; KIND = cmocka | script
 	rc=$?
 	cat "$log"
 	res=ok
-	if [ "$rc" -eq 124 ] || [ "$rc" -eq 137 ]; then
+	if [ "$rc" -eq 77 ]; then
+		res="SKIPPED ($(grep -m1 '^SKIP' "$log"))"
+	elif [ "$rc" -eq 124 ] || [ "$rc" -eq 137 ]; then
 		res="FAILED (timed out after $(deadline "$name") s)"
 	elif [ "$rc" -ne 0 ]; then
 		res="FAILED (exit $rc)"
@@ -46,21 +53,26 @@ run() { # run NAME KIND CMD... ; KIND = cmocka | script
 	fi
 	if [ "$res" = ok ]; then
 		passed=$((passed + 1))
+	elif [ "$rc" -eq 77 ] && [ "${ROBOELF_NO_SKIP:-0}" != 1 ]; then
+		skipped=$((skipped + 1))
 	else
 		failed=$((failed + 1)); failures="$failures $name"
 	fi
 	echo "=== $name: $res ($(( $(date +%s) - start )) s)"
 }
-for dir in unit load sim dmc system; do
+dirs=${*:-unit load sim dmc system net}
+for dir in $dirs; do
 	for t in "$BUILD/tests/$dir"/test_*; do
 		[ -x "$t" ] || continue
 		run "$dir/$(basename "$t")" cmocka "$t"
 	done
 done
-for s in tests/checks/*.sh; do
+checks="tests/checks/*.sh"
+[ $# -gt 0 ] && checks=""
+for s in $checks; do
 	[ -f "$s" ] || continue
 	run "checks/$(basename "$s")" script "$(head -1 "$s" | grep -q bash && echo bash || echo sh)" "$s"
 done
 [ -n "$failures" ] && echo "failed:$failures"
-echo "$passed passed, $failed failed"
+echo "$passed passed, $failed failed, $skipped skipped"
 [ "$failed" -eq 0 ] && [ "$passed" -gt 0 ]

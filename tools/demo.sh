@@ -8,11 +8,15 @@
 # invalid switch state that must not trip, and finally a potentiometer fault
 # that must trip the E-stop. It ends by naming the flight recorder's trace
 # of that fault (kept in $BUILD/demo/) and the PNG pages roboelf
-# --show-trace drew from it. Every process it starts is stopped on exit,
-# whatever happens.
+# --show-trace drew from it, and the directory $BUILD/demo/run-<time>
+# where roboelf ran (its log, calibration file and output). roboelf's board
+# keeps to the bottom of the terminal; this narration scrolls above it.
+# roboelf is stopped by a SIGTERM to itself (an orderly quit), every other
+# process it starts by its process group; on exit, whatever happens.
 #
 # INTERACTIVE=1: no script; drive the joysticks and inject faults from the
-# keyboard (keys shown on start).
+# keyboard (keys shown on start, each one says what it did); q quits
+# roboelf, s or f starts it again, Q ends the demo.
 set -u
 set -m # each background job in its own process group, stopped as a group
 BUILD=${BUILD:-build}
@@ -33,7 +37,7 @@ stop() { # stop PID: SIGTERM to its process group, SIGKILL after 5 s
 	wait "$1" 2>/dev/null
 }
 cleanup() {
-	[ -n "$RE_PID" ] && stop "$RE_PID"
+	[ -n "$RE_PID" ] && stop_roboelf
 	[ -n "$SIM_PID" ] && stop "$SIM_PID"
 	rm -rf "$TMP"
 }
@@ -62,6 +66,17 @@ ctl() {
 	printf '%s\n' "$ans"
 }
 
+# latch AXIS DIR: a key holds a joystick (both switches) until space
+latch() {
+	ctl "joy $1 $2" >/dev/null
+	say "key $key: joystick $1 $2 LATCHED (stays pressed until space); another joystick as well is two commands: an INPUT fault"
+}
+# inject KEY REQUEST WHAT: a fault injected in galil-sim
+inject() {
+	ctl "$2" >/dev/null
+	say "key $1: injected: $3"
+}
+
 say "starting galil-sim (default robot)"
 "$BIN/galil-sim" --port 0 --control-port 0 --relay-link "$TMP/relay" \
 	>"$TMP/sim.out" 2>"$TMP/sim.err" &
@@ -79,36 +94,84 @@ if [ "${INTERACTIVE:-}" = 1 ]; then
 	say "  a/z axis A fwd/rev, s/x B, d/c C: the joystick STAYS pressed until space"
 	say "  space: every joystick neutral; i: A fwd on one channel only (invalid:"
 	say "  held 0.5 s it is an INPUT fault); p pot fault B, e encoder stuck A,"
-	say "  j jam C, r relay unplug, q quit"
+	say "  j jam C, r relay unplug; q quits roboelf (then s or f starts it again), Q ends the demo"
 fi
 
 # roboelf runs on a pseudo-terminal made by script(1), so that it shows its
-# live status board here while its output is also kept in a file to watch.
-# It runs in $TMP: the calibration table and the log go there.
-say "starting roboelf (full calibration)"
-(cd "$TMP" && exec script -qfec "exec '$BIN/roboelf' -c '$TOP/config/roboelf.yaml' \
-	--galil '$addr' --relay '$TMP/relay' --calibration full --log '$TMP/roboelf.log'" \
-	"$TMP/roboelf.out" </dev/null) &
-RE_PID=$!
-wait_line "$TMP/roboelf.out" 'RoboELF Ready for Use' 60 || die "roboelf did not become ready"
+# live status board here (on the bottom lines; this narration scrolls
+# above it) while its output is also kept in a file to watch. It runs in
+# $RUN: the calibration table and the log stay there after the demo.
+start_roboelf() { # start_roboelf full|file
+	(cd "$RUN" && exec script -qfec "exec '$BIN/roboelf' -c '$TOP/config/roboelf.yaml' \
+		--galil '$addr' --relay '$TMP/relay' --calibration $1 --log '$RUN/roboelf.log'" \
+		"$RUN/roboelf.out" </dev/null) &
+	RE_PID=$!
+}
+# stop_roboelf: SIGTERM to roboelf itself (the child of script), which
+# quits in order and ends script quietly; the group only if it hangs.
+stop_roboelf() {
+	local pid i
+	[ -n "$RE_PID" ] || return 0
+	pid=$(ps -o pid= --ppid "$RE_PID" 2>/dev/null | head -n 1)
+	[ -n "$pid" ] && kill -TERM "$pid" 2>/dev/null
+	for i in $(seq 100); do
+		kill -0 "$RE_PID" 2>/dev/null || break
+		sleep 0.1
+	done
+	kill -0 "$RE_PID" 2>/dev/null && stop "$RE_PID"
+	wait "$RE_PID" 2>/dev/null
+	RE_PID=""
+}
+RUN="$TOP/$BUILD/demo/run-$(date +%Y%m%d-%H%M%S)"
+mkdir -p "$RUN" || die "cannot make $RUN"
+say "starting roboelf (full calibration); its log and calibration file go to $RUN"
+start_roboelf full
+wait_line "$RUN/roboelf.out" 'RoboELF Ready for Use' 60 || die "roboelf did not become ready"
 
 if [ "${INTERACTIVE:-}" = 1 ]; then
 	# keys typed during start-up and calibration must not move the robot
 	# once it is armed: drop them
 	while IFS= read -r -s -n 1 -t 0.01 _ <&3; do :; done
-	say "keys are read now"
+	say "keys are read now (a/z s/x d/c joysticks, space release, i p e j r faults, q quit roboelf)"
 	while IFS= read -r -s -n 1 key <&3; do
+		if [ -z "$RE_PID" ]; then
+			case "$key" in
+			s|f) how=file; [ "$key" = f ] && how=full
+			   say "key $key: starting roboelf again (calibration: $how)"
+			   start_roboelf "$how"
+			   wait_line "$RUN/roboelf.out" 'RoboELF Ready for Use' 90 ||
+				say "roboelf did not become ready (see its messages above; after an encoder fault the file no longer fits: f): s, f or Q"
+			   # keys typed while it started are dropped
+			   while IFS= read -r -s -n 1 -t 0.01 _ <&3; do :; done ;;
+			Q) break ;;
+			*) say "roboelf is not running: s starts it again (calibration from the file), f with a full calibration, Q ends the demo" ;;
+			esac
+			continue
+		fi
 		case "$key" in
-		a) ctl "joy A fwd" ;; z) ctl "joy A rev" ;;
-		s) ctl "joy B fwd" ;; x) ctl "joy B rev" ;;
-		d) ctl "joy C fwd" ;; c) ctl "joy C rev" ;;
-		" ") for ax in A B C; do ctl "joy $ax neutral"; done ;;
-		i) ctl "joy A fwd a" ;;
-		p) ctl "pot B offset 0.5" ;; e) ctl "enc A stuck" ;;
-		j) ctl "block C 1" ;; r) ctl "relayfault unplug" ;;
-		q) break ;;
-		esac >/dev/null
+		a) latch A fwd ;; z) latch A rev ;;
+		s) latch B fwd ;; x) latch B rev ;;
+		d) latch C fwd ;; c) latch C rev ;;
+		" ") for ax in A B C; do ctl "joy $ax neutral" >/dev/null; done
+		     say "key space: every joystick RELEASED (neutral)" ;;
+		i) ctl "joy A fwd a" >/dev/null
+		   say "key i: axis A fwd switch a only: LATCHED (an invalid state: held 0.5 s it is an INPUT fault; space releases)" ;;
+		p) inject p "pot B offset 0.5" "potentiometer B +0.5 V" ;;
+		e) inject e "enc A stuck" "encoder A stuck" ;;
+		j) inject j "block C 1" "axis C jammed" ;;
+		r) inject r "relayfault unplug" "relay unplugged" ;;
+		q) say "key q: quitting roboelf (as its own q does)"
+		   stop_roboelf
+		   for ax in A B C; do ctl "joy $ax neutral" >/dev/null; done
+		   for req in "pot B ok" "enc A ok" "block C 0" "relayfault ok"; do
+			ctl "$req" >/dev/null
+		   done
+		   say "roboelf stopped (every joystick released, injected faults cleared): s starts it again (calibration from the file), f with a full calibration, Q ends the demo" ;;
+		Q) break ;;
+		esac
 	done
+	stop_roboelf
+	say "the log and the calibration file are kept in $RUN"
 	exit 0
 fi
 
@@ -125,28 +188,29 @@ for ax in A B C; do
 done
 say "joystick: axis B, only channel a closed for 0.2 s (a transient invalid state: must not trip)"
 ctl "joy B fwd a" >/dev/null; sleep 0.2; ctl "joy B neutral" >/dev/null; sleep 1
-grep -q 'FAULT [A-Z]*:' "$TMP/roboelf.out" && die "a transient invalid state tripped the system"
+grep -q 'FAULT [A-Z]*:' "$RUN/roboelf.out" && die "a transient invalid state tripped the system"
 
 say "injecting a potentiometer fault on axis B (offset +0.5 V): the E-stop must trip"
 ctl "joy B fwd" >/dev/null
 ctl "pot B offset 0.5" >/dev/null
-wait_line "$TMP/roboelf.out" 'FAULT ENCODER:' 5 || die "the potentiometer fault did not trip"
+wait_line "$RUN/roboelf.out" 'FAULT ENCODER:' 5 || die "the potentiometer fault did not trip"
 [ "$(ctl relay)" = off ] || die "the relay is still on after the fault"
-say "relay: $(ctl relay); $(grep -o -m1 'FAULT ENCODER:.*' "$TMP/roboelf.out" | tr -d '\r')"
+say "relay: $(ctl relay); $(grep -o -m1 'FAULT ENCODER:.*' "$RUN/roboelf.out" | tr -d '\r')"
 
 # The flight recorder (issue 16): the fault's trace is written
 # recorder.after_fault_s (2 s) after the fault; kept in $BUILD/demo and drawn.
 say "waiting for the flight recorder's trace of the fault (written 2 s after it)"
-wait_line "$TMP/roboelf.log" 'trace: .* written' 10 || die "no trace of the fault was written"
-trace=$(sed -n 's/.* trace: \(.*\) written (.*/\1/p' "$TMP/roboelf.log" | head -n 1)
+wait_line "$RUN/roboelf.log" 'trace: .* written' 10 || die "no trace of the fault was written"
+trace=$(sed -n 's/.* trace: \(.*\) written (.*/\1/p' "$RUN/roboelf.log" | head -n 1)
 OUT="$TOP/$BUILD/demo"
 mkdir -p "$OUT" && cp "$trace" "$OUT/" || die "cannot keep the trace in $OUT"
 trace="$OUT/$(basename "$trace")"
 "$BIN/roboelf" --show-trace "$trace" >"$TMP/show.out" 2>"$TMP/show.err" ||
 	die "roboelf --show-trace failed: $(cat "$TMP/show.err")"
 say "demo finished: stopping roboelf and galil-sim"
-stop "$RE_PID"; RE_PID=""
+stop_roboelf
 stop "$SIM_PID"; SIM_PID=""
 say "the fault's trace: $trace"
 say "its plots: $(sed -n 's/^wrote //p' "$TMP/show.out" | tr '\n' ' ')"
+say "the log, the calibration file and roboelf's output are kept in $RUN"
 exit 0

@@ -173,6 +173,13 @@ static void sock_options(int fd)
 
 	/* small command lines must leave at once, not wait for Nagle */
 	setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof(one));
+	/* a thin stream (one command in flight): a lost frame is resent
+	 * after the route's rto_min again, not after twice the last wait, for
+	 * the first retransmissions (docs/link.md); ignored where unknown */
+#ifdef TCP_THIN_LINEAR_TIMEOUTS
+	setsockopt(fd, IPPROTO_TCP, TCP_THIN_LINEAR_TIMEOUTS, &one,
+		   sizeof(one));
+#endif
 	/* a dead controller or cable surfaces even while the link is idle */
 	setsockopt(fd, SOL_SOCKET, SO_KEEPALIVE, &one, sizeof(one));
 #ifdef TCP_KEEPIDLE
@@ -308,6 +315,9 @@ static int chan_write(gl_link *l, struct gl_chan *ch, const void *buf,
 
 /*
  * Read what is there (one recv) into the parser. @deadline < 0: do not wait.
+ * When waiting is allowed the socket is polled first: a reply awaited is
+ * rarely there yet, and poll + recv is one system call fewer than a recv
+ * that finds nothing, then poll, then recv (issue 17: the lean cycle).
  * Return: GL_OK (bytes fed), GL_ERR_AGAIN (nothing without waiting),
  *         GL_ERR_TIMEOUT, GL_ERR_CLOSED, GL_ERR_SYS.
  */
@@ -322,6 +332,11 @@ static int chan_read(gl_link *l, struct gl_chan *ch, int64_t deadline)
 		want = sizeof(buf);
 	if (want == 0)
 		return GL_ERR_PROTO; /* cannot happen: next() drains input */
+	if (deadline >= 0) {
+		rc = wait_fd(ch->fd, POLLIN, deadline);
+		if (rc < 0)
+			return rc;
+	}
 	for (;;) {
 		n = recv(ch->fd, buf, want, 0);
 		if (n > 0)
@@ -594,11 +609,16 @@ int gl_link_record(gl_link *l, const char *prefix, struct gl_record *rec,
 	if (l->layout == GL_LAYOUT_NONE && (rc = gl_link_query_layout(l)) < 0)
 		return rc;
 	ctrl_clear(l);
-	rc = snprintf(line, sizeof(line), "%s%sQR", prefix ? prefix : "",
-		      prefix ? ";" : "");
-	if (rc < 0 || (size_t)rc >= sizeof(line))
+	/* "PREFIX;QR" by hand: this is built every cycle (no snprintf) */
+	x.len = prefix ? strlen(prefix) : 0;
+	if (x.len + 3 >= sizeof(line))
 		return GL_ERR_ARG;
-	x.len = (size_t)rc;
+	if (prefix) {
+		memcpy(line, prefix, x.len);
+		line[x.len++] = ';';
+	}
+	memcpy(line + x.len, "QR", 3);
+	x.len += 2;
 	x.n_term = count_commands(line, x.len);
 	x.bin_len = gl_record_size(l->layout, l->n_axes);
 	if (x.n_term < 0)

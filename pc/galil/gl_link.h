@@ -32,7 +32,8 @@ typedef struct gl_link gl_link;
  * @timeout_ms: connect timeout and the default per-call timeout.
  * @err: [out] optional buffer of GL_ERRTEXT_LEN bytes for a message such as
  *       "cannot connect to '127.0.0.1:23': Connection refused".
- * Sets TCP_NODELAY and SO_KEEPALIVE. Allocates (start-up only).
+ * Sets TCP_NODELAY, TCP_THIN_LINEAR_TIMEOUTS and SO_KEEPALIVE (docs/link.md).
+ * Allocates (start-up only).
  * Return: GL_OK, GL_ERR_ARG, GL_ERR_SYS, GL_ERR_TIMEOUT, GL_ERR_NOMEM.
  */
 int gl_link_open(gl_link **out, const char *addr, int timeout_ms,

@@ -14,7 +14,9 @@
  *     (roboelf's "stats:" log line at exit, when it writes one), TCP
  *     segments and bytes per cycle on roboelf's controller connections
  *     (ss -ti), CPU time per cycle (/proc/PID/schedstat), heap allocations
- *     after start-up (LD_PRELOAD counter, SIGUSR2 marks);
+ *     after start-up (LD_PRELOAD counter, SIGUSR2 marks), system calls per
+ *     cycle (perf stat on the raw_syscalls:sys_enter tracepoint, all
+ *     threads of roboelf);
  *  3. galil-sim's virtual-time speed (galil-sim --bench 10: 8 busy
  *     program threads, in-process sim_advance_ms());
  *  4. fault reaction times: test_sys_faults run with ROBOELF_REPEAT=N,
@@ -31,6 +33,7 @@
  * Environment as for the system tests (ROBOELF_BIN, ROBOELF_TOP, BUILD).
  */
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -41,6 +44,8 @@
 #include <unistd.h>
 
 #include "base_clock.h"
+#include "gl_err.h"
+#include "re_config.h"
 #include "re_rec.h"
 #include "sys_h.h"
 
@@ -210,7 +215,60 @@ struct loop_fig {
 	long overruns;	    /* -1 n/a */
 	double wd_worst_ms; /* -1 n/a */
 	double late[3];	    /* p50, p99, max ms; -1 n/a */
+	double syscalls;    /* per cycle (perf raw_syscalls), -1 n/a */
 };
+
+/* ---- system calls per cycle: perf stat on the tracepoint ---------------- */
+
+/* perf stat counting @pid's system calls (all threads) into @out until
+ * SIGINT; -1 when it cannot start. Counting a tracepoint costs the process
+ * nothing measurable (strace's ptrace would slow every call). */
+static pid_t perf_start(pid_t pid, const char *out)
+{
+	char p[24];
+	pid_t k;
+
+	snprintf(p, sizeof(p), "%d", (int)pid);
+	k = fork();
+	if (k == 0) {
+		int fd = open("/dev/null", O_WRONLY);
+
+		if (fd >= 0) {
+			dup2(fd, 1);
+			dup2(fd, 2);
+		}
+		execlp("perf", "perf", "stat", "-x,", "-o", out, "-e",
+		       "raw_syscalls:sys_enter", "-p", p, (char *)NULL);
+		_exit(127);
+	}
+	return k;
+}
+
+/* Stop @perf; the count it wrote to @out, or -1. */
+static double perf_stop(pid_t perf, const char *out)
+{
+	char line[256];
+	double n = -1;
+	int status;
+	FILE *f;
+
+	if (perf <= 0)
+		return -1;
+	kill(perf, SIGINT);
+	/* perf stat ends on SIGINT by re-raising it (after writing @out) */
+	if (waitpid(perf, &status, 0) != perf ||
+	    (WIFEXITED(status) && WEXITSTATUS(status) != 0))
+		return -1;
+	f = fopen(out, "r");
+	while (f && fgets(line, sizeof(line), f))
+		if (strstr(line, "raw_syscalls:sys_enter"))
+			n = strncmp(line, "<not counted>", 13)
+				? strtod(line, NULL)
+				: 0;
+	if (f)
+		fclose(f);
+	return n;
+}
 
 static double hbpc(struct sys_case *c)
 {
@@ -329,7 +387,9 @@ static int loop_run(struct sys_env *e, const struct opts *o, int period,
 		    struct loop_fig *f)
 {
 	char out_env[SYS_PATH_MAX + 32], pre_env[SYS_PATH_MAX + 16],
-	    alloc_out[SYS_PATH_MAX];
+	    alloc_out[SYS_PATH_MAX], perf_out[SYS_PATH_MAX];
+	pid_t perf = -1;
+	double calls = -1;
 	char *env[3] = {NULL, NULL, NULL};
 	struct sys_opts so = {.period_ms = period, .re_env = env};
 	struct sys_case c;
@@ -341,6 +401,7 @@ static int loop_run(struct sys_env *e, const struct opts *o, int period,
 	f->allocs = f->overruns = -1;
 	f->trip_s = -1;
 	f->wd_worst_ms = f->late[0] = f->late[1] = f->late[2] = -1;
+	f->syscalls = -1;
 	snprintf(alloc_out, sizeof(alloc_out), "%s/alloc-%d.txt", e->dir,
 		 period);
 	if (o->alloc_lib) {
@@ -357,13 +418,18 @@ static int loop_run(struct sys_env *e, const struct opts *o, int period,
 		return -1;
 	}
 	f->ready_s = c.ready_wall_s;
+	snprintf(perf_out, sizeof(perf_out), "%s/perf-%d.txt", e->dir, period);
 	if (sys_ctl(&c, "watch hbpc") < 0 ||
-	    sys_wait_sim(&c, c.t_ready_ms + 1000, 5000) < 0 ||
-	    take_mark(&c, o->alloc_lib != NULL, &a) < 0)
+	    sys_wait_sim(&c, c.t_ready_ms + 1000, 5000) < 0)
+		goto out;
+	perf = perf_start(c.re.pid, perf_out);
+	if (take_mark(&c, o->alloc_lib != NULL, &a) < 0)
 		goto out;
 	f->trip_s = drive(&c, o->seconds);
 	if (f->trip_s < 0 || take_mark(&c, o->alloc_lib != NULL, &b) < 0)
 		goto out;
+	calls = perf_stop(perf, perf_out);
+	perf = -1;
 	if (f->trip_s > 0) {
 		int i = sys_events(&c) < 0
 			    ? -1
@@ -374,6 +440,8 @@ static int loop_run(struct sys_env *e, const struct opts *o, int period,
 		f->trip_s = -1;
 	}
 	figures(f, &a, &b);
+	/* the count spans the two marks and two hbpc reads: good to 1 % */
+	f->syscalls = calls >= 0 && f->cycles > 0 ? calls / f->cycles : -1;
 	proc_find_line(&c.re, PROC_STDOUT, "FAULT ", f->fault,
 		       sizeof(f->fault));
 	proc_signal(&c.re, SIGTERM);
@@ -384,6 +452,8 @@ static int loop_run(struct sys_env *e, const struct opts *o, int period,
 		f->allocs = alloc_figure(alloc_out);
 	rc = 0;
 out:
+	if (perf > 0)
+		perf_stop(perf, perf_out);
 	if (rc < 0)
 		snprintf(f->fault, sizeof(f->fault), "run failed: %.400s",
 			 c.err);
@@ -428,6 +498,9 @@ static void add_loop_cycle(const struct loop_fig *f, const char *item, int is50)
 	}
 	fmt_or_na(v, sizeof(v), f->cpu_us, 1);
 	add("loop", item, "supervisor CPU per cycle", "us", "", "%s", v);
+	fmt_or_na(v, sizeof(v), f->syscalls, 2);
+	add("loop", item, "system calls per cycle", "", "", "%s%s", v,
+	    f->syscalls < 0 ? " (perf not available)" : "");
 	fmt_or_na(v, sizeof(v), (double)f->allocs, 0);
 	add("loop", item, "heap allocations after start-up", "", "", "%s", v);
 }
@@ -669,6 +742,37 @@ static void print_table(void)
 		       rows[i].value, rows[i].unit, rows[i].original);
 }
 
+/* ---- calibration against its physical bounds (issue 17) ----------------- */
+
+/* The sweep (travel / vmax of the slowest axis: the axes move together)
+ * and the least a calibration from the centre can take at vmax: half the
+ * travel to the reverse switch, the sweep, half back to the centre. */
+static void calib_bounds(const struct sys_env *e)
+{
+	static struct re_config cfg;
+	char err[RE_CONFIG_ERR_MAX];
+	double sweep = 0;
+
+	if (re_config_load_file(e->cfg, &cfg, err, sizeof(err)) != GL_OK) {
+		add("calibration", "sweep time (travel / vmax)", "time", "s",
+		    "", "n/a (%s)", err);
+		return;
+	}
+	for (int i = 0; i < RE_AXES; i++) {
+		double t =
+		    (double)cfg.axes[i].travel_counts / cfg.axes[i].vmax_cps;
+
+		if (t > sweep)
+			sweep = t;
+	}
+	add("calibration", "sweep time (travel / vmax, slowest axis)", "time",
+	    "s", "", "%.1f", sweep);
+	add("calibration", "least from the centre (1/2 + sweep + 1/2 at vmax)",
+	    "time", "s", "", "%.1f", 2 * sweep);
+	add("calibration", "full calibration / sweep time", "ratio", "", "",
+	    "%.2f", e->calib_s / sweep);
+}
+
 /* ---- the flight recorder (issue 16) ------------------------------------- */
 
 static int64_t rb_now(void *ud)
@@ -834,9 +938,11 @@ int main(int argc, char **argv)
 	if (getenv("ROBOELF_SYS_CAL") && *getenv("ROBOELF_SYS_CAL"))
 		add("calibration", "full calibration, default robot", "time",
 		    "s", "", "n/a (reused from ROBOELF_SYS_CAL)");
-	else
+	else {
 		add("calibration", "full calibration, default robot", "time",
 		    "s", "", "%.1f", env.calib_s);
+		calib_bounds(&env);
+	}
 	for (size_t i = 0; i < sizeof(periods) / sizeof(periods[0]); i++) {
 		struct loop_fig f;
 

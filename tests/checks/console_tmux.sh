@@ -9,7 +9,10 @@
 #   - the board's header "RoboELF  mode" exactly once on the screen;
 #   - the FAULT text and its recovery still on the screen 10 s after the
 #     fault;
-#   - after a resize to 80x24 mid-run: the same.
+#   - after a resize to 80x24 mid-run: the same;
+#   - a full calibration on the board (80x24): each axis's phase, bar and
+#     time left; interrupted with Ctrl-C, which table is in force said
+#     (none before the first calibration file, the file's one after).
 # Every wait polls a condition with a deadline. Needs tmux (make deps).
 set -u
 cd "$(dirname "$0")/../.." || exit 1
@@ -60,15 +63,28 @@ ctlreq() { # one request on galil-sim's control port; prints its answer
 	printf '%s\n' "${ans%$'\r'}"
 }
 
-# one full calibration, in line mode, to have a file for every size
-"$BIN/roboelf" -c "$tmp/roboelf.yaml" --galil "127.0.0.1:$port" \
-	--calibration full </dev/null >"$tmp/cal.out" 2>&1 &
-rpid=$!
-wait_for 120 grep -q "RoboELF Ready for Use" "$tmp/cal.out" ||
-	{ kill $rpid; fail "calibration: $(tail -3 "$tmp/cal.out")"; }
-kill -TERM $rpid; wait $rpid
-
 screen() { tmux -S "$sock" capture-pane -p -J -t re; }
+on_screen() { screen | tr '\n' ' ' | tr -s ' ' | grep -q -- "$1"; }
+# interrupt SIZE PHASE WANT [WANT2]: a full calibration in a tmux pane, its
+# board showing PHASE on axis A's line, Ctrl-C, then WANT (and WANT2) said
+# (the table in force)
+interrupt() {
+	tmux -S "$sock" new-session -d -s re -x "${1%x*}" -y "${1#*x}" \
+		"$BIN/roboelf -c $tmp/roboelf.yaml --galil 127.0.0.1:$port --calibration full; echo EXIT=\$?; sleep 60"
+	wait_for 60 sh -c "tmux -S '$sock' capture-pane -p -J -t re | grep -q '^A  $2 '" ||
+		{ screen; fail "calibration board: no '$2' on axis A"; }
+	check_screen "${1%x*}" "calibration ($2)"
+	grep -q "^calibrating [0-9]* s, about [0-9]* s left; Ctrl-C stops it (old table kept)" "$tmp/screen" ||
+		{ cat "$tmp/screen"; fail "calibration board: no time left"; }
+	cp "$tmp/screen" "$tmp/screen-calibration-$2.txt"
+	[ -n "${SHOW:-}" ] && { echo "--- calibration $1"; cat "$tmp/screen"; }
+	tmux -S "$sock" send-keys -t re C-c
+	wait_for 20 on_screen "EXIT=0" || { screen; fail "Ctrl-C in calibration: no exit 0"; }
+	on_screen "$3" || { screen; fail "Ctrl-C in calibration: not said: $3"; }
+	[ -z "${4:-}" ] || on_screen "$4" || { screen; fail "Ctrl-C in calibration: not said: $4"; }
+	tmux -S "$sock" kill-session -t re 2>/dev/null
+}
+# one_header, check_screen: see below (defined before use)
 one_header() { [ "$(screen | grep -c '^RoboELF  mode')" = 1 ]; }
 check_screen() { # WIDTH WHAT
 	# a capture can meet a frame half drawn (tmux reads the terminal's
@@ -78,6 +94,24 @@ check_screen() { # WIDTH WHAT
 	long=$(awk -v w="$1" 'length($0) > w' "$tmp/screen" | head -1)
 	[ -z "$long" ] || fail "$2: a line longer than $1: '$long'"
 }
+
+# A session that lives as long as the check: killing the last session
+# ends the tmux server, and a new-session racing with that ending fails
+# ("server exited unexpectedly").
+tmux -S "$sock" new-session -d -s keep -x 80 -y 24 "sleep 100000" ||
+	fail "tmux: cannot start a server"
+
+# no calibration file yet: interrupted, none is in force
+interrupt 80x24 "sweep fwd" "calibration interrupted: no table is in force ('$tmp/cal.txt' does not exist): the next start needs a full calibration"
+
+# one full calibration, in line mode, to have a file for every size
+"$BIN/roboelf" -c "$tmp/roboelf.yaml" --galil "127.0.0.1:$port" \
+	--calibration full </dev/null >"$tmp/cal.out" 2>&1 &
+rpid=$!
+wait_for 120 grep -q "RoboELF Ready for Use" "$tmp/cal.out" ||
+	{ kill $rpid; fail "calibration: $(tail -3 "$tmp/cal.out")"; }
+kill -TERM $rpid; wait $rpid
+
 ready() { screen | grep -q "RoboELF  mode"; }
 faulted() { screen | grep -q "FAULT ENCODER"; }
 
@@ -104,9 +138,15 @@ for size in 80x24 100x30 200x60; do
 	[ -n "${SHOW:-}" ] && { echo "--- $size"; cat "$tmp/screen"; }
 	cp "$tmp/screen" "$tmp/screen-$size.txt"
 	tmux -S "$sock" send-keys -t re q
+	# roboelf has quit (its locks released) before the next one starts
+	wait_for 20 sh -c "! pgrep -f '^$BIN/roboelf -c $tmp/roboelf.yaml' >/dev/null" ||
+		fail "$size: roboelf did not quit within 20 s of q"
 	tmux -S "$sock" kill-session -t re 2>/dev/null
 	ctlreq 'pot B ok' >/dev/null
 done
+# with a calibration file: interrupted, the file's table is kept
+interrupt 80x24 "onto rev switch" "calibration interrupted: no new table; the table in force is still the one in '$tmp/cal.txt' (made 20" \
+	"Z), kept unchanged: the next start can load it"
 # Ctrl-D at the calibration question: said, exit 2, nothing moved
 tmux -S "$sock" new-session -d -s re -x 80 -y 24 \
 	"$BIN/roboelf -c $tmp/roboelf.yaml --galil 127.0.0.1:$port; echo EXIT=\$?; sleep 60"
@@ -117,4 +157,4 @@ said() { screen | grep -q "EXIT=2"; }
 wait_for 10 said || { screen; fail "Ctrl-D: no exit 2"; }
 screen | tr '\n' ' ' | tr -s ' ' | grep -q "no answer to the calibration question (end of input): nothing moved, motor power stays off" ||
 	{ screen; fail "Ctrl-D: no reason given"; }
-echo "console_tmux: ok (80x24, 100x30, 200x60 and a resize: no wrapped line, one header, the FAULT and its recovery on screen 10 s later; Ctrl-D at the calibration question explained, exit 2)"
+echo "console_tmux: ok (80x24, 100x30, 200x60 and a resize: no wrapped line, one header, the FAULT and its recovery on screen 10 s later; the calibration board with phases and time left, Ctrl-C in it says which table is in force; Ctrl-D at the calibration question explained, exit 2)"

@@ -327,7 +327,7 @@ static int sim_parse_ready(struct proc_sim *s, const char *line)
 	char relay[256] = "";
 
 	if (sscanf(line,
-		   "galil-sim: listening on 127.0.0.1:%d control %d "
+		   "galil-sim: listening on %*[0-9.]:%d control %d "
 		   "relay %255s",
 		   &s->port, &s->ctl_port, relay) < 2)
 		return -1;
@@ -338,13 +338,28 @@ static int sim_parse_ready(struct proc_sim *s, const char *line)
 int proc_sim_start(struct proc_sim *s, const char *bin_dir,
 		   const char *relay_link, char *const extra[], int timeout_ms)
 {
+	return proc_sim_start_wrapped(s, NULL, bin_dir, relay_link, NULL, extra,
+				      timeout_ms);
+}
+
+int proc_sim_start_wrapped(struct proc_sim *s, char *const wrap[],
+			   const char *bin_dir, const char *relay_link,
+			   const char *listen, char *const extra[],
+			   int timeout_ms)
+{
 	char bin[512], line[512];
-	char *argv[32];
+	char *argv[48];
 	int n = 0;
 
 	memset(s, 0, sizeof(*s));
 	snprintf(bin, sizeof(bin), "%s/galil-sim", bin_dir);
+	for (int i = 0; wrap && wrap[i] && n < 12; i++)
+		argv[n++] = wrap[i];
 	argv[n++] = bin;
+	if (listen) {
+		argv[n++] = (char *)"--listen";
+		argv[n++] = (char *)listen;
+	}
 	argv[n++] = (char *)"--port";
 	argv[n++] = (char *)"0";
 	argv[n++] = (char *)"--control-port";
@@ -357,7 +372,7 @@ int proc_sim_start(struct proc_sim *s, const char *bin_dir,
 		 * running demo must not meet there */
 		argv[n++] = (char *)"--no-relay-link";
 	}
-	for (int i = 0; extra && extra[i] && n < 31; i++)
+	for (int i = 0; extra && extra[i] && n < 47; i++)
 		argv[n++] = extra[i];
 	argv[n] = NULL;
 	if (proc_spawn(&s->p, argv, NULL) < 0)
@@ -375,13 +390,19 @@ int proc_sim_start(struct proc_sim *s, const char *bin_dir,
 
 int proc_ctl_connect(int port, int timeout_ms)
 {
+	return proc_ctl_connect_at(NULL, port, timeout_ms);
+}
+
+int proc_ctl_connect_at(const char *addr, int port, int timeout_ms)
+{
 	long long deadline = proc_now_ms() + timeout_ms;
 	struct sockaddr_in sa;
 
 	memset(&sa, 0, sizeof(sa));
 	sa.sin_family = AF_INET;
 	sa.sin_port = htons((uint16_t)port);
-	sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+	if (inet_pton(AF_INET, addr ? addr : "127.0.0.1", &sa.sin_addr) != 1)
+		return -1;
 	for (;;) {
 		int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
 		int one = 1;

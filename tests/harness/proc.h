@@ -116,6 +116,19 @@ struct proc_sim {
 int proc_sim_start(struct proc_sim *s, const char *bin_dir,
 		   const char *relay_link, char *const extra[], int timeout_ms);
 
+/*
+ * proc_sim_start_wrapped() - proc_sim_start() with galil-sim run through
+ * @wrap (a NULL-terminated argv prefix that ends by exec'ing its arguments,
+ * e.g. {"ip", "netns", "exec", "NS", NULL}, so that the pid is galil-sim's),
+ * or directly when @wrap is NULL; with @listen (an IPv4 address, or NULL for
+ * 127.0.0.1) given as --listen.
+ * Return: 0, or -1 (the process is killed and reaped).
+ */
+int proc_sim_start_wrapped(struct proc_sim *s, char *const wrap[],
+			   const char *bin_dir, const char *relay_link,
+			   const char *listen, char *const extra[],
+			   int timeout_ms);
+
 /* ---- galil-sim control port client ------------------------------------- */
 
 /*
@@ -123,6 +136,12 @@ int proc_sim_start(struct proc_sim *s, const char *bin_dir,
  * Return: the socket, or -1.
  */
 int proc_ctl_connect(int port, int timeout_ms);
+
+/*
+ * proc_ctl_connect_at() - connect to @addr (dotted IPv4, NULL: 127.0.0.1)
+ * port @port within @timeout_ms. Return: the socket, or -1.
+ */
+int proc_ctl_connect_at(const char *addr, int port, int timeout_ms);
 
 /*
  * proc_ctl_request() - send "@req\n" and read one answer line (without the

@@ -347,7 +347,7 @@ static int run_load(struct sys_case *c)
 	int status, rc = -1;
 
 	snprintf(bin, sizeof(bin), "%s/galil-load", e->bin);
-	snprintf(addr, sizeof(addr), "127.0.0.1:%d", c->sim.port);
+	snprintf(addr, sizeof(addr), "%s:%d", c->sim_addr, c->sim.port);
 	snprintf(dmc, sizeof(dmc), "%s/dmc", e->top);
 	if (proc_spawn(&p, argv, NULL) < 0) {
 		seterr(c->err, "cannot start '%s': %s", bin, strerror(errno));
@@ -373,7 +373,7 @@ static int start_roboelf(struct sys_case *c, const struct sys_opts *o)
 	int n = 0;
 
 	snprintf(bin, sizeof(bin), "%s/roboelf", e->bin);
-	snprintf(addr, sizeof(addr), "127.0.0.1:%d", c->sim.port);
+	snprintf(addr, sizeof(addr), "%s:%d", c->sim_addr, c->sim.port);
 	argv[n++] = bin;
 	argv[n++] = (char *)"-c";
 	argv[n++] = c->cfg;
@@ -484,14 +484,18 @@ int sys_case_start(struct sys_case *c, struct sys_env *e,
 			goto fail;
 		}
 	}
-	if (proc_sim_start(&c->sim, e->bin, c->relay_link, o->sim_args, 10000) <
-	    0) {
+	snprintf(c->sim_addr, sizeof(c->sim_addr), "%s",
+		 o->sim_addr ? o->sim_addr : "127.0.0.1");
+	if (proc_sim_start_wrapped(&c->sim, o->sim_wrap, e->bin, c->relay_link,
+				   o->sim_wrap ? "0.0.0.0" : NULL, o->sim_args,
+				   10000) < 0) {
 		seterr(c->err, "galil-sim did not start ('%s/galil-sim')",
 		       e->bin);
 		goto fail;
 	}
 	c->sim_up = 1;
-	c->ctl = proc_ctl_connect(c->sim.ctl_port, CTL_TIMEOUT_MS);
+	c->ctl =
+	    proc_ctl_connect_at(o->ctl_addr, c->sim.ctl_port, CTL_TIMEOUT_MS);
 	if (c->ctl < 0) {
 		seterr(c->err, "cannot connect to the control port %d",
 		       c->sim.ctl_port);
@@ -1032,7 +1036,7 @@ int sys_log_time_ms(struct sys_case *c, const char *a, double *ms)
 
 int sys_cmd_open(struct sys_case *c)
 {
-	int fd = proc_ctl_connect(c->sim.port, CTL_TIMEOUT_MS);
+	int fd = proc_ctl_connect_at(c->sim_addr, c->sim.port, CTL_TIMEOUT_MS);
 
 	if (fd < 0)
 		seterr(c->err, "cannot connect to the controller port %d",

@@ -84,6 +84,12 @@ struct sys_opts {
 	char *const *re_env;	       /* extra "NAME=value" for roboelf */
 	int ready_timeout_ms;	       /* 0: 20 s ("file"), 150 s ("full") */
 	int no_ready;		       /* don't wait for Ready */
+	/* galil-sim elsewhere (tests/net): run it through @sim_wrap (see
+	 * proc_sim_start_wrapped()) listening on every interface; roboelf and
+	 * galil-load use @sim_addr, the control port @ctl_addr. NULL: local */
+	char *const *sim_wrap;
+	const char *sim_addr; /* dotted IPv4, NULL: 127.0.0.1 */
+	const char *ctl_addr; /* dotted IPv4, NULL: 127.0.0.1 */
 };
 
 struct sys_evt {
@@ -100,6 +106,7 @@ struct sys_case {
 	struct proc re; /* roboelf */
 	int re_up;
 	char relay_link[SYS_PATH_MAX];
+	char sim_addr[16]; /* galil-sim's command-port address */
 	char log[SYS_PATH_MAX];
 	char cfg[SYS_PATH_MAX]; /* env->cfg or a variant */
 	double t_ready_ms;	/* sim time when Ready was seen */

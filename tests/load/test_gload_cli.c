@@ -23,6 +23,7 @@
 
 #include <cmocka.h>
 
+#include "base_version.h"
 #include "load_h.h"
 #include "proc.h"
 
@@ -108,7 +109,13 @@ struct usage_case {
 };
 
 static const struct usage_case usages[] = {
-    {{NULL}, "galil-load: no program files and no commands\n"},
+    /* no files: ./dmc of the source tree the tests run in (the default
+     * DMC directory, tests/checks/install.sh tests the installed one) */
+    {{NULL},
+     "galil-load: no controller address (-a HOST); use --check to check "
+     "offline\n"},
+    {{"--check", "--dmc", "dmc", GOOD "clean.dmc", NULL},
+     "galil-load: --dmc DIR and program files: give one or the other\n"},
     {{GOOD "clean.dmc", NULL},
      "galil-load: no controller address (-a HOST); use --check to check "
      "offline\n"},
@@ -117,7 +124,7 @@ static const struct usage_case usages[] = {
     {{"--check", "--start", GOOD "clean.dmc", NULL},
      "galil-load: --check does not talk to a controller; drop -c, --burn "
      "and --start\n"},
-    {{"-a", "127.0.0.1", "--burn", NULL},
+    {{"-a", "127.0.0.1", "-c", "TP", "--burn", NULL},
      "galil-load: --burn, --start and -o need program files (only a "
      "checked program is burned or started)\n"},
     {{"-a", "127.0.0.1", "-c", "DL", NULL},
@@ -285,6 +292,54 @@ static void test_project_dmc(void **state)
 	proc_kill(&p);
 }
 
+/* The identity line galil-load printed for a check ("" when absent). */
+static void identity_of(const char *out, char id[32])
+{
+	const char *at = strstr(out, "identity line 'NO ID ");
+
+	id[0] = '\0';
+	if (at)
+		snprintf(id, 32, "%.22s", at + strlen("identity line '"));
+}
+
+/* No files: --check takes ./dmc (here the source tree's) and says so;
+ * --version names the same programs and the identity --check dmc
+ * stamps, with the release and the interface of base_version.h. */
+static void test_default_dmc(void **state)
+{
+	static const char *const given[] = {"--check", "dmc", NULL};
+	static const char *const none[] = {"--check", NULL};
+	static const char *const version[] = {"--version", NULL};
+	char want_id[32], id[32], want[256];
+	struct proc p;
+
+	(void)state;
+	assert_int_equal(run(&p, given), 0);
+	identity_of(proc_output(&p, PROC_STDOUT), want_id);
+	assert_int_equal(strlen(want_id), 22); /* NO ID + 16 hex digits */
+	proc_kill(&p);
+
+	assert_int_equal(run(&p, none), 0);
+	assert_string_equal(proc_output(&p, PROC_STDERR), "");
+	assert_true(strncmp(proc_output(&p, PROC_STDOUT),
+			    "DMC programs: dmc (no files given)\nsource: 2 "
+			    "files, ",
+			    52) == 0);
+	identity_of(proc_output(&p, PROC_STDOUT), id);
+	assert_string_equal(id, want_id);
+	proc_kill(&p);
+
+	assert_int_equal(run(&p, version), 0);
+	snprintf(want, sizeof(want),
+		 "galil-load " ROBOELF_VERSION " (controller program "
+		 "interface " ROBOELF_DMC_VERSION ", dmc/constants.dmc "
+		 "vers)\nDMC programs: dmc, identity '%s'\n",
+		 want_id);
+	assert_string_equal(proc_output(&p, PROC_STDOUT), want);
+	assert_string_equal(proc_output(&p, PROC_STDERR), "");
+	proc_kill(&p);
+}
+
 /* Nobody listening: exit 3 with the reason, and the (here empty) list of
  * controllers that answer the discovery probe, sent to loopback. */
 static void test_connection_refused(void **state)
@@ -341,6 +396,7 @@ int main(void)
 	    cmocka_unit_test(test_check_ok),
 	    cmocka_unit_test(test_output_file),
 	    cmocka_unit_test(test_check_before_connect),
+	    cmocka_unit_test(test_default_dmc),
 	    cmocka_unit_test(test_project_dmc),
 	    cmocka_unit_test(test_connection_refused),
 	    cmocka_unit_test(test_no_answer),

@@ -1488,8 +1488,8 @@ static void enc_stuck(int axis, int calibrating)
 		snprintf(tpl, sizeof(tpl),
 			 "FAULT ENCODER: axis %c: potentiometer reads {n} V "
 			 "but {n} V is expected at encoder position {n} counts "
-			 "(difference {n} V above the tolerance {n} V for {n} "
-			 "cycles)." SAFE_OK " Recovery: keep the E-stop "
+			 "(they differ by {n} V, more than the {n} V allowed, "
+			 "for {n} cycles)." SAFE_OK " Recovery: keep the E-stop "
 			 "pressed, check the encoder and potentiometer cables "
 			 "of axis %c, restart roboelf and recalibrate",
 			 'A' + axis, 'A' + axis);
@@ -2033,8 +2033,8 @@ static void test_log_full(void **state)
 		     how, t_relay, d, t_mo, d + SYS_MAINMS, w2 - w1);
 	snprintf(tpl, sizeof(tpl),
 		 "FAULT ENCODER: axis A: potentiometer reads {n} V but {n} V "
-		 "is expected at encoder position {n} counts (difference {n} "
-		 "V above the tolerance {n} V for {n} cycles)." SAFE_OK
+		 "is expected at encoder position {n} counts (they differ by "
+		 "{n} V, more than the {n} V allowed, for {n} cycles)." SAFE_OK
 		 " Recovery: keep the E-stop pressed, check the encoder and "
 		 "potentiometer cables of axis A, restart roboelf and "
 		 "recalibrate");

@@ -2,8 +2,8 @@
  * test_sys_notrip.c - what must NOT trip the supervisor or the controller
  * (issue 8): transient invalid joystick states shorter than the timeout,
  * potentiometer noise at half the encoder/pot tolerance, reply delays
- * between the non-critical and the critical watchdog limits, and a long run
- * of ordinary joystick use (ROBOELF_LONG_S seconds, default 120).
+ * between the non-critical and the critical watchdog limits. The long
+ * randomised session of joystick use is the soak, test_sys_soak.c.
  *
  * Each case runs on a fresh galil-sim with roboelf started from the
  * calibration made once in the group setup, and asserts: no FAULT line,
@@ -28,7 +28,6 @@
 
 #define SLACK_MS       25
 #define EXIT_WAIT_MS   5000
-#define LONG_S_DEFAULT 120
 
 static struct sys_env env;
 static int env_ok;
@@ -323,82 +322,6 @@ static void test_watchdog_between_limits(void **state)
 	quit_clean();
 }
 
-/* ---- a long run of ordinary use ----------------------------------------- */
-
-static unsigned long rng_next(unsigned long long *s)
-{
-	*s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
-	return (unsigned long)(*s >> 33);
-}
-
-static int long_seconds(void)
-{
-	const char *v = getenv("ROBOELF_LONG_S");
-	int s = v && *v ? atoi(v) : LONG_S_DEFAULT;
-
-	return s < 1 ? 1 : s;
-}
-
-/* One command: an axis, a direction away from the nearer end, a hold. */
-static void one_move(unsigned long long *rng, double *moved)
-{
-	static const double half[3] = {50000, 50000, 40000};
-	char st[2048], key[8], axis = (char)('A' + rng_next(rng) % 3);
-	const char *dir;
-	double x0, x1, hold = 200 + rng_next(rng) % 1300, t;
-
-	if (sys_state(&cs, st, sizeof(st)) < 0)
-		fail_msg("%s", cs.err);
-	snprintf(key, sizeof(key), "%c.act", axis);
-	x0 = sys_state_num(st, key);
-	if (fabs(x0) > 0.5 * half[axis - 'A'])
-		dir = x0 > 0 ? "rev" : "fwd";
-	else
-		dir = rng_next(rng) % 2 ? "fwd" : "rev";
-	if (sys_ctl(&cs, "joy %c %s", axis, dir) < 0)
-		fail_msg("%s", cs.err);
-	t = sys_sim_time(&cs);
-	if (sys_wait_sim(&cs, t + hold, (int)hold + 5000) < 0)
-		fail_msg("%s", cs.err);
-	if (sys_ctl(&cs, "joy %c neutral", axis) < 0)
-		fail_msg("%s", cs.err);
-	if (sys_wait_stopped(&cs, axis, 3000, &t) < 0 ||
-	    sys_wait_sim(&cs, t + 100 + rng_next(rng) % 400, 5000) < 0 ||
-	    sys_state(&cs, st, sizeof(st)) < 0)
-		fail_msg("%s", cs.err);
-	x1 = sys_state_num(st, key);
-	*moved += fabs(x1 - x0);
-}
-
-static void test_long_run(void **state)
-{
-	unsigned long long rng = 20260501;
-	int secs = long_seconds(), moves = 0;
-	double moved = 0, t0, t_end;
-
-	(void)state;
-	start();
-	print_message("[   INFO   ] long run: %d s of joystick use (seed "
-		      "%llu; ROBOELF_LONG_S sets the duration)\n",
-		      secs, rng);
-	t0 = sys_sim_time(&cs);
-	t_end = t0 + secs * 1000.0;
-	while (sys_sim_time(&cs) < t_end) {
-		one_move(&rng, &moved);
-		moves++;
-		no_fault("long run");
-	}
-	still_armed("after the long run");
-	print_message("[   INFO   ] long run: %d commands, %.0f counts moved "
-		      "in %.0f s\n",
-		      moves, moved, (sys_sim_time(&cs) - t0) / 1000.0);
-	if (moves < secs / 3 || moved < 1000.0 * secs)
-		fail_msg("the long run hardly moved the robot: %d commands, "
-			 "%.0f counts",
-			 moves, moved);
-	quit_clean();
-}
-
 #define T(f) cmocka_unit_test_teardown(f, case_teardown)
 
 int main(void)
@@ -407,7 +330,6 @@ int main(void)
 	    T(test_transient_invalid),
 	    T(test_pot_noise_half_tolerance),
 	    T(test_watchdog_between_limits),
-	    T(test_long_run),
 	};
 	const char *filter = getenv("ROBOELF_SYS_FILTER");
 

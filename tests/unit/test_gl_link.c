@@ -374,6 +374,13 @@ static void test_link_split1(void **state)
 	assert_int_equal(gl_link_record(l, NULL, &rec, 0), GL_OK); /* QZ */
 	ok(l, STUB_SPLIT1);
 	gl_link_stats(l, NULL, &rx0, NULL);
+	{ /* "PREFIX;QR" longer than a line: refused, nothing sent */
+		char longp[GL_LINE_MAX];
+
+		memset(longp, 'a', GL_LINE_MAX - 2);
+		longp[GL_LINE_MAX - 2] = '\0';
+		assert_int_equal(gl_link_record(l, longp, &rec, 0), GL_ERR_ARG);
+	}
 	assert_int_equal(gl_link_record(l, "hbpc=21", &rec, 0), GL_OK);
 	gl_link_stats(l, NULL, &rx1, NULL);
 	assert_int_equal(rx1 - rx0, 1 + 190 + 1);

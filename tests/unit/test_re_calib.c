@@ -53,10 +53,10 @@ static struct {
 	int mvax[3];
 	int fast_in_zone; /* a fast move toward a near switch was seen */
 	int64_t stall_at, stall_ns; /* the sampler stalls once */
-	int late_begin;	   /* the program begins a requested move only when
-			      the PC asks "MG mvreq" (after its record) */
-	int req_waiting;   /* mvreq=1 sent, not begun (late_begin) */
-	int sampler_fault_at;	    /* the sampler reports RE_FAULT */
+	int late_begin;	      /* the program begins a requested move only when
+				 the PC asks "MG mvreq" (after its record) */
+	int req_waiting;      /* mvreq=1 sent, not begun (late_begin) */
+	int sampler_fault_at; /* the sampler reports RE_FAULT */
 } fk;
 
 #define PNLO 0.83 /* the plan's slow zones for this robot (V) */
@@ -78,7 +78,7 @@ static void zone_rule(int i)
 {
 	const struct fax *a = &fk.ax[i];
 	double pot = pot_volts(i, a->pos);
-	int toward_rev = a->target < a->pos, toward_fwd = a->target > a->pos;
+	int toward_rev = a->target<a->pos, toward_fwd = a->target> a->pos;
 
 	if (a->moving && a->v > SEEK &&
 	    ((toward_rev && pot < PNLO) || (toward_fwd && pot > PNHI)))
@@ -208,7 +208,8 @@ static int f_command(void *ud, const char *cmd, char *resp, size_t cap,
 		if (one_cmd(c) != GL_OK)
 			return GL_ERR_CTRL;
 	if (cap)
-		snprintf(resp, cap, "%s", strcmp(cmd, "MG mvreq") ? "" : " 0.0000");
+		snprintf(resp, cap, "%s",
+			 strcmp(cmd, "MG mvreq") ? "" : " 0.0000");
 	return 0;
 }
 
@@ -358,7 +359,7 @@ static int setup(void **state)
 	for (int i = 0; i < 3; i++) {
 		fk.gain[i] = 4.0;
 		fk.ax[i].pos = i * 10000.0 - 10000; /* anywhere */
-		fk.ax[i].motor_on = 1; /* the service state */
+		fk.ax[i].motor_on = 1;		    /* the service state */
 	}
 	memset(&cfg, 0, sizeof(cfg));
 	cfg.n_axes = 3;
@@ -442,6 +443,71 @@ static void test_calib_clean(void **state)
 	}
 	print_message("calibration took %.2f s (fake time)\n", secs);
 	assert_true(secs > 20 && secs < 35);
+}
+
+/* re_calib_progress() from inside the sampler, as roboelf's board does. */
+static struct {
+	const char *seen[16]; /* axis A's phases, in order, each once */
+	int n_seen;
+	double first_left_s, mid_total_s; /* estimates: at the start and at
+					   * 15 s (elapsed + left) */
+	int samples;
+	double pct_min, pct_max;
+} pg;
+
+static int p_sample(void *ud, const struct gl_record **out)
+{
+	struct re_calib_progress p;
+	int rc = f_sample(ud, out);
+
+	re_calib_progress(cal, &cfg, &rec, fk.now, &p);
+	assert_int_equal(p.active, 1);
+	assert_int_equal(p.full, 1);
+	if (pg.samples++ == 0)
+		pg.first_left_s = p.left_s;
+	if (!pg.mid_total_s && p.elapsed_s >= 15)
+		pg.mid_total_s = p.elapsed_s + p.left_s;
+	if (!pg.n_seen || strcmp(pg.seen[pg.n_seen - 1], p.axis[0].phase))
+		pg.seen[pg.n_seen++ & 15] = p.axis[0].phase;
+	pg.pct_min = fmin(pg.pct_min, p.axis[0].pct);
+	pg.pct_max = fmax(pg.pct_max, p.axis[0].pct);
+	return rc;
+}
+
+/* The board's calibration progress: axis A goes through every phase in
+ * order, its position over the travel from 0 % to 100 %, and the time
+ * left estimated within 25 % of what the calibration really took (fake
+ * time, at its start and half-way); nothing once it has ended. */
+static void test_calib_progress(void **state)
+{
+	static const char *const want[] = {
+	    "starting",	      "to rev switch", "onto rev switch",
+	    "off rev switch", "sweep fwd",     "onto fwd switch",
+	    "off fwd switch", "table built",   "to centre",
+	};
+	struct re_calib_progress p;
+	struct re_fault f;
+	double secs = 0;
+
+	(void)state;
+	memset(&pg, 0, sizeof(pg));
+	pg.pct_min = 100;
+	re_calib_progress(cal, &cfg, NULL, fk.now, &p);
+	assert_int_equal(p.active, 0);
+	cfg.sampler.sample = p_sample;
+	assert_int_equal(re_calib_full(cal, &io, &cfg, &set, &f, &secs, NULL),
+			 GL_OK);
+	assert_int_equal(pg.n_seen, 9);
+	for (int i = 0; i < 9; i++)
+		assert_string_equal(pg.seen[i], want[i]);
+	assert_true(pg.pct_min < 1 && pg.pct_max > 99);
+	print_message("took %.1f s; estimated %.1f s at the start, %.1f s at "
+		      "15 s\n",
+		      secs, pg.first_left_s, pg.mid_total_s);
+	assert_true(fabs(pg.first_left_s - secs) < 0.25 * secs);
+	assert_true(fabs(pg.mid_total_s - secs) < 0.25 * secs);
+	re_calib_progress(cal, &cfg, NULL, fk.now, &p);
+	assert_int_equal(p.active, 0);
 }
 
 /* The program takes each move request (mvreq 0) only after the sample's
@@ -623,8 +689,10 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test_setup_teardown(test_calib_clean, setup, teardown),
-	    cmocka_unit_test_setup_teardown(test_calib_taken_after_record, setup,
+	    cmocka_unit_test_setup_teardown(test_calib_progress, setup,
 					    teardown),
+	    cmocka_unit_test_setup_teardown(test_calib_taken_after_record,
+					    setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_calib_switch_never_comes,
 					    setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_calib_nonmonotonic, setup,

@@ -47,6 +47,9 @@ static const struct bad_case bad_cases[] = {
      "got 9601"},
     {"bad_bool.yaml", 3, 15,
      "expected true or false for 'active_low', got 'yes'"},
+    {"bad_unit.yaml", 5, 11, "'unit' must be deg or mm, got 'inch'"},
+    {"bad_counts_per_unit.yaml", 6, 22,
+     "'counts_per_unit' must be between 0 and 10000000, got -5"},
     {"bad_channel.yaml", 3, 12, "'channel' must be between 1 and 8, got 9"},
     {"bad_clinical_loopback.yaml", 5, 12,
      "'address' 127.0.0.1:23023 is a loopback address; clinical mode needs the "
@@ -150,6 +153,17 @@ static const struct bad_case bad_cases[] = {
      "'on' must list 1 to 16 bytes, got 17"},
     {"bad_quoted_number.yaml", 2, 12,
      "expected an integer for 'period_ms', got a quoted string"},
+    {"bad_realtime_cpu.yaml", 3, 8,
+     "'cpu' must be between -1 and 1023, got -2"},
+    {"bad_realtime_period.yaml", 4, 13,
+     "'period_ms' 5 needs real-time scheduling: set 'realtime.priority' "
+     "1..99 or a period of 10 ms or more"},
+    {"bad_quote_single.yaml", 3, 10,
+     "this quote is not closed on its line (the parser then stopped at "
+     "line 5 column 1: found unexpected end of stream)"},
+    {"bad_quote_unclosed.yaml", 3, 12,
+     "this quote is not closed on its line (the parser then stopped at "
+     "line 8 column 1: found unexpected end of stream)"},
     {"bad_readback_protocol.yaml", 4, 13,
      "'readback' needs the devantech protocol"},
     {"bad_root_list.yaml", 1, 1,
@@ -281,6 +295,8 @@ static void test_defaults_documented(void **state)
 		assert_true(a->allowed_error == 0.5);
 		assert_int_equal(a->persistence_cycles, 1);
 		assert_true(a->monotonic_margin_v == 0.005);
+		assert_int_equal(a->unit, i == 2 ? RE_UNIT_MM : RE_UNIT_DEG);
+		assert_true(a->counts_per_unit == 0); /* counts shown */
 	}
 	assert_string_equal(c.calibration.file, "roboelf-calibration.txt");
 	assert_true(c.calibration.backup);
@@ -310,7 +326,8 @@ static void test_defaults_refused_clinical(void **state)
 	assert_int_equal(re_config_validate(&c, err, sizeof(err)), GL_OK);
 }
 
-/* config/roboelf.yaml loads and is exactly the defaults in development. */
+/* config/roboelf.yaml: the defaults in development mode, with galil-sim's
+ * scale for the console. */
 static void test_default_file_loads(void **state)
 {
 	struct re_config c, d;
@@ -323,6 +340,9 @@ static void test_default_file_loads(void **state)
 	assert_string_equal(err, "");
 	re_config_defaults(&d);
 	d.mode = RE_MODE_DEVELOPMENT;
+	/* the scale of galil-sim's robot (the default is 0: counts shown) */
+	for (int i = 0; i < RE_AXES; i++)
+		d.axes[i].counts_per_unit = 1000;
 	assert_memory_equal(&c, &d, sizeof(c));
 }
 
@@ -405,6 +425,8 @@ static void emit_axis(struct sbuf *b, const struct re_config_axis *a)
 	put(b, "    allowed_error: %.17g\n    persistence_cycles: %d\n",
 	    a->allowed_error, a->persistence_cycles);
 	put(b, "    monotonic_margin_v: %.17g\n", a->monotonic_margin_v);
+	put(b, "    unit: %s\n    counts_per_unit: %.17g\n",
+	    re_unit_name(a->unit), a->counts_per_unit);
 }
 
 /* emit() - every field of @c as YAML. */
@@ -457,6 +479,8 @@ static void emit(struct sbuf *b, const struct re_config *c)
 	put(b, "recorder:\n  seconds: %.17g\n  after_fault_s: %.17g\n",
 	    c->recorder.seconds, c->recorder.after_fault_s);
 	put(b, "  dir: \"%s\"\n", c->recorder.dir);
+	put(b, "realtime:\n  priority: %d\n  cpu: %d\n  lock_memory: %s\n",
+	    c->realtime.priority, c->realtime.cpu, tf(c->realtime.lock_memory));
 }
 
 /* A configuration with every field away from its default. */
@@ -469,6 +493,9 @@ static void changed(struct re_config *c)
 	re_config_defaults(c);
 	c->mode = RE_MODE_CLINICAL;
 	c->period_ms = 20;
+	c->realtime.priority = 70;
+	c->realtime.cpu = 1;
+	c->realtime.lock_memory = false;
 	strcpy(c->controller.address, "192.168.42.7:23");
 	strcpy(c->controller.model, "DMC4040");
 	c->controller.timeout_ms = 75;
@@ -521,6 +548,8 @@ static void changed(struct re_config *c)
 		a->allowed_error = 0.3;
 		a->persistence_cycles = 2 + i;
 		a->monotonic_margin_v = 0.01;
+		a->unit = i == 0 ? RE_UNIT_MM : RE_UNIT_DEG;
+		a->counts_per_unit = 123.25 + i;
 	}
 	strcpy(c->calibration.file, "/var/lib/roboelf/cal.txt");
 	c->calibration.backup = false;

@@ -20,6 +20,7 @@
 
 #include "base_clock.h"
 #include "re_console.h"
+#include "re_fault.h"
 
 static int64_t mono_ns(void)
 {
@@ -181,10 +182,464 @@ static void test_status_words(void **state)
 				     "9)\""));
 }
 
+/* Line @n (0-based) of @text into @out (without its newline). */
+static void line_of(const char *text, int n, char *out, size_t cap)
+{
+	const char *e;
+
+	while (n-- > 0 && (text = strchr(text, '\n')) != NULL)
+		text++;
+	assert_non_null(text);
+	e = strchr(text, '\n');
+	assert_non_null(e);
+	snprintf(out, cap, "%.*s", (int)(e - text), text);
+}
+
+/* Three calibrated axes, soft limits -49000..49000 counts, shown in deg
+ * (A, B) and mm (C) at 1000 counts per unit. */
+static void calibrated(struct re_console *c, struct re_status *st)
+{
+	status_of(st);
+	for (int i = 0; i < 3; i++) {
+		struct re_axis_status *a = &st->axis[i];
+
+		a->have_soft = 1;
+		a->soft_rev_counts = -49000;
+		a->soft_fwd_counts = 49000;
+		a->pos_pct = 50;
+		a->pot_v = 2.5;
+	}
+	re_console_units(c, 0, "deg", 1000);
+	re_console_units(c, 1, "deg", 1000);
+	re_console_units(c, 2, "mm", 1000);
+}
+
+/* Positions in the robot's units, the bar with the soft limits '|' and the
+ * position '#' (beyond a soft limit past its mark), counts on request and
+ * where the scale is not known, '?' without a calibration. */
+static void test_units_and_bar(void **state)
+{
+	static struct re_console c;
+	static char buf[RE_CONSOLE_FRAME];
+	struct re_status st;
+	char l[256];
+
+	(void)state;
+	re_console_open(&c, stdout, -1);
+	calibrated(&c, &st);
+	st.axis[0].enc_counts = -12345;
+	st.axis[0].vel_cps = -1500;
+	st.axis[1].enc_counts = 49000;
+	st.axis[1].pos_pct = 100;
+	st.axis[2].enc_counts = -52000; /* past the reverse soft limit */
+	st.axis[2].pos_pct = 0;
+	assert_int_equal(re_console_render(&c, &st, 80, 24, buf, sizeof(buf)),
+			 8);
+	line_of(buf, 1, l, sizeof(l));
+	assert_string_equal(l,
+			    "ax     position   |soft  limits|   pot V expect "
+			    "margin    speed state   lim mot");
+	line_of(buf, 2, l, sizeof(l));
+	assert_string_equal(l, "A    -12.35 deg [-|----#-------|-] 2.500     -"
+			       "      -   -1.5/s stopped -   on");
+	line_of(buf, 3, l, sizeof(l));
+	assert_string_equal(l, "B     49.00 deg [-|------------#-] 2.500     -"
+			       "      -    0.0/s at-lim  sF  on");
+	line_of(buf, 4, l, sizeof(l));
+	assert_string_equal(l, "C    -52.00 mm  [#|------------|-] 2.500     -"
+			       "      -    0.0/s at-lim  sR  on");
+	re_console_counts(&c, 1);
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 2, l, sizeof(l));
+	assert_string_equal(l, "A    -12345 cnt [-|----#-------|-] 2.500     -"
+			       "      -  -1500/s stopped -   on");
+	re_console_counts(&c, 0);
+	re_console_units(&c, 0, "deg", 0); /* scale not known: counts */
+	st.axis[0].have_soft = 0;	   /* not calibrated: '?' */
+	st.axis[0].pos_pct = -1;
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 2, l, sizeof(l));
+	assert_string_equal(l, "A    -12345 cnt [????????????????] 2.500     -"
+			       "      -  -1500/s stopped -   on");
+	st.link_ok = 0; /* the last values, marked */
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 3, l, sizeof(l));
+	assert_string_equal(l, "B     49.00 deg [-|------------#-] 2.500     -"
+			       "      -    0.0/s STALE   sF  on");
+}
+
+static void event(struct re_console *c, double t, enum re_log_level lvl,
+		  enum re_event_kind kind, const char *text)
+{
+	struct re_event ev;
+
+	memset(&ev, 0, sizeof(ev));
+	ev.t_s = t;
+	ev.level = lvl;
+	ev.kind = kind;
+	snprintf(ev.text, sizeof(ev.text), "%s", text);
+	re_console_event(c, &ev);
+}
+
+/* The first FAULT stays under the header; below it the later faults and
+ * warnings newest first (repeats of one kind folded, with a count), as
+ * many as fit, and the log's path. */
+static void test_history(void **state)
+{
+	static struct re_console c;
+	static char buf[RE_CONSOLE_FRAME];
+	struct re_status st;
+	char l[256];
+	int n;
+
+	(void)state;
+	re_console_open(&c, stdout, -1);
+	c.tty_out = 1; /* the board's history, not printed lines */
+	calibrated(&c, &st);
+	re_console_log_path(&c, "/var/log/roboelf.log");
+	event(&c, 1.5, RE_LOG_WARN, RE_EV_WATCHDOG,
+	      "watchdog: reply after 80 ms");
+	event(&c, 1.6, RE_LOG_WARN, RE_EV_WATCHDOG,
+	      "watchdog: reply after 90 ms");
+	c.fault[0] = '\0';
+	snprintf(c.fault, sizeof(c.fault),
+		 "FAULT COMM: the link is gone. "
+		 "Recovery: restart roboelf");
+	event(&c, 4.25, RE_LOG_FAULT, RE_EV_LATER, "FAULT ESTOP: relay lost");
+	n = re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	assert_int_equal(n, 12);
+	line_of(buf, 1, l, sizeof(l));
+	assert_string_equal(l,
+			    "FAULT COMM: the link is gone. Recovery: restart "
+			    "roboelf");
+	line_of(buf, 2, l, sizeof(l));
+	assert_string_equal(l, "    4.2 s later FAULT ESTOP: relay lost");
+	line_of(buf, 3, l, sizeof(l));
+	assert_string_equal(l, "    1.6 s WARN (x2): watchdog: reply after 90 "
+			       "ms");
+	line_of(buf, 4, l, sizeof(l));
+	assert_string_equal(l, "every fault and warning is in the log "
+			       "/var/log/roboelf.log");
+	for (int i = 0; i < 10; i++)
+		event(&c, 5 + i, RE_LOG_WARN, RE_EV_OTHER, "x");
+	/* 24 rows: 4 kept for messages and 1 spare; header, the fault's one
+	 * line, column header, 3 axes and 3 lines: 9; the history gets 10:
+	 * the 9 newest (of 12) and the log line */
+	n = re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	assert_int_equal(n, 19);
+	line_of(buf, 2, l, sizeof(l));
+	assert_string_equal(l, "   14.0 s WARN: x");
+	line_of(buf, 10, l, sizeof(l));
+	assert_string_equal(l, "    6.0 s WARN: x");
+	line_of(buf, 11, l, sizeof(l));
+	assert_string_equal(l, "3 older not shown; all in the log "
+			       "/var/log/roboelf.log");
+}
+
+/* Without a terminal, each later fault or warning is one line. */
+static void test_event_lines(void **state)
+{
+	static struct re_console c;
+	char buf[512];
+	FILE *f = tmpfile();
+	size_t n;
+
+	(void)state;
+	assert_non_null(f);
+	re_console_open(&c, f, -1);
+	assert_int_equal(c.tty_out, 0);
+	event(&c, 2.0, RE_LOG_WARN, RE_EV_FOREIGN,
+	      "another program connected to the controller (handle C)");
+	event(&c, 3.0, RE_LOG_FAULT, RE_EV_LATER, "FAULT ESTOP: relay lost");
+	rewind(f);
+	n = fread(buf, 1, sizeof(buf) - 1, f);
+	buf[n] = '\0';
+	fclose(f);
+	assert_string_equal(buf, "roboelf: warning: another program connected "
+				 "to the controller (handle C)\n"
+				 "roboelf: later FAULT ESTOP: relay lost\n");
+	assert_int_equal(c.nhist, 2);
+}
+
+/* ---- snapshots: the whole board at 80x24, exactly --------------------
+ *
+ * Each case renders the board (no colour) and compares it with
+ * tests/data/console/<name>.txt byte for byte. RE_SNAPSHOT_UPDATE=1
+ * rewrites the files instead (then review them with git diff).
+ */
+
+#define SNAP_DIR "tests/data/console/"
+
+static void snapshot(struct re_console *c, const struct re_status *st,
+		     const char *name)
+{
+	static char got[RE_CONSOLE_FRAME], want[RE_CONSOLE_FRAME];
+	char path[256];
+	FILE *f;
+	size_t n;
+	int lines = re_console_render(c, st, 80, 24, got, sizeof(got));
+
+	assert_true(lines > 0 && lines <= 24 - 1 - RE_CONSOLE_ROOM);
+	snprintf(path, sizeof(path), SNAP_DIR "%s.txt", name);
+	if (getenv("RE_SNAPSHOT_UPDATE")) {
+		f = fopen(path, "w");
+		assert_non_null(f);
+		fputs(got, f);
+		fclose(f);
+		return;
+	}
+	f = fopen(path, "r");
+	if (!f)
+		fail_msg("snapshot %s missing (RE_SNAPSHOT_UPDATE=1 makes it)",
+			 path);
+	n = fread(want, 1, sizeof(want) - 1, f);
+	fclose(f);
+	want[n] = '\0';
+	for (int i = 0; i < lines; i++) {
+		char g[256], w[256];
+
+		line_of(got, i, g, sizeof(g));
+		line_of(want, i, w, sizeof(w));
+		if (strcmp(g, w))
+			fail_msg("%s line %d:\n got  '%s'\n want '%s'", path,
+				 i + 1, g, w);
+		assert_true(strlen(g) < 80); /* never wraps */
+	}
+	assert_string_equal(got, want);
+}
+
+/* A robot at rest in the centre after a fault: relay off, motors off. */
+static void latched_status(struct re_console *c, struct re_status *st)
+{
+	calibrated(c, st);
+	st->uptime_s = 42.5;
+	st->period_ms = 50;
+	st->wd_last_ms = 50.1;
+	st->wd_worst_ms = 61.2;
+	st->late_last_ms = 0.2;
+	st->late_worst_ms = 3.4;
+	st->relay = RE_RELAY_OFF;
+	st->latched = 1;
+	st->have_za = 1;
+	st->za.state = RE_DMC_FAULT;
+	st->za.fcode = RE_DMC_F_SUPERVISOR;
+	for (int i = 0; i < 3; i++) {
+		struct re_axis_status *a = &st->axis[i];
+
+		a->enc_counts = 100 * i - 100;
+		a->motor_off = 1;
+		a->have_expect = 1;
+		a->pot_v = 2.55 + 0.001 * i;
+		a->pot_expected_v = 2.55;
+		a->margin_v = 0.06 - 0.001 * i;
+	}
+}
+
+struct snap_case {
+	const char *name;
+	enum re_fault_id id;
+	int axis;
+	int dmc_fcode, dmc_faxis; /* the controller's own latched fault */
+	int link_down;
+};
+
+/* One fault of each class, as the operator sees the board 10 s later. */
+static const struct snap_case snap_cases[] = {
+    {"fault-encoder", RE_F_ENCPOT, 1, RE_DMC_F_SUPERVISOR, 0, 0},
+    {"fault-watchdog", RE_F_WDOG_REPLY, -1, RE_DMC_F_SUPERVISOR, 0, 1},
+    {"fault-estop", RE_F_ESTOP_LOST, -1, RE_DMC_F_SUPERVISOR, 0, 0},
+    {"fault-motion", RE_F_CTRL_POSERR, 0, RE_DMC_F_POSERR, 1, 0},
+    {"fault-input", RE_F_CTRL_INPUT, -1, RE_DMC_F_INPUT, 0, 0},
+    {"fault-comm", RE_F_COMM, -1, RE_DMC_F_SUPERVISOR, 0, 1},
+    {"fault-config", RE_F_CONFIG, -1, RE_DMC_F_SUPERVISOR, 0, 0},
+    {"fault-calibration", RE_F_CAL_ABORT, 2, RE_DMC_F_SUPERVISOR, 0, 0},
+    {"fault-param", RE_F_CTRL_PARAM, -1, RE_DMC_F_PARAM, 0, 0},
+    {"fault-limit", RE_F_CTRL_LIMIT, 2, RE_DMC_F_LIMIT, 3, 0},
+    {"fault-program", RE_F_CTRL_THREAD, -1, RE_DMC_F_THREAD, 0, 0},
+    {"fault-foreign", RE_F_CTRL_FOREIGN_HB, -1, RE_DMC_F_FOREIGN, 0, 0},
+};
+
+/* The values each fault's text uses (re_fault.h), fixed. */
+static void snap_fault(const struct snap_case *k, struct re_fault *f)
+{
+	re_fault_set(f, k->id, k->axis);
+	f->i[0] = 4;
+	f->i[1] = 2;
+	f->i[2] = 200;
+	f->f[0] = 3.049;
+	f->f[1] = 2.55;
+	f->f[2] = 0.499;
+	f->f[3] = 0.06;
+	if (k->id == RE_F_ESTOP_LOST)
+		snprintf(f->s, sizeof(f->s),
+			 "/dev/ttyACM0: read-back shows "
+			 "channel 1 off, expected on");
+	else if (k->id == RE_F_COMM)
+		snprintf(f->s, sizeof(f->s), "cannot read record: timeout");
+	else if (k->id == RE_F_CONFIG)
+		snprintf(f->s, sizeof(f->s), "read-back of KPA differs");
+	else if (k->id == RE_F_CAL_ABORT)
+		snprintf(f->s, sizeof(f->s),
+			 "the forward limit switch never came within 120000 "
+			 "counts");
+	else if (k->id == RE_F_CTRL_LIMIT)
+		snprintf(f->s, sizeof(f->s), "reverse");
+	if (k->id == RE_F_CTRL_LIMIT)
+		f->i[0] = 3;
+	if (k->id == RE_F_WDOG_REPLY) { /* ms without a reply, the limit */
+		f->i[0] = 130;
+		f->i[1] = 125;
+	}
+	if (k->id == RE_F_CTRL_POSERR)
+		f->i[0] = 500;
+}
+
+/* The FAULT line as the supervisor composes it: what happened, what was
+ * confirmed, the recovery. */
+static void snap_line(const struct re_fault *f, char *line, size_t cap)
+{
+	static const char *const names[] = {"A", "B", "C"};
+	char text[768], *rec;
+
+	assert_true(re_fault_format(f, names, text, sizeof(text)) > 0);
+	rec = strstr(text, ". Recovery: ");
+	assert_non_null(rec);
+	snprintf(line, cap,
+		 "%.*s. Safe state confirmed: motor power off (relay open), "
+		 "motors off. %s",
+		 (int)(rec - text), text, rec + 2);
+}
+
+static void test_snapshot_faults(void **state)
+{
+	static struct re_console c;
+	struct re_status st;
+	struct re_fault f;
+	char line[1024];
+	FILE *devnull = fopen("/dev/null", "w");
+
+	(void)state;
+	assert_non_null(devnull);
+	for (size_t k = 0; k < sizeof(snap_cases) / sizeof(snap_cases[0]);
+	     k++) {
+		const struct snap_case *sc = &snap_cases[k];
+
+		re_console_open(&c, devnull, -1);
+		c.tty_out = 1; /* the board's panel and history */
+		c.tty_in = 1;  /* the keys line */
+		re_console_log_path(&c, "/var/log/roboelf/roboelf.log");
+		latched_status(&c, &st);
+		st.za.fcode = sc->dmc_fcode;
+		st.za.faxis = sc->dmc_faxis;
+		st.link_ok = !sc->link_down;
+		if (sc->id == RE_F_CTRL_LIMIT)
+			st.axis[2].rev_limit = 1;
+		if (sc->id == RE_F_WDOG_REPLY)
+			event(&c, 30.1, RE_LOG_WARN, RE_EV_WATCHDOG,
+			      "watchdog: reply after 80.2 ms (non-critical "
+			      "limit 75.0 ms, critical 125.0 ms)");
+		if (sc->id == RE_F_ESTOP_LOST)
+			event(&c, 33.3, RE_LOG_FAULT, RE_EV_LATER,
+			      "FAULT COMM: cannot read record: timeout");
+		snap_fault(sc, &f);
+		snap_line(&f, line, sizeof(line));
+		re_console_fault(&c, line);
+		snapshot(&c, &st, sc->name);
+	}
+	fclose(devnull);
+}
+
+/* The board in each phase: start-up (safe, no tables), the full
+ * calibration, the check of the file and the move to the centre, armed
+ * and driving (B forward), at a soft limit. */
+static void test_snapshot_phases(void **state)
+{
+	static struct re_console c;
+	struct re_calib_progress p;
+	struct re_status st;
+
+	(void)state;
+	re_console_open(&c, stdout, -1);
+	c.tty_in = 1;
+	re_console_log_path(&c, "/var/log/roboelf/roboelf.log");
+	latched_status(&c, &st);
+	st.latched = 0;
+	st.relay = RE_RELAY_OFF;
+	st.za.state = RE_DMC_UNARMED;
+	st.za.fcode = 0;
+	for (int i = 0; i < 3; i++) {
+		st.axis[i].have_soft = 0;
+		st.axis[i].pos_pct = -1;
+		st.axis[i].have_expect = 0;
+	}
+	snapshot(&c, &st, "phase-safe");
+
+	memset(&p, 0, sizeof(p));
+	p.active = 1;
+	p.full = 1;
+	p.elapsed_s = 12.2;
+	p.left_s = 16.4;
+	for (int i = 0; i < 3; i++) {
+		p.axis[i].phase = i == 2 ? "off fwd switch" : "sweep fwd";
+		p.axis[i].pct = i == 2 ? 99.4 : 31.2;
+		p.axis[i].left_s = i == 2 ? 4.9 : 16.4;
+		st.axis[i].motor_off = 0;
+		st.axis[i].moving = 1;
+		st.axis[i].vel_cps = i == 2 ? -2000 : 8000;
+		st.axis[i].enc_counts = i == 2 ? 39500 : -19560;
+		st.axis[i].pot_v = i == 2 ? 4.475 : 1.758;
+	}
+	st.relay = RE_RELAY_ON;
+	st.za.state = RE_DMC_SERVICE;
+	st.period_ms = 10;
+	re_console_calib(&c, &p);
+	snapshot(&c, &st, "phase-calibration");
+
+	p.full = 0;
+	p.elapsed_s = 1.0;
+	p.left_s = 6.1;
+	for (int i = 0; i < 3; i++) {
+		p.axis[i].phase = "to centre";
+		p.axis[i].pct = 80;
+		p.axis[i].left_s = 6.1 - i;
+	}
+	re_console_calib(&c, &p);
+	snapshot(&c, &st, "phase-file-check");
+
+	re_console_calib(&c, NULL);
+	calibrated(&c, &st);
+	st.uptime_s = 61.0;
+	st.period_ms = 50;
+	st.wd_last_ms = 50.0;
+	st.wd_worst_ms = 52.3;
+	st.have_za = 1;
+	st.za.state = RE_DMC_ARMED;
+	st.za.jcmd = 3;
+	st.za.mcmd = 3;
+	st.axis[1].moving = 1;
+	st.axis[1].vel_cps = 7990;
+	st.axis[1].enc_counts = 12345;
+	st.axis[1].pos_pct = 62.6;
+	st.axis[0].enc_counts = 49000;
+	st.axis[0].pos_pct = 100;
+	st.axis[0].moving = 1; /* the tracking profiler, at the limit */
+	for (int i = 0; i < 3; i++) {
+		st.axis[i].have_expect = 1;
+		st.axis[i].pot_expected_v = st.axis[i].pot_v;
+		st.axis[i].margin_v = 0.06;
+	}
+	snapshot(&c, &st, "phase-armed");
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_status_words),
+	    cmocka_unit_test(test_units_and_bar),
+	    cmocka_unit_test(test_history),
+	    cmocka_unit_test(test_event_lines),
+	    cmocka_unit_test(test_snapshot_faults),
+	    cmocka_unit_test(test_snapshot_phases),
 	    cmocka_unit_test(test_stalled_reader_never_blocks),
 	    cmocka_unit_test(test_regular_file_appends),
 	};

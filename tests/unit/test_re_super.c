@@ -699,6 +699,53 @@ static void test_super_latch(void **state)
 	assert_int_equal(st.relay, RE_RELAY_OFF);
 }
 
+/* The later faults and warnings for the console, in the fixed ring: the
+ * watchdog warning, the relay lost and a fault while latched, in order,
+ * read once each; the oldest overwritten after RE_SUPER_EVENTS more. */
+static void test_super_events_ring(void **state)
+{
+	struct re_event ev;
+	struct re_fault f;
+	uint64_t seen = 0;
+
+	(void)state;
+	assert_int_equal(re_super_event(&sup, 0, &ev), 0);
+	assert_int_equal(run(2), RE_OK);
+	fk.delay_ns = 40 * MS;
+	assert_int_equal(step(), RE_WARN);
+	fk.delay_ns = MS / 10;
+	fk.record_rc = GL_ERR_CLOSED;
+	assert_int_equal(step(), RE_FAULT); /* the first: not an event */
+	fk.record_rc = GL_OK;
+	fk.relay_check_rc = GL_ERR_RELAY;
+	assert_int_equal(run(3), RE_OK);
+	re_fault_set(&f, RE_F_ESTOP_LOST, -1);
+	snprintf(f.s, sizeof(f.s), "test");
+	assert_int_equal(re_super_fault(&sup, &f), RE_OK);
+	assert_int_equal(re_super_event(&sup, seen, &ev), 1);
+	assert_int_equal(ev.seq, 1);
+	assert_int_equal(ev.level, RE_LOG_WARN);
+	assert_int_equal(ev.kind, RE_EV_WATCHDOG);
+	assert_true(!strncmp(ev.text, "watchdog: reply after 89.9 ms", 29));
+	seen = ev.seq;
+	assert_int_equal(re_super_event(&sup, seen, &ev), 1);
+	assert_int_equal(ev.kind, RE_EV_RELAY);
+	assert_int_equal(ev.level, RE_LOG_FAULT);
+	assert_true(!strncmp(ev.text, "FAULT ESTOP: ", 13));
+	seen = ev.seq;
+	assert_int_equal(re_super_event(&sup, seen, &ev), 1);
+	assert_int_equal(ev.kind, RE_EV_LATER);
+	assert_true(!strncmp(ev.text, "FAULT ESTOP: ", 13));
+	assert_non_null(strstr(ev.text, "(test)"));
+	seen = ev.seq;
+	assert_int_equal(re_super_event(&sup, seen, &ev), 0);
+	for (int i = 0; i < RE_SUPER_EVENTS + 2; i++)
+		re_super_note(&sup, RE_LOG_WARN, RE_EV_OTHER, "n");
+	/* 3 + 18 kept in a ring of 16: the next unread one is seq 6 */
+	assert_int_equal(re_super_event(&sup, seen, &ev), 1);
+	assert_int_equal(ev.seq, 3 + RE_SUPER_EVENTS + 2 - RE_SUPER_EVENTS + 1);
+}
+
 /* Absolute deadlines: a long cycle is one overrun and no burst after. */
 static void test_super_schedule_overrun(void **state)
 {
@@ -913,6 +960,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test_setup(test_super_healthy_one_round_trip, setup),
+	    cmocka_unit_test_setup(test_super_events_ring, setup),
 	    cmocka_unit_test_setup(test_super_encpot_fault_order, setup),
 	    cmocka_unit_test_setup(test_super_encpot_transient, setup),
 	    cmocka_unit_test_setup(test_super_watchdog_noncritical, setup),

@@ -17,6 +17,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "base_paths.h"
 #include "base_version.h"
 #include "dmc_rule.h"
 #include "gl_disc.h"
@@ -52,10 +53,17 @@ struct opts {
 	int ncmds;
 	char **paths;
 	int npaths;
+	const char *dmc;	    /* --dmc DIR */
+	int version;		    /* --version */
+	int dmc_default;	    /* no files given: dmc_dir was chosen */
+	char *dmc_path[1];	    /* paths when --dmc or the default */
+	char dmc_dir[PATH_MAX + 1]; /* the default DMC directory */
 };
 
 static const char usage_text[] =
     "usage: galil-load [-a HOST[:PORT]] [options] FILE.dmc...|DIR\n"
+    "       galil-load [-a HOST[:PORT]] [options]   (the DMC programs in\n"
+    "                  ./dmc, else the installed ones)\n"
     "\n"
     "  -a, --address HOST[:PORT]  controller (default port 23)\n"
     "      --check                check and preprocess only; no controller\n"
@@ -85,8 +93,10 @@ static const char usage_text[] =
     "      --find-addr ADDR       where the discovery probe goes (default\n"
     "                             255.255.255.255)\n"
     "      --find-port PORT       its UDP port (default 50000)\n"
+    "      --dmc DIR              the program directory (as DIR above)\n"
     "  -h, --help                 this text\n"
-    "      --version              the release and the DMC interface\n"
+    "      --version              the release, the DMC interface and the\n"
+    "                             identity of the DMC programs\n"
     "\n"
     "A DIR is loaded through DIR/MANIFEST (one file name per line, '#'\n"
     "comments). Exit: 0 ok, 1 check failed, 2 usage, 3 connection,\n"
@@ -219,7 +229,8 @@ enum {
 	OPT_FIND,
 	OPT_FIND_ADDR,
 	OPT_FIND_PORT,
-	OPT_VERSION
+	OPT_VERSION,
+	OPT_DMC
 };
 
 static const struct option long_opts[] = {
@@ -239,6 +250,7 @@ static const struct option long_opts[] = {
     {"find-port", required_argument, NULL, OPT_FIND_PORT},
     {"help", no_argument, NULL, 'h'},
     {"version", no_argument, NULL, OPT_VERSION},
+    {"dmc", required_argument, NULL, OPT_DMC},
     {NULL, 0, NULL, 0},
 };
 
@@ -254,12 +266,8 @@ static int parse_opt(struct opts *o, int ch, const char *arg)
 	case OPT_NO_START: o->start = 0; return 0;
 	case 'c': return add_command(o, arg);
 	case 'h': return -1;
-	case OPT_VERSION:
-		printf("galil-load %s (controller program interface %s; "
-		       "`galil-load --check dmc/` prints the identity it "
-		       "stamps)\n",
-		       ROBOELF_VERSION, ROBOELF_DMC_VERSION);
-		exit(EXIT_SUCCESS);
+	case OPT_VERSION: o->version = 1; return 0;
+	case OPT_DMC: o->dmc = arg; return 0;
 	case 'm':
 		o->model = dmc_model_find(arg);
 		return o->model ? 0
@@ -320,6 +328,36 @@ static int check_combination(const struct opts *o)
 	return 0;
 }
 
+/* --dmc DIR, or with neither files nor -c commands (nor --find) the
+ * default DMC directory: ./dmc, else the installed one (base_paths.h). */
+static int choose_programs(struct opts *o)
+{
+	if (o->dmc && o->npaths)
+		return usage_error("%s", "--dmc DIR and program files: give "
+					 "one or the other");
+	if (o->dmc) {
+		o->dmc_path[0] = (char *)o->dmc;
+		o->paths = o->dmc_path;
+		o->npaths = 1;
+		return 0;
+	}
+	if (o->npaths || ((o->ncmds || o->find) && !o->version))
+		return 0;
+	if (base_paths_dmc_dir(o->dmc_dir, sizeof(o->dmc_dir)) < 0) {
+		if (o->version)
+			return 0;
+		return usage_error("no program files and no commands, and no "
+				   "DMC programs: neither dmc/MANIFEST here "
+				   "nor %s/MANIFEST",
+				   o->dmc_dir);
+	}
+	o->dmc_default = 1;
+	o->dmc_path[0] = o->dmc_dir;
+	o->paths = o->dmc_path;
+	o->npaths = 1;
+	return 0;
+}
+
 /* Return 0 to go on, -1 for --help, or an exit code. */
 static int parse_args(int argc, char **argv, struct opts *o)
 {
@@ -343,6 +381,9 @@ static int parse_args(int argc, char **argv, struct opts *o)
 	}
 	o->paths = argv + optind;
 	o->npaths = argc - optind;
+	rc = choose_programs(o);
+	if (rc || o->version)
+		return rc;
 	return check_combination(o);
 }
 
@@ -396,6 +437,42 @@ static void print_sizes(const struct gload_prog *p,
 	       o->model->confirmed ? "" : ", unconfirmed limits", st->lines,
 	       o->model->max_lines, st->labels, o->model->max_labels, st->vars,
 	       o->model->max_vars);
+}
+
+/* --version: the release, the interface, and the identity a download of
+ * the programs (the files given, --dmc, or the default) is stamped with. */
+static int print_version(const struct opts *o)
+{
+	struct gload_prog p = {0};
+	struct gload_diags d = {0};
+	struct gload_stats st;
+	int i, ok = 1;
+
+	printf("galil-load %s (controller program interface %s, "
+	       "dmc/constants.dmc vers)\n",
+	       ROBOELF_VERSION, ROBOELF_DMC_VERSION);
+	if (o->npaths == 0) {
+		printf("DMC programs: none (neither dmc/MANIFEST here nor "
+		       "%s/MANIFEST)\n",
+		       o->dmc_dir);
+		return 0;
+	}
+	for (i = 0; i < o->npaths; i++)
+		if (gload_prep_path(&p, o->paths[i], &d) != GL_OK)
+			ok = 0;
+	if (ok && (gload_check(&p, o->model, &d, &st) != 0 || d.n > 0 ||
+		   gload_prog_finish(&p) != GL_OK))
+		ok = 0;
+	if (ok)
+		printf("DMC programs: %s%s, identity '%s'\n", o->paths[0],
+		       o->npaths > 1 ? " ..." : "", p.stamp);
+	else
+		printf("DMC programs: %s%s: do not pass the check (run "
+		       "galil-load --check)\n",
+		       o->paths[0], o->npaths > 1 ? " ..." : "");
+	gload_diags_free(&d);
+	gload_prog_free(&p);
+	return 0;
 }
 
 /* Read, preprocess, check and stamp. Return 0 or an exit code. */
@@ -832,6 +909,15 @@ int main(int argc, char **argv)
 	}
 	if (ex)
 		return ex;
+	if (base_paths_root())
+		fprintf(stderr,
+			"galil-load: %s=%s: the installed files are looked "
+			"for under it\n",
+			BASE_PATHS_ROOT_ENV, base_paths_root());
+	if (o.version)
+		return print_version(&o);
+	if (o.dmc_default)
+		printf("DMC programs: %s (no files given)\n", o.dmc_dir);
 	if (o.npaths > 0)
 		ex = prepare(&o, &p);
 	if (ex || o.check_only)

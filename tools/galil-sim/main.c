@@ -32,6 +32,7 @@
 
 struct opts {
 	int port, control_port;
+	const char *listen_addr; /* --listen, NULL: 127.0.0.1 */
 	const char *plant, *relay_link, *protocol;
 	unsigned long seed;
 	int have_seed, verbose;
@@ -56,7 +57,8 @@ static void usage(FILE *f)
 {
 	fprintf(
 	    f,
-	    "usage: galil-sim [--port N] [--control-port M] [--plant FILE]\n"
+	    "usage: galil-sim [--port N] [--control-port M] [--listen ADDR]\n"
+	    "                 [--plant FILE]\n"
 	    "                 [--relay-link PATH | --no-relay-link]\n"
 	    "                 [--relay-protocol NAME] [--seed N] [--verbose]\n"
 	    "                 [--no-amp-undervoltage] [--power-output N]\n"
@@ -64,9 +66,11 @@ static void usage(FILE *f)
 	    "NAME]...\n"
 	    "       galil-sim --bench [SECONDS]\n"
 	    "       galil-sim --help | --version\n"
-	    "  --port N            command port on 127.0.0.1 (default %d, 0 = "
+	    "  --port N            command port (default %d, 0 = "
 	    "any)\n"
 	    "  --control-port M    control port (default %d, 0 = any)\n"
+	    "  --listen ADDR       IPv4 address of both ports (default "
+	    "127.0.0.1)\n"
 	    "  --plant FILE        robot model (default: built in, see "
 	    "config/plant.yaml)\n"
 	    "  --relay-link PATH   symbolic link to the relay pty (default "
@@ -156,6 +160,7 @@ static int parse_opt(int c, const char *arg, struct opts *o)
 		*(c == 'p' ? &o->port : &o->control_port) = (int)v;
 		return 0;
 	case 'P': o->plant = arg; return 0;
+	case 'L': o->listen_addr = arg; return 0;
 	case 'l': o->relay_link = arg; return 0;
 	case 'n': o->relay_link = ""; return 0;
 	case 'r': o->protocol = arg; return 0;
@@ -207,6 +212,7 @@ static int parse_args(int argc, char **argv, struct opts *o)
 	static const struct option longopts[] = {
 	    {"port", required_argument, NULL, 'p'},
 	    {"control-port", required_argument, NULL, 'c'},
+	    {"listen", required_argument, NULL, 'L'},
 	    {"plant", required_argument, NULL, 'P'},
 	    {"relay-link", required_argument, NULL, 'l'},
 	    {"no-relay-link", no_argument, NULL, 'n'},
@@ -299,14 +305,14 @@ static int serve(struct sim *s, const struct opts *o)
 	char err[ERR_LEN];
 	int rc;
 
-	if (sim_net_open(&net, s, o->port, o->control_port, err, sizeof(err)) <
-	    0) {
+	if (sim_net_open(&net, s, o->listen_addr, o->port, o->control_port, err,
+			 sizeof(err)) < 0) {
 		fprintf(stderr, "galil-sim: %s\n", err);
 		return 1;
 	}
-	printf("galil-sim: listening on 127.0.0.1:%d control %d relay %s\n",
-	       sim_net_port(net), sim_net_control_port(net),
-	       sim_relay_tty(sim_get_relay(s)));
+	printf("galil-sim: listening on %s:%d control %d relay %s\n",
+	       o->listen_addr ? o->listen_addr : "127.0.0.1", sim_net_port(net),
+	       sim_net_control_port(net), sim_relay_tty(sim_get_relay(s)));
 	fflush(stdout);
 	rc = sim_net_run(net, &stop, err, sizeof(err));
 	if (rc < 0)

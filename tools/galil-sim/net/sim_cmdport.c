@@ -32,10 +32,10 @@ void sim_cmdport_init(struct sim_cmdport *cp, struct sim *s)
 	}
 }
 
-int sim_cmdport_listen(struct sim_cmdport *cp, int port, char *err,
-		       size_t errlen)
+int sim_cmdport_listen(struct sim_cmdport *cp, const char *addr, int port,
+		       char *err, size_t errlen)
 {
-	cp->lfd = sim_sock_listen(port, &cp->port, err, errlen);
+	cp->lfd = sim_sock_listen(addr, port, &cp->port, err, errlen);
 	return cp->lfd < 0 ? GL_ERR_SYS : 0;
 }
 

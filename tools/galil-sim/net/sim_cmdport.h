@@ -85,12 +85,13 @@ struct sim_cmdport {
 void sim_cmdport_init(struct sim_cmdport *cp, struct sim *s);
 
 /*
- * sim_cmdport_listen() - bind 127.0.0.1:@port (0 = any free port), listen.
+ * sim_cmdport_listen() - bind @addr:@port (0 = any free port), listen.
+ * @addr: dotted IPv4 address, NULL for 127.0.0.1.
  * @err: [out] the reason on failure; @errlen its size.
  * Return: 0 or GL_ERR_SYS.
  */
-int sim_cmdport_listen(struct sim_cmdport *cp, int port, char *err,
-		       size_t errlen);
+int sim_cmdport_listen(struct sim_cmdport *cp, const char *addr, int port,
+		       char *err, size_t errlen);
 
 /*
  * sim_cmdport_shutdown() - close every connection (no event, the

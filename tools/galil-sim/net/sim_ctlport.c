@@ -23,10 +23,10 @@ void sim_ctlport_init(struct sim_ctlport *cp, struct sim *s)
 		cp->client[i].fd = -1;
 }
 
-int sim_ctlport_listen(struct sim_ctlport *cp, int port, char *err,
-		       size_t errlen)
+int sim_ctlport_listen(struct sim_ctlport *cp, const char *addr, int port,
+		       char *err, size_t errlen)
 {
-	cp->lfd = sim_sock_listen(port, &cp->port, err, errlen);
+	cp->lfd = sim_sock_listen(addr, port, &cp->port, err, errlen);
 	return cp->lfd < 0 ? GL_ERR_SYS : 0;
 }
 

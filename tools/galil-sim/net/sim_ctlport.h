@@ -45,12 +45,13 @@ struct sim_ctlport {
 void sim_ctlport_init(struct sim_ctlport *cp, struct sim *s);
 
 /*
- * sim_ctlport_listen() - bind 127.0.0.1:@port (0 = any free port), listen.
+ * sim_ctlport_listen() - bind @addr:@port (0 = any free port), listen.
+ * @addr: dotted IPv4 address, NULL for 127.0.0.1.
  * @err: [out] the reason on failure; @errlen its size.
  * Return: 0 or GL_ERR_SYS.
  */
-int sim_ctlport_listen(struct sim_ctlport *cp, int port, char *err,
-		       size_t errlen);
+int sim_ctlport_listen(struct sim_ctlport *cp, const char *addr, int port,
+		       char *err, size_t errlen);
 
 /* sim_ctlport_shutdown() - close every client (freeing its answer buffer)
  * and the listener. */

@@ -39,8 +39,8 @@ struct sim_net {
 
 /* ---- life cycle ------------------------------------------------------- */
 
-int sim_net_open(struct sim_net **out, struct sim *s, int port,
-		 int control_port, char *err, size_t errlen)
+int sim_net_open(struct sim_net **out, struct sim *s, const char *addr,
+		 int port, int control_port, char *err, size_t errlen)
 {
 	struct sim_net *n = calloc(1, sizeof(*n));
 
@@ -53,8 +53,8 @@ int sim_net_open(struct sim_net **out, struct sim *s, int port,
 	n->tfd = -1;
 	sim_cmdport_init(&n->cmd, s);
 	sim_ctlport_init(&n->ctl, s);
-	if (sim_cmdport_listen(&n->cmd, port, err, errlen) < 0 ||
-	    sim_ctlport_listen(&n->ctl, control_port, err, errlen) < 0) {
+	if (sim_cmdport_listen(&n->cmd, addr, port, err, errlen) < 0 ||
+	    sim_ctlport_listen(&n->ctl, addr, control_port, err, errlen) < 0) {
 		sim_net_free(n);
 		return GL_ERR_SYS;
 	}

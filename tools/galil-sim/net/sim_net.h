@@ -38,17 +38,19 @@ struct sim_net_stats {
 
 /*
  * sim_net_open() - bind the command port @port and the control port
- * @control_port on 127.0.0.1 (0 = any free port) and listen; the server
+ * @control_port on @addr (0 = any free port) and listen; the server
  * becomes @s's disconnect callback (sim_set_disconnect()).
  * @out: [out] the server (owned by the caller: sim_net_free()), NULL on
  *       failure.
  * @s: the simulator served (not owned; it must outlive the server).
+ * @addr: dotted IPv4 address to listen on ("0.0.0.0": every interface), or
+ *        NULL for 127.0.0.1.
  * @err: [out] e.g. "cannot listen on 127.0.0.1:23023: Address already in
  *       use"; @errlen its size.
  * Return: 0, GL_ERR_SYS, GL_ERR_NOMEM.
  */
-int sim_net_open(struct sim_net **out, struct sim *s, int port,
-		 int control_port, char *err, size_t errlen);
+int sim_net_open(struct sim_net **out, struct sim *s, const char *addr,
+		 int port, int control_port, char *err, size_t errlen);
 
 /*
  * sim_net_free() - close every socket and the timer, and stop being @n's

@@ -26,20 +26,26 @@ int sim_sock_again(int err)
 	return err == EAGAIN || err == EWOULDBLOCK || err == EINTR;
 }
 
-int sim_sock_listen(int port, int *bound, char *err, size_t errlen)
+int sim_sock_listen(const char *addr, int port, int *bound, char *err,
+		    size_t errlen)
 {
 	struct sockaddr_in sa = {.sin_family = AF_INET};
 	socklen_t len = sizeof(sa);
-	int one = 1, fd = socket(AF_INET, SOCK_STREAM, 0);
+	int one = 1, fd;
 
+	addr = addr ? addr : "127.0.0.1";
+	if (inet_pton(AF_INET, addr, &sa.sin_addr) != 1) {
+		snprintf(err, errlen, "invalid listen address '%s'", addr);
+		return GL_ERR_SYS;
+	}
 	sa.sin_port = htons((uint16_t)port);
-	sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+	fd = socket(AF_INET, SOCK_STREAM, 0);
 	if (fd < 0 ||
 	    setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one)) < 0 ||
 	    bind(fd, (struct sockaddr *)&sa, sizeof(sa)) < 0 ||
 	    listen(fd, 16) < 0 ||
 	    getsockname(fd, (struct sockaddr *)&sa, &len) < 0) {
-		snprintf(err, errlen, "cannot listen on 127.0.0.1:%d: %s", port,
+		snprintf(err, errlen, "cannot listen on %s:%d: %s", addr, port,
 			 strerror(errno));
 		if (fd >= 0)
 			close(fd);

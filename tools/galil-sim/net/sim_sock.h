@@ -11,15 +11,18 @@
 #include <stddef.h>
 
 /*
- * sim_sock_listen() - a TCP socket bound to 127.0.0.1:@port (0 = any free
+ * sim_sock_listen() - a TCP socket bound to @addr:@port (0 = any free
  * port), listening (backlog 16), non-blocking and close-on-exec.
+ * @addr: a dotted IPv4 address ("0.0.0.0" = every interface), or NULL for
+ *        127.0.0.1.
  * @bound: [out] the port number bound.
  * @err: [out] e.g. "cannot listen on 127.0.0.1:23023: Address already in
  *       use"; @errlen its size.
  * Return: the socket (>= 0, owned by the caller, close() it), or
  *         GL_ERR_SYS.
  */
-int sim_sock_listen(int port, int *bound, char *err, size_t errlen);
+int sim_sock_listen(const char *addr, int port, int *bound, char *err,
+		    size_t errlen);
 
 /* sim_sock_nonblock() - make @fd non-blocking and close-on-exec. */
 void sim_sock_nonblock(int fd);

@@ -1,0 +1,100 @@
+#!/bin/sh
+# install.sh - an installation works outside the source tree (issue 17):
+# `make install DESTDIR=$tmp/root PREFIX=/usr`, then the installed roboelf
+# and galil-load, started in an empty directory with ROBOELF_ROOT=$tmp/root
+# (the staged installation's root, base_paths.h), find the installed DMC
+# programs and configuration; --dmc and -c still win; the edited
+# configuration survives a second install; the docs tree keeps its links.
+set -u
+cd "$(dirname "$0")/../.." || exit 1
+TOP=$PWD
+BUILD=${BUILD:-build}
+tmp=$(mktemp -d) || exit 1
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "install: FAIL: $*"; exit 1; }
+root=$tmp/root
+mkdir "$tmp/elsewhere"
+
+make -s --no-print-directory BUILD="$BUILD" install DESTDIR="$root" PREFIX=/usr \
+	>"$tmp/make.log" 2>&1 || { cat "$tmp/make.log"; fail "make install"; }
+for f in usr/bin/roboelf usr/bin/galil-load usr/bin/galil-sim \
+	usr/share/roboelf/dmc/MANIFEST usr/share/roboelf/dmc/constants.dmc \
+	usr/share/roboelf/dmc/roboelf.dmc usr/share/roboelf/config/plant.yaml \
+	etc/roboelf/roboelf.yaml usr/share/man/man1/roboelf.1 \
+	usr/share/man/man1/galil-load.1 usr/share/man/man5/roboelf.yaml.5 \
+	usr/share/doc/roboelf/README.md usr/share/doc/roboelf/docs/technician.md \
+	usr/share/doc/roboelf/docs/trace-demo-pot-B.png; do
+	[ -f "$root/$f" ] || fail "not installed: /$f"
+done
+[ -e "$root/usr/bin/galil-stub" ] && fail "the test stub was installed"
+
+# every relative link of the installed Markdown resolves in the installed tree
+doc=$root/usr/share/doc/roboelf
+for md in "$doc"/README.md "$doc"/docs/*.md; do
+	for l in $(grep -o '](\([^)#: ]*\)' "$md" | sed 's/^](//' | sort -u); do
+		[ -e "$(dirname "$md")/$l" ] || fail "broken link in ${md#$doc/}: $l"
+	done
+done
+
+# galil-load: no files -> the installed DMC; the identity is the source tree's
+want_id=$("$BUILD/bin/galil-load" --check dmc | sed -n "s/.*identity line '\(.*\)'/\1/p")
+[ -n "$want_id" ] || fail "no identity from galil-load --check dmc"
+gl() { (cd "$tmp/elsewhere" && ROBOELF_ROOT=$root "$root/usr/bin/galil-load" "$@"); }
+out=$(gl --check 2>"$tmp/err") || fail "galil-load --check: exit $?: $(cat "$tmp/err")"
+first=$(printf '%s\n' "$out" | head -1)
+[ "$first" = "DMC programs: $root/usr/share/roboelf/dmc (no files given)" ] || fail "galil-load --check: '$first'"
+printf '%s\n' "$out" | grep -qF "identity line '$want_id'" || fail "galil-load --check: identity: $out"
+[ "$(cat "$tmp/err")" = "galil-load: ROBOELF_ROOT=$root: the installed files are looked for under it" ] ||
+	fail "galil-load: ROBOELF_ROOT notice: '$(cat "$tmp/err")'"
+version=$(sed -n 's/^#define ROBOELF_VERSION[ \t]*"\(.*\)"/\1/p' pc/base/base_version.h)
+iface=$(sed -n 's/^#define ROBOELF_DMC_VERSION[ \t]*"\(.*\)"/\1/p' pc/base/base_version.h)
+want="galil-load $version (controller program interface $iface, dmc/constants.dmc vers)
+DMC programs: $root/usr/share/roboelf/dmc, identity '$want_id'"
+out=$(gl --version 2>/dev/null) || fail "galil-load --version: exit $?"
+[ "$out" = "$want" ] || fail "galil-load --version: '$out'"
+# --dmc wins over the installed programs
+out=$(gl --check --dmc "$TOP/tests/data/dmc_good/split" 2>&1) || fail "--dmc: exit $?: $out"
+case $out in *"DMC programs:"* | *"$want_id"*) fail "--dmc did not win: $out" ;; esac
+# nothing installed under the root: the message names both places
+out=$(cd "$tmp/elsewhere" && ROBOELF_ROOT=$tmp/none "$root/usr/bin/galil-load" --check 2>&1)
+rc=$?
+[ $rc -eq 2 ] || fail "no DMC: exit $rc"
+want="galil-load: no program files and no commands, and no DMC programs: neither dmc/MANIFEST here nor $tmp/none/usr/share/roboelf/dmc/MANIFEST"
+[ "$(printf '%s\n' "$out" | head -1)" = "$want" ] || fail "no DMC: '$out'"
+
+# roboelf: --version names the installed configuration and DMC programs
+re() { (cd "$tmp/elsewhere" && ROBOELF_ROOT=$root "$root/usr/bin/roboelf" "$@" </dev/null); }
+want="roboelf $version (controller program interface $iface, dmc/constants.dmc vers)
+configuration: $root/etc/roboelf/roboelf.yaml
+DMC programs: $root/usr/share/roboelf/dmc"
+out=$(re --version 2>/dev/null) || fail "roboelf --version: exit $?"
+[ "$out" = "$want" ] || fail "roboelf --version: '$out'"
+# the installed configuration is the one read: an edit shows in the error
+cfg=$root/etc/roboelf/roboelf.yaml
+sed -i 's/^period_ms: .*/period_ms: 1/' "$cfg"
+line=$(grep -n '^period_ms: 1$' "$cfg" | cut -d: -f1)
+[ -n "$line" ] || fail "no period_ms line in the installed configuration"
+out=$(re --calibration file 2>&1)
+rc=$?
+[ $rc -eq 2 ] || fail "edited configuration: exit $rc: $out"
+printf '%s\n' "$out" | grep -q "^$cfg:$line:" || fail "edited configuration not read: $out"
+# ROBOELF_ROOT is refused in clinical mode, before anything is opened
+cp "$cfg" "$tmp/edited.yaml"
+sed -i -e 's/^period_ms: 1$/period_ms: 50/' -e 's/^mode: development$/mode: clinical/' \
+	-e 's|^  port_clinical: ""$|  port_clinical: /dev/roboelf-relay|' \
+	-e 's|^  address: "127.0.0.1:23023"$|  address: "192.0.2.1"|' "$cfg"
+out=$(re --calibration file 2>&1)
+rc=$?
+want="roboelf: ROBOELF_ROOT=$root: the installed files are looked for under it
+roboelf: error: ROBOELF_ROOT is set: refused in clinical mode (it is for testing a staged installation); unset it"
+[ $rc -eq 2 ] && [ "$out" = "$want" ] || fail "clinical with ROBOELF_ROOT: exit $rc: '$out'"
+cp "$tmp/edited.yaml" "$cfg"
+# -c wins
+printf 'period_ms: 0\n' >"$tmp/mine.yaml"
+out=$(re -c "$tmp/mine.yaml" --calibration file 2>&1)
+printf '%s\n' "$out" | grep -q "^$tmp/mine.yaml:1:" || fail "-c did not win: $out"
+# a second install keeps the edited configuration
+make -s --no-print-directory BUILD="$BUILD" install DESTDIR="$root" PREFIX=/usr \
+	>"$tmp/make.log" 2>&1 || { cat "$tmp/make.log"; fail "second make install"; }
+grep -q '^period_ms: 1$' "$cfg" || fail "the second install replaced the edited configuration"
+echo "install: ok"

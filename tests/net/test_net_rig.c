@@ -1,0 +1,632 @@
+/*
+ * test_net_rig.c - the network cases of issue 18 on a virtual cable:
+ * galil-sim in its own network namespace behind a veth pair
+ * (tests/net/netns_rig.sh), roboelf, galil-load and the relay on the host.
+ * The rig's second veth pair carries only galil-sim's control port, so the
+ * test reads the controller's events while the cable is out.
+ *
+ * The link is set up as installed (docs/link.md): rto_min RTO_MIN_MS on the
+ * route at both ends. Each case asserts the outcome that docs/safety.md
+ * ("Network cases") states: no trip, warnings only, or a WATCHDOG fault
+ * with the relay off and every motor off within the deadline, measured on
+ * galil-sim's event log from the injection (the simulated time read just
+ * before the rig command).
+ *
+ * Without root (no CAP_NET_ADMIN) or without iptables/NFQUEUE the program
+ * prints "SKIP: <reason>" and exits 77: tests/run-all.sh reports SKIPPED.
+ * `make check` runs the short cases; ROBOELF_NETRIG=long (make netrig) adds
+ * the long ones (minutes). ROBOELF_REACTION_CSV=FILE appends the figures.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <signal.h>
+#include <net/if.h>
+#include <sys/ioctl.h>
+#include <sys/resource.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "proc.h"
+#include "sys_h.h"
+
+#define SKIP_EXIT     77
+#define SLACK_MS      25   /* scheduling allowance, as test_sys_faults */
+#define HOLD_MS	      300  /* no motion over this after the safe state */
+#define FAULT_WAIT_MS 8000 /* FAULT line, beyond the deadline */
+#define EXIT_WAIT_MS  8000
+#define RIG_WAIT_MS   10000
+#define RTO_MIN_MS    5 /* the installed route's rto_min (docs/link.md) */
+
+static struct sys_env env;
+static int env_ok, rig_ok;
+static char rig_sh[SYS_PATH_MAX + 32], rig_id[16], ns[32];
+static char data_addr[16], mgmt_addr[16], data_if[IFNAMSIZ];
+static struct sys_case cs;
+
+/* ---- the rig script --------------------------------------------------- */
+
+/* Run netns_rig.sh with @args (space separated); its exit code, -1. */
+static int rig(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static int rig(const char *fmt, ...)
+{
+	char args[256], *argv[16], *save = NULL;
+	struct proc p;
+	va_list ap;
+	int n = 0, status;
+
+	va_start(ap, fmt);
+	vsnprintf(args, sizeof(args), fmt, ap);
+	va_end(ap);
+	argv[n++] = (char *)"/bin/bash";
+	argv[n++] = rig_sh;
+	for (char *t = strtok_r(args, " ", &save); t && n < 15;
+	     t = strtok_r(NULL, " ", &save))
+		argv[n++] = t;
+	argv[n] = NULL;
+	if (proc_spawn(&p, argv, NULL) < 0)
+		return -1;
+	if (proc_wait_exit(&p, RIG_WAIT_MS, &status) < 0) {
+		proc_kill(&p);
+		return -1;
+	}
+	n = proc_exit_code(&p);
+	if (n != 0)
+		print_message("[   RIG    ] %s: exit %d: %s%s\n", args, n,
+			      proc_output(&p, PROC_STDOUT),
+			      proc_output(&p, PROC_STDERR));
+	proc_kill(&p);
+	return n;
+}
+
+/* The host's end of the data pair up or down (SIOCSIFFLAGS: no process
+ * to start, so the injection time is exact even on a loaded machine). */
+static int link_set(int up)
+{
+	struct ifreq ifr;
+	int fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0), rc = -1;
+
+	memset(&ifr, 0, sizeof(ifr));
+	snprintf(ifr.ifr_name, sizeof(ifr.ifr_name), "%s", data_if);
+	if (fd >= 0 && ioctl(fd, SIOCGIFFLAGS, &ifr) == 0) {
+		if (up)
+			ifr.ifr_flags |= IFF_UP;
+		else
+			ifr.ifr_flags &= ~IFF_UP;
+		rc = ioctl(fd, SIOCSIFFLAGS, &ifr);
+	}
+	if (fd >= 0)
+		close(fd);
+	return rc;
+}
+
+/* Pull the cable: the simulated time just before it (the injection). */
+static double pull_cable(struct sys_case *c)
+{
+	double t = sys_sim_time(c);
+
+	if (t < 0)
+		fail_msg("sim time: %s", c->err);
+	if (link_set(0) < 0)
+		fail_msg("cannot set '%s' down", data_if);
+	return t;
+}
+
+/* A rig command that takes effect as it returns (delay, loss): the
+ * simulated time just after it; the measured reaction is from the moment
+ * the rule was in place at the latest. */
+static double rig_after(struct sys_case *c, const char *what, const char *arg)
+{
+	double t;
+
+	if (rig("%s %s %s", what, rig_id, arg) != 0)
+		fail_msg("rig '%s %s' failed", what, arg);
+	t = sys_sim_time(c);
+	if (t < 0)
+		fail_msg("sim time: %s", c->err);
+	return t;
+}
+
+/* ---- expectations ----------------------------------------------------- */
+
+static double P(void)
+{
+	return env.period_ms;
+}
+static double C(void)
+{
+	return env.crit_factor * env.period_ms;
+}
+/* the controller's own watchdog: the last heartbeat got through before the
+ * injection at the latest; then wdto, one main loop and one sample */
+static double W_stop(void)
+{
+	return env.wdto_ms + SYS_MAINMS + 1;
+}
+
+struct outcome {
+	double relay_ms;  /* relay off after the injection, -1 none */
+	double motors_ms; /* every motor off after the injection, -1 */
+	double age_ms;	  /* the reply age the FAULT line names, -1 */
+	long warnings;	  /* "watchdog: reply after" log lines */
+	char line[1024];  /* the FAULT line, "" none */
+};
+
+static void record(const char *name, const char *expected,
+		   const struct outcome *o)
+{
+	const char *csv = getenv("ROBOELF_REACTION_CSV");
+	FILE *f;
+
+	print_message(
+	    "[ MEASURE  ] %s: expected %s; relay off %.0f ms, "
+	    "motors off %.0f ms, reply age %.0f ms, %ld warnings%s%s\n",
+	    name, expected, o->relay_ms, o->motors_ms, o->age_ms, o->warnings,
+	    o->line[0] ? "; " : "", o->line);
+	if (!csv || !*csv || !(f = fopen(csv, "a")))
+		return;
+	fprintf(f, "%s,%s,%.1f,%.1f,%.1f,%ld\n", name, expected, o->relay_ms,
+		o->motors_ms, o->age_ms, o->warnings);
+	fclose(f);
+}
+
+/* The log's "watchdog: reply after" warnings so far. */
+static long count_warnings(struct sys_case *c)
+{
+	char line[2048];
+	long n = 0;
+	FILE *f = fopen(c->log, "r");
+
+	while (f && fgets(line, sizeof(line), f))
+		n += strstr(line, "watchdog: reply after") != NULL;
+	if (f)
+		fclose(f);
+	return n;
+}
+
+/* Wait until every motor has a "motor off" event after @after. */
+static double wait_motors_off(struct sys_case *c, double after, int ms)
+{
+	long long deadline = proc_now_ms() + ms;
+
+	for (;;) {
+		double t = sys_motors_off_time(c, after);
+
+		if (t >= 0 || proc_now_ms() > deadline)
+			return t;
+		if (sys_wait_sim(c, sys_sim_time(c) + 15, 1000) < 0 ||
+		    sys_events(c) < 0)
+			return -1;
+	}
+}
+
+/*
+ * A WATCHDOG trip: the FAULT line names the reply age (RE_F_WDOG_REPLY),
+ * the relay goes off within @d_relay and every motor within @d_motors of
+ * @t_inj (a negative deadline: not asserted, only measured), the robot is
+ * safe and stays so.
+ */
+static void expect_trip(struct sys_case *c, const char *name, double t_inj,
+			double d_relay, double d_motors, struct outcome *o)
+{
+	static const enum re_fault_id ids[] = {RE_F_WDOG_REPLY, RE_F_NONE};
+	double t;
+
+	if (sys_wait_fault(c, FAULT_WAIT_MS, o->line, sizeof(o->line)) < 0)
+		fail_msg("%s: %s", name, c->err);
+	if (sys_fault_match(o->line, -1, ids) != RE_F_WDOG_REPLY)
+		fail_msg("%s: not the reply-age WATCHDOG fault: %s", name,
+			 o->line);
+	if (sscanf(strstr(o->line, "no reply from the controller for "),
+		   "no reply from the controller for %lf ms", &o->age_ms) != 1)
+		o->age_ms = -1;
+	if (sys_wait_event(c, "relay off", t_inj, 3000, &t) < 0)
+		fail_msg("%s: %s", name, c->err);
+	o->relay_ms = t - t_inj;
+	t = wait_motors_off(c, t_inj, 3000);
+	if (t < 0)
+		fail_msg("%s: not every motor was switched off", name);
+	o->motors_ms = t - t_inj;
+	o->warnings = count_warnings(c);
+	record(name, "trip", o);
+	if (sys_check_safe(c, 0, HOLD_MS) < 0)
+		fail_msg("%s: %s", name, c->err);
+	if (d_relay >= 0 && o->relay_ms > d_relay + SLACK_MS)
+		fail_msg("%s: relay off after %.0f ms, deadline %.0f ms (+%d)",
+			 name, o->relay_ms, d_relay, SLACK_MS);
+	if (d_motors >= 0 && o->motors_ms > d_motors + SLACK_MS)
+		fail_msg("%s: motors off after %.0f ms, deadline %.0f ms (+%d)",
+			 name, o->motors_ms, d_motors, SLACK_MS);
+	if (o->age_ms < 0 || o->age_ms > C() + P() + SLACK_MS)
+		fail_msg("%s: reply age %.0f ms in the FAULT line, limit "
+			 "C + P = %.0f ms",
+			 name, o->age_ms, C() + P());
+}
+
+/* No trip for @secs of simulated time from @t0: no FAULT line, still
+ * armed (relay on, every motor on). */
+static void expect_no_trip(struct sys_case *c, const char *name, double t0,
+			   double secs, const char *expected, long max_warn)
+{
+	struct outcome o = {.relay_ms = -1, .motors_ms = -1, .age_ms = -1};
+	char st[2048];
+
+	if (sys_wait_sim(c, t0 + secs * 1000, (int)(secs * 1000) + 5000) < 0)
+		fail_msg("%s: %s", name, c->err);
+	proc_pump(&c->re, 0);
+	proc_find_line(&c->re, PROC_STDOUT, "FAULT ", o.line, sizeof(o.line));
+	o.warnings = count_warnings(c);
+	record(name, expected, &o);
+	if (o.line[0] && strstr(o.line, "this supervisor did not run"))
+		fail_msg(
+		    "%s: inconclusive: the PC stalled (machine overloaded), "
+		    "not the link: %s",
+		    name, o.line);
+	if (o.line[0])
+		fail_msg("%s: tripped within %.0f s: %s", name, secs, o.line);
+	if (sys_state(c, st, sizeof(st)) < 0)
+		fail_msg("%s: %s", name, c->err);
+	if (!strstr(st, " relay=on ") || !strstr(st, " A.mo=0 ") ||
+	    !strstr(st, " B.mo=0 ") || !strstr(st, " C.mo=0 "))
+		fail_msg("%s: no longer armed: %s", name, st);
+	if (max_warn >= 0 && o.warnings > max_warn)
+		fail_msg("%s: %ld watchdog warnings, at most %ld expected",
+			 name, o.warnings, max_warn);
+}
+
+/* After a fault: SIGTERM, exit 4 (a latched fault) within EXIT_WAIT_MS. */
+static void quit_latched(struct sys_case *c, const char *name)
+{
+	int status;
+
+	proc_signal(&c->re, SIGTERM);
+	if (proc_wait_exit(&c->re, EXIT_WAIT_MS, &status) < 0)
+		fail_msg("%s: roboelf did not exit within %d ms of SIGTERM",
+			 name, EXIT_WAIT_MS);
+	assert_int_equal(proc_exit_code(&c->re), 4);
+}
+
+/* ---- cases -------------------------------------------------------------- */
+
+/* A case on the rig as installed (rto_min RTO_MIN_MS) or, with @rto 0,
+ * as before docs/link.md (the kernel's default minimum). */
+static void start_rto(struct sys_case *c, const char *calibration, int rto)
+{
+	/* the script exec's ip, which exec's galil-sim: the pid is its */
+	char *wrap[] = {(char *)"/bin/bash", rig_sh, (char *)"exec", rig_id,
+			NULL};
+	struct sys_opts o = {.sim_wrap = wrap,
+			     .sim_addr = data_addr,
+			     .ctl_addr = mgmt_addr,
+			     .calibration = calibration,
+			     .no_ready = calibration != NULL};
+
+	if (!env_ok || !rig_ok)
+		fail_msg("no environment (calibration or rig failed)");
+	if (rig("clear %s", rig_id) || rig("up %s", rig_id) ||
+	    (rto && rig("rto %s %d", rig_id, rto)))
+		fail_msg("rig reset failed");
+	if (sys_case_start(c, &env, &o) < 0)
+		fail_msg("case start: %s", c->err);
+	/* the rig measures the link, not a CPU shared with builds and
+	 * fuzzers: roboelf and galil-sim run at nice -10 (root is given) */
+	setpriority(PRIO_PROCESS, (id_t)c->re.pid, -10);
+	setpriority(PRIO_PROCESS, (id_t)c->sim.p.pid, -10);
+}
+
+static void start(struct sys_case *c, const char *calibration)
+{
+	start_rto(c, calibration, RTO_MIN_MS);
+}
+
+static void stop(struct sys_case *c)
+{
+	sys_case_stop(c);
+	rig("clear %s", rig_id);
+	rig("up %s", rig_id);
+}
+
+/* Jog axis B so that a pull meets a moving robot. */
+static void jog(struct sys_case *c)
+{
+	if (sys_ctl(c, "joy B fwd") < 0 ||
+	    sys_wait_moving(c, 'B', 200, 5000) < 0)
+		fail_msg("jog: %s", c->err);
+}
+
+/* Cable pulled while armed and jogging: the PC's reply-age watchdog opens
+ * the relay within C + P; its stop cannot reach the controller, whose own
+ * watchdog switches the motors off within W + M + s. */
+static void test_pull_armed(void **state)
+{
+	struct outcome o = {0};
+	double t;
+
+	(void)state;
+	start(&cs, NULL);
+	/* roboelf checked the route at start-up (docs/link.md) */
+	assert_int_equal(proc_find_line(&cs.re, PROC_STDOUT,
+					"roboelf: route to the controller: "
+					"rto_min 5 ms (limit 25 ms)",
+					NULL, 0),
+			 0);
+	jog(&cs);
+	t = pull_cable(&cs);
+	expect_trip(&cs, "cable pull, armed", t, C() + P(), W_stop(), &o);
+	quit_latched(&cs, "cable pull, armed");
+	stop(&cs);
+}
+
+/* Cable pulled during the full calibration (state 3, axes moving). */
+static void test_pull_calibrating(void **state)
+{
+	struct outcome o = {0};
+	double t;
+
+	(void)state;
+	start(&cs, "full");
+	if (sys_wait_moving(&cs, 'A', 200, 60000) < 0)
+		fail_msg("no calibration motion: %s", cs.err);
+	t = pull_cable(&cs);
+	expect_trip(&cs, "cable pull, calibrating", t, C() + P(), W_stop(), &o);
+	quit_latched(&cs, "cable pull, calibrating");
+	stop(&cs);
+}
+
+/* Cable pulled while latched (after an encoder/pot fault): nothing changes,
+ * nothing moves, no second fault is invented, the quit still exits 4. */
+static void test_pull_latched(void **state)
+{
+	char line[1024];
+	double t;
+
+	(void)state;
+	start(&cs, NULL);
+	if (sys_ctl(&cs, "pot A offset 0.5") < 0 ||
+	    sys_wait_fault(&cs, FAULT_WAIT_MS, line, sizeof(line)) < 0 ||
+	    sys_check_safe(&cs, 0, HOLD_MS) < 0)
+		fail_msg("latch: %s", cs.err);
+	t = pull_cable(&cs);
+	if (sys_check_safe(&cs, 0, 1000) < 0)
+		fail_msg("cable pull, latched: %s", cs.err);
+	if (sys_events(&cs) < 0)
+		fail_msg("%s", cs.err);
+	assert_int_equal(sys_event_find(&cs, "relay on", t), -1);
+	assert_int_equal(sys_event_find(&cs, "axis A motor on", t), -1);
+	print_message("[ MEASURE  ] cable pull, latched: expected safe "
+		      "state held; held 1000 ms, no relay or motor on\n");
+	quit_latched(&cs, "cable pull, latched");
+	stop(&cs);
+}
+
+/* Cable pulled and back after 200 ms: the fault stays latched, nothing
+ * resumes (relay off, motors off, no motion) after the link is back. */
+static void test_pull_back_200ms(void **state)
+{
+	struct outcome o = {0};
+	double t;
+
+	(void)state;
+	start(&cs, NULL);
+	jog(&cs);
+	t = pull_cable(&cs);
+	if (sys_wait_sim(&cs, t + 200, 3000) < 0 || link_set(1) < 0)
+		fail_msg("cable back: %s", cs.err);
+	expect_trip(&cs, "cable back after 200 ms", t, C() + P(), W_stop(), &o);
+	if (sys_check_safe(&cs, 0, 1000) < 0 || sys_events(&cs) < 0)
+		fail_msg("cable back after 200 ms: %s", cs.err);
+	for (int a = 0; a < 3; a++) {
+		char ev[32];
+
+		snprintf(ev, sizeof(ev), "axis %c motor on", 'A' + a);
+		assert_int_equal(sys_event_find(&cs, ev, t), -1);
+	}
+	assert_int_equal(sys_event_find(&cs, "relay on", t), -1);
+	/* no second Ready after the one the case started with */
+	assert_int_equal(proc_wait_line(&cs.re, PROC_STDOUT,
+					"RoboELF Ready for Use", 0, NULL, 0),
+			 -1);
+	quit_latched(&cs, "cable back after 200 ms");
+	stop(&cs);
+}
+
+/* One-way delay @ms on every frame the controller sends. */
+static void delay_case(const char *name, int ms, int trip, double secs)
+{
+	char arg[SYS_PATH_MAX + 16];
+	struct outcome o = {0};
+	double t;
+
+	start(&cs, NULL);
+	snprintf(arg, sizeof(arg), "%d %s", ms, env.bin);
+	t = rig_after(&cs, "delay", arg);
+	if (trip) {
+		expect_trip(&cs, name, t, C() + P() + ms, W_stop() + ms, &o);
+		quit_latched(&cs, name);
+	} else {
+		expect_no_trip(&cs, name, t, secs, "no trip, warnings", -1);
+	}
+	stop(&cs);
+}
+
+static void test_delay_40(void **state)
+{
+	(void)state;
+	delay_case("delay 40 ms", 40, 0, 10);
+}
+
+static void test_delay_80(void **state)
+{
+	(void)state;
+	delay_case("delay 80 ms", 80, 1, 0);
+}
+
+static void test_delay_150(void **state)
+{
+	(void)state;
+	delay_case("delay 150 ms", 150, 1, 0);
+}
+
+/* Random loss @pct % each way for @secs; a trip is the reply-age fault
+ * with the reply age within C + P. @rto: with the installed rto_min (else
+ * the kernel's default 200 ms minimum, the state before docs/link.md). */
+static void loss_case(const char *name, const char *pct, int trip, double secs,
+		      int rto)
+{
+	struct outcome o = {0};
+	double t;
+
+	start_rto(&cs, NULL, rto ? RTO_MIN_MS : 0);
+	if (!rto)
+		assert_int_equal(
+		    proc_find_line(&cs.re, PROC_STDOUT,
+				   "roboelf: warning: the route to the "
+				   "controller '10.231.",
+				   NULL, 0),
+		    0);
+	t = rig_after(&cs, "loss", pct);
+	if (trip) {
+		/* the burst that trips comes at a random time: no deadline
+		 * from the injection; the reply age and the controller's
+		 * stop are asserted */
+		expect_trip(&cs, name, t, -1, -1, &o);
+		if (o.motors_ms > o.relay_ms + W_stop() + SLACK_MS)
+			fail_msg("%s: motors off %.0f ms after the relay", name,
+				 o.motors_ms - o.relay_ms);
+		quit_latched(&cs, name);
+	} else {
+		expect_no_trip(&cs, name, t, secs, "no trip", -1);
+	}
+	stop(&cs);
+}
+
+static void test_loss_5_short(void **state)
+{
+	(void)state;
+	loss_case("loss 5 % (10 s)", "5", 0, 10, 1);
+}
+
+static void test_loss_30(void **state)
+{
+	(void)state;
+	loss_case("loss 30 %", "30", 1, 0, 1);
+}
+
+static void test_loss_1_60s(void **state)
+{
+	(void)state;
+	loss_case("loss 1 % (60 s)", "1", 0, 60, 1);
+}
+
+static void test_loss_5_60s(void **state)
+{
+	(void)state;
+	loss_case("loss 5 % (60 s)", "5", 0, 60, 1);
+}
+
+/* The state before the link design: no rto_min, 5 % loss trips. */
+static void test_loss_5_no_rto(void **state)
+{
+	(void)state;
+	loss_case("loss 5 %, no rto_min", "5", 1, 0, 0);
+}
+
+/* ---- fixtures ----------------------------------------------------------- */
+
+static int group_setup(void **state)
+{
+	(void)state;
+	if (rig("setup %s", rig_id) == 0)
+		rig_ok = 1;
+	if (sys_env_init(&env) == 0 && sys_env_calibrate(&env, 150000) == 0)
+		env_ok = 1;
+	print_message("[   INFO   ] rig %s (%s, galil-sim at %s, control %s); "
+		      "full calibration %s in %.1f s (P %d ms)\n",
+		      rig_ok ? "up" : "FAILED", ns, data_addr, mgmt_addr,
+		      env_ok ? "done" : "FAILED", env.calib_s, env.period_ms);
+	return 0;
+}
+
+static int group_teardown(void **state)
+{
+	(void)state;
+	sys_case_stop(&cs);
+	rig("teardown %s", rig_id);
+	sys_env_cleanup(&env);
+	return 0;
+}
+
+/* The rig's precondition: 0, or prints the SKIP line and returns 77. */
+static int rig_check(void)
+{
+	char *argv[] = {(char *)"/bin/bash", rig_sh, (char *)"check", NULL};
+	struct proc p;
+	int status, rc;
+
+	if (proc_spawn(&p, argv, NULL) < 0 ||
+	    proc_wait_exit(&p, RIG_WAIT_MS, &status) < 0) {
+		proc_kill(&p);
+		printf("SKIP: cannot run '%s'\n", rig_sh);
+		return SKIP_EXIT;
+	}
+	rc = proc_exit_code(&p);
+	if (rc != 0)
+		printf("%s", rc == SKIP_EXIT ? proc_output(&p, PROC_STDOUT)
+					     : "SKIP: the rig check failed\n");
+	proc_kill(&p);
+	return rc == 0 ? 0 : SKIP_EXIT;
+}
+
+int main(void)
+{
+	const struct CMUnitTest short_tests[] = {
+	    cmocka_unit_test(test_pull_armed),
+	    cmocka_unit_test(test_pull_back_200ms),
+	    cmocka_unit_test(test_pull_latched),
+	    cmocka_unit_test(test_delay_150),
+	    cmocka_unit_test(test_loss_30),
+	};
+	const struct CMUnitTest long_tests[] = {
+	    cmocka_unit_test(test_pull_armed),
+	    cmocka_unit_test(test_pull_back_200ms),
+	    cmocka_unit_test(test_pull_latched),
+	    cmocka_unit_test(test_pull_calibrating),
+	    cmocka_unit_test(test_delay_40),
+	    cmocka_unit_test(test_delay_80),
+	    cmocka_unit_test(test_delay_150),
+	    cmocka_unit_test(test_loss_5_short),
+	    cmocka_unit_test(test_loss_30),
+	    cmocka_unit_test(test_loss_1_60s),
+	    cmocka_unit_test(test_loss_5_60s),
+	    cmocka_unit_test(test_loss_5_no_rto),
+	};
+	const char *top = getenv("ROBOELF_TOP"),
+		   *mode = getenv("ROBOELF_NETRIG");
+	const char *filter = getenv("ROBOELF_SYS_FILTER");
+	unsigned id = (unsigned)getpid() % 100000;
+	int rc;
+
+	snprintf(rig_sh, sizeof(rig_sh), "%s/tests/net/netns_rig.sh",
+		 top && *top ? top : ".");
+	rc = rig_check();
+	if (rc)
+		return rc;
+	snprintf(rig_id, sizeof(rig_id), "%u", id);
+	snprintf(ns, sizeof(ns), "roboelf-net-%u", id);
+	snprintf(data_addr, sizeof(data_addr), "10.231.%u.2", id % 250 + 1);
+	snprintf(mgmt_addr, sizeof(mgmt_addr), "10.232.%u.2", id % 250 + 1);
+	snprintf(data_if, sizeof(data_if), "rd%uh", id);
+	if (filter && *filter)
+		cmocka_set_test_filter(filter);
+	if (mode && !strcmp(mode, "long"))
+		return cmocka_run_group_tests(long_tests, group_setup,
+					      group_teardown);
+	return cmocka_run_group_tests(short_tests, group_setup, group_teardown);
+}
