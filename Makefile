@@ -8,6 +8,7 @@
 #   make bench    performance figures (printed and written as CSV)
 #   make soak     the randomised soak (SOAK_SECONDS, default 600; SOAK_SEED)
 #   make lint     clang-format dry run and cppcheck
+#   make fuzz     every libFuzzer target for FUZZ_SECONDS (default 600) each
 #   make install / uninstall   (PREFIX, DESTDIR)
 #   make deb      the Debian package build/roboelf_<version>_<arch>.deb
 #
@@ -165,9 +166,41 @@ lint: have-lint-deps
 		--suppress=missingIncludeSystem $(addprefix -I,$(INC_DIRS)) \
 		pc tools tests
 
+# ---- fuzzing (issue 18, docs/fuzzing.md) ------------------------------------
+# One libFuzzer target per tests/fuzz/fuzz_<name>.c, built with clang and
+# -fsanitize=fuzzer,address,undefined into $(FUZZ_BUILD) (its own libraries,
+# never the normal objects). `make fuzz` runs each for FUZZ_SECONDS on a copy
+# of tests/fuzz/corpus/<name> + regress/<name> kept in $(FUZZ_BUILD)/corpus
+# (the repository's corpus is never written); `make check` runs each for a
+# few seconds (tests/checks/fuzz_short.sh).
+FUZZ_CC ?= clang
+FUZZ_SECONDS ?= 600
+FUZZ_BUILD ?= $(BUILD)/fuzz
+FUZZ_SAN = -fsanitize=fuzzer,address,undefined \
+           -fno-sanitize-recover=address,undefined -fno-omit-frame-pointer
+FUZZ_NAMES := $(patsubst tests/fuzz/fuzz_%.c,%,$(wildcard tests/fuzz/fuzz_*.c))
+FUZZ_BINS := $(addprefix $(FUZZ_BUILD)/bin/fuzz_,$(FUZZ_NAMES))
+FUZZ_LIBS := $(patsubst $(BUILD)/%,$(FUZZ_BUILD)/%,$(LIB_LOAD) $(LIB_SIM) \
+             $(LIB_RE) $(LIB_DMC) $(LIB_GL) $(LIB_BASE))
+.PHONY: fuzz fuzz-build
+fuzz: deps
+	@$(MAKE) --no-print-directory fuzz-build
+	@FUZZ_BUILD=$(FUZZ_BUILD) FUZZ_SECONDS=$(FUZZ_SECONDS) tests/fuzz/run.sh $(FUZZ_NAMES)
+fuzz-build:
+	@$(MAKE) --no-print-directory BUILD=$(FUZZ_BUILD) CC=$(FUZZ_CC) \
+		SANITIZE=address,undefined CFLAGS="-O1 -g -fsanitize=fuzzer-no-link" \
+		$(FUZZ_LIBS)
+	@$(MAKE) --no-print-directory $(FUZZ_BINS)
+$(FUZZ_BUILD)/bin/fuzz_%: tests/fuzz/fuzz_%.c $(FUZZ_LIBS)
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(WARN) -O1 -g $(FUZZ_SAN) -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE \
+		$(addprefix -I,$(INC_DIRS)) $(PKG_CFLAGS) -MMD -MP -MF $@.d -o $@ $< \
+		$(FUZZ_LIBS) $(LIBS)
+-include $(wildcard $(FUZZ_BUILD)/bin/*.d)
+
 # ---- dependencies ------------------------------------------------------------
 DEB_PKGS = gcc make pkg-config libserialport-dev libyaml-dev libcmocka-dev gnuplot-nox tmux \
-           clang-format cppcheck
+           clang-format cppcheck clang libclang-rt-dev
 deps:
 	@missing=""; for p in $(DEB_PKGS); do \
 		dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'ok installed' || missing="$$missing $$p"; \

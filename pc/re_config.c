@@ -1403,6 +1403,7 @@ static int load_document(struct pctx *c, const char *buf, size_t len,
 	return rc ? syntax_error(c, rc, &e, buf, len) : GL_OK;
 }
 
+/* Defaults derived from other fields; they are in range (check_table()). */
 static void auto_defaults(struct pctx *c, struct re_config *cfg)
 {
 	int wd = 4 * cfg->period_ms;
@@ -1430,6 +1431,11 @@ static int parse_document(struct pctx *c, yaml_document_t *doc)
 			       "level, got %s",
 			       node_kind(root));
 	rc = parse_map(c, root, root_fields, c->cfg, "configuration");
+	/* The ranges first: the defaults derived from a field (4 x period_ms)
+	 * may only be computed from a value in its range (a period_ms of
+	 * 1326439257 overflowed int here before it was refused). */
+	if (!rc)
+		rc = check_table(c, root_fields, c->cfg);
 	if (rc)
 		return rc;
 	auto_defaults(c, c->cfg);

@@ -22,10 +22,11 @@ LOGDIR=$BUILD/test-logs
 mkdir -p "$LOGDIR"
 passed=0; failed=0; skipped=0; failures=""
 # Per-program deadline (s): a hung test fails with exit 124 instead of hanging
-# the run; system tests get more (ROBOELF_TEST_TIMEOUT overrides both).
+# the run; system tests get more, and so does the fuzz check, which builds
+# its targets first (ROBOELF_TEST_TIMEOUT overrides both).
 deadline() {
 	case $1 in
-	system/* | net/*) echo "${ROBOELF_TEST_TIMEOUT:-600}" ;;
+	system/* | net/* | checks/fuzz_short.sh) echo "${ROBOELF_TEST_TIMEOUT:-600}" ;;
 	*) echo "${ROBOELF_TEST_TIMEOUT:-180}" ;;
 	esac
 }

@@ -12,6 +12,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "ctrl_buf.h"
 #include "gl_record.h"
 #include "test_ctrl_util.h"
 
@@ -60,6 +61,40 @@ static void test_framing(void **state)
 	exchange(p, 0, "2\r", " 42.0000\r\n:");
 	exchange(p, 1, "bg\r", "?");
 	exchange(p, 1, "TC\r", " 1\r\n:");
+}
+
+/*
+ * The first reply of a fresh controller that has no text (its reply buffer
+ * never held anything): ':' only. tests/fuzz/fuzz_sim_cmd.c found that this
+ * path computed NULL + 0 (undefined behaviour) before ctrl_buf_data().
+ */
+static void test_first_reply_empty(void **state)
+{
+	struct tplant *p = *state;
+
+	exchange(p, 2, "x=1\r", ":");
+	exchange(p, 3, "\r", ":");
+	exchange(p, 2, "MG x\r", " 1.0000\r\n:");
+}
+
+/* ctrl_buf_data(): never NULL, the unread bytes once there are some. */
+static void test_buf_data(void **state)
+{
+	struct ctrl_buf b = {0};
+	uint8_t one;
+
+	(void)state;
+	assert_non_null(ctrl_buf_data(&b));
+	assert_int_equal(ctrl_buf_pending(&b), 0);
+	assert_int_equal(ctrl_buf_puts(&b, "ab"), 0);
+	assert_memory_equal(ctrl_buf_data(&b), "ab", 2);
+	assert_int_equal(ctrl_buf_take(&b, &one, 1), 1);
+	assert_int_equal(one, 'a');
+	assert_int_equal(ctrl_buf_pending(&b), 1);
+	assert_memory_equal(ctrl_buf_data(&b), "b", 1);
+	ctrl_buf_free(&b);
+	assert_non_null(ctrl_buf_data(&b));
+	assert_int_equal(ctrl_buf_pending(&b), 0);
 }
 
 /* More than 80 characters: refused whole, one '?' per command, TC 5. */
@@ -337,6 +372,9 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test_setup_teardown(test_framing, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_first_reply_empty, setup,
+					    teardown),
+	    cmocka_unit_test(test_buf_data),
 	    cmocka_unit_test_setup_teardown(test_line_limit, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_identification, setup,
 					    teardown),

@@ -138,6 +138,10 @@ static const struct bad_case bad_cases[] = {
      "'period_ms' must be between 2 and 100, got 99999999999999999999"},
     {"bad_period_low.yaml", 2, 12,
      "'period_ms' must be between 2 and 100, got 1"},
+    /* found by tests/fuzz/fuzz_config.c: 4 x period_ms overflowed int
+     * (undefined behaviour) before the range check (issue 18) */
+    {"bad_period_overflow.yaml", 2, 12,
+     "'period_ms' must be between 2 and 100, got 1326439257"},
     {"bad_protocol_byte.yaml", 4, 22,
      "'on' bytes must be between 0 and 255, got 0x101"},
     {"bad_protocol_name.yaml", 3, 13,

@@ -19,8 +19,8 @@ static int diags_grow(struct gload_diags *d)
 	return GL_OK;
 }
 
-static char *format_text(const char *path, int line, const char *fmt,
-			 va_list ap)
+__attribute__((format(printf, 3, 0))) static char *
+format_text(const char *path, int line, const char *fmt, va_list ap)
 {
 	char msg[512];
 	char *text;

@@ -77,6 +77,13 @@ size_t ctrl_buf_pending(const struct ctrl_buf *b)
 	return b->len - b->start;
 }
 
+const uint8_t *ctrl_buf_data(const struct ctrl_buf *b)
+{
+	static const uint8_t empty[1];
+
+	return b->p ? b->p + b->start : empty;
+}
+
 size_t ctrl_buf_take(struct ctrl_buf *b, uint8_t *out, size_t cap)
 {
 	size_t n = ctrl_buf_pending(b);

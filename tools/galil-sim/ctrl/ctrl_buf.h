@@ -21,6 +21,12 @@ int ctrl_buf_printf(struct ctrl_buf *b, const char *fmt, ...)
 /* ctrl_buf_pending() - bytes of @b not yet taken. */
 size_t ctrl_buf_pending(const struct ctrl_buf *b);
 /*
+ * ctrl_buf_data() - the first of the ctrl_buf_pending() unread bytes of @b,
+ * valid until @b changes; never NULL (an empty buffer that never held
+ * anything gives a pointer to a static empty string, not NULL + offset).
+ */
+const uint8_t *ctrl_buf_data(const struct ctrl_buf *b);
+/*
  * ctrl_buf_take() - move up to @cap unread bytes of @b into @out (FIFO).
  * Return: the number of bytes copied.
  */

@@ -324,7 +324,7 @@ static int run_stmt(struct ctrl *c, int t, int line)
 	if (rc == CTRL_STOP || !th->running)
 		return 0;
 	if (rc == 0 && ctrl_buf_pending(&c->tmp) &&
-	    ctrl_unsol_send(c, x.route, c->tmp.p + c->tmp.start,
+	    ctrl_unsol_send(c, x.route, ctrl_buf_data(&c->tmp),
 			    ctrl_buf_pending(&c->tmp)) < 0)
 		rc = CTRL_RETRY;
 	if (rc == CTRL_RETRY) {

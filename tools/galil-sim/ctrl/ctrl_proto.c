@@ -134,11 +134,11 @@ static int host_cmd(struct ctrl *c, int h, const char *s, int *errors)
 		return 1;
 	}
 	if (x.route != CTRL_ROUTE_DEFAULT)
-		ctrl_unsol_send(c, x.route, c->tmp.p + c->tmp.start,
+		ctrl_unsol_send(c, x.route, ctrl_buf_data(&c->tmp),
 				ctrl_buf_pending(&c->tmp));
 	else
-		ctrl_out_put(c, h, c->tmp.p + c->tmp.start,
-			ctrl_buf_pending(&c->tmp));
+		ctrl_out_put(c, h, ctrl_buf_data(&c->tmp),
+			     ctrl_buf_pending(&c->tmp));
 	ctrl_out_put(c, h, ":", 1);
 	return 0;
 }
@@ -234,7 +234,7 @@ static void dl_finish(struct ctrl *c, int h)
 		c->tc = hd->dl_err;
 		ctrl_out_put(c, h, "?", 1);
 	} else {
-		rc = ctrl_load_program(c, (const char *)hd->dl.p + hd->dl.start,
+		rc = ctrl_load_program(c, (const char *)ctrl_buf_data(&hd->dl),
 				       ctrl_buf_pending(&hd->dl), &bad_line);
 		ctrl_out_put(c, h, rc ? "?" : ":", 1);
 	}
