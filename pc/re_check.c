@@ -87,8 +87,9 @@ int re_check_encpot(const struct re_caltable *t,
 {
 	struct re_encpot_result r;
 
-	if (!re_caltable_ok(t) || !cfg || !st || !isfinite(cfg->allowed_error) ||
-	    cfg->allowed_error < 0 || cfg->persistence_cycles < 0)
+	if (!re_caltable_ok(t) || !cfg || !st ||
+	    !isfinite(cfg->allowed_error) || cfg->allowed_error < 0 ||
+	    cfg->persistence_cycles < 0)
 		return GL_ERR_ARG;
 	memset(&r, 0, sizeof(r));
 	if (re_cal_expect(t, enc_counts, &r.exp) != GL_OK) {
@@ -283,8 +284,7 @@ int re_check_record(const struct gl_record *rec, int n_axes, int expect,
 		return RE_FAULT;
 	}
 	v = re_thread_fault(rec, 0, fault);
-	if (v != RE_OK ||
-	    (expect != RE_DMC_ARMED && expect != RE_DMC_SERVICE))
+	if (v != RE_OK || (expect != RE_DMC_ARMED && expect != RE_DMC_SERVICE))
 		return v;
 	if (expect == RE_DMC_SERVICE && z.state != RE_DMC_SERVICE) {
 		re_fault_set(fault, RE_F_CTRL_STATE, -1);

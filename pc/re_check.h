@@ -7,8 +7,9 @@
  * passed in as monotonic nanoseconds), no allocation, no printing. The
  * supervisor (re_super) calls these every cycle and acts on the verdict.
  * The fault catalogue is re_fault.h, the DMC contract re_dmcif.h, the
- * calibration-time checks re_calcheck.h. Decisions (table ends, persistence counting, watchdog edges) are
- * documented in docs/calibration-file.md, section 2.
+ * calibration-time checks re_calcheck.h. Decisions (table ends, persistence
+ * counting, watchdog edges) are documented in docs/calibration-file.md,
+ * section 2.
  *
  * Verdicts: functions that judge return RE_OK (0), RE_WARN (1: log only) or
  * RE_FAULT (2), or a negative gl_err code (GL_ERR_ARG) for a caller bug.

@@ -432,8 +432,8 @@ struct param {
 	double v[RE_JOY_INPUTS];
 };
 
-static int check_param(const struct re_io *io, const struct param *p,
-		       char *err, size_t errlen);
+static int check_param(const struct re_io *io, const struct param *p, char *err,
+		       size_t errlen);
 
 #define N_PARAMS 23
 
@@ -441,9 +441,9 @@ static void axis_params(const struct re_config *cfg, const struct re_plan *pl,
 			const struct re_calset *cal, struct param *p)
 {
 	static const char *const arrays[] = {
-	    "vmin",  "vmax",  "wst",  "wen",  "stp",	"srev",	  "sfwd",
-	    "potin", "potlo", "pothi", "pnlo", "pnhi", "svmax", "svslow",
-	    "svdmax",
+	    "vmin", "vmax", "wst",   "wen",    "stp",
+	    "srev", "sfwd", "potin", "potlo",  "pothi",
+	    "pnlo", "pnhi", "svmax", "svslow", "svdmax",
 	};
 
 	for (int k = 0; k < 15; k++) {
@@ -459,8 +459,10 @@ static void axis_params(const struct re_config *cfg, const struct re_plan *pl,
 		p[2].v[i] = a->accel_start_ms;
 		p[3].v[i] = a->accel_end_ms;
 		p[4].v[i] = a->step_counts;
-		p[5].v[i] = cal ? floor(cal->axis[i].soft_rev + 0.5) : -SOFT_WIDE;
-		p[6].v[i] = cal ? floor(cal->axis[i].soft_fwd + 0.5) : SOFT_WIDE;
+		p[5].v[i] =
+		    cal ? floor(cal->axis[i].soft_rev + 0.5) : -SOFT_WIDE;
+		p[6].v[i] =
+		    cal ? floor(cal->axis[i].soft_fwd + 0.5) : SOFT_WIDE;
 		p[7].v[i] = a->analog.input;
 		p[8].v[i] = x->potlo_v;
 		p[9].v[i] = x->pothi_v;
@@ -584,9 +586,8 @@ int re_ctl_start_program(const struct re_io *io, struct re_ctl_info *info,
 /* Records carrying the heartbeat every POLL_MS until the program shows
  * @want (GL_OK), a latched fault (RE_FAULT, @fault filled) or @wait_ms
  * passed (GL_ERR_TIMEOUT). @want 0 also accepts a latched state. */
-static int wait_state(const struct re_io *io, int want, int wait_ms,
-		      long *hbpc, struct re_fault *fault, char *err,
-		      size_t errlen)
+static int wait_state(const struct re_io *io, int want, int wait_ms, long *hbpc,
+		      struct re_fault *fault, char *err, size_t errlen)
 {
 	int64_t deadline = now_ns(io) + (int64_t)wait_ms * BASE_NS_PER_MS;
 	struct gl_record rec;
@@ -697,8 +698,8 @@ static int wait_still(const struct re_io *io, char *err, size_t errlen)
 	return rc;
 }
 
-int re_ctl_arm(const struct re_io *io, const struct re_calset *cal,
-	       long *hbpc, struct re_fault *fault, char *err, size_t errlen)
+int re_ctl_arm(const struct re_io *io, const struct re_calset *cal, long *hbpc,
+	       struct re_fault *fault, char *err, size_t errlen)
 {
 	struct param p[2] = {{"srev", RE_AXES, {0}}, {"sfwd", RE_AXES, {0}}};
 	char line[48];
@@ -719,8 +720,8 @@ int re_ctl_arm(const struct re_io *io, const struct re_calset *cal,
 	if (rc == GL_OK)
 		rc = cmd(io, line, err, errlen);
 	if (rc == GL_OK)
-		rc = wait_state(io, RE_DMC_ARMED, ARM_WAIT_MS, hbpc, fault,
-				err, errlen);
+		rc = wait_state(io, RE_DMC_ARMED, ARM_WAIT_MS, hbpc, fault, err,
+				errlen);
 	return rc;
 }
 

@@ -146,8 +146,8 @@ int re_ctl_set_limits(const struct re_io *io, const struct re_calset *cal,
  * until state 1 (1 s).
  * Return: as re_ctl_service().
  */
-int re_ctl_arm(const struct re_io *io, const struct re_calset *cal,
-	       long *hbpc, struct re_fault *fault, char *err, size_t errlen);
+int re_ctl_arm(const struct re_io *io, const struct re_calset *cal, long *hbpc,
+	       struct re_fault *fault, char *err, size_t errlen);
 
 /*
  * re_ctl_off() - back to the safe state in order: offreq=1, then wait

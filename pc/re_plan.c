@@ -9,8 +9,8 @@
 
 #include "base_clock.h"
 
-#define MAINMS_DEFAULT 10  /* dmc/constants.dmc */
-#define ACFACT	       10  /* dmc/constants.dmc: AC = DC = 10 x speed */
+#define MAINMS_DEFAULT 10 /* dmc/constants.dmc */
+#define ACFACT	       10 /* dmc/constants.dmc: AC = DC = 10 x speed */
 #define DECEL_MS       (1000 / ACFACT) /* full speed to rest, ms */
 
 static int max3(int a, int b, int c)
@@ -28,8 +28,8 @@ static void plan_axis(const struct re_config *cfg, int i,
 	const struct re_config_calibration *c = &cfg->calibration;
 	double tol = an->absolute_tolerance_v;
 
-	o->gain_v_per_count = (an->forward_v - an->reverse_v) /
-			      (double)a->travel_counts;
+	o->gain_v_per_count =
+	    (an->forward_v - an->reverse_v) / (double)a->travel_counts;
 	o->margin_v = c->near_margin_counts * o->gain_v_per_count;
 	/* past a switch the axis can go as far as its end stop: the margin
 	 * covers that (and the pot's own tolerance covers the switch) */
@@ -50,13 +50,12 @@ static void plan_axis(const struct re_config *cfg, int i,
 	    2L * c->backoff_counts + 2L * c->near_margin_counts;
 }
 
-void re_plan_make(const struct re_config *cfg, int mainms,
-		  struct re_plan *out)
+void re_plan_make(const struct re_config *cfg, int mainms, struct re_plan *out)
 {
 	int64_t p_ns = (int64_t)cfg->period_ms * BASE_NS_PER_MS;
 	int ms = mainms > 0 ? mainms : MAINMS_DEFAULT;
 	int fastest = cfg->period_ms < RE_PLAN_SAMPLE_MS ? cfg->period_ms
-							  : RE_PLAN_SAMPLE_MS;
+							 : RE_PLAN_SAMPLE_MS;
 	double crit = cfg->watchdog.critical_factor;
 
 	memset(out, 0, sizeof(*out));
@@ -110,6 +109,6 @@ void re_plan_super_cfg(const struct re_plan *p, const struct re_config *cfg,
 	out->relay_off_ms = p->relay_off_ms;
 	out->settle_ms = p->settle_ms;
 	out->uncmd_grace_ns = p->uncmd_grace_ns;
-	out->mode_name = cfg->mode == RE_MODE_CLINICAL ? "clinical"
-						       : "development";
+	out->mode_name =
+	    cfg->mode == RE_MODE_CLINICAL ? "clinical" : "development";
 }

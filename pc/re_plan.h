@@ -31,20 +31,20 @@ struct re_plan_axis {
 
 struct re_plan {
 	struct re_plan_axis axis[RE_AXES];
-	int mainms;	   /* the program's period, ms (0: not known yet) */
-	int wdto_ms;	   /* controller watchdog (DMC wdto) */
-	int hbmaxd;	   /* largest heartbeat step (DMC hbmaxd) */
-	int pwrout;	   /* motor-power output (DMC pwrout), 0: none */
-	int move_timeout_ms;	  /* one service move (DMC mvto) */
-	int64_t period_ns;	  /* supervisor cycle */
-	int64_t sample_ns;	  /* cycle while calibrating: the period
-				   * or RE_PLAN_SAMPLE_MS, the shorter */
-	int64_t hb_limit_ns;	  /* program heartbeat frozen: fault */
-	int64_t sample_limit_ns;  /* record sample number frozen: fault */
-	int64_t uncmd_grace_ns;	  /* motion not commanded: fault after */
-	int settle_ms;		  /* wait for the program's own verdict */
-	int fresh_stop_ms;	  /* the stop over a new connection */
-	int relay_off_ms;	  /* relay off confirmed within */
+	int mainms;	     /* the program's period, ms (0: not known yet) */
+	int wdto_ms;	     /* controller watchdog (DMC wdto) */
+	int hbmaxd;	     /* largest heartbeat step (DMC hbmaxd) */
+	int pwrout;	     /* motor-power output (DMC pwrout), 0: none */
+	int move_timeout_ms; /* one service move (DMC mvto) */
+	int64_t period_ns;   /* supervisor cycle */
+	int64_t sample_ns;   /* cycle while calibrating: the period
+			      * or RE_PLAN_SAMPLE_MS, the shorter */
+	int64_t hb_limit_ns; /* program heartbeat frozen: fault */
+	int64_t sample_limit_ns; /* record sample number frozen: fault */
+	int64_t uncmd_grace_ns;	 /* motion not commanded: fault after */
+	int settle_ms;		 /* wait for the program's own verdict */
+	int fresh_stop_ms;	 /* the stop over a new connection */
+	int relay_off_ms;	 /* relay off confirmed within */
 };
 
 #define RE_PLAN_SAMPLE_MS 10 /* the cycle while calibrating, ms */
@@ -55,8 +55,7 @@ struct re_plan {
  * depend on it use the constants' default 10 ms).
  * @out: [out] the plan.
  */
-void re_plan_make(const struct re_config *cfg, int mainms,
-		  struct re_plan *out);
+void re_plan_make(const struct re_config *cfg, int mainms, struct re_plan *out);
 
 /*
  * re_plan_super_cfg() - the supervisor's settings from the plan.

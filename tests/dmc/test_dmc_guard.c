@@ -386,7 +386,8 @@ static void test_handle_reused(void **state)
 	ctrl_handle_open(h->ctrl, 1);
 	if (dmc_h_wait_var(h, "fhnew", 2, 5 * mainms) < 0)
 		fail_msg("a new connection on the freed handle B was not "
-			 "reported: fhnew %g", dmc_h_var(h, "fhnew"));
+			 "reported: fhnew %g",
+			 dmc_h_var(h, "fhnew"));
 	dmc_h_advance(h, 10 * mainms);
 	assert_int_equal(count_lines(h, "FOREIGN 2"), 1);
 	assert_true(dmc_h_var(h, "state") == 1);
@@ -406,7 +407,7 @@ struct setcase {
 static void test_settings_changed(void **state)
 {
 	static const struct setcase cases[] = {
-	    {"wdto=5000", 3}, {"jto=9000", 3},	 {"OE 0,1,1", 4},
+	    {"wdto=5000", 3}, {"jto=9000", 3}, {"OE 0,1,1", 4},
 	    {"OE 1,0,1", 4},  {"OE ,,0", 4},
 	};
 

@@ -93,8 +93,8 @@ static void run_case(struct dmc_h *h, const struct pcase *c)
 				fail_msg("%s: %s", c->what, h->err);
 		dmc_h_advance(h, 20);
 	}
-	if (c->moving && (dmc_h_service(h) < 0 ||
-			  dmc_h_move(h, 1, 20000, 5000, 10000) < 0))
+	if (c->moving &&
+	    (dmc_h_service(h) < 0 || dmc_h_move(h, 1, 20000, 5000, 10000) < 0))
 		fail_msg("%s: service move: %s", c->what, h->err);
 	if (dmc_h_arm(h) != GL_ERR_CTRL)
 		fail_msg("%s: armed (or timed out): %s", c->what, h->err);

@@ -79,7 +79,9 @@ struct reqcase {
 static void test_request_after_death(void **state)
 {
 	static const struct reqcase cases[] = {
-	    {"svcreq", 3, 0}, {"armreq", 1, 0}, {"svcreq", 3, 1},
+	    {"svcreq", 3, 0},
+	    {"armreq", 1, 0},
+	    {"svcreq", 3, 1},
 	    {"armreq", 1, 1},
 	};
 
@@ -117,8 +119,7 @@ static void test_request_after_death(void **state)
 		t = dmc_h_now(&h) - t_last;
 		print_message("measured: %s %.0f ms after the last heartbeat: "
 			      "motors %s, fault %g at %.0f ms\n",
-			      c->req, delay,
-			      on ? "went on" : "never on",
+			      c->req, delay, on ? "went on" : "never on",
 			      dmc_h_var(&h, "fcode"), t);
 		assert_true(dmc_h_var(&h, "state") == 2);
 		assert_true(dmc_h_var(&h, "fcode") == 2);

@@ -37,10 +37,10 @@ struct dmc_h_params {
 	double er[DMC_H_AXES];			   /* controller ER, counts */
 	int oe; /* controller OE for every axis */
 	/* version 2.00: service state, potentiometer range, power output */
-	double hbmaxd, pwrout;			   /* -, output no. */
-	double potin[DMC_H_AXES];		   /* analog input no. */
-	double potlo[DMC_H_AXES], pothi[DMC_H_AXES]; /* V */
-	double pnlo[DMC_H_AXES], pnhi[DMC_H_AXES];   /* V */
+	double hbmaxd, pwrout;			      /* -, output no. */
+	double potin[DMC_H_AXES];		      /* analog input no. */
+	double potlo[DMC_H_AXES], pothi[DMC_H_AXES];  /* V */
+	double pnlo[DMC_H_AXES], pnhi[DMC_H_AXES];    /* V */
 	double svmax[DMC_H_AXES], svslow[DMC_H_AXES]; /* counts/s */
 	double svdmax[DMC_H_AXES];		      /* counts */
 };

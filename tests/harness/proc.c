@@ -401,7 +401,8 @@ int proc_ctl_connect_at(const char *addr, int port, int timeout_ms)
 	memset(&sa, 0, sizeof(sa));
 	sa.sin_family = AF_INET;
 	sa.sin_port = htons((uint16_t)port);
-	if (inet_pton(AF_INET, addr && *addr ? addr : "127.0.0.1", &sa.sin_addr) != 1)
+	if (inet_pton(AF_INET, addr && *addr ? addr : "127.0.0.1",
+		      &sa.sin_addr) != 1)
 		return -1;
 	for (;;) {
 		int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);

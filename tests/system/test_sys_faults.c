@@ -346,13 +346,14 @@ static void pot_at_rest(const char *name, const char *req, int axis,
 	FOR_REPEATS(i)
 	{
 		int ctrl = id == RE_F_CTRL_POTRANGE;
-		struct expect x = {
-		    .name = name,
-		    .ids = {id, RE_F_NONE},
-		    .axis = axis,
-		    .d_relay = ctrl ? d_ctrl_to_relay() : d_encpot(),
-		    .d_motors = ctrl ? SYS_MAINMS + 1 : d_encpot() + SYS_MAINMS};
-		struct measured m;
+		struct expect x = {.name = name,
+				   .ids = {id, RE_F_NONE},
+				   .axis = axis,
+				   .d_relay =
+				       ctrl ? d_ctrl_to_relay() : d_encpot(),
+				   .d_motors = ctrl ? SYS_MAINMS + 1
+						    : d_encpot() + SYS_MAINMS};
+		struct measured m = {0};
 
 		start(&cs, NULL);
 		x.t_inj = inject_fault(&cs, req);
@@ -390,7 +391,7 @@ static void test_pot_stuck(void **state)
 				   .axis = 1,
 				   .d_relay = d,
 				   .d_motors = d + SYS_MAINMS};
-		struct measured m;
+		struct measured m = {0};
 
 		start(&cs, NULL);
 		inject_fault(&cs, "pot B stuck");
@@ -417,7 +418,7 @@ static void test_enc_stuck(void **state)
 				   .axis = 0,
 				   .d_relay = d,
 				   .d_motors = d + SYS_MAINMS};
-		struct measured m;
+		struct measured m = {0};
 
 		start(&cs, NULL);
 		inject_fault(&cs, "enc A stuck");
@@ -445,7 +446,7 @@ static void test_enc_slip(void **state)
 				   .axis = 1,
 				   .d_relay = d_encpot(),
 				   .d_motors = d_encpot() + SYS_MAINMS};
-		struct measured m;
+		struct measured m = {0};
 		char req[64];
 
 		start(&cs, NULL);
@@ -461,7 +462,8 @@ static void test_enc_slip(void **state)
 					   sizeof(line)) == 0)
 				fail_msg("encoder slip of %d counts (%.0f %% "
 					 "of the tolerance) tripped: %s",
-					 k * stepc, 100.0 * k * stepc / tol, line);
+					 k * stepc, 100.0 * k * stepc / tol,
+					 line);
 		}
 		/* one more step: past the tolerance (checked strictly) */
 		assert_true((n + 1) * stepc > tol);
@@ -503,7 +505,7 @@ static void test_jam(void **state)
 				   .axis = 2,
 				   .d_relay = dm + d_ctrl_to_relay(),
 				   .d_motors = dm};
-		struct measured m;
+		struct measured m = {0};
 
 		start(&cs, NULL);
 		inject_fault(&cs, "block C 1");
@@ -541,7 +543,7 @@ static void test_encoder_failure_oa(void **state)
 		    .axis = 0,
 		    .d_relay = dm + d_ctrl_to_relay(),
 		    .d_motors = dm};
-		struct measured m;
+		struct measured m = {0};
 
 		start(&cs, &o);
 		inject_fault(&cs, "block A 1");
@@ -597,7 +599,7 @@ static void test_limit_switch(void **state)
 				   .axis = 2,
 				   .d_relay = 0,
 				   .d_motors = SYS_MAINMS};
-		struct measured m;
+		struct measured m = {0};
 
 		x.d_relay = SYS_MAINMS + d_ctrl_to_relay();
 		start(&cs, &o);
@@ -628,7 +630,7 @@ static void expect_input_fault(struct sys_case *c, const char *name,
 			   .t_inj = t_inj,
 			   .d_relay = dm + d_ctrl_to_relay(),
 			   .d_motors = dm};
-	struct measured m;
+	struct measured m = {0};
 
 	expect_fault(c, &x, &m);
 	if (m.motors_ms < env.jto_ms - SYS_LOOPMS)
@@ -774,7 +776,7 @@ static void link_fault(const char *name, const char *req, enum re_fault_id id,
 				   .axis = -1,
 				   .d_relay = d_relay,
 				   .d_motors = d_relay + SYS_MAINMS};
-		struct measured m;
+		struct measured m = {0};
 
 		x.link_down = 1;
 		start(&cs, NULL);
@@ -829,7 +831,7 @@ static void relay_fault(const char *name, const char *req,
 				   .axis = -1,
 				   .d_relay = 0,
 				   .d_motors = SYS_MAINMS};
-		struct measured m;
+		struct measured m = {0};
 		double w0, w1;
 
 		memcpy(x.ids, ids, sizeof(x.ids));
@@ -911,13 +913,12 @@ static void test_foreign_connection(void **state)
 	(void)state;
 	FOR_REPEATS(i)
 	{
-		struct expect x = {
-		    .name = "foreign connection",
-		    .ids = {RE_F_CTRL_THREAD, RE_F_NONE},
-		    .axis = -1,
-		    .d_relay = d_ctrl_to_relay(),
-		    .d_motors = SYS_MAINMS + 1};
-		struct measured m;
+		struct expect x = {.name = "foreign connection",
+				   .ids = {RE_F_CTRL_THREAD, RE_F_NONE},
+				   .axis = -1,
+				   .d_relay = d_ctrl_to_relay(),
+				   .d_motors = SYS_MAINMS + 1};
+		struct measured m = {0};
 		char st[2048];
 		double a0, a1;
 		int fd;
@@ -970,7 +971,7 @@ static void test_power_cycle(void **state)
 		    .axis = -1,
 		    .d_relay = C() + P(),
 		    .d_motors = -1};
-		struct measured m;
+		struct measured m = {0};
 		char line[1024];
 		double t;
 
@@ -1026,7 +1027,7 @@ static void test_operator_quit(void **state)
 				   .axis = -1,
 				   .d_relay = d,
 				   .d_motors = d};
-		struct measured m;
+		struct measured m = {0};
 		char line[2048];
 		int status;
 

@@ -180,7 +180,8 @@ static void print_table(void)
 	" Recovery: keep the E-stop pressed, restart roboelf; if it happens "  \
 	"again, reload the program with galil-load"
 /* The sentence that names another program's connection (%c: its handle). */
-#define OTHER_PROG " Another program had connected to the controller (handle %c)."
+#define OTHER_PROG                                                             \
+	" Another program had connected to the controller (handle %c)."
 
 /* One number: -?digits[.digits]. Return: its length, 0 when none. */
 static size_t number_len(const char *s)
@@ -1191,9 +1192,10 @@ static void foreign_move(const char *name, const char *line1, const char *cmd1,
 	    t_mo - t_conn > SYS_MAINMS + 1 + SLACK_MS)
 		fail_msg("too late: relay off %.0f ms, motors off %.0f ms",
 			 t_relay - t_conn, t_mo - t_conn);
-	row_pass(r, "MOTION (another program's move) latched; travel %.0f "
-		    "counts",
-		    a1 - a0);
+	row_pass(r,
+		 "MOTION (another program's move) latched; travel %.0f "
+		 "counts",
+		 a1 - a0);
 }
 
 static void test_foreign_pa(void **state)
@@ -1430,14 +1432,14 @@ static double cause_calibrating(int axis, const char *req)
 /* The controller's position error (fault 4) on @axis: the limit ER. */
 static void tpl_poserr(char *tpl, size_t cap, int axis)
 {
-	snprintf(tpl, cap,
-		 "FAULT MOTION: axis %c: position error of at least %d counts, "
-		 "above its limit (blocked, jammed, or its encoder stuck?)."
-		 SAFE_OK
-		 " Recovery: keep the E-stop pressed, check that axis %c moves "
-		 "freely and nothing blocks it, then its encoder cable, then "
-		 "restart roboelf",
-		 'A' + axis, env.er_counts, 'A' + axis);
+	snprintf(
+	    tpl, cap,
+	    "FAULT MOTION: axis %c: position error of at least %d counts, "
+	    "above its limit (blocked, jammed, or its encoder stuck?)." SAFE_OK
+	    " Recovery: keep the E-stop pressed, check that axis %c moves "
+	    "freely and nothing blocks it, then its encoder cable, then "
+	    "restart roboelf",
+	    'A' + axis, env.er_counts, 'A' + axis);
 }
 
 static void jam(int axis, int calibrating)
@@ -1455,13 +1457,14 @@ static void jam(int axis, int calibrating)
 	if (calibrating)
 		tpl_poserr(tpl, sizeof(tpl), axis);
 	else
-		snprintf(tpl, sizeof(tpl),
-			 "FAULT ENCODER: axis %c: the controller detected an "
-			 "encoder failure or a blocked axis (stop code 12)."
-			 SAFE_OK " Recovery: keep the E-stop pressed, check "
-			 "that axis %c moves freely, then its encoder cable "
-			 "and its motor, restart roboelf and recalibrate",
-			 'A' + axis, 'A' + axis);
+		snprintf(
+		    tpl, sizeof(tpl),
+		    "FAULT ENCODER: axis %c: the controller detected an "
+		    "encoder failure or a blocked axis (stop code 12)." SAFE_OK
+		    " Recovery: keep the E-stop pressed, check "
+		    "that axis %c moves freely, then its encoder cable "
+		    "and its motor, restart roboelf and recalibrate",
+		    'A' + axis, 'A' + axis);
 	expect_cause(r, t, tpl, d_jam() + d_ctrl_to_relay(), d_jam(), NULL, 0);
 	row_pass(r, "axis %c named (%s)", 'A' + axis,
 		 calibrating ? "MOTION position error" : "ENCODER, OA");
@@ -1489,7 +1492,8 @@ static void enc_stuck(int axis, int calibrating)
 			 "FAULT ENCODER: axis %c: potentiometer reads {n} V "
 			 "but {n} V is expected at encoder position {n} counts "
 			 "(they differ by {n} V, more than the {n} V allowed, "
-			 "for {n} cycles)." SAFE_OK " Recovery: keep the E-stop "
+			 "for {n} cycles)." SAFE_OK
+			 " Recovery: keep the E-stop "
 			 "pressed, check the encoder and potentiometer cables "
 			 "of axis %c, restart roboelf and recalibrate",
 			 'A' + axis, 'A' + axis);

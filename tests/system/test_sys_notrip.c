@@ -26,8 +26,8 @@
 #include "re_calfile.h"
 #include "sys_h.h"
 
-#define SLACK_MS       25
-#define EXIT_WAIT_MS   5000
+#define SLACK_MS     25
+#define EXIT_WAIT_MS 5000
 
 static struct sys_env env;
 static int env_ok;

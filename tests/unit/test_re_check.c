@@ -572,8 +572,8 @@ static void test_ctrl_fault_texts(void **state)
 }
 
 /* The text of program fault @fcode, axis @faxis, detail @det. */
-static void v2_line(int fcode, int faxis, long long det, char *line,
-		    size_t cap, struct re_fault *f)
+static void v2_line(int fcode, int faxis, long long det, char *line, size_t cap,
+		    struct re_fault *f)
 {
 	struct re_za z = {0};
 

@@ -131,6 +131,8 @@ static int setup(void **state)
 {
 	struct re_comm *c = calloc(1, sizeof(*c));
 
+	if (!c)
+		return -1;
 	memset(&w, 0, sizeof(w));
 	w.broken_after = -1;
 	w.press = 1;
@@ -142,7 +144,7 @@ static int setup(void **state)
 	c->wait_ms = 1000;
 	c->quit = &w.quit;
 	*state = c;
-	return c ? 0 : -1;
+	return 0;
 }
 
 static int teardown(void **state)

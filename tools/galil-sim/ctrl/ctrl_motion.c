@@ -224,7 +224,8 @@ void ctrl_motion_sense(struct ctrl *c, const struct ctrl_sense *in)
 		/* the amplifiers' status at power-up: under-voltage while
 		 * motor power is absent, as after a loss */
 		c->amp_ok = in->amp_power != 0;
-		c->ta0 = c->amp_ok ? (uint8_t)(c->ta0 & ~8) : (uint8_t)(c->ta0 | 8);
+		c->ta0 =
+		    c->amp_ok ? (uint8_t)(c->ta0 & ~8) : (uint8_t)(c->ta0 | 8);
 	}
 	c->zero_pending = 0;
 }
