@@ -144,6 +144,10 @@ static int32_t phase_of(const struct re_super *s)
 	return s->expect == RE_DMC_SERVICE ? RE_TPH_SERVICE : RE_TPH_IDLE;
 }
 
+/* dt_s: the controller's time between this record and the previous one,
+ * from its sample counter (1 sample = 1 ms at TM 1000, the time unit of
+ * its counts/s), so that the PC's wake-up jitter does not show as noise in
+ * the commanded velocity; 0 when unknown. */
 static void take_axis(struct re_rec *r, const struct re_super *s, int i,
 		      double dt_s, struct re_trace_axis *x)
 {
@@ -181,9 +185,8 @@ void re_rec_take(struct re_rec *r, const struct re_super *s)
 {
 	struct re_trace_rec *x = &r->ring[r->head];
 	int64_t now = sup_now(s);
-	double dt_s = r->have_prev && s->have_record
-			  ? (double)(now - r->prev_ns) / 1e9
-			  : 0;
+	uint16_t dsamp = (uint16_t)(s->rec.sample - r->prev_sample);
+	double dt_s = r->have_prev && s->have_record ? dsamp / 1000.0 : 0;
 
 	memset(x, 0, sizeof(*x));
 	x->t_s = (double)(now - r->t0_ns) / 1e9;
@@ -208,6 +211,7 @@ void re_rec_take(struct re_rec *r, const struct re_super *s)
 	}
 	r->have_prev = s->have_record;
 	r->prev_ns = now;
+	r->prev_sample = s->rec.sample;
 	r->head = (r->head + 1) % r->cap;
 	if (r->count < r->cap)
 		r->count++;

@@ -46,7 +46,8 @@ struct re_rec {
 	struct re_trace_rec *ring;
 	size_t cap, head, count; /* head: the next slot */
 	int64_t t0_ns;		 /* t_s = 0 */
-	int64_t prev_ns;	 /* the previous record's time (vcmd) */
+	int64_t prev_ns;	 /* the previous record's time */
+	uint16_t prev_sample;	 /* and its sample number (vcmd) */
 	int32_t prev_ref[RE_TRACE_AXES];
 	int have_prev;
 	struct re_trace_hdr hdr; /* the header's fixed part */
