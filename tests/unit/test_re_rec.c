@@ -273,10 +273,53 @@ static void test_rec_no_syscall(void **state)
 	re_rec_free(&r);
 }
 
+/* The commanded velocity is the change of _RP over the controller's time
+ * (its 16-bit sample counter, 1 ms per sample), whatever the PC's clock
+ * did between the cycles: 10 counts per sample is 10000 counts/s with
+ * records 9, 10, 11 samples apart, across the counter's wrap; the same
+ * record twice gives no figure (NAN). */
+static void test_rec_vcmd_controller_time(void **state)
+{
+	static struct re_super s;
+	static struct re_rec r;
+	struct re_rec_cfg c = {.seconds = 2,
+			       .after_fault_s = 1,
+			       .period_ms = 10,
+			       .dir = "/tmp",
+			       .n_axes = 3,
+			       .axis_names = {"A", "B", "C"}};
+	static const int gap[] = {10, 9, 11, 10, 0};
+
+	(void)state;
+	memset(&s, 0, sizeof(s));
+	s.io.ops = &f_ops;
+	s.cfg.n_axes = 3;
+	s.have_record = s.have_za = s.link_ok = 1;
+	s.rec.sample = 65520; /* wraps after the second record */
+	assert_int_equal(re_rec_init(&r, &c), GL_OK);
+	re_rec_attach(&r, &s, "1");
+	re_rec_take(&r, &s);
+	assert_true(isnan(r.ring[0].axis[0].vcmd_cps)); /* no previous */
+	for (int k = 0; k < 5; k++) {
+		s.cycles++;
+		s.rec.sample = (uint16_t)(s.rec.sample + gap[k]);
+		s.rec.axis[0].ref_pos += 10 * gap[k];
+		re_rec_take(&r, &s);
+		if (gap[k])
+			assert_float_equal(r.ring[k + 1].axis[0].vcmd_cps,
+					   10000.0, 1e-6);
+		else
+			assert_true(isnan(r.ring[k + 1].axis[0].vcmd_cps));
+		assert_float_equal(r.ring[k + 1].axis[1].vcmd_cps, 0, 0);
+	}
+	re_rec_free(&r);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_rec_sizes),
+	    cmocka_unit_test(test_rec_vcmd_controller_time),
 	    cmocka_unit_test(test_rec_no_syscall),
 	    cmocka_unit_test(test_rec_kill_while_writing),
 	};
