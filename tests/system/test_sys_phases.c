@@ -449,7 +449,7 @@ static int ph_start(struct sys_case *c, const struct ph_opts *o)
 	    (o->off_centre && preposition(c, o->power_output) < 0) ||
 	    sys_ctl(c, "watch state") < 0 || sys_ctl(c, "watch fcode") < 0 ||
 	    sys_ctl(c, "watch hbpc") < 0 || sys_ctl(c, "watch armreq") < 0 ||
-	    sys_events(c) < 0)
+	    sys_ctl(c, "watch mneut") < 0 || sys_events(c) < 0)
 		return -1;
 	return start_roboelf(c, o->calibration);
 }
@@ -464,7 +464,16 @@ static int wait_ready(struct sys_case *c, int timeout_ms)
 				   20, NULL, 0) == 0) {
 			c->ready_wall_s = (double)(proc_now_ms() - t0) / 1e3;
 			c->t_ready_ms = sys_sim_time(c);
-			return c->t_ready_ms < 0 ? -1 : 0;
+			/* The program moves an axis only after it has seen the
+			 * joystick at neutral since arming (#MSTEP's mneut): a
+			 * command pressed before its first look is ignored
+			 * until released. On a loaded machine that look can
+			 * come after Ready is printed; wait for it. */
+			return c->t_ready_ms < 0 ||
+				       sys_wait_state(c, "var.mneut", "1.0000",
+						      5000) < 0
+				   ? -1
+				   : 0;
 		}
 		if (proc_find_line(&c->re, PROC_STDOUT, "FAULT ", NULL, 0) ==
 			0 ||
