@@ -671,9 +671,10 @@ int re_ctl_service(const struct re_io *io, long *hbpc, struct re_fault *fault,
 	return rc;
 }
 
-/* The arm check (17) wants every axis at rest, TV included: TV averages
- * 256 samples, so it remembers the last service move for a while. */
-static int wait_still(const struct re_io *io, char *err, size_t errlen)
+/* The check 17 of #PCHK (before service and at arm) wants every axis at
+ * rest, TV included: TV averages 256 samples, so it remembers the last
+ * move for a while. */
+int re_ctl_wait_still(const struct re_io *io, char *err, size_t errlen)
 {
 	static const char *const tv[RE_AXES] = {"_TVA", "_TVB", "_TVC"};
 	int64_t deadline = now_ns(io) + ARM_WAIT_MS * BASE_NS_PER_MS;
@@ -688,8 +689,8 @@ static int wait_still(const struct re_io *io, char *err, size_t errlen)
 		}
 		if (now_ns(io) >= deadline) {
 			seterr(err, errlen,
-			       "axis %c still moving (TV %g counts/s) %d ms "
-			       "after the service moves ended",
+			       "axis %c still moving (TV %g counts/s) after "
+			       "%d ms of waiting for it to be at rest",
 			       AXES[i], v, ARM_WAIT_MS);
 			return GL_ERR_TIMEOUT;
 		}
@@ -714,7 +715,7 @@ int re_ctl_arm(const struct re_io *io, const struct re_calset *cal, long *hbpc,
 	for (int k = 0; rc == GL_OK && k < 2; k++)
 		rc = check_param(io, &p[k], err, errlen);
 	if (rc == GL_OK)
-		rc = wait_still(io, err, errlen);
+		rc = re_ctl_wait_still(io, err, errlen);
 	*hbpc = (*hbpc + 1) % RE_HBPC_WRAP;
 	snprintf(line, sizeof(line), "hbpc=%ld;armreq=1", *hbpc);
 	if (rc == GL_OK)

@@ -120,6 +120,16 @@ int re_ctl_write_params(const struct re_io *io, const struct re_config *cfg,
 			char *err, size_t errlen);
 
 /*
+ * re_ctl_wait_still() - wait up to 1 s until every axis is at rest as the
+ * program's check 17 (#PCHK, before service and at arm) judges it: |_TVx|
+ * at most vstill. TV averages 256 samples, so an axis stopped a moment
+ * ago (the previous session interrupted while it moved) still shows speed.
+ * Return: GL_OK; GL_ERR_TIMEOUT with @err naming the axis and its TV; a
+ *         link error.
+ */
+int re_ctl_wait_still(const struct re_io *io, char *err, size_t errlen);
+
+/*
  * re_ctl_service() - enter the service state: hbpc=<@hbpc>, svcreq=1, then
  * records (QR) carrying the heartbeat every 10 ms until the program shows
  * state 3 (1 s).

@@ -343,6 +343,10 @@ static int enter_service(struct app *a)
 	if (re_ctl_write_params(&a->io, &a->cfg, &a->plan, NULL, a->err,
 				sizeof(a->err)))
 		return latch_err(a);
+	/* the program refuses service while an axis is still moving (its
+	 * check 17): a session interrupted a moment ago left TV non-zero */
+	if (re_ctl_wait_still(&a->io, a->err, sizeof(a->err)) != GL_OK)
+		return latch_err(a);
 	a->hbpc = re_ctl_session();
 	rc = re_ctl_service(&a->io, &a->hbpc, &f, a->err, sizeof(a->err));
 	if (rc == RE_FAULT)
