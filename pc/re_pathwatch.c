@@ -32,6 +32,14 @@ void re_pathwatch_init(struct re_pathwatch *pw)
 	pw->n = 0;
 }
 
+void re_pathwatch_stop(struct re_pathwatch *pw)
+{
+	for (int i = 0; i < pw->n; i++)
+		if (pw->fd >= 0 && pw->w[i].wd >= 0)
+			inotify_rm_watch(pw->fd, pw->w[i].wd);
+	pw->n = 0;
+}
+
 void re_pathwatch_close(struct re_pathwatch *pw)
 {
 	if (pw->fd >= 0)

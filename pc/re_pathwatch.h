@@ -58,6 +58,16 @@ int re_pathwatch_open(struct re_pathwatch *pw, const char *path);
  */
 int re_pathwatch_changed(struct re_pathwatch *pw);
 
+/*
+ * re_pathwatch_stop() - remove every watch but keep the descriptor, so that
+ * a re_pathwatch_close() some milliseconds later does not wait for the
+ * kernel to free them (closing an inotify descriptor that still has
+ * watches waits for an RCU grace period: 7 to 15 ms measured on a loaded
+ * 2-core machine). re_pathwatch_changed() then answers 0 until it is
+ * opened again. No return value; cannot fail.
+ */
+void re_pathwatch_stop(struct re_pathwatch *pw);
+
 /* re_pathwatch_close() - stop watching; @pw is then as after init. */
 void re_pathwatch_close(struct re_pathwatch *pw);
 

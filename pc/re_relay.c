@@ -912,7 +912,11 @@ int re_relay_off(re_relay *r)
 
 int re_relay_close_start(re_relay *r)
 {
-	return r ? re_relay_off_start(r) : GL_OK;
+	if (!r)
+		return GL_OK;
+	/* the watch's kernel side is freed while "off" is confirmed */
+	re_pathwatch_stop(&r->pw);
+	return re_relay_off_start(r);
 }
 
 int re_relay_close_finish(re_relay *r, int deadline_ms)
