@@ -1533,6 +1533,7 @@ void re_config_relay_cfg(const struct re_config *cfg, struct re_relay_cfg *out)
 	out->off_deadline_ms = r->off_deadline_ms;
 	out->readback = r->readback;
 	out->readback_timeout_ms = r->readback_timeout_ms;
+	out->query_ms = RE_RELAY_QUERY_MS;
 	memcpy(out->on, r->on, sizeof(out->on));
 	out->on_len = r->on_len;
 	memcpy(out->off, r->off, sizeof(out->off));

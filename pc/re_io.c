@@ -2,12 +2,15 @@
  * re_io.c - the real binding of struct re_io: gl_link, re_relay, re_log and
  * the monotonic clock (base_clock). See re_io.h.
  */
+#define _GNU_SOURCE /* ppoll */
 #include "re_io.h"
 
 #include <errno.h>
+#include <poll.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #include "base_clock.h"
@@ -18,16 +21,116 @@ int64_t re_io_now_ns(void)
 	return base_now_ns();
 }
 
+/* ---- the one look before a cycle (issue 17) ------------------------------ */
+
+#define LOOK_EVENTS (POLLIN | POLLERR | POLLHUP | POLLNVAL)
+
+static void look_forget(struct re_io_real *r)
+{
+	for (int i = 0; i < RE_LOOK_N; i++)
+		r->look.fd[i] = -1;
+}
+
+/* The look's entry @i for descriptor @fd, taken once: true with its
+ * events in @ev, or false (not looked at, taken, or another descriptor). */
+static bool look_take(struct re_io_real *r, int i, int fd, short *ev)
+{
+	if (fd < 0 || r->look.fd[i] != fd)
+		return false;
+	r->look.fd[i] = -1;
+	*ev = r->look.revents[i];
+	return true;
+}
+
+static void look_set(struct pollfd *p, int fd, short events)
+{
+	p->fd = fd;
+	p->events = events;
+	p->revents = 0;
+}
+
+/* The descriptors of the look, -1 where there is none. */
+static void look_fds(struct re_io_real *r, struct pollfd p[RE_LOOK_N])
+{
+	int relay, watch;
+
+	re_relay_fds(r->relay, &relay, &watch);
+	look_set(&p[RE_LOOK_CMD], gl_link_fd(r->link), POLLIN);
+	look_set(&p[RE_LOOK_MSG], gl_link_msg_fd(r->link), POLLIN);
+	look_set(&p[RE_LOOK_RELAY], relay, 0); /* errors and hang-up only */
+	look_set(&p[RE_LOOK_WATCH], watch, POLLIN);
+	look_set(&p[RE_LOOK_KEY], r->watch_key ? r->key_fd : -1, POLLIN);
+}
+
+/* Sleep until @t_ns in ppoll() over the cycle's descriptors, noting each
+ * one's events; one that shows any is left out for the rest of the wait
+ * (it is read in the cycle). No look when the time has already come. */
+static void look_wait(struct re_io_real *r, int64_t t_ns)
+{
+	struct pollfd p[RE_LOOK_N];
+	int fd[RE_LOOK_N];
+	int64_t left;
+	int looked = 0;
+
+	look_forget(r);
+	look_fds(r, p);
+	for (int i = 0; i < RE_LOOK_N; i++)
+		fd[i] = p[i].fd;
+	while ((left = t_ns - re_io_now_ns()) > 0) {
+		struct timespec ts = {(time_t)(left / BASE_NS_PER_S),
+				      (long)(left % BASE_NS_PER_S)};
+		int rc;
+
+		for (int i = 0; i < RE_LOOK_N; i++)
+			p[i].revents = 0;
+		rc = ppoll(p, RE_LOOK_N, &ts, NULL);
+		if (rc < 0 && errno != EINTR) {
+			base_sleep_until_ns(t_ns); /* no look: readers look */
+			return;
+		}
+		if (rc < 0)
+			continue; /* a signal: poll again until the time */
+		looked = 1;
+		for (int i = 0; i < RE_LOOK_N; i++)
+			if (p[i].fd >= 0 && p[i].revents) {
+				r->look.revents[i] = p[i].revents;
+				p[i].fd = -1;
+			}
+	}
+	if (!looked)
+		return; /* the time had come: nothing was looked at */
+	for (int i = 0; i < RE_LOOK_N; i++) {
+		if (fd[i] >= 0 && p[i].fd >= 0)
+			r->look.revents[i] = 0;
+		r->look.fd[i] = fd[i];
+	}
+}
+
+int re_io_key_look(struct re_io_real *r)
+{
+	short ev = 0;
+
+	if (!r->watch_key || !look_take(r, RE_LOOK_KEY, r->key_fd, &ev))
+		return -1;
+	return (ev & LOOK_EVENTS) != 0;
+}
+
+/* ---- the controller -------------------------------------------------- */
+
 static int real_record(void *ud, const char *prefix, struct gl_record *rec,
 		       int timeout_ms)
 {
 	struct re_io_real *r = ud;
+	short ev = 0;
+	bool idle;
 	int rc;
 
 	if (!r->link)
 		return GL_ERR_CLOSED;
+	idle = look_take(r, RE_LOOK_CMD, gl_link_fd(r->link), &ev) &&
+	       !(ev & LOOK_EVENTS);
 	r->last_run_ns = re_io_now_ns();
-	rc = gl_link_record(r->link, prefix, rec, timeout_ms);
+	rc = gl_link_record_seen(r->link, prefix, rec, timeout_ms, idle);
 	r->last_run_ns = re_io_now_ns();
 	return rc;
 }
@@ -58,22 +161,33 @@ static const char *real_ctrl_error(void *ud, int *code)
 static int real_message(void *ud, char *line, size_t cap)
 {
 	struct re_io_real *r = ud;
+	short ev = 0;
 
 	if (!r->link)
 		return GL_ERR_AGAIN;
+	if (look_take(r, RE_LOOK_MSG, gl_link_msg_fd(r->link), &ev) &&
+	    !(ev & LOOK_EVENTS))
+		return gl_link_message_queued(r->link, line, cap);
 	return gl_link_message(r->link, line, cap);
 }
 
 static int real_relay_check(void *ud, char *why, size_t cap)
 {
 	struct re_io_real *r = ud;
-	int rc;
+	short ev = 0, wev = POLLIN; /* watch not looked at: stat() */
+	int rc, fd, wfd;
 
 	if (!r->relay) {
 		snprintf(why, cap, "relay not open");
 		return GL_ERR_RELAY;
 	}
-	rc = re_relay_check(r->relay);
+	re_relay_fds(r->relay, &fd, &wfd);
+	if (look_take(r, RE_LOOK_RELAY, fd, &ev)) {
+		look_take(r, RE_LOOK_WATCH, wfd, &wev);
+		rc = re_relay_check_seen(r->relay, ev, wev);
+	} else {
+		rc = re_relay_check(r->relay);
+	}
 	if (rc != GL_OK)
 		snprintf(why, cap, "%s", re_relay_errmsg(r->relay));
 	return rc;
@@ -159,6 +273,7 @@ static int real_stop_fresh(void *ud, const char *cmd, char *resp, size_t cap,
 						     : deadline_ms);
 	gl_link_close(r->link);
 	r->link = l;
+	look_forget(r); /* of the old link's descriptors */
 	return rc;
 }
 
@@ -236,8 +351,7 @@ static int64_t real_now_ns(void *ud)
 
 static void real_sleep_until(void *ud, int64_t t_ns)
 {
-	(void)ud;
-	base_sleep_until_ns(t_ns);
+	look_wait(ud, t_ns);
 }
 
 static const struct re_io_ops real_ops = {
@@ -260,6 +374,7 @@ void re_io_bind(struct re_io *io, struct re_io_real *real)
 {
 	io->ops = &real_ops;
 	io->ud = real;
+	look_forget(real);
 }
 
 int re_io_logf(const struct re_io *io, enum re_log_level lvl, const char *fmt,

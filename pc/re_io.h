@@ -92,6 +92,30 @@ struct re_io_logq_ent {
 	char text[RE_IO_LOGQ_LEN];
 };
 
+/* The descriptors of the cycle's one look (issue 17). */
+enum re_io_look_fd {
+	RE_LOOK_CMD,   /* the command socket: stray bytes before a request */
+	RE_LOOK_MSG,   /* the message socket */
+	RE_LOOK_RELAY, /* the relay port: error, hang-up (events 0) */
+	RE_LOOK_WATCH, /* the relay path's inotify watch */
+	RE_LOOK_KEY,   /* the keyboard (key_fd, when watch_key) */
+	RE_LOOK_N
+};
+
+/*
+ * What the wait before a cycle saw (issue 17: one look per cycle). The
+ * wait (ops->sleep_until) is a ppoll() over every descriptor the cycle
+ * reads; a descriptor that shows an event is noted and left out for the
+ * rest of the wait. Each reader then takes its entry once, and skips its
+ * own look (a recv, poll or read that would find nothing) when the entry
+ * shows no event: fd[i] is the descriptor seen (-1: not looked at, or
+ * taken), so a reader whose descriptor changed since looks itself.
+ */
+struct re_io_look {
+	int fd[RE_LOOK_N];
+	short revents[RE_LOOK_N];
+};
+
 /* The real world: any member may be NULL (then its calls fail safely). */
 struct re_io_real {
 	gl_link *link;
@@ -109,6 +133,10 @@ struct re_io_real {
 	unsigned logq_n;
 	unsigned long logq_dropped;
 	struct re_io_logq_ent logq[RE_IO_LOGQ];
+	/* the keyboard, looked at in the wait when watch_key is set */
+	int key_fd;
+	int watch_key;
+	struct re_io_look look; /* set by the wait; see re_io_look */
 };
 
 /*
@@ -126,6 +154,14 @@ void re_io_bind(struct re_io *io, struct re_io_real *real);
  * Return: GL_OK, or the first error of re_log_write_at().
  */
 int re_io_flush_log(struct re_io_real *real);
+
+/*
+ * re_io_key_look() - what the wait before this cycle saw of the keyboard
+ * (@real->key_fd, when @real->watch_key); its entry is then taken.
+ * No system call. Return: 1 input (or end of it) is waiting, 0 none,
+ * -1 not looked at (read it at the caller's own rate).
+ */
+int re_io_key_look(struct re_io_real *real);
 
 /* re_io_now_ns() - CLOCK_MONOTONIC in ns (for callers without an io). */
 int64_t re_io_now_ns(void);

@@ -99,6 +99,7 @@ struct re_relay {
 	int rb_due;		  /* state queries sent, not answered */
 	bool rb_discard;	  /* the answers due predate a write */
 	int64_t rb_sent_ns; /* the oldest query due was sent (base_now_ns) */
+	int64_t rb_next_ns; /* the next query of re_relay_check() (base_now_ns) */
 	char err[RE_RELAY_ERR_MAX];
 };
 
@@ -484,36 +485,60 @@ static int node_check(struct re_relay *r, int events)
 	return GL_OK;
 }
 
-/* Descriptor, hang-up and device node; no byte written. One poll() with
- * timeout 0 looks at the descriptor (POLLNVAL: it is gone) and at the
- * inotify watch of the path together (issue 17: one system call per cycle
- * when nothing happened). */
-static int link_check(struct re_relay *r)
+/* Descriptor, hang-up and device node from a poll() of the descriptor
+ * and the path's watch; no byte written. */
+static int link_seen(struct re_relay *r, short fd_ev, short watch_ev)
 {
-	struct pollfd p[2] = {{.events = POLLIN}, {.events = POLLIN}};
-	int fd, np;
-
-	if (!r->linked)
-		return set_err(r, GL_ERR_RELAY, "port not open");
-	fd = r->ops->fd(&r->io);
-	if (fd < 0)
+	if (fd_ev & POLLNVAL)
 		return set_err(r, GL_ERR_RELAY, "descriptor lost: %s",
 			       strerror(EBADF));
-	p[0].fd = fd;
+	if (fd_ev & POLLHUP)
+		return set_err(r, GL_ERR_RELAY, "link lost (hang-up)");
+	if (fd_ev & POLLERR)
+		return set_err(r, GL_ERR_RELAY, "link error");
+	/* no watch: re_pathwatch_changed() answers 1 (stat every call) */
+	return node_check(r, r->pw.fd < 0 || watch_ev != 0);
+}
+
+/* Is the port open with a descriptor? GL_OK or GL_ERR_RELAY. */
+static int link_open_fd(struct re_relay *r, int *fd)
+{
+	if (!r->linked)
+		return set_err(r, GL_ERR_RELAY, "port not open");
+	*fd = r->ops->fd(&r->io);
+	if (*fd < 0)
+		return set_err(r, GL_ERR_RELAY, "descriptor lost: %s",
+			       strerror(EBADF));
+	return GL_OK;
+}
+
+/* One poll() with timeout 0 looks at the descriptor (POLLNVAL: it is
+ * gone) and at the inotify watch of the path together (issue 17: one
+ * system call per cycle when nothing happened). */
+static int link_check(struct re_relay *r)
+{
+	struct pollfd p[2] = {{.events = 0}, {.events = POLLIN}};
+	int np;
+
+	if (link_open_fd(r, &p[0].fd))
+		return GL_ERR_RELAY;
 	p[1].fd = r->pw.fd;
 	np = r->pw.fd >= 0 ? 2 : 1;
 	if (poll(p, (nfds_t)np, 0) < 0 && errno != EINTR)
 		return set_err(r, GL_ERR_RELAY, "poll failed: %s",
 			       strerror(errno));
-	if (p[0].revents & POLLNVAL)
-		return set_err(r, GL_ERR_RELAY, "descriptor lost: %s",
-			       strerror(EBADF));
-	if (p[0].revents & POLLHUP)
-		return set_err(r, GL_ERR_RELAY, "link lost (hang-up)");
-	if (p[0].revents & POLLERR)
-		return set_err(r, GL_ERR_RELAY, "link error");
-	/* no watch: re_pathwatch_changed() answers 1 (stat every call) */
-	return node_check(r, np < 2 || p[1].revents != 0);
+	return link_seen(r, p[0].revents, np == 2 ? p[1].revents : 0);
+}
+
+/* Between two queries of re_relay_check(): query_ms, or less so that two
+ * fit in readback_timeout_ms. */
+static int64_t rb_interval_ns(const struct re_relay *r)
+{
+	int ms = r->cfg.readback_timeout_ms / 2;
+
+	if (ms > r->cfg.query_ms)
+		ms = r->cfg.query_ms;
+	return ms > 0 ? (int64_t)ms * BASE_NS_PER_MS : 0;
 }
 
 /*
@@ -532,6 +557,9 @@ static int readback_step(struct re_relay *r)
 	if (!r->cfg.readback || r->out_done < r->out_len)
 		return GL_OK;
 	if (!r->rb_due) {
+		if (base_now_ns() < r->rb_next_ns)
+			return GL_OK;
+		r->rb_next_ns = base_now_ns() + rb_interval_ns(r);
 		if (drop_input(r))
 			return GL_ERR_RELAY;
 		n = r->ops->write(&r->io, &query, 1, r->err, sizeof(r->err));
@@ -575,6 +603,26 @@ int re_relay_check(re_relay *r)
 	if (!r)
 		return GL_ERR_ARG;
 	rc = link_check(r);
+	if (!rc)
+		rc = readback_step(r);
+	return rc;
+}
+
+void re_relay_fds(const re_relay *r, int *fd, int *watch_fd)
+{
+	*fd = r && r->linked ? r->ops->fd(&r->io) : -1;
+	*watch_fd = *fd >= 0 ? r->pw.fd : -1;
+}
+
+int re_relay_check_seen(re_relay *r, short fd_revents, short watch_revents)
+{
+	int fd, rc;
+
+	if (!r)
+		return GL_ERR_ARG;
+	rc = link_open_fd(r, &fd);
+	if (!rc)
+		rc = link_seen(r, fd_revents, watch_revents);
 	if (!rc)
 		rc = readback_step(r);
 	return rc;

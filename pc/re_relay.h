@@ -89,6 +89,10 @@ struct re_relay_cfg {
 	bool readback;		 /* Devantech: query the state (0x5B)
 				  * from re_relay_check() */
 	int readback_timeout_ms; /* answer deadline of that query, ms */
+	int query_ms;		 /* re_relay_check() queries at most this
+				  * often (RE_RELAY_QUERY_MS; 0: in every
+				  * check), and at least twice within
+				  * readback_timeout_ms, ms */
 	/* RE_RELAY_EXPLICIT only: the complete messages. */
 	uint8_t on[RE_RELAY_CODE_MAX];
 	size_t on_len;
@@ -194,18 +198,42 @@ int re_relay_off(re_relay *r);
 /*
  * re_relay_check() - is the relay link still sound? For every cycle.
  * Writes no state byte and never re-energises anything; does not block
- * (poll with timeout 0, fcntl, one non-blocking read of inotify events,
- * and for a Devantech read-back one query byte written and its answer read
- * without waiting). Checks: the descriptor is valid, no hang-up or error is
- * pending, the device node still exists and is the same node (st_rdev,
- * inode, change time) as the one opened, and (read-back) the board reports
- * the channel in the state last confirmed. The node is stat()ed after an
- * inotify event on the path, its links or the node (re_pathwatch.h), and
- * at least once a second (an ancestor directory renamed is not watched);
- * after a failed stat() check, in every call until it passes again.
+ * (one poll with timeout 0 of the descriptor and the path's inotify watch,
+ * a non-blocking read of inotify events when it has some, and for a
+ * Devantech read-back one query byte written every query_ms and
+ * its answer read without waiting). Checks: the descriptor is valid, no
+ * hang-up or error is pending, the device node still exists and is the
+ * same node (st_rdev, inode, change time) as the one opened, and
+ * (read-back) the board reports the channel in the state last confirmed.
+ * The node is stat()ed after an inotify event on the path, its links or
+ * the node (re_pathwatch.h), and at least once a second (an ancestor
+ * directory renamed is not watched); after a failed stat() check, in
+ * every call until it passes again.
  * Return: GL_OK; GL_ERR_RELAY with the reason in re_relay_errmsg().
  */
 int re_relay_check(re_relay *r);
+
+/* The configured board's state is asked for at most this often by
+ * re_relay_check() (read-back; re_relay_cfg.query_ms), ms. */
+#define RE_RELAY_QUERY_MS 200
+
+/*
+ * re_relay_fds() - the descriptors re_relay_check() looks at, for a
+ * caller that polls them itself (re_relay_check_seen()).
+ * @fd: [out] the port (poll it for errors and hang-up only: events 0);
+ * @watch_fd: [out] the path's inotify watch (POLLIN), -1 when none.
+ * Both are -1 when the port is not open. No return value.
+ */
+void re_relay_fds(const re_relay *r, int *fd, int *watch_fd);
+
+/*
+ * re_relay_check_seen() - re_relay_check() with the poll() already done
+ * by the caller (issue 17: one look per cycle over every descriptor).
+ * @fd_revents, @watch_revents: what that poll, of re_relay_fds()' @fd
+ *       (events 0) and @watch_fd (POLLIN), returned for them just before.
+ * Return: as re_relay_check().
+ */
+int re_relay_check_seen(re_relay *r, short fd_revents, short watch_revents);
 
 /*
  * re_relay_close_start() - re_relay_off_start(), for re_relay_close_finish().

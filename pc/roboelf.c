@@ -605,9 +605,11 @@ static void run(struct app *a)
 {
 	struct re_status st;
 	int64_t next_retry = 0, next_key = 0;
-	int key = 0, v;
+	int key = 0, v, look;
 
 	re_console_raw(&a->con);
+	a->real.key_fd = a->con.in_fd;
+	a->real.watch_key = a->con.tty_in && a->con.in_fd >= 0;
 	while (!re_sig.quit) {
 		re_super_wait(a->sup);
 		a->real.defer_log = 1; /* no file write in the cycle */
@@ -624,8 +626,10 @@ static void run(struct app *a)
 		re_console_status(&a->con, &st, re_io_now_ns(), 0);
 		re_io_flush_log(&a->real); /* after the cycle (issue 17) */
 		retry_log(a, &next_retry);
-		/* the keyboard every KEY_POLL_MS, not every cycle (issue 17) */
-		if (re_io_now_ns() >= next_key) {
+		/* the keyboard when the wait saw input, or every
+		 * KEY_POLL_MS when it did not look (issue 17) */
+		look = re_io_key_look(&a->real);
+		if (look == 1 || (look < 0 && re_io_now_ns() >= next_key)) {
 			next_key = re_io_now_ns() + KEY_POLL_MS * 1000000LL;
 			key = re_console_key(&a->con);
 		}

@@ -105,6 +105,9 @@ struct xfer {
 	size_t bin_len;
 	char *ubuf; /* non-NULL: UL reply into this buffer */
 	size_t ucap;
+	/* the caller polled the socket just before and it held nothing:
+	 * no read before the request, none for surplus after the reply */
+	bool seen_idle;
 };
 
 /* ---- time ---------------------------------------------------------------- */
@@ -396,7 +399,7 @@ static int xfer_begin(gl_link *l, struct gl_chan *ch, const struct xfer *x,
 		return GL_ERR_BROKEN;
 	if (x->len > GL_LINE_MAX)
 		return GL_ERR_ARG;
-	rc = chan_drain_idle(l, ch);
+	rc = x->seen_idle ? GL_OK : chan_drain_idle(l, ch);
 	if (rc < 0)
 		return rc;
 	rc = x->ubuf ? gl_proto_expect_upload(&ch->p, x->ubuf, x->ucap)
@@ -411,13 +414,16 @@ static int xfer_begin(gl_link *l, struct gl_chan *ch, const struct xfer *x,
 /*
  * After a reply: retire it (its text stays valid); nothing solicited may
  * follow. One non-blocking read first, so that surplus bytes sent with the
- * reply are seen now rather than at the next call.
+ * reply are seen now rather than at the next call; not when the caller
+ * looks before each request itself (@seen_idle: its next look, before
+ * the next request, sees them). Bytes that came with the reply are seen
+ * in both cases.
  */
-static int xfer_finish(gl_link *l, struct gl_chan *ch)
+static int xfer_finish(gl_link *l, struct gl_chan *ch, bool seen_idle)
 {
 	struct gl_reply extra;
 
-	if (gl_proto_space(&ch->p) > 0)
+	if (!seen_idle && gl_proto_space(&ch->p) > 0)
 		chan_read(l, ch, -1); /* errors show up at the next call */
 	if (gl_proto_next(&ch->p, &extra) != GL_ERR_AGAIN)
 		return chan_fail(ch, GL_ERR_PROTO);
@@ -427,8 +433,8 @@ static int xfer_finish(gl_link *l, struct gl_chan *ch)
 }
 
 /* Wait for the awaited reply. */
-static int xfer_end(gl_link *l, struct gl_chan *ch, struct gl_reply *r,
-		    int64_t deadline)
+static int xfer_end(gl_link *l, struct gl_chan *ch, const struct xfer *x,
+		    struct gl_reply *r, int64_t deadline)
 {
 	int rc;
 
@@ -439,7 +445,7 @@ static int xfer_end(gl_link *l, struct gl_chan *ch, struct gl_reply *r,
 	}
 	if (rc < 0)
 		return chan_fail(ch, rc);
-	return xfer_finish(l, ch);
+	return xfer_finish(l, ch, x->seen_idle);
 }
 
 static int xfer(gl_link *l, struct gl_chan *ch, const struct xfer *x,
@@ -451,7 +457,7 @@ static int xfer(gl_link *l, struct gl_chan *ch, const struct xfer *x,
 	rc = xfer_begin(l, ch, x, deadline);
 	if (rc < 0)
 		return rc;
-	return xfer_end(l, ch, r, deadline);
+	return xfer_end(l, ch, x, r, deadline);
 }
 
 /* ---- commands ------------------------------------------------------------ */
@@ -599,8 +605,14 @@ int gl_link_axes(gl_link *l)
 int gl_link_record(gl_link *l, const char *prefix, struct gl_record *rec,
 		   int timeout_ms)
 {
+	return gl_link_record_seen(l, prefix, rec, timeout_ms, false);
+}
+
+int gl_link_record_seen(gl_link *l, const char *prefix, struct gl_record *rec,
+			int timeout_ms, bool seen_idle)
+{
 	char line[GL_LINE_MAX + 1];
-	struct xfer x = {.line = line};
+	struct xfer x = {.line = line, .seen_idle = seen_idle};
 	struct gl_reply r;
 	int rc, t = l ? pick_timeout(l, timeout_ms) : GL_ERR_ARG;
 
@@ -829,8 +841,8 @@ static int dl_run(gl_link *l, const char *prog, size_t len, int *bad,
 	rc = chan_write(l, &l->cmd, "\\", 1, deadline);
 	if (rc < 0)
 		return chan_fail(&l->cmd, rc);
-	return done ? xfer_finish(l, &l->cmd)
-		    : xfer_end(l, &l->cmd, r, deadline);
+	return done ? xfer_finish(l, &l->cmd, false)
+		    : xfer_end(l, &l->cmd, &x, r, deadline);
 }
 
 int gl_link_download(gl_link *l, const char *prog, size_t len, int *bad_line,
@@ -961,6 +973,20 @@ static int msg_pump(gl_link *l)
 	return GL_OK;
 }
 
+int gl_link_message_queued(gl_link *l, char *line, size_t cap)
+{
+	int rc;
+
+	if (!l || !line || cap == 0)
+		return GL_ERR_ARG;
+	rc = gl_proto_unsol_next(&l->cmd.p, line, cap);
+	if (rc != GL_ERR_AGAIN)
+		return rc;
+	if (l->msg.fd < 0)
+		return l->msg.broken ? GL_ERR_CLOSED : GL_ERR_AGAIN;
+	return gl_proto_unsol_next(&l->msg.p, line, cap);
+}
+
 int gl_link_message(gl_link *l, char *line, size_t cap)
 {
 	int rc, pump;
@@ -1054,6 +1080,11 @@ void gl_link_stats(const gl_link *l, uint64_t *tx_bytes, uint64_t *rx_bytes,
 int gl_link_fd(const gl_link *l)
 {
 	return l ? l->cmd.fd : -1;
+}
+
+int gl_link_msg_fd(const gl_link *l)
+{
+	return l ? l->msg.fd : -1;
 }
 
 bool gl_link_broken(const gl_link *l)

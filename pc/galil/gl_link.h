@@ -100,6 +100,21 @@ int gl_link_record(gl_link *l, const char *prefix, struct gl_record *rec,
 		   int timeout_ms);
 
 /*
+ * gl_link_record_seen() - gl_link_record() for a caller that looks at the
+ * command socket itself before each request (poll() of gl_link_fd()).
+ * @seen_idle: true when that look, just before this call, showed no input
+ *             (nor an error or hang-up): the read that looks for stray
+ *             bytes before the request and the one that looks for surplus
+ *             after the reply are left out (two system calls per cycle,
+ *             issue 17). Surplus that came with the reply is still found;
+ *             later surplus is found by the caller's next look, before the
+ *             next request. false: exactly gl_link_record().
+ * Return: as gl_link_record().
+ */
+int gl_link_record_seen(gl_link *l, const char *prefix, struct gl_record *rec,
+			int timeout_ms, bool seen_idle);
+
+/*
  * gl_link_ctrl_request() - send a control-character request of the command
  * reference and read its reply: ^R^V (0x12 0x16, firmware revision), ^R^S
  * (0x12 0x13, master reset) or ^L^K (0x0C 0x0B, lock; printable arguments
@@ -209,6 +224,14 @@ int gl_link_open_messages(gl_link *l, int timeout_ms);
 int gl_link_message(gl_link *l, char *line, size_t cap);
 
 /*
+ * gl_link_message_queued() - as gl_link_message(), but only lines already
+ * received: no system call. For a caller that polled gl_link_msg_fd() just
+ * before and saw no input (issue 17: one look per cycle).
+ * Return: as gl_link_message(), never GL_ERR_SYS.
+ */
+int gl_link_message_queued(gl_link *l, char *line, size_t cap);
+
+/*
  * gl_link_stats() - traffic since gl_link_open().
  * @tx_bytes: [out] optional, bytes sent; @rx_bytes: [out] optional, bytes
  * received; @round_trips: [out] optional, command-handle replies completed.
@@ -222,6 +245,12 @@ void gl_link_stats(const gl_link *l, uint64_t *tx_bytes, uint64_t *rx_bytes,
  * read or write it). Return: the descriptor, or -1.
  */
 int gl_link_fd(const gl_link *l);
+
+/*
+ * gl_link_msg_fd() - the message socket (gl_link_open_messages()), for
+ * poll() only, as gl_link_fd(). Return: the descriptor, or -1 when none.
+ */
+int gl_link_msg_fd(const gl_link *l);
 
 /*
  * gl_link_broken() - true once the command handle is out of step (after

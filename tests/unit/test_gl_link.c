@@ -572,6 +572,46 @@ static void test_link_record(void **state)
 	assert_int_equal(gl_link_record(l, NULL, &b, 0), GL_OK);
 }
 
+/* TEST_link_record_seen: a caller that looks at the socket itself
+ * (gl_link_record_seen, issue 17). Seen idle, a terminator too many that
+ * comes after the reply is not read by the call (no surplus read), but the
+ * caller's next look shows it and the next call, told so, refuses it
+ * (PROTO, broken) before sending; one in the same write as the reply is
+ * refused at once, as without the look. */
+static void test_link_record_seen(void **state)
+{
+	gl_link *l = *state;
+	struct gl_record rec;
+	struct pollfd pfd;
+
+	assert_int_equal(gl_link_query_layout(l), GL_OK);
+	assert_int_equal(gl_link_record_seen(l, "hbpc=9", &rec, 0, true),
+			 GL_OK);
+	assert_int_equal(rec.axis[0].za, 9);
+	ok(l, STUB_EXTRA " 100");
+	assert_int_equal(gl_link_record_seen(l, "hbpc=10", &rec, 0, true),
+			 GL_OK);
+	assert_int_equal(rec.axis[0].za, 10);
+	assert_false(gl_link_broken(l));
+	pfd = (struct pollfd){.fd = gl_link_fd(l), .events = POLLIN};
+	assert_int_equal(poll(&pfd, 1, 3000), 1); /* the caller's look */
+	assert_int_equal(gl_link_record_seen(l, "hbpc=11", &rec, 0, false),
+			 GL_ERR_PROTO);
+	assert_true(gl_link_broken(l));
+}
+
+static void test_link_record_seen_same_write(void **state)
+{
+	gl_link *l = *state;
+	struct gl_record rec;
+
+	assert_int_equal(gl_link_query_layout(l), GL_OK);
+	ok(l, STUB_EXTRA);
+	assert_int_equal(gl_link_record_seen(l, "hbpc=12", &rec, 0, true),
+			 GL_ERR_PROTO);
+	assert_true(gl_link_broken(l));
+}
+
 /* TEST_link_record_bad_header: framing fine, header wrong -> RECORD. */
 static void test_link_record_bad_header(void **state)
 {
@@ -714,16 +754,31 @@ static void test_link_dl_invalid(void **state)
 static void test_link_messages(void **state)
 {
 	gl_link *l = *state;
+	struct pollfd pfd;
 	char line[64];
+	int rc;
 
 	assert_int_equal(gl_link_message(l, line, sizeof(line)), GL_ERR_AGAIN);
+	assert_int_equal(gl_link_msg_fd(l), -1);
 	assert_int_equal(gl_link_open_messages(l, 0), GL_OK);
 	expect_reply(l, "MG _CW", " 1.0000");
 	ok(l, STUB_MSG " FAULT 4 2 5012");
 	ok(l, STUB_MSG " ARMED");
+	/* queued only: nothing is read from the socket, until a look at
+	 * gl_link_msg_fd() shows input and gl_link_message() reads it */
+	assert_int_equal(gl_link_message_queued(l, line, sizeof(line)),
+			 GL_ERR_AGAIN);
+	pfd = (struct pollfd){.fd = gl_link_msg_fd(l), .events = POLLIN};
+	assert_int_equal(poll(&pfd, 1, 2000), 1);
 	assert_int_equal(wait_message(l, line, sizeof(line), 2000), 14);
 	assert_string_equal(line, "FAULT 4 2 5012");
-	assert_int_equal(wait_message(l, line, sizeof(line), 2000), 5);
+	/* a line already received is given without reading */
+	rc = gl_link_message_queued(l, line, sizeof(line));
+	if (rc == GL_ERR_AGAIN) { /* ARMED came in a later segment */
+		assert_int_equal(poll(&pfd, 1, 2000), 1);
+		rc = wait_message(l, line, sizeof(line), 2000);
+	}
+	assert_int_equal(rc, 5);
 	assert_string_equal(line, "ARMED");
 	assert_int_equal(gl_link_message(l, line, sizeof(line)), GL_ERR_AGAIN);
 	/* a line longer than the caller's buffer */
@@ -826,6 +881,8 @@ int main(void)
 	    T(test_link_drop),
 	    T(test_link_silent),
 	    T(test_link_record),
+	    T(test_link_record_seen),
+	    T(test_link_record_seen_same_write),
 	    T(test_link_record_bad_header),
 	    T(test_link_identify),
 	    T(test_link_dl_ul),

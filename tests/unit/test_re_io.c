@@ -4,6 +4,11 @@
  * untouched until re_io_flush_log(), which writes them in order with the
  * times they happened at; an overflow is counted and said; a FAULT flushes
  * the queue first and is on disk at once.
+ *
+ * And the one look before a cycle (issue 17): the wait (ops->sleep_until)
+ * is a ppoll() over the cycle's descriptors that ends at its deadline, not
+ * before, whatever shows input; what it saw is handed out once
+ * (re_io_key_look: 1 input, 0 none, -1 not looked at).
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -14,6 +19,8 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+#include "base_clock.h"
 
 #include <cmocka.h>
 
@@ -152,6 +159,47 @@ static void test_not_deferred(void **state)
 	assert_string_equal(buf, "INFO at once\n");
 }
 
+/* Wait @ms through the io: the ms it took. */
+static double wait_ms(int ms)
+{
+	int64_t t0 = base_now_ns();
+
+	io.ops->sleep_until(io.ud, t0 + ms * BASE_NS_PER_MS);
+	return (double)(base_now_ns() - t0) / 1e6;
+}
+
+static void test_look(void **state)
+{
+	int pfd[2];
+	double ms;
+
+	(void)state;
+	assert_int_equal(pipe(pfd), 0);
+	real.key_fd = pfd[0];
+	real.watch_key = 1;
+	/* nothing typed: looked at, nothing; taken once */
+	ms = wait_ms(30);
+	assert_true(ms >= 30 && ms < 30 + 15);
+	assert_int_equal(re_io_key_look(&real), 0);
+	assert_int_equal(re_io_key_look(&real), -1);
+	/* a key waiting: the wait still ends at its deadline (the descriptor
+	 * is left out once seen, no busy loop), and the key is said */
+	assert_int_equal(write(pfd[1], "q", 1), 1);
+	ms = wait_ms(30);
+	assert_true(ms >= 30 && ms < 30 + 15);
+	assert_int_equal(re_io_key_look(&real), 1);
+	assert_int_equal(re_io_key_look(&real), -1);
+	/* a deadline already passed: no look */
+	io.ops->sleep_until(io.ud, base_now_ns() - BASE_NS_PER_MS);
+	assert_int_equal(re_io_key_look(&real), -1);
+	/* the keyboard not watched: never looked at */
+	real.watch_key = 0;
+	wait_ms(5);
+	assert_int_equal(re_io_key_look(&real), -1);
+	close(pfd[0]);
+	close(pfd[1]);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -162,6 +210,7 @@ int main(void)
 	    cmocka_unit_test_setup_teardown(test_fault_flushes_first, setup,
 					    teardown),
 	    cmocka_unit_test_setup_teardown(test_not_deferred, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_look, setup, teardown),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

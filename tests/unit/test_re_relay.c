@@ -855,6 +855,63 @@ static void test_sp_readback(void **state)
 	re_relay_close(r);
 }
 
+/* The checks' state query goes out at most every query_ms (issue 17: a
+ * fixed rate, not every cycle), answered or not; and at least twice within
+ * readback_timeout_ms. */
+static void test_sp_readback_rate(void **state)
+{
+	static const uint8_t q1[] = {0x5B};
+	struct fix *f = *state;
+	int64_t t0, dt_ms = -1;
+	re_relay *r;
+
+	f->cfg.readback = true;
+	f->cfg.query_ms = 60;
+	fk.answers = true;
+	r = open_ok(f);
+	assert_int_equal(re_relay_on(r), GL_OK);
+	fk.nwire = 0;
+	fk.answers = false;
+	t0 = mono_ns();
+	assert_int_equal(re_relay_check(r), GL_OK); /* sends the query */
+	wire_is(q1, 1);
+	rx_add(0x01);
+	assert_int_equal(re_relay_check(r), GL_OK); /* reads its answer */
+	assert_int_equal(fk.nrx, 0);
+	while (mono_ns() - t0 < 2000 * BASE_NS_PER_MS) {
+		assert_int_equal(re_relay_check(r), GL_OK);
+		if (fk.nwire) {
+			dt_ms = (mono_ns() - t0) / BASE_NS_PER_MS;
+			break;
+		}
+	}
+	print_message("second query after %lld ms (query_ms 60)\n",
+		      (long long)dt_ms);
+	assert_true(dt_ms >= 60 && dt_ms < 60 + LATE_MS);
+	wire_is(q1, 1);
+	re_relay_close(r);
+	/* a short readback_timeout_ms: two queries fit in it */
+	f->cfg.readback_timeout_ms = 40;
+	fk.answers = true;
+	r = open_ok(f);
+	fk.nwire = 0;
+	fk.answers = false;
+	t0 = mono_ns();
+	assert_int_equal(re_relay_check(r), GL_OK);
+	wire_is(q1, 1);
+	rx_add(0x00);
+	dt_ms = -1;
+	while (mono_ns() - t0 < 2000 * BASE_NS_PER_MS) {
+		assert_int_equal(re_relay_check(r), GL_OK);
+		if (fk.nwire) {
+			dt_ms = (mono_ns() - t0) / BASE_NS_PER_MS;
+			break;
+		}
+	}
+	assert_true(dt_ms >= 20 && dt_ms < 20 + LATE_MS);
+	re_relay_close(r);
+}
+
 /* The link checks: descriptor unavailable; hang-up on the line. */
 static void test_sp_check_fails(void **state)
 {
@@ -962,6 +1019,7 @@ int main(void)
 	    T(test_sp_off_readback_wrong),
 	    T(test_sp_check_fails),
 	    T(test_sp_readback),
+	    T(test_sp_readback_rate),
 	    T(test_sp_icstation),
 	    T(test_sp_clinical_tty_refused),
 	};

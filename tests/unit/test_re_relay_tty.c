@@ -918,6 +918,55 @@ static void test_check_stat_on_event(void **state)
 	re_relay_close(r);
 }
 
+/* re_relay_check_seen(): the caller's own poll of re_relay_fds() (the
+ * supervisor's one look per cycle, issue 17). Nothing seen: no stat();
+ * the watch's event: the events read and the node stat()ed (a changed
+ * mode refused); a hang-up or an invalid descriptor seen: refused. */
+static void test_check_seen(void **state)
+{
+	struct fix *f = *state;
+	struct pollfd p[2];
+	char want[RE_RELAY_ERR_MAX];
+	re_relay *r;
+	int fd, wfd;
+
+	open_ok(f, &r);
+	re_relay_fds(r, &fd, &wfd);
+	assert_true(fd >= 0 && wfd >= 0 && fd != wfd);
+	assert_int_equal(re_relay_check(r), GL_OK); /* the first one stat()s */
+	n_stat = 0;
+	for (int i = 0; i < 100; i++)
+		assert_int_equal(re_relay_check_seen(r, 0, 0), GL_OK);
+	assert_int_equal(n_stat, 0);
+	ctime_passes(f->pty.name);
+	assert_int_equal(chmod(f->pty.name, 0600), 0);
+	p[0] = (struct pollfd){.fd = fd, .events = 0};
+	p[1] = (struct pollfd){.fd = wfd, .events = POLLIN};
+	assert_int_equal(poll(p, 2, 1000), 1);
+	assert_int_equal(p[1].revents, POLLIN);
+	assert_int_equal(re_relay_check_seen(r, p[0].revents, p[1].revents),
+			 GL_ERR_RELAY);
+	assert_int_equal(n_stat, 1);
+	snprintf(want, sizeof(want),
+		 "relay '%s': the port now names another device", f->link);
+	assert_string_equal(re_relay_errmsg(r), want);
+	re_relay_close(r);
+
+	open_ok(f, &r);
+	assert_int_equal(re_relay_check_seen(r, POLLHUP, 0), GL_ERR_RELAY);
+	snprintf(want, sizeof(want), "relay '%s': link lost (hang-up)",
+		 f->link);
+	assert_string_equal(re_relay_errmsg(r), want);
+	assert_int_equal(re_relay_check_seen(r, POLLNVAL, 0), GL_ERR_RELAY);
+	snprintf(want, sizeof(want),
+		 "relay '%s': descriptor lost: Bad file descriptor", f->link);
+	assert_string_equal(re_relay_errmsg(r), want);
+	re_relay_close(r);
+	re_relay_fds(NULL, &fd, &wfd);
+	assert_int_equal(fd, -1);
+	assert_int_equal(wfd, -1);
+}
+
 /*
  * A directory above the watched ones renamed (dir/sub/relay -> the path
  * no longer exists, no inotify event reaches the watches on dir/sub and
@@ -1038,6 +1087,8 @@ int main(void)
 	    cmocka_unit_test_setup_teardown(test_check_nonblocking, setup,
 					    teardown),
 	    cmocka_unit_test_setup_teardown(test_check_stat_on_event, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_check_seen, setup,
 					    teardown),
 	    cmocka_unit_test_setup_teardown(test_check_ancestor_moved, setup,
 					    teardown),
