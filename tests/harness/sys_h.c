@@ -336,6 +336,24 @@ void sys_env_cleanup(struct sys_env *e)
 	e->dir[0] = '\0';
 }
 
+int sys_env_ready(struct sys_env *e)
+{
+	int ok = sys_env_init(e) == 0 && sys_env_calibrate(e, 150000) == 0;
+
+	printf("[   INFO   ] full calibration %s in %.1f s (P %d ms, %s)%s%s\n",
+	       ok ? "done" : "FAILED", e->calib_s, e->period_ms, e->dir,
+	       ok ? "" : ": ", ok ? "" : e->err);
+	fflush(stdout);
+	return ok;
+}
+
+void sys_env_done(struct sys_env *e, int ready)
+{
+	if (!ready)
+		e->keep = 1;
+	sys_env_cleanup(e);
+}
+
 /* ---- one case: start and stop ------------------------------------------- */
 
 static int run_load(struct sys_case *c)
@@ -577,6 +595,41 @@ int sys_ctl_ask(struct sys_case *c, const char *req, char *resp, size_t cap)
 	if (n < 0)
 		seterr(c->err, "control request '%s': no answer", req);
 	return n;
+}
+
+int sys_no_fault(struct sys_case *c, const char *when)
+{
+	char line[SYS_ERR_MAX / 2];
+
+	proc_pump(&c->re, 0);
+	if (proc_find_line(&c->re, PROC_STDOUT, "FAULT ", line, sizeof(line)) ==
+	    0) {
+		seterr(c->err, "%s: roboelf tripped (a false trip): %s", when,
+		       line);
+		return -1;
+	}
+	if (c->re.out[PROC_STDOUT].fd < 0) {
+		seterr(c->err, "%s: roboelf exited:\n%s", when,
+		       tail(&c->re, PROC_STDERR, SYS_ERR_MAX / 2));
+		return -1;
+	}
+	return 0;
+}
+
+int sys_still_armed(struct sys_case *c, const char *when)
+{
+	char st[2048];
+
+	if (sys_no_fault(c, when) < 0 || sys_state(c, st, sizeof(st)) < 0)
+		return -1;
+	if (!strstr(st, " relay=on ") || sys_state_num(st, "A.mo") != 0 ||
+	    sys_state_num(st, "B.mo") != 0 || sys_state_num(st, "C.mo") != 0 ||
+	    sys_state_num(st, "var.state") != 1) {
+		seterr(c->err, "%s: the robot is no longer armed: %s", when,
+		       st);
+		return -1;
+	}
+	return 0;
 }
 
 int sys_ctl(struct sys_case *c, const char *fmt, ...)

@@ -143,6 +143,18 @@ int sys_env_calibrate(struct sys_env *e, int timeout_ms);
 void sys_env_cleanup(struct sys_env *e);
 
 /*
+ * sys_env_ready() - a group's set-up: sys_env_init() and a full calibration
+ * (150 s at most), then an INFO line saying how it went and in how long.
+ * Return: 1 when ready, 0 when not (e->err says why; the cases then fail
+ * with it).
+ */
+int sys_env_ready(struct sys_env *e);
+
+/* sys_env_done() - a group's tear-down: sys_env_cleanup(), but the
+ * directory is kept for a look when the set-up was not @ready. */
+void sys_env_done(struct sys_env *e, int ready);
+
+/*
  * sys_env_write_config() - write a copy of the test configuration with
  * @subst applied to @path.
  * Return: 0, or -1 with e->err set (a key that is not found is an error).
@@ -166,6 +178,20 @@ int sys_case_start(struct sys_case *c, struct sys_env *e,
  * struct.
  */
 void sys_case_stop(struct sys_case *c);
+
+/*
+ * sys_no_fault() - roboelf has printed no FAULT line and still runs.
+ * @when: named in the error.
+ * Return: 0, or -1 with c->err set (with roboelf's output).
+ */
+int sys_no_fault(struct sys_case *c, const char *when);
+
+/*
+ * sys_still_armed() - sys_no_fault(), and galil-sim shows the robot armed:
+ * motor power on (relay on), every motor on, the program's state 1.
+ * Return: 0, or -1 with c->err set (with the state seen).
+ */
+int sys_still_armed(struct sys_case *c, const char *when);
 
 /*
  * sys_ctl() - one control-port request that must answer "ok".

@@ -261,21 +261,14 @@ static void quit_latched(struct sys_case *c, const char *name)
 static int group_setup(void **state)
 {
 	(void)state;
-	if (sys_env_init(&env) == 0 && sys_env_calibrate(&env, 150000) == 0)
-		env_ok = 1;
-	print_message("[   INFO   ] full calibration %s in %.1f s (P %d ms, "
-		      "%s)\n",
-		      env_ok ? "done" : "FAILED", env.calib_s, env.period_ms,
-		      env.dir);
+	env_ok = sys_env_ready(&env);
 	return 0;
 }
 
 static int group_teardown(void **state)
 {
 	(void)state;
-	if (!env_ok)
-		env.keep = 1;
-	sys_env_cleanup(&env);
+	sys_env_done(&env, env_ok);
 	return 0;
 }
 

@@ -38,21 +38,14 @@ static struct sys_case cs;
 static int group_setup(void **state)
 {
 	(void)state;
-	if (sys_env_init(&env) == 0 && sys_env_calibrate(&env, 150000) == 0)
-		env_ok = 1;
-	print_message("[   INFO   ] full calibration %s in %.1f s (P %d ms, "
-		      "%s)\n",
-		      env_ok ? "done" : "FAILED", env.calib_s, env.period_ms,
-		      env.dir);
+	env_ok = sys_env_ready(&env);
 	return 0;
 }
 
 static int group_teardown(void **state)
 {
 	(void)state;
-	if (!env_ok)
-		env.keep = 1;
-	sys_env_cleanup(&env);
+	sys_env_done(&env, env_ok);
 	return 0;
 }
 
@@ -75,27 +68,15 @@ static void start(void)
 
 static void no_fault(const char *when)
 {
-	proc_pump(&cs.re, 0);
-	if (proc_find_line(&cs.re, PROC_STDOUT, "FAULT ", NULL, 0) == 0)
-		fail_msg("%s: roboelf tripped:\n%s", when,
-			 proc_output(&cs.re, PROC_STDOUT));
-	if (cs.re.out[PROC_STDOUT].fd < 0)
-		fail_msg("%s: roboelf exited:\n%s", when,
-			 proc_output(&cs.re, PROC_STDERR));
+	if (sys_no_fault(&cs, when) < 0)
+		fail_msg("%s", cs.err);
 }
 
 /* Still armed: program state 1, power on, every motor on. */
 static void still_armed(const char *when)
 {
-	char st[2048];
-
-	no_fault(when);
-	if (sys_state(&cs, st, sizeof(st)) < 0)
+	if (sys_still_armed(&cs, when) < 0)
 		fail_msg("%s", cs.err);
-	if (!strstr(st, " relay=on ") || sys_state_num(st, "A.mo") != 0 ||
-	    sys_state_num(st, "B.mo") != 0 || sys_state_num(st, "C.mo") != 0 ||
-	    sys_state_num(st, "var.state") != 1)
-		fail_msg("%s: the robot is no longer armed: %s", when, st);
 }
 
 /* The joystick still moves axis @axis: a short jog and back to neutral. */
