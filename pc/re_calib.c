@@ -18,6 +18,10 @@
 #define AXES	  "ABC"
 #define ACFACT	  10  /* dmc/constants.dmc: DC = 10 x speed */
 #define GUARD_CNT 200 /* extra counts before a slow zone */
+/* What one more stop and start costs a move: the braking and the
+ * acceleration (1 / ACFACT s each, half of it lost against the full
+ * speed) and up to three samples before the next move runs. */
+#define RESTART_MS (1000 / ACFACT + 3 * RE_CALIB_SAMPLE_MS)
 
 enum phase {
 	PH_START,    /* nothing sent yet */
@@ -44,6 +48,8 @@ struct cal_axis {
 	double edge; /* encoder where the switch was first seen */
 	int have_edge;
 	double start; /* table point 0 = reverse soft limit */
+	int off_rev;  /* the sweep passed start with the switch open */
+	int off_fwd;  /* the axis passed soft_fwd with that switch open */
 	double soft_fwd;
 	double seek_len; /* length of the bounded slow move, counts */
 	double centre;	 /* PH_CENTRE: the target, counts */
@@ -355,17 +361,38 @@ static void note_edge(struct re_calib *c, int i, int active)
 	}
 }
 
+/* What a fast move at @speed keeps before the slow zone it heads for:
+ * its braking distance (AC = DC = ACFACT x speed: speed / (2 ACFACT)),
+ * two samples at that speed and a guard for the pot's noise, counts. */
+static double brake_counts(int speed)
+{
+	return speed / (2.0 * ACFACT) + speed * 0.02 + GUARD_CNT;
+}
+
 /* How far the axis can run at @speed before its pot reaches @zone_v:
  * from the pot's absolute reading, with the gain overestimated by the
- * range tolerance (the move ends early, never late), less the braking
- * distance, two samples and a guard. <= 0: already too close. */
+ * range tolerance (the move ends early, never late), less brake_counts().
+ * <= 0: already too close. The shortfall is range_tol of the distance:
+ * a further fast move (fast_worth()) takes most of what is left. */
 static double fast_len(const struct re_calib_axis_cfg *a, double pot,
 		       double zone_v, int speed)
 {
 	double gain_hi = a->gain_v * (1 + a->check.range_tol);
-	double brake = speed / (2.0 * ACFACT) + speed * 0.02 + GUARD_CNT;
 
-	return fabs(pot - zone_v) / gain_hi - brake;
+	return fabs(pot - zone_v) / gain_hi - brake_counts(speed);
+}
+
+/* Is a fast move of @len counts at @fast worth making rather than going
+ * on at @slow? The first one always is when there is room (the slow move
+ * after it is bounded in length); a further one only when it saves more
+ * than the extra stop and start cost (RESTART_MS). */
+static int fast_worth(double len, int fast, int slow, int first)
+{
+	if (len <= 0)
+		return 0;
+	if (first && fast <= slow)
+		return 1;
+	return fast > slow && len / slow - len / fast > RESTART_MS / 1000.0;
 }
 
 /* The bounded slow move onto a switch: to the far side of where it can
@@ -396,11 +423,11 @@ static int step_start(struct re_calib *c, const struct re_io *io,
 	double pot = pot_of(c, cfg, i), len;
 
 	if (rev_switch(c, i)) { /* already on it: just back off */
-		move_to(c, i, enc_of(c, i) + a->backoff_counts, a->seek_cps);
+		move_to(c, i, enc_of(c, i) + a->backoff_counts, a->travel_cps);
 		return enter(c, io, i, PH_BACK_REV);
 	}
 	len = pot > a->pnlo_v ? fast_len(a, pot, a->pnlo_v, a->travel_cps) : 0;
-	if (len <= 0)
+	if (!fast_worth(len, a->travel_cps, a->seek_cps, 1))
 		return start_seek_rev(c, io, cfg, i);
 	move_to(c, i, enc_of(c, i) - len, a->travel_cps);
 	return enter(c, io, i, PH_FAST_REV);
@@ -417,10 +444,17 @@ static int stopped_badly(const struct re_calib *c, int i, const char *where,
 			  where, re_stop_reason(sc), sc, enc_of(c, i));
 }
 
+/* A fast move toward the reverse switch ended short of its slow zone:
+ * another one while what is left is worth it (the gain is known only
+ * within the range tolerance, so each ends early by that fraction), then
+ * the slow seek. */
 static int step_fast_rev(struct re_calib *c, const struct re_io *io,
 			 const struct re_calib_cfg *cfg, int i,
 			 struct re_fault *f)
 {
+	const struct re_calib_axis_cfg *a = &cfg->axis[i];
+	double pot = pot_of(c, cfg, i), len;
+
 	if (moving(c, i))
 		return GL_OK;
 	if (rev_switch(c, i)) /* the switch came early: fine, it is there */
@@ -428,7 +462,11 @@ static int step_fast_rev(struct re_calib *c, const struct re_io *io,
 	if (c->rec->axis[i].stop_code != 1)
 		return stopped_badly(c, i, "slow zone of the reverse switch",
 				     f);
-	return start_seek_rev(c, io, cfg, i);
+	len = pot > a->pnlo_v ? fast_len(a, pot, a->pnlo_v, a->travel_cps) : 0;
+	if (!fast_worth(len, a->travel_cps, a->seek_cps, 0))
+		return start_seek_rev(c, io, cfg, i);
+	move_to(c, i, enc_of(c, i) - len, a->travel_cps);
+	return enter(c, io, i, PH_FAST_REV);
 }
 
 /* At a switch the potentiometer must read what it reads there on this
@@ -454,6 +492,29 @@ static int check_at_switch(const struct re_calib *c,
 	return RE_FAULT;
 }
 
+/* The sweep from where the axis is, with table point 0 at @start: at
+ * vmax to short of the forward slow zone, or slowly onto the switch when
+ * that is too close for a fast move. */
+static int begin_sweep(struct re_calib *c, const struct re_io *io,
+		       const struct re_calib_cfg *cfg, int i, double start)
+{
+	const struct re_calib_axis_cfg *a = &cfg->axis[i];
+	struct cal_axis *ax = &c->ax[i];
+	double pot = pot_of(c, cfg, i), len;
+
+	ax->start = start;
+	ax->off_rev = enc_of(c, i) >= start && !rev_switch(c, i);
+	memset(ax->acc, 0, sizeof(ax->acc));
+	len = fast_len(a, pot, a->pnhi_v, a->vmax_cps);
+	if (!fast_worth(len, a->vmax_cps, a->seek_cps, 1)) {
+		ax->seek_len = seek_len(a, pot, a->pothi_v);
+		move_to(c, i, enc_of(c, i) + ax->seek_len, a->seek_cps);
+		return enter(c, io, i, PH_SLOW_FWD);
+	}
+	move_to(c, i, enc_of(c, i) + len, a->vmax_cps);
+	return enter(c, io, i, PH_SWEEP);
+}
+
 static int step_to_rev(struct re_calib *c, const struct re_io *io,
 		       const struct re_calib_cfg *cfg, int i,
 		       struct re_fault *f)
@@ -472,17 +533,19 @@ static int step_to_rev(struct re_calib *c, const struct re_io *io,
 		return stopped_badly(c, i, "reverse limit switch", f);
 	if (check_at_switch(c, cfg, i, 0, f) == RE_FAULT)
 		return RE_FAULT;
-	move_to(c, i, c->ax[i].edge + a->backoff_counts, a->seek_cps);
-	return enter(c, io, i, PH_BACK_REV);
+	/* the back-off is the start of the sweep: point 0 and the reverse
+	 * soft limit are the back-off from where the switch was first seen,
+	 * and the switch must be open there (sweep_sample()) */
+	return begin_sweep(c, io, cfg, i, c->ax[i].edge + a->backoff_counts);
 }
 
+/* Only when the axis was already on the reverse switch at the start (its
+ * edge unknown): backed off from there, point 0 where it came to rest. */
 static int step_back_rev(struct re_calib *c, const struct re_io *io,
 			 const struct re_calib_cfg *cfg, int i,
 			 struct re_fault *f)
 {
 	const struct re_calib_axis_cfg *a = &cfg->axis[i];
-	struct cal_axis *ax = &c->ax[i];
-	double pot = pot_of(c, cfg, i), len;
 
 	if (moving(c, i))
 		return GL_OK;
@@ -493,16 +556,7 @@ static int step_back_rev(struct re_calib *c, const struct re_io *io,
 				  a->backoff_counts);
 	if (c->rec->axis[i].stop_code != 1)
 		return stopped_badly(c, i, "end of the back-off", f);
-	ax->start = enc_of(c, i);
-	memset(ax->acc, 0, sizeof(ax->acc));
-	len = fast_len(a, pot, a->pnhi_v, a->vmax_cps);
-	if (len <= 0) {
-		ax->seek_len = seek_len(a, pot, a->pothi_v);
-		move_to(c, i, ax->start + ax->seek_len, a->seek_cps);
-		return enter(c, io, i, PH_SLOW_FWD);
-	}
-	move_to(c, i, ax->start + len, a->vmax_cps);
-	return enter(c, io, i, PH_SWEEP);
+	return begin_sweep(c, io, cfg, i, enc_of(c, i));
 }
 
 /* Add this sample to the table point nearest to the encoder. */
@@ -527,13 +581,37 @@ static void accumulate(struct re_calib *c, const struct re_calib_cfg *cfg,
 	a->sxy += dx * pot;
 }
 
+/* One sample of the sweep: into the table, and the first one at or past
+ * point 0 (the back-off from the reverse switch's edge) must show that
+ * switch open. */
+static int sweep_sample(struct re_calib *c, const struct re_calib_cfg *cfg,
+			int i, struct re_fault *f)
+{
+	struct cal_axis *ax = &c->ax[i];
+
+	accumulate(c, cfg, i);
+	if (ax->off_rev || enc_of(c, i) < ax->start)
+		return GL_OK;
+	if (rev_switch(c, i))
+		return abort_axis(f, i,
+				  "still on the reverse limit switch "
+				  "after backing off %d counts",
+				  cfg->axis[i].backoff_counts);
+	ax->off_rev = 1;
+	return GL_OK;
+}
+
+/* A sweep move ended short of the forward slow zone: another one at vmax
+ * while what is left is worth it (as step_fast_rev()), then slowly on. */
 static int step_sweep(struct re_calib *c, const struct re_io *io,
 		      const struct re_calib_cfg *cfg, int i, struct re_fault *f)
 {
 	const struct re_calib_axis_cfg *a = &cfg->axis[i];
 	struct cal_axis *ax = &c->ax[i];
+	double pot, len;
 
-	accumulate(c, cfg, i);
+	if (sweep_sample(c, cfg, i, f) == RE_FAULT)
+		return RE_FAULT;
 	if (moving(c, i))
 		return GL_OK;
 	if (fwd_switch(c, i))
@@ -541,9 +619,26 @@ static int step_sweep(struct re_calib *c, const struct re_io *io,
 	if (c->rec->axis[i].stop_code != 1)
 		return stopped_badly(c, i, "slow zone of the forward switch",
 				     f);
-	ax->seek_len = seek_len(a, pot_of(c, cfg, i), a->pothi_v);
+	pot = pot_of(c, cfg, i);
+	len = pot < a->pnhi_v ? fast_len(a, pot, a->pnhi_v, a->vmax_cps) : 0;
+	if (fast_worth(len, a->vmax_cps, a->seek_cps, 0)) {
+		move_to(c, i, enc_of(c, i) + len, a->vmax_cps);
+		return enter(c, io, i, PH_SWEEP);
+	}
+	ax->seek_len = seek_len(a, pot, a->pothi_v);
 	move_to(c, i, enc_of(c, i) + ax->seek_len, a->seek_cps);
 	return enter(c, io, i, PH_SLOW_FWD);
+}
+
+/* How far the encoder check reaches past the table build_table() will
+ * make from start to soft_fwd: its last point and RE_CAL_EXTRAP_STEPS
+ * more (less a tenth of a step), counts. */
+static double table_reach(const struct cal_axis *ax,
+			  const struct re_calib_axis_cfg *a)
+{
+	double last = floor((ax->soft_fwd - ax->start) / a->step_counts);
+
+	return ax->start + (last + RE_CAL_EXTRAP_STEPS - 0.1) * a->step_counts;
 }
 
 static int step_slow_fwd(struct re_calib *c, const struct re_io *io,
@@ -552,7 +647,8 @@ static int step_slow_fwd(struct re_calib *c, const struct re_io *io,
 {
 	const struct re_calib_axis_cfg *a = &cfg->axis[i];
 
-	accumulate(c, cfg, i);
+	if (sweep_sample(c, cfg, i, f) == RE_FAULT)
+		return RE_FAULT;
 	note_edge(c, i, fwd_switch(c, i));
 	if (moving(c, i))
 		return GL_OK;
@@ -565,7 +661,17 @@ static int step_slow_fwd(struct re_calib *c, const struct re_io *io,
 		return stopped_badly(c, i, "forward limit switch", f);
 	if (check_at_switch(c, cfg, i, 1, f) == RE_FAULT)
 		return RE_FAULT;
-	move_to(c, i, c->ax[i].edge - a->backoff_counts, a->seek_cps);
+	/* the forward soft limit: the back-off from the switch's edge. When
+	 * the axis rests where the new table still reaches (table_reach()),
+	 * the back-off is the start of the move to the centre (to_centre()
+	 * checks the switch open there); else a move of its own, away from
+	 * the switch at the travel speed */
+	c->ax[i].soft_fwd = c->ax[i].edge - a->backoff_counts;
+	if (enc_of(c, i) < table_reach(&c->ax[i], a)) {
+		c->ax[i].off_fwd = 0;
+		return enter(c, io, i, PH_DONE);
+	}
+	move_to(c, i, c->ax[i].soft_fwd, a->travel_cps);
 	return enter(c, io, i, PH_BACK_FWD);
 }
 
@@ -583,6 +689,7 @@ static int step_back_fwd(struct re_calib *c, const struct re_io *io,
 	if (c->rec->axis[i].stop_code != 1)
 		return stopped_badly(c, i, "end of the back-off", f);
 	c->ax[i].soft_fwd = enc_of(c, i);
+	c->ax[i].off_fwd = 1;
 	return enter(c, io, i, PH_DONE);
 }
 
@@ -599,7 +706,7 @@ static int axis_step(struct re_calib *c, const struct re_io *io,
 				  cfg->move_timeout_ms, enc_of(c, i));
 	if (waiting(c, i)) {
 		if (c->ax[i].ph == PH_SWEEP || c->ax[i].ph == PH_SLOW_FWD)
-			accumulate(c, cfg, i);
+			return sweep_sample(c, cfg, i, f);
 		return GL_OK;
 	}
 	switch (c->ax[i].ph) {
@@ -722,6 +829,27 @@ static int all_stopped(const struct re_calib *c, int n)
 	return 1;
 }
 
+/* An axis that left the forward switch on its way to the centre: the
+ * first sample at or inside the forward soft limit must show the switch
+ * open (as at the end of a back-off of its own). */
+static int off_fwd_check(struct re_calib *c, const struct re_calib_cfg *cfg,
+			 const struct re_calset *set, struct re_fault *f)
+{
+	for (int i = 0; i < cfg->n_axes; i++) {
+		struct cal_axis *ax = &c->ax[i];
+
+		if (ax->off_fwd || enc_of(c, i) > set->axis[i].soft_fwd)
+			continue;
+		if (fwd_switch(c, i))
+			return abort_axis(f, i,
+					  "still on the forward limit switch "
+					  "after backing off %d counts",
+					  cfg->axis[i].backoff_counts);
+		ax->off_fwd = 1;
+	}
+	return GL_OK;
+}
+
 /* Every axis to the centre of its soft limits at the travel speed; the
  * supervisor checks the encoders against @set on every sample. */
 static int to_centre(struct re_calib *c, const struct re_io *io,
@@ -743,6 +871,8 @@ static int to_centre(struct re_calib *c, const struct re_io *io,
 			rc = sample(c, cfg, f);
 		if (rc == GL_OK)
 			rc = taken(c, io, cfg, f);
+		if (rc == GL_OK)
+			rc = off_fwd_check(c, cfg, set, f);
 		if (rc == GL_OK && !c->pending && !c->taken_now &&
 		    all_stopped(c, cfg->n_axes))
 			return GL_OK;
@@ -884,8 +1014,10 @@ int re_calib_check_robot(struct re_calib *c, const struct re_io *io,
 	c->t0_ns = now_ns(io);
 	c->running = 1;
 	c->full = 0;
-	for (int i = 0; i < RE_AXES; i++)
+	for (int i = 0; i < RE_AXES; i++) {
 		enter(c, io, i, PH_CHECK);
+		c->ax[i].off_fwd = 1; /* not at a switch: nothing to check */
+	}
 	rc = sample(c, cfg, fault);
 	if (rc == GL_OK)
 		rc = check_position(c, cfg, set, fault);
@@ -909,8 +1041,9 @@ static const char *const phase_names[] = {
     [PH_CHECK] = "checking file",     [PH_CENTRE] = "to centre",
 };
 
-/* The pot at the reverse and forward switches, and the slow zones'
- * lengths in counts. */
+/* The pot at the reverse and forward switches, and the lengths run
+ * slowly before each, counts: the slow zone and what the fast moves keep
+ * before it (brake_counts()). */
 struct span {
 	double rev_v, fwd_v, zone_rev, zone_fwd;
 };
@@ -922,8 +1055,10 @@ static struct span span_of(const struct re_calib_axis_cfg *a)
 
 	sp.rev_v = a->check.abs_first_v - a->backoff_counts * a->gain_v;
 	sp.fwd_v = a->check.abs_last_v + a->backoff_counts * a->gain_v;
-	sp.zone_rev = fmax(0, (a->pnlo_v - sp.rev_v) / g);
-	sp.zone_fwd = fmax(0, (sp.fwd_v - a->pnhi_v) / g);
+	sp.zone_rev =
+	    fmax(0, (a->pnlo_v - sp.rev_v) / g) + brake_counts(a->travel_cps);
+	sp.zone_fwd =
+	    fmax(0, (sp.fwd_v - a->pnhi_v) / g) + brake_counts(a->vmax_cps);
 	return sp;
 }
 
@@ -932,7 +1067,10 @@ static double secs(double counts, int cps)
 	return cps > 0 ? fmax(0, counts) / cps : 0;
 }
 
-/* Seconds left for axis @i in phase @ph at encoder @enc, pot @pot. */
+/* Seconds left for axis @i in phase @ph at encoder @enc, pot @pot: fast
+ * to the slow zone, slowly onto the reverse switch, the sweep from there
+ * (its start is the reverse back-off), slowly onto the forward switch,
+ * off it and to the centre at the travel speed. */
 static double axis_left_s(const struct re_calib *c,
 			  const struct re_calib_axis_cfg *a, int i, double enc,
 			  double pot)
@@ -942,7 +1080,7 @@ static double axis_left_s(const struct re_calib *c,
 	double d_rev = fmax(0, (pot - sp.rev_v) / g);
 	double d_fwd = fmax(0, (sp.fwd_v - pot) / g);
 	double centre = secs(t / 2, a->travel_cps);
-	double back = secs(a->backoff_counts, a->seek_cps);
+	double back = secs(a->backoff_counts, a->travel_cps);
 	double sweep = secs(t - sp.zone_fwd, a->vmax_cps) +
 		       secs(sp.zone_fwd, a->seek_cps) + back + centre;
 
@@ -951,8 +1089,7 @@ static double axis_left_s(const struct re_calib *c,
 	case PH_FAST_REV:
 	case PH_TO_REV:
 		return secs(d_rev - sp.zone_rev, a->travel_cps) +
-		       secs(fmin(d_rev, sp.zone_rev), a->seek_cps) + back +
-		       sweep;
+		       secs(fmin(d_rev, sp.zone_rev), a->seek_cps) + sweep;
 	case PH_BACK_REV: return back + sweep;
 	case PH_SWEEP:
 		return secs(d_fwd - sp.zone_fwd, a->vmax_cps) +

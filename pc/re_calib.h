@@ -15,11 +15,14 @@
  * Full calibration runs all axes at once, each through the same steps:
  *   1. toward the reverse switch: fast (travel speed) while the
  *      potentiometer's absolute reading says the switch is far, to just
- *      before the slow zone; then slowly (seek speed) onto the switch with
- *      a bounded move that must end on it (stop code 3): a move that ends
- *      without it is "a limit switch that never came";
+ *      before the slow zone (another fast move while what the gain's
+ *      tolerance left short is worth one); then slowly (seek speed) onto
+ *      the switch with a bounded move that must end on it (stop code 3):
+ *      a move that ends without it is "a limit switch that never came";
  *   2. back off by calibration.backoff_counts from where the switch was
- *      first seen: that position is the reverse soft limit and point 0;
+ *      first seen: that position is the reverse soft limit and point 0,
+ *      passed without a stop (the sweep starts on the switch) and with
+ *      the switch open;
  *   3. a continuous sweep forward at vmax to just before the forward slow
  *      zone, then slowly onto the forward switch, while the data record is
  *      read every sample (10 ms): each sample (encoder, potentiometer) goes
@@ -28,7 +31,9 @@
  *      step), read at the point. A point without a sample of its own (a PC
  *      stall shorter than the controller watchdog loses at most one step at
  *      vmax) is fitted from the samples of both neighbours, and logged;
- *   4. back off the forward switch: the forward soft limit.
+ *   4. back off the forward switch: the forward soft limit, passed with
+ *      the switch open on the way to the centre (a move of its own when
+ *      the axis rests beyond the new table's reach).
  * Then the table checks of re_calcheck.h (monotonic with the noise margin,
  * range, number of points, encoder advance, and both end values against
  * the potentiometer's expected absolute values), and every axis to the

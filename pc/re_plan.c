@@ -20,6 +20,16 @@ static int max3(int a, int b, int c)
 	return m > c ? m : c;
 }
 
+/* The counts a service move at @svmax_cps still runs once in the slow
+ * zone: one program pass (mainms) before the program sees it there, and
+ * its braking distance at the configured acceleration (AC = DC = ACFACT
+ * x speed: speed / (2 ACFACT)). For vmax 8000: 80 + 400 counts. */
+static double zone_counts(int svmax_cps)
+{
+	return svmax_cps * (MAINMS_DEFAULT / 1000.0) +
+	       svmax_cps / (2.0 * ACFACT);
+}
+
 static void plan_axis(const struct re_config *cfg, int i,
 		      struct re_plan_axis *o)
 {
@@ -31,12 +41,6 @@ static void plan_axis(const struct re_config *cfg, int i,
 	o->gain_v_per_count =
 	    (an->forward_v - an->reverse_v) / (double)a->travel_counts;
 	o->margin_v = c->near_margin_counts * o->gain_v_per_count;
-	/* past a switch the axis can go as far as its end stop: the margin
-	 * covers that (and the pot's own tolerance covers the switch) */
-	o->potlo_v = an->reverse_v - tol - o->margin_v;
-	o->pothi_v = an->forward_v + tol + o->margin_v;
-	o->pnlo_v = an->reverse_v + tol + o->margin_v;
-	o->pnhi_v = an->forward_v - tol - o->margin_v;
 	o->vmax_cps = a->vmax_cps;
 	o->travel_cps = c->travel_cps ? c->travel_cps : a->vmax_cps;
 	o->seek_cps = c->seek_cps ? c->seek_cps : a->vmax_cps / 2;
@@ -45,6 +49,16 @@ static void plan_axis(const struct re_config *cfg, int i,
 	o->svmax_cps = max3(o->travel_cps, o->seek_cps, a->vmax_cps);
 	if (o->seek_cps > o->svmax_cps)
 		o->seek_cps = o->svmax_cps;
+	/* past a switch the axis can go as far as its end stop: the margin
+	 * covers that (and the pot's own tolerance covers the switch) */
+	o->potlo_v = an->reverse_v - tol - o->margin_v;
+	o->pothi_v = an->forward_v + tol + o->margin_v;
+	/* the slow zone: where the switch can be, and before it what a
+	 * fast move the program finds there (one pass late) still runs */
+	o->zone_v = zone_counts(o->svmax_cps) * o->gain_v_per_count +
+		    a->monotonic_margin_v;
+	o->pnlo_v = an->reverse_v + tol + o->zone_v;
+	o->pnhi_v = an->forward_v - tol - o->zone_v;
 	o->svdmax_counts =
 	    lround(a->travel_counts * (1 + a->travel_tolerance)) +
 	    2L * c->backoff_counts + 2L * c->near_margin_counts;

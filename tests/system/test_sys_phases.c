@@ -1418,11 +1418,14 @@ static const struct fclass fclasses[FK_COUNT] = {
 		     2,
 		     {RE_F_CTRL_POTRANGE, RE_F_NONE},
 		     {RE_F_CTRL_POTRANGE, RE_F_NONE}},
+    /* in calibration also the pot's range (16): stuck within ER of a
+     * switch, the profiler stops at the switch before the error reaches
+     * ER and the open loop drives the axis on past it */
     [FK_ENC_STUCK] = {"encoder stuck",
 		      "enc A stuck",
 		      0,
 		      {RE_F_CTRL_POSERR, RE_F_CTRL_ENCODER, RE_F_MOTOR_OFF,
-		       RE_F_NONE},
+		       RE_F_CTRL_POTRANGE, RE_F_NONE},
 		      {RE_F_ENCPOT, RE_F_CTRL_POSERR, RE_F_CTRL_ENCODER,
 		       RE_F_MOTOR_OFF, RE_F_NONE}},
     [FK_JAM] = {"jammed axis",
