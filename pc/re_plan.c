@@ -21,16 +21,15 @@ static int max3(int a, int b, int c)
 }
 
 /* The counts a service move at @svmax_cps still runs once in the slow
- * zone: one program pass (mainms) before the program sees it there, and
+ * zone: one program pass (@mainms) before the program sees it there, and
  * its braking distance at the configured acceleration (AC = DC = ACFACT
- * x speed: speed / (2 ACFACT)). For vmax 8000: 80 + 400 counts. */
-static double zone_counts(int svmax_cps)
+ * x speed: speed / (2 ACFACT)). For vmax 8000, mainms 10: 80 + 400. */
+static double stop_counts(int svmax_cps, int mainms)
 {
-	return svmax_cps * (MAINMS_DEFAULT / 1000.0) +
-	       svmax_cps / (2.0 * ACFACT);
+	return svmax_cps * (mainms / 1000.0) + svmax_cps / (2.0 * ACFACT);
 }
 
-static void plan_axis(const struct re_config *cfg, int i,
+static void plan_axis(const struct re_config *cfg, int i, int mainms,
 		      struct re_plan_axis *o)
 {
 	const struct re_config_axis *a = &cfg->axes[i];
@@ -53,10 +52,15 @@ static void plan_axis(const struct re_config *cfg, int i,
 	 * covers that (and the pot's own tolerance covers the switch) */
 	o->potlo_v = an->reverse_v - tol - o->margin_v;
 	o->pothi_v = an->forward_v + tol + o->margin_v;
-	/* the slow zone: where the switch can be, and before it what a
-	 * fast move the program finds there (one pass late) still runs */
-	o->zone_v = zone_counts(o->svmax_cps) * o->gain_v_per_count +
+	/* the slow zone, before the earliest place the switch can be: what
+	 * a fast move the program finds there (one pass late) still runs,
+	 * plus the pot's noise; never less than near_margin_counts (a margin
+	 * for what the model leaves out: a slower pass on a loaded
+	 * controller, the analog input's filter) */
+	o->zone_v = stop_counts(o->svmax_cps, mainms) * o->gain_v_per_count +
 		    a->monotonic_margin_v;
+	if (o->zone_v < o->margin_v)
+		o->zone_v = o->margin_v;
 	o->pnlo_v = an->reverse_v + tol + o->zone_v;
 	o->pnhi_v = an->forward_v - tol - o->zone_v;
 	o->svdmax_counts =
@@ -74,7 +78,7 @@ void re_plan_make(const struct re_config *cfg, int mainms, struct re_plan *out)
 
 	memset(out, 0, sizeof(*out));
 	for (int i = 0; i < RE_AXES; i++)
-		plan_axis(cfg, i, &out->axis[i]);
+		plan_axis(cfg, i, ms, &out->axis[i]);
 	out->mainms = mainms;
 	out->wdto_ms = cfg->watchdog.controller_timeout_ms;
 	/* every write adds 1; the program sees at most this many writes

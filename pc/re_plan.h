@@ -21,10 +21,10 @@ struct re_plan_axis {
 	double gain_v_per_count; /* nominal pot gain, V/count, > 0 */
 	double margin_v;	 /* near_margin_counts in volts */
 	double potlo_v, pothi_v; /* the pot's absolute range (DMC potlo/hi) */
-	/* how far the slow zones reach past the earliest place a switch can
-	 * be (reverse_v + absolute_tolerance_v): one program pass and the
-	 * braking distance at svmax, plus monotonic_margin_v for the pot's
-	 * noise, V */
+	/* how far the slow zones reach before the earliest place a switch
+	 * can be (reverse_v + absolute_tolerance_v): one program pass and
+	 * the braking distance at svmax, plus monotonic_margin_v for the
+	 * pot's noise, and never less than margin_v, V */
 	double zone_v;
 	double pnlo_v, pnhi_v; /* slow zones (DMC pnlo, pnhi) */
 	int vmax_cps;	       /* joystick and sweep speed */

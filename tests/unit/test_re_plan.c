@@ -46,11 +46,19 @@ static void test_plan_defaults(void **state)
 	near(p.axis[0].potlo_v, 0.5 - 0.25 - 0.08);
 	near(p.axis[0].pothi_v, 4.5 + 0.25 + 0.08);
 	/* the slow zone: one pass (10 ms) and the braking distance at
-	 * svmax 8000 (8000 / 20), in volts, plus the 5 mV noise margin */
+	 * svmax 8000 (8000 / 20), in volts, plus the 5 mV noise margin:
+	 * 0.0242 V, less than near_margin_counts (0.08 V), which it is then */
+	near(p.axis[0].zone_v, 0.08);
+	near(p.axis[0].pnlo_v, 0.5 + 0.25 + 0.08);
+	near(p.axis[0].pnhi_v, 4.5 - 0.25 - 0.08);
+	near(p.axis[2].pnlo_v, 0.5 + 0.25 + 0.1);
+	/* a small near margin: the stopping distance rules */
+	c.calibration.near_margin_counts = 100;
+	re_plan_make(&c, 0, &p);
 	near(p.axis[0].zone_v, (80 + 400) * 4.0 / 100000 + 0.005);
-	near(p.axis[0].pnlo_v, 0.5 + 0.25 + 0.0242);
-	near(p.axis[0].pnhi_v, 4.5 - 0.25 - 0.0242);
 	near(p.axis[2].pnlo_v, 0.5 + 0.25 + 480 * 4.0 / 80000 + 0.005);
+	c.calibration.near_margin_counts = 2000;
+	re_plan_make(&c, 0, &p);
 	assert_int_equal(p.axis[0].travel_cps, 8000); /* 0: vmax */
 	assert_int_equal(p.axis[0].seek_cps, 4000);   /* 0: vmax / 2 */
 	assert_int_equal(p.axis[0].svmax_cps, 8000);
@@ -98,8 +106,9 @@ static void test_plan_variant(void **state)
 	assert_int_equal(p.axis[0].svmax_cps, 30000);
 	near(p.axis[1].gain_v_per_count, 8.0 / 100000);
 	near(p.axis[1].margin_v, 0.08);
-	/* svmax 30000: 300 + 1500 counts x 8e-5 V + 5 mV */
-	near(p.axis[1].pnlo_v, 1.0 + 0.5 + 1800 * 8.0 / 100000 + 0.005);
+	/* svmax 30000, mainms 30: 900 + 1500 counts x 8e-5 V + 5 mV (more
+	 * than near_margin_counts' 0.08 V) */
+	near(p.axis[1].pnlo_v, 1.0 + 0.5 + 2400 * 8.0 / 100000 + 0.005);
 	near(p.axis[1].potlo_v, 1.0 - 0.5 - 0.08);
 	assert_int_equal(p.hbmaxd, 125 / 2 + 1 + 2); /* ceil(62.5) + 2 */
 	assert_int_equal(p.pwrout, 3);
