@@ -99,7 +99,8 @@ struct re_relay {
 	int rb_due;		  /* state queries sent, not answered */
 	bool rb_discard;	  /* the answers due predate a write */
 	int64_t rb_sent_ns; /* the oldest query due was sent (base_now_ns) */
-	int64_t rb_next_ns; /* the next query of re_relay_check() (base_now_ns) */
+	int64_t
+	    rb_next_ns; /* the next query of re_relay_check() (base_now_ns) */
 	char err[RE_RELAY_ERR_MAX];
 };
 

@@ -1002,26 +1002,16 @@ static void test_sp_clinical_tty_refused(void **state)
 int main(void)
 {
 	static const struct CMUnitTest tests[] = {
-	    T(test_sp_good_path),
-	    T(test_sp_name_fails),
-	    T(test_sp_open_fails),
-	    T(test_sp_configure_fails),
-	    T(test_sp_first_off_fails),
-	    T(test_sp_on_not_accepted),
-	    T(test_sp_on_discarded),
-	    T(test_sp_outq_fails),
-	    T(test_sp_off_recovers),
-	    T(test_sp_off_fails),
-	    T(test_sp_off_wedged_queue),
-	    T(test_sp_off_not_accepted),
-	    T(test_sp_off_split),
-	    T(test_sp_off_readback),
-	    T(test_sp_off_readback_wrong),
-	    T(test_sp_check_fails),
-	    T(test_sp_readback),
-	    T(test_sp_readback_rate),
-	    T(test_sp_icstation),
-	    T(test_sp_clinical_tty_refused),
+	    T(test_sp_good_path),	   T(test_sp_name_fails),
+	    T(test_sp_open_fails),	   T(test_sp_configure_fails),
+	    T(test_sp_first_off_fails),	   T(test_sp_on_not_accepted),
+	    T(test_sp_on_discarded),	   T(test_sp_outq_fails),
+	    T(test_sp_off_recovers),	   T(test_sp_off_fails),
+	    T(test_sp_off_wedged_queue),   T(test_sp_off_not_accepted),
+	    T(test_sp_off_split),	   T(test_sp_off_readback),
+	    T(test_sp_off_readback_wrong), T(test_sp_check_fails),
+	    T(test_sp_readback),	   T(test_sp_readback_rate),
+	    T(test_sp_icstation),	   T(test_sp_clinical_tty_refused),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);
