@@ -200,7 +200,7 @@ $(FUZZ_BUILD)/bin/fuzz_%: tests/fuzz/fuzz_%.c $(FUZZ_LIBS)
 
 # ---- dependencies ------------------------------------------------------------
 DEB_PKGS = gcc make pkg-config libserialport-dev libyaml-dev libcmocka-dev gnuplot-nox tmux \
-           clang-format cppcheck clang libclang-rt-dev
+           clang-format cppcheck clang libclang-rt-dev valgrind
 deps:
 	@missing=""; for p in $(DEB_PKGS); do \
 		dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'ok installed' || missing="$$missing $$p"; \

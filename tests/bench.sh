@@ -7,7 +7,9 @@
 # tests; this script compiles the bench program with the project's flags
 # (the Makefile's object rule), links it, builds the LD_PRELOAD allocation
 # counter, and runs it. Knobs: ROBOELF_BENCH_S (seconds of joystick use per
-# period, default 20), ROBOELF_BENCH_REPEAT (runs of each fault, default 5).
+# period, default 20), ROBOELF_BENCH_REPEAT (runs of each fault, default 5),
+# ROBOELF_BENCH_ONLY=instr (only the user instructions per cycle, under
+# valgrind's callgrind; ROBOELF_SYS_CAL=FILE reuses a calibration).
 set -eu
 BUILD=${BUILD:-build}
 CC=${CC:-cc}
@@ -28,6 +30,10 @@ $CC -o "$BUILD/bench/bench_sys" "$BUILD/obj/tests/bench/bench_sys.o" \
 $CC -O2 -Wall -Wextra -shared -fPIC -o "$BUILD/bench/alloc_count.so" \
 	tests/bench/alloc_count.c -ldl
 
+if [ -n "${ROBOELF_BENCH_ONLY:-}" ]; then
+	exec "$BUILD/bench/bench_sys" --csv "$BUILD/bench.csv" \
+		--seconds "${ROBOELF_BENCH_S:-20}" --only "$ROBOELF_BENCH_ONLY"
+fi
 "$BUILD/bench/bench_sys" --csv "$BUILD/bench.csv" \
 	--seconds "${ROBOELF_BENCH_S:-20}" \
 	--repeat "${ROBOELF_BENCH_REPEAT:-5}" \

@@ -3,7 +3,7 @@
  * galil-sim, printed as a table and written as CSV. Figures, not pass/fail.
  *
  *   bench_sys --csv FILE [--seconds S] [--repeat N] [--alloc-lib SO]
- *             [--faults-bin PATH]
+ *             [--faults-bin PATH] [--only instr]
  *
  *  1. full calibration time (roboelf --calibration full on the default
  *     robot);
@@ -25,7 +25,11 @@
  *     on a filled supervisor, 10^6 times in-process), its system calls
  *     per cycle (strace -c of this program run with --rec-loop N against
  *     --rec-loop 0), and the dump of a full 30 s ring at 10 ms (text and
- *     durable write, ms and bytes).
+ *     durable write, ms and bytes);
+ *  6. user instructions per cycle (issue 17): roboelf under valgrind's
+ *     callgrind at 50 ms with S seconds of joystick use, the instructions
+ *     collected in its supervisor loop over the cycles run (--only instr:
+ *     this figure alone).
  * Beside each figure: the original system's value where it has one
  * (roboelf-software-description.txt: 50 ms loop, 75/125 ms watchdog,
  * 0.5 s invalid input, one controller command per value read).
@@ -95,6 +99,7 @@ struct opts {
 	const char *csv;
 	const char *alloc_lib;
 	const char *faults_bin;
+	const char *only; /* "instr": only the instruction count */
 	int seconds;
 	int repeat;
 };
@@ -115,6 +120,8 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 			o->alloc_lib = v;
 		else if (!strcmp(a, "--faults-bin"))
 			o->faults_bin = v;
+		else if (!strcmp(a, "--only") && !strcmp(v, "instr"))
+			o->only = v;
 		else if (!strcmp(a, "--seconds"))
 			o->seconds = atoi(v);
 		else if (!strcmp(a, "--repeat"))
@@ -127,7 +134,8 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 		return 0;
 usage:
 	fprintf(stderr, "usage: bench_sys --csv FILE [--seconds S] [--repeat "
-			"N] [--alloc-lib SO] [--faults-bin PATH]\n");
+			"N] [--alloc-lib SO] [--faults-bin PATH] [--only "
+			"instr]\n");
 	return -1;
 }
 
@@ -528,6 +536,145 @@ static void add_loop(const struct loop_fig *f)
 	add_loop_cycle(f, item, is50);
 }
 
+/* ---- user instructions per cycle: callgrind (issue 17) ------------------- */
+
+/* This VM, like many, has no hardware performance counters (perf stat -e
+ * instructions:u is "not supported"), so the instructions are counted by
+ * valgrind's callgrind: roboelf runs under it armed on galil-sim at 50 ms
+ * with joystick use, collecting only inside roboelf.c's run() (the
+ * supervisor loop: wait, cycle, status, console, log flush, keyboard,
+ * recorder tick; --toggle-collect, so start-up and power-off are not
+ * counted), and the instructions collected (Ir, user space only: the
+ * kernel's side of the system calls and the wait is not seen) are divided
+ * by the calls to re_super_cycle() collected with them. */
+
+struct instr_fig {
+	double ir;   /* collected Ir, -1 n/a */
+	long cycles; /* calls to re_super_cycle */
+	char why[256];
+	char out[SYS_PATH_MAX + 32];
+};
+
+/* The absolute path of valgrind on PATH into @buf, or -1. */
+static int find_valgrind(char *buf, size_t cap)
+{
+	FILE *f = popen("command -v valgrind 2>/dev/null", "r");
+	int ok = f && fgets(buf, (int)cap, f) && buf[0] == '/';
+
+	if (f)
+		pclose(f);
+	if (ok)
+		buf[strcspn(buf, "\n")] = '\0';
+	return ok ? 0 : -1;
+}
+
+/* Name compression of callgrind's output: "(id) name" defines @id's name,
+ * "(id)" refers to it. Does @ref (after "fn=" / "cfn=") name @want? */
+static int cg_names(const char *ref, const char *want, long *want_id)
+{
+	char *end;
+	long id;
+
+	if (*ref != '(')
+		return !strcmp(ref, want);
+	id = strtol(ref + 1, &end, 10);
+	if (*end != ')')
+		return 0;
+	if (end[1] == ' ' && !strcmp(end + 2, want))
+		*want_id = id;
+	return *want_id >= 0 && id == *want_id;
+}
+
+/* From a callgrind output file: the total Ir and the calls to @fn. */
+static int cg_read(const char *path, const char *fn, struct instr_fig *f)
+{
+	char line[4096];
+	long id = -1;
+	int in_cfn = 0;
+	FILE *in = fopen(path, "r");
+
+	if (!in)
+		return -1;
+	while (fgets(line, sizeof(line), in)) {
+		line[strcspn(line, "\n")] = '\0';
+		if (!strncmp(line, "cfn=", 4)) {
+			in_cfn = cg_names(line + 4, fn, &id);
+			continue;
+		}
+		if (!strncmp(line, "fn=", 3))
+			cg_names(line + 3, fn, &id);
+		else if (!strncmp(line, "calls=", 6) && in_cfn)
+			f->cycles += strtol(line + 6, NULL, 10);
+		else if (!strncmp(line, "summary:", 8) ||
+			 !strncmp(line, "totals:", 7))
+			f->ir = strtod(strchr(line, ':') + 1, NULL);
+		in_cfn = 0;
+	}
+	fclose(in);
+	return 0;
+}
+
+static void instr_run(struct sys_env *e, const struct opts *o,
+		      struct instr_fig *f)
+{
+	char vg[SYS_PATH_MAX], outopt[SYS_PATH_MAX + 64];
+	char *wrap[] = {vg,
+			(char *)"--tool=callgrind",
+			(char *)"--collect-atstart=no",
+			(char *)"--toggle-collect=run",
+			(char *)"--toggle-collect=run.*",
+			outopt,
+			NULL};
+	struct sys_opts so = {
+	    .period_ms = 50, .re_wrap = wrap, .ready_timeout_ms = 120000};
+	struct sys_case c;
+	double t;
+
+	memset(f, 0, sizeof(*f));
+	f->ir = -1;
+	if (find_valgrind(vg, sizeof(vg)) < 0) {
+		snprintf(f->why, sizeof(f->why), "valgrind not installed");
+		return;
+	}
+	snprintf(f->out, sizeof(f->out), "%s/callgrind-50.out", e->dir);
+	snprintf(outopt, sizeof(outopt), "--callgrind-out-file=%s", f->out);
+	if (sys_case_start(&c, e, &so) < 0) {
+		snprintf(f->why, sizeof(f->why), "did not start: %.200s",
+			 c.err);
+		return;
+	}
+	t = drive(&c, o->seconds);
+	if (t != 0)
+		snprintf(f->why, sizeof(f->why), "%s",
+			 t > 0 ? "tripped under valgrind" : "run failed");
+	proc_signal(&c.re, SIGTERM);
+	if (proc_wait_exit(&c.re, 30000, NULL) < 0 && !f->why[0])
+		snprintf(f->why, sizeof(f->why), "roboelf did not exit");
+	sys_case_stop(&c);
+	if (!f->why[0] && (cg_read(f->out, "re_super_cycle", f) < 0 ||
+			   f->ir < 0 || f->cycles <= 0))
+		snprintf(f->why, sizeof(f->why), "no cycles in '%.200s'",
+			 f->out);
+}
+
+static void add_instr(const struct instr_fig *f)
+{
+	const char *item = "period 50 ms: callgrind Ir in run() / cycles";
+
+	if (f->why[0]) {
+		add("loop", item, "user instructions per cycle", "", "",
+		    "n/a (%.40s)", f->why);
+		return;
+	}
+	add("loop", item, "user instructions per cycle", "", "5 k (issue 17)",
+	    "%.0f", f->ir / (double)f->cycles);
+	add("loop", item, "instructions counted", "", "", "%.0f / %ld cycles",
+	    f->ir, f->cycles);
+	printf("bench: the cycle's instructions by function: "
+	       "callgrind_annotate --inclusive=yes %s\n",
+	       f->out);
+}
+
 /* ---- galil-sim's virtual-time speed ------------------------------------- */
 
 static void sim_speed(const struct sys_env *e)
@@ -918,6 +1065,7 @@ int main(int argc, char **argv)
 {
 	static const int periods[] = {50, 10, 2};
 	static struct sys_env env;
+	struct instr_fig instr;
 	struct opts o;
 
 	if (argc == 3 && !strcmp(argv[1], "--rec-loop")) { /* for strace */
@@ -943,7 +1091,13 @@ int main(int argc, char **argv)
 		    "s", "", "%.1f", env.calib_s);
 		calib_bounds(&env);
 	}
-	for (size_t i = 0; i < sizeof(periods) / sizeof(periods[0]); i++) {
+	printf("bench: %d s of joystick use at 50 ms under callgrind ...\n",
+	       o.seconds);
+	fflush(stdout);
+	instr_run(&env, &o, &instr);
+	add_instr(&instr);
+	for (size_t i = 0; !o.only && i < sizeof(periods) / sizeof(periods[0]);
+	     i++) {
 		struct loop_fig f;
 
 		printf("bench: %d s of joystick use at a %d ms period ...\n",
@@ -952,9 +1106,11 @@ int main(int argc, char **argv)
 		loop_run(&env, &o, periods[i], &f);
 		add_loop(&f);
 	}
-	sim_speed(&env);
-	recorder_cost(argv[0]);
-	reactions(&env, &o);
+	if (!o.only) {
+		sim_speed(&env);
+		recorder_cost(argv[0]);
+		reactions(&env, &o);
+	}
 	print_table();
 	printf("\nbench: written to %s (work files in %s)\n", o.csv, env.dir);
 	env.keep = 1;

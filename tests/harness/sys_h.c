@@ -392,6 +392,8 @@ static int start_roboelf(struct sys_case *c, const struct sys_opts *o)
 
 	snprintf(bin, sizeof(bin), "%s/roboelf", e->bin);
 	snprintf(addr, sizeof(addr), "%s:%d", c->sim_addr, c->sim.port);
+	for (int i = 0; o->re_wrap && o->re_wrap[i] && n < 12; i++)
+		argv[n++] = o->re_wrap[i];
 	argv[n++] = bin;
 	argv[n++] = (char *)"-c";
 	argv[n++] = c->cfg;

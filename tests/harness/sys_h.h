@@ -82,6 +82,8 @@ struct sys_opts {
 	char *const *sim_args;	       /* extra galil-sim args, or NULL */
 	char *const *re_args;	       /* extra roboelf args, or NULL */
 	char *const *re_env;	       /* extra "NAME=value" for roboelf */
+	char *const *re_wrap;	       /* run roboelf through this command (e.g.
+					  valgrind and its options), or NULL */
 	int ready_timeout_ms;	       /* 0: 20 s ("file"), 150 s ("full") */
 	int no_ready;		       /* don't wait for Ready */
 	/* galil-sim elsewhere (tests/net): run it through @sim_wrap (see
