@@ -482,6 +482,37 @@ static void test_proto_malformed(void **state)
 	assert_int_equal(g.n, 0);
 }
 
+/* TEST_proto_record_length_field: a record's body is taken in one copy
+ * (issue 17), yet a length field that disagrees stops the parser right
+ * after it, as byte by byte: the rest of the input is not consumed. */
+static void test_proto_record_length_field(void **state)
+{
+	struct gl_proto *p = test_malloc(sizeof(*p));
+	uint8_t in[300];
+	struct gl_reply r;
+
+	(void)state;
+	in[0] = ':';
+	make_record(in + 1);
+	in[3] = 189;
+	in[191] = ':';
+	gl_proto_init(p);
+	assert_int_equal(gl_proto_expect(p, 2, 190), GL_OK);
+	assert_int_equal(gl_proto_feed(p, in, 192), GL_OK);
+	assert_int_equal(gl_proto_next(p, &r), GL_ERR_PROTO);
+	assert_int_equal(gl_proto_space(p), GL_PROTO_IN_MAX - (192 - 5));
+	/* agreeing: the whole record, the ':' after it, nothing left */
+	in[3] = 190;
+	gl_proto_reset(p);
+	assert_int_equal(gl_proto_expect(p, 2, 190), GL_OK);
+	assert_int_equal(gl_proto_feed(p, in, 192), GL_OK);
+	assert_int_equal(gl_proto_next(p, &r), GL_OK);
+	assert_int_equal(r.bin_len, 190);
+	assert_memory_equal(r.bin, in + 1, 190);
+	assert_int_equal(gl_proto_space(p), GL_PROTO_IN_MAX);
+	test_free(p);
+}
+
 /* TEST_proto_error_sticky: after GL_ERR_PROTO only reset helps. */
 static void test_proto_error_sticky(void **state)
 {
@@ -703,6 +734,7 @@ int main(void)
 	    cmocka_unit_test(test_proto_unsol_inside_record),
 	    cmocka_unit_test(test_proto_unsol_idle),
 	    cmocka_unit_test(test_proto_malformed),
+	    cmocka_unit_test(test_proto_record_length_field),
 	    cmocka_unit_test(test_proto_error_sticky),
 	    cmocka_unit_test(test_proto_upload),
 	    cmocka_unit_test(test_proto_text_truncated),
