@@ -827,14 +827,20 @@ static int board_fits(struct re_console *c, int *width, int *height)
 	return 1;
 }
 
+int re_console_due(const struct re_console *c, int64_t now_ns)
+{
+	int64_t gap = c->tty_out ? RE_CONSOLE_BOARD_NS : RE_CONSOLE_LINE_NS;
+
+	return !c->last_draw_ns || now_ns - c->last_draw_ns >= gap;
+}
+
 void re_console_status(struct re_console *c, const struct re_status *st,
 		       int64_t now_ns, int force)
 {
 	char line[1024];
-	int64_t gap = c->tty_out ? RE_CONSOLE_BOARD_NS : RE_CONSOLE_LINE_NS;
 	int width = 80, height = 24;
 
-	if (!force && c->last_draw_ns && now_ns - c->last_draw_ns < gap)
+	if (!force && !re_console_due(c, now_ns))
 		return;
 	c->last_draw_ns = now_ns;
 	if (c->tty_out && board_fits(c, &width, &height)) {

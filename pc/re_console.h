@@ -214,6 +214,14 @@ void re_console_status(struct re_console *c, const struct re_status *st,
 		       int64_t now_ns, int force);
 
 /*
+ * re_console_due() - would re_console_status(@c, ..., @now_ns, 0) draw?
+ * The caller fills the status only then (issue 17: it is drawn at most
+ * every RE_CONSOLE_BOARD_NS, the cycle runs far more often).
+ * Return: 1 when a frame is due, 0 when not.
+ */
+int re_console_due(const struct re_console *c, int64_t now_ns);
+
+/*
  * re_console_key() - one key from the keyboard if one is waiting (never
  * blocks). Return: the character, 0 when none, -1 at end of input.
  */

@@ -451,13 +451,15 @@ static int sample_cb(void *ud, const struct gl_record **rec)
 	a->real.defer_log = 1; /* no file write in the cycle (issue 17) */
 	v = re_super_cycle(a->sup);
 	a->real.defer_log = 0;
-	re_super_status(a->sup, &st);
-	re_start_show_foreign(a, st.foreign);
+	re_start_show_foreign(a, a->sup->foreign);
 	re_start_show_events(a);
 	re_calib_progress(a->calrun, a->calcfg, &a->sup->rec, re_io_now_ns(),
 			  &prog);
 	re_console_calib(&a->con, &prog);
-	re_console_status(&a->con, &st, re_io_now_ns(), 0);
+	if (re_console_due(&a->con, re_io_now_ns())) {
+		re_super_status(a->sup, &st); /* only when drawn */
+		re_console_status(&a->con, &st, re_io_now_ns(), 1);
+	}
 	re_io_flush_log(&a->real); /* after the cycle (issue 17) */
 	if (v == RE_FAULT) {
 		re_console_fault(&a->con, re_super_fault_line(a->sup));

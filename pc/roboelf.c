@@ -620,10 +620,12 @@ static void run(struct app *a)
 			/* keys typed before the fault do not act after it */
 			re_console_flush_keys(&a->con);
 		}
-		re_super_status(a->sup, &st);
-		re_start_show_foreign(a, st.foreign);
+		re_start_show_foreign(a, a->sup->foreign);
 		re_start_show_events(a);
-		re_console_status(&a->con, &st, re_io_now_ns(), 0);
+		if (re_console_due(&a->con, re_io_now_ns())) {
+			re_super_status(a->sup, &st); /* only when drawn */
+			re_console_status(&a->con, &st, re_io_now_ns(), 1);
+		}
 		re_io_flush_log(&a->real); /* after the cycle (issue 17) */
 		retry_log(a, &next_retry);
 		/* the keyboard when the wait saw input, or every
@@ -636,6 +638,7 @@ static void run(struct app *a)
 		trace_tick(a, key);
 		if (key == 'u' || key == 'U') {
 			re_console_counts(&a->con, !a->con.counts);
+			re_super_status(a->sup, &st);
 			re_console_status(&a->con, &st, re_io_now_ns(), 1);
 		}
 		if (key == 'q' || key == 'Q' || key < 0)

@@ -117,6 +117,45 @@ static void test_stalled_reader_never_blocks(void **state)
 	close(p[0]);
 }
 
+/* re_console_due() says when re_console_status() draws: at once, then once
+ * per RE_CONSOLE_LINE_NS without a terminal (the caller fills the status
+ * only then, issue 17). */
+static void test_status_due(void **state)
+{
+	static struct re_console c;
+	struct re_status st;
+	int p[2];
+	FILE *out;
+	char buf[4096];
+	ssize_t n;
+	int lines = 0;
+
+	(void)state;
+	assert_int_equal(pipe(p), 0);
+	out = fdopen(p[1], "w");
+	assert_non_null(out);
+	assert_int_equal(re_console_open(&c, out, -1), 0);
+	status_of(&st);
+	assert_int_equal(re_console_due(&c, 5), 1);
+	re_console_status(&c, &st, 5, 0);
+	assert_int_equal(c.last_draw_ns, 5);
+	assert_int_equal(re_console_due(&c, 5 + RE_CONSOLE_LINE_NS - 1), 0);
+	re_console_status(&c, &st, 5 + RE_CONSOLE_LINE_NS - 1, 0);
+	assert_int_equal(c.last_draw_ns, 5); /* not drawn */
+	assert_int_equal(re_console_due(&c, 5 + RE_CONSOLE_LINE_NS), 1);
+	re_console_status(&c, &st, 5 + RE_CONSOLE_LINE_NS, 0);
+	assert_int_equal(c.last_draw_ns, 5 + RE_CONSOLE_LINE_NS);
+	re_console_close(&c);
+	fclose(out);
+	n = read(p[0], buf, sizeof(buf) - 1);
+	assert_true(n > 0);
+	buf[n] = '\0';
+	for (char *q = strstr(buf, "status "); q; q = strstr(q + 1, "status "))
+		lines++;
+	assert_int_equal(lines, 2);
+	close(p[0]);
+}
+
 /* A regular file is never reopened (that would write from its start): the
  * frames go through the FILE and append after what is there. */
 static void test_regular_file_appends(void **state)
@@ -641,6 +680,7 @@ int main(void)
 	    cmocka_unit_test(test_snapshot_faults),
 	    cmocka_unit_test(test_snapshot_phases),
 	    cmocka_unit_test(test_stalled_reader_never_blocks),
+	    cmocka_unit_test(test_status_due),
 	    cmocka_unit_test(test_regular_file_appends),
 	};
 
