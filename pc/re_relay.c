@@ -72,7 +72,8 @@
 #define PTY_MAJOR_MAX	143
 #define NAP_NS		BASE_NS_PER_MS /* longest sleep while waiting */
 #define FULL_CHECK_NS	BASE_NS_PER_S  /* stat() the port at least this often */
-#define STALE_CHUNKS	4 /* x 16 bytes of stale input dropped per call */
+#define STALE_CHUNKS	4  /* x 16 bytes of stale input dropped per call */
+#define RB_READ_MAX	16 /* answer bytes read at once by a check */
 
 enum re_relay_op { OP_NONE = 0, OP_ON, OP_OFF };
 
@@ -98,6 +99,8 @@ struct re_relay {
 	bool reopen;		  /* "off" could not be written */
 	int rb_due;		  /* state queries sent, not answered */
 	bool rb_discard;	  /* the answers due predate a write */
+	bool rb_flush;		  /* answers may be in flight that nobody
+				   * awaits: drop input before a query */
 	int64_t rb_sent_ns; /* the oldest query due was sent (base_now_ns) */
 	int64_t
 	    rb_next_ns; /* the next query of re_relay_check() (base_now_ns) */
@@ -261,6 +264,7 @@ static int link_open(struct re_relay *r)
 	r->next_full_ns = 0;
 	r->node_suspect = false;
 	r->rb_due = 0;
+	r->rb_flush = true;
 	out_set(r, NULL, 0);
 	return GL_OK;
 }
@@ -427,6 +431,7 @@ static int readback_wait(struct re_relay *r, const char *what, bool on,
 			r->rb_due--;
 		if (n == 1 && rb_shows(r, b, on)) {
 			r->rb_due = 0; /* the rest, if any, agrees */
+			r->rb_flush = skip > 0;
 			return GL_OK;
 		}
 		if (n == 1 && !skip--)
@@ -542,39 +547,68 @@ static int64_t rb_interval_ns(const struct re_relay *r)
 	return ms > 0 ? (int64_t)ms * BASE_NS_PER_MS : 0;
 }
 
+/* The state query of re_relay_check(), when one is due (query_ms). */
+static int rb_query(struct re_relay *r)
+{
+	static const uint8_t query = DEVANTECH_QUERY;
+	int n;
+
+	if (base_now_ns() < r->rb_next_ns)
+		return GL_OK;
+	r->rb_next_ns = base_now_ns() + rb_interval_ns(r);
+	if (r->rb_flush && drop_input(r))
+		return GL_ERR_RELAY;
+	r->rb_flush = false;
+	n = r->ops->write(&r->io, &query, 1, r->err, sizeof(r->err));
+	if (n < 0)
+		return GL_ERR_RELAY;
+	if (n == 0)
+		return set_err(r, GL_ERR_RELAY,
+			       "the state query (0x5B) was not "
+			       "accepted: output buffer full");
+	rb_sent_one(r);
+	r->rb_discard = false;
+	return GL_OK;
+}
+
+/* One answer byte @b: the last one due is judged against the state last
+ * confirmed (not while UNKNOWN, not when it predates a write); a byte
+ * nobody awaits is dropped. */
+static int rb_answer(struct re_relay *r, uint8_t b)
+{
+	bool on;
+
+	if (!r->rb_due)
+		return GL_OK;
+	if (--r->rb_due || r->rb_discard || r->state == RE_RELAY_UNKNOWN)
+		return GL_OK; /* an older answer, or nothing to compare */
+	on = r->state == RE_RELAY_ON;
+	if (!rb_shows(r, b, on))
+		return set_err(r, GL_ERR_RELAY,
+			       "read-back shows channel %d %s, expected %s",
+			       r->cfg.channel, on ? "off" : "on",
+			       on ? "on" : "off");
+	return GL_OK;
+}
+
 /*
  * Devantech read-back: one step per check, never waiting. The board must
- * answer within readback_timeout_ms whatever the state; the answer is
- * judged against the state last confirmed (not while UNKNOWN, not when
- * it predates a write). Nothing is sent while a message is half written.
+ * answer within readback_timeout_ms whatever the state. What has arrived
+ * is read at once (up to RB_READ_MAX bytes): the input is then empty for
+ * the next query, so no read to drop stale bytes is needed before it
+ * unless answers may be in flight that nobody awaits (rb_flush). Nothing
+ * is sent while a message is half written.
  */
 static int readback_step(struct re_relay *r)
 {
-	static const uint8_t query = DEVANTECH_QUERY;
-	uint8_t b;
-	bool on;
-	int n;
+	uint8_t buf[RB_READ_MAX];
+	int n, rc;
 
 	if (!r->cfg.readback || r->out_done < r->out_len)
 		return GL_OK;
-	if (!r->rb_due) {
-		if (base_now_ns() < r->rb_next_ns)
-			return GL_OK;
-		r->rb_next_ns = base_now_ns() + rb_interval_ns(r);
-		if (drop_input(r))
-			return GL_ERR_RELAY;
-		n = r->ops->write(&r->io, &query, 1, r->err, sizeof(r->err));
-		if (n < 0)
-			return GL_ERR_RELAY;
-		if (n == 0)
-			return set_err(r, GL_ERR_RELAY,
-				       "the state query (0x5B) was not "
-				       "accepted: output buffer full");
-		rb_sent_one(r);
-		r->rb_discard = false;
-		return GL_OK;
-	}
-	n = r->ops->read(&r->io, &b, 1, r->err, sizeof(r->err));
+	if (!r->rb_due)
+		return rb_query(r);
+	n = r->ops->read(&r->io, buf, sizeof(buf), r->err, sizeof(r->err));
 	if (n < 0)
 		return GL_ERR_RELAY;
 	if (n == 0) {
@@ -586,14 +620,11 @@ static int readback_step(struct re_relay *r)
 			       "(0x5B) within %d ms",
 			       r->cfg.readback_timeout_ms);
 	}
-	if (--r->rb_due || r->rb_discard || r->state == RE_RELAY_UNKNOWN)
-		return GL_OK; /* an older answer, or nothing to compare */
-	on = r->state == RE_RELAY_ON;
-	if (!rb_shows(r, b, on))
-		return set_err(r, GL_ERR_RELAY,
-			       "read-back shows channel %d %s, expected %s",
-			       r->cfg.channel, on ? "off" : "on",
-			       on ? "on" : "off");
+	for (int i = 0; i < n; i++)
+		if ((rc = rb_answer(r, buf[i])) != GL_OK)
+			return rc;
+	if (n == (int)sizeof(buf))
+		r->rb_flush = true; /* more may be waiting */
 	return GL_OK;
 }
 

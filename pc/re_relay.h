@@ -90,9 +90,9 @@ struct re_relay_cfg {
 				  * from re_relay_check() */
 	int readback_timeout_ms; /* answer deadline of that query, ms */
 	int query_ms;		 /* re_relay_check() queries at most this
-				  * often (RE_RELAY_QUERY_MS; 0: in every
-				  * check), and at least twice within
-				  * readback_timeout_ms, ms */
+				  * often (roboelf: 1.5 periods, every second
+				  * cycle; 0: in every check), and at least
+				  * twice within readback_timeout_ms, ms */
 	/* RE_RELAY_EXPLICIT only: the complete messages. */
 	uint8_t on[RE_RELAY_CODE_MAX];
 	size_t on_len;
@@ -212,10 +212,6 @@ int re_relay_off(re_relay *r);
  * Return: GL_OK; GL_ERR_RELAY with the reason in re_relay_errmsg().
  */
 int re_relay_check(re_relay *r);
-
-/* The configured board's state is asked for at most this often by
- * re_relay_check() (read-back; re_relay_cfg.query_ms), ms. */
-#define RE_RELAY_QUERY_MS 200
 
 /*
  * re_relay_fds() - the descriptors re_relay_check() looks at, for a
