@@ -166,8 +166,9 @@ static int check_stall(struct re_super *s, struct re_fault *f)
 }
 
 /* "hbpc=N" into @buf (32 bytes; N < RE_HBPC_WRAP, 10 digits at most)
- * without snprintf: the one command text built every cycle (issue 17). */
-static void hb_prefix(char *buf, long hb)
+ * without snprintf: the one command text built every cycle (issue 17).
+ * Return: its length. */
+static int hb_prefix(char *buf, long hb)
 {
 	char dig[16];
 	int n = 0;
@@ -180,6 +181,27 @@ static void hb_prefix(char *buf, long hb)
 	for (int i = 0; i < n; i++)
 		buf[5 + i] = dig[n - 1 - i];
 	buf[5 + n] = '\0';
+	return 5 + n;
+}
+
+/* s->prefix for @hb: the last one's digits counted up in place when @hb
+ * is one more (as it is in every cycle but the wrap: no division), else
+ * written anew. */
+static void hb_prefix_next(struct re_super *s, long hb)
+{
+	int i = s->prefix_len - 1;
+
+	if (s->prefix_len > 5 && hb == s->prefix_hb + 1) {
+		while (i >= 5 && s->prefix[i] == '9')
+			s->prefix[i--] = '0';
+		if (i >= 5) { /* else 99..9 + 1: one digit more */
+			s->prefix[i]++;
+			s->prefix_hb = hb;
+			return;
+		}
+	}
+	s->prefix_len = hb_prefix(s->prefix, hb);
+	s->prefix_hb = hb;
 }
 
 /* The round trip and the PC-side watchdog verdict on it. */
@@ -189,7 +211,7 @@ static int exchange(struct re_super *s, struct re_fault *f)
 	int rc, v, tmo = reply_timeout_ms(s);
 
 	s->hbpc = (s->hbpc + 1) % RE_HBPC_WRAP;
-	hb_prefix(s->prefix, s->hbpc);
+	hb_prefix_next(s, s->hbpc);
 	rc = s->io.ops->record(s->io.ud, s->prefix, &s->rec, tmo);
 	now = now_ns(s);
 	s->link_ok = rc == GL_OK;

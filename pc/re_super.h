@@ -211,7 +211,9 @@ struct re_super {
 	const char *(*rec_fault)(void *ud, const struct re_super *s);
 	void *rec_ud;
 	/* scratch, preallocated */
-	char prefix[32];
+	char prefix[32]; /* "hbpc=N" of the last request ... */
+	long prefix_hb;	 /* ... its N ... */
+	int prefix_len;	 /* ... and length (0: not built yet) */
 	char resp[128];
 	char verdict[96]; /* what the settle wait found, for the log */
 	char then[160];	  /* consequences seen after the first cause */

@@ -347,6 +347,31 @@ static const char *fault_log(void)
 
 /* ---- tests --------------------------------------------------------------- */
 
+/* The heartbeat text counted up in place (issue 17: no division per
+ * cycle): carries, a value set from outside, and the wrap. */
+static void test_super_hbpc_text(void **state)
+{
+	(void)state;
+	assert_int_equal(run(10), RE_OK);
+	assert_string_equal(fk.last_prefix, "hbpc=10");
+	sup.hbpc = 12344; /* not the last one + 1: written anew */
+	assert_int_equal(run(1), RE_OK);
+	assert_string_equal(fk.last_prefix, "hbpc=12345");
+	sup.hbpc = 1998;
+	assert_int_equal(run(2), RE_OK);
+	assert_string_equal(fk.last_prefix, "hbpc=2000");
+	sup.hbpc = 9998;
+	assert_int_equal(run(1), RE_OK);
+	assert_string_equal(fk.last_prefix, "hbpc=9999");
+	assert_int_equal(run(1), RE_OK); /* one digit more */
+	assert_string_equal(fk.last_prefix, "hbpc=10000");
+	sup.hbpc = RE_HBPC_WRAP - 2;
+	assert_int_equal(run(1), RE_OK);
+	assert_string_equal(fk.last_prefix, "hbpc=999999999");
+	assert_int_equal(run(2), RE_OK); /* the wrap */
+	assert_string_equal(fk.last_prefix, "hbpc=1");
+}
+
 /* A healthy controller: one QR round trip per cycle, heartbeat counting. */
 static void test_super_healthy_one_round_trip(void **state)
 {
@@ -960,6 +985,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test_setup(test_super_healthy_one_round_trip, setup),
+	    cmocka_unit_test_setup(test_super_hbpc_text, setup),
 	    cmocka_unit_test_setup(test_super_events_ring, setup),
 	    cmocka_unit_test_setup(test_super_encpot_fault_order, setup),
 	    cmocka_unit_test_setup(test_super_encpot_transient, setup),
