@@ -670,8 +670,8 @@ static void instr_run(struct sys_env *e, int secs, struct instr_fig *f)
 	if (proc_wait_exit(&c.re, 30000, NULL) < 0 && !f->why[0])
 		snprintf(f->why, sizeof(f->why), "roboelf did not exit");
 	sys_case_stop(&c);
-	if (!f->why[0] && (cg_read(f->out, f) < 0 ||
-			   f->ir < 0 || f->cycles <= 0))
+	if (!f->why[0] &&
+	    (cg_read(f->out, f) < 0 || f->ir < 0 || f->cycles <= 0))
 		snprintf(f->why, sizeof(f->why), "no cycles in '%.200s'",
 			 f->out);
 }
