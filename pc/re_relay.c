@@ -102,8 +102,7 @@ struct re_relay {
 	bool rb_flush;		  /* answers may be in flight that nobody
 				   * awaits: drop input before a query */
 	int64_t rb_sent_ns; /* the oldest query due was sent (base_now_ns) */
-	int64_t
-	    rb_next_ns; /* the next query of re_relay_check() (base_now_ns) */
+	int64_t rb_next_ns; /* re_relay_check()'s next query (base_now_ns) */
 	char err[RE_RELAY_ERR_MAX];
 };
 

@@ -989,15 +989,10 @@ int gl_link_message_queued(gl_link *l, char *line, size_t cap)
 
 int gl_link_message(gl_link *l, char *line, size_t cap)
 {
-	int rc, pump;
+	int rc = gl_link_message_queued(l, line, cap), pump;
 
-	if (!l || !line || cap == 0)
-		return GL_ERR_ARG;
-	rc = gl_proto_unsol_next(&l->cmd.p, line, cap);
-	if (rc != GL_ERR_AGAIN)
+	if (rc != GL_ERR_AGAIN || l->msg.fd < 0)
 		return rc;
-	if (l->msg.fd < 0)
-		return l->msg.broken ? GL_ERR_CLOSED : GL_ERR_AGAIN;
 	pump = msg_pump(l);
 	rc = gl_proto_unsol_next(&l->msg.p, line, cap);
 	if (rc != GL_ERR_AGAIN || pump == GL_OK)
