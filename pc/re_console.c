@@ -343,6 +343,9 @@ static void ctrl_text(const struct re_status *st, char *buf, size_t cap)
 	else if (st->za.state == RE_DMC_FAULT || f)
 		snprintf(buf, cap, "FAULT %s (code %d)",
 			 f >= 0 && f <= RE_DMC_F_MAX ? fcode_names[f] : "?", f);
+	else if (st->za.state == RE_DMC_ARMED && !st->za.mneut &&
+		 st->za.jcmd > 0)
+		snprintf(buf, cap, "armed, release the joystick");
 	else
 		snprintf(buf, cap, "%s",
 			 st->za.state == RE_DMC_ARMED	  ? "armed"

@@ -15,6 +15,7 @@
 #include <time.h>
 
 #include "base_clock.h"
+#include "base_version.h"
 #include "gl_err.h"
 #include "gl_ident.h"
 
@@ -545,6 +546,25 @@ static int check_param(const struct re_io *io, const struct param *p, char *err,
 	return rc;
 }
 
+/* The program's vers (dmc/constants.dmc) is the interface this roboelf
+ * was built for: the identity stamp only shows that the program is whole,
+ * and a whole program of another release may publish other fields. */
+static int check_version(const struct re_io *io, char *err, size_t errlen)
+{
+	double vers = 0, want = strtod(ROBOELF_DMC_VERSION, NULL);
+	int rc = read_err(io, "vers", &vers, err, errlen);
+
+	if (rc == GL_OK && fabs(vers - want) > 0.005) {
+		seterr(err, errlen,
+		       "the controller's program is version %.2f and this "
+		       "roboelf needs version %s: load this release's dmc/ "
+		       "with galil-load (docs/technician.md)",
+		       vers, ROBOELF_DMC_VERSION);
+		rc = GL_ERR_MISMATCH;
+	}
+	return rc;
+}
+
 /* After XQ #AUTO,0: state 0 and the program heartbeat advancing. */
 static int wait_program(const struct re_io *io, struct re_ctl_info *info,
 			char *err, size_t errlen)
@@ -572,7 +592,7 @@ static int wait_program(const struct re_io *io, struct re_ctl_info *info,
 	}
 	rc = read_err(io, "mainms", &mainms, err, errlen);
 	info->mainms = (int)mainms;
-	return rc;
+	return rc == GL_OK ? check_version(io, err, errlen) : rc;
 }
 
 int re_ctl_start_program(const struct re_io *io, struct re_ctl_info *info,

@@ -99,9 +99,12 @@ int re_ctl_amp_power(const struct re_io *io, int want_on, int timeout_ms,
 
 /*
  * re_ctl_start_program() - XQ #AUTO,0, wait (1 s) for state 0 and the
- * program heartbeat advancing; read mainms.
+ * program heartbeat advancing; read mainms; the program's vers must be
+ * ROBOELF_DMC_VERSION (the record fields this roboelf decodes).
  * @info: [in,out] mainms filled.
- * Return: GL_OK; GL_ERR_TIMEOUT (the program did not start); a link error.
+ * Return: GL_OK; GL_ERR_TIMEOUT (the program did not start);
+ *         GL_ERR_MISMATCH (another version: @err says to run galil-load);
+ *         a link error.
  */
 int re_ctl_start_program(const struct re_io *io, struct re_ctl_info *info,
 			 char *err, size_t errlen);

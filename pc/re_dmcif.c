@@ -26,9 +26,10 @@ int re_za_decode(int32_t zaa, int32_t zab, int32_t zac, struct re_za *out)
 	z.faxis = zab / 1000;
 	z.jraw = zac % 4096;
 	z.jcmd = (zac / 4096) % 8 - 1;
-	z.mcmd = zac / 32768;
+	z.mcmd = (zac / 32768) % 8;
+	z.mneut = zac / 262144;
 	if (z.state > RE_DMC_SERVICE || z.fcode > RE_DMC_F_MAX || z.faxis > 3 ||
-	    z.mcmd > 6 || z.jcmd > 6)
+	    z.mcmd > 6 || z.jcmd > 6 || z.mneut > 1)
 		return GL_ERR_RANGE;
 	*out = z;
 	return GL_OK;

@@ -52,7 +52,9 @@ struct re_za {
 	int faxis;     /* ZAB / 1000: 1..3 = A..C, 0 none */
 	int jraw;      /* ZAC % 4096 */
 	int jcmd;      /* (ZAC / 4096) % 8 - 1: -1 invalid, 0, 1..6 */
-	int mcmd;      /* ZAC / 32768: 0..6 */
+	int mcmd;      /* (ZAC / 32768) % 8: 0..6 */
+	int mneut;     /* ZAC / 262144: 1 once the joystick was seen neutral
+			* since arming (program 2.10) */
 };
 
 /*
@@ -60,7 +62,7 @@ struct re_za {
  * @out: [out] filled only on success.
  * Return: GL_OK; GL_ERR_RANGE when a field is negative or a decoded value is
  *         outside its range (state > 3, fcode > 16, faxis > 3, jcmd > 6,
- *         mcmd > 6, hbdmc > 999999); GL_ERR_ARG on NULL.
+ *         mcmd > 6, mneut > 1, hbdmc > 999999); GL_ERR_ARG on NULL.
  */
 int re_za_decode(int32_t zaa, int32_t zab, int32_t zac, struct re_za *out);
 

@@ -735,11 +735,36 @@ int re_start(struct app *a)
 		if (!rc)
 			rc = check_stall(a);
 	}
-	if (!rc && !re_sig.quit) {
+	return rc;
+}
+
+void re_start_show_ready(struct app *a)
+{
+	const struct re_super *s = a->sup;
+	int k;
+
+	if (a->ready_said || !s || !s->armed || s->latched || !s->have_za ||
+	    s->za.state != RE_DMC_ARMED)
+		return;
+	if (s->za.mneut) {
 		re_console_msg(&a->con, "RoboELF Ready for Use");
 		re_log_msg(&a->log, RE_LOG_INFO, "RoboELF Ready for Use");
+		a->ready_said = 1;
+		return;
 	}
-	return rc;
+	if (a->held_said || s->za.jcmd < 1 || s->za.jcmd > 2 * RE_AXES)
+		return;
+	k = s->za.jcmd - 1;
+	re_console_msg(&a->con,
+		       "roboelf: the joystick is held (axis %s %s) since "
+		       "arming: release it to neutral; nothing moves until "
+		       "the controller has seen it released",
+		       a->names[k / 2], k % 2 ? "reverse" : "forward");
+	re_log_msg(&a->log, RE_LOG_WARN,
+		   "arm: joystick held (axis %s %s) since arming; waiting for "
+		   "neutral",
+		   a->names[k / 2], k % 2 ? "reverse" : "forward");
+	a->held_said = 1;
 }
 
 /* The controller for the commissioning run: connected, identified, not

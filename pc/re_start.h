@@ -84,6 +84,9 @@ struct app {
 	struct re_calib *calrun; /* the calibration running, or NULL */
 	const struct re_calib_cfg *calcfg; /* its settings */
 	int ctl_ours; /* the controller was taken over: ours to stop */
+	/* after arming: 0 "Ready" not said yet, 1 said; held_said: the
+	 * operator was told to release a joystick held at arming */
+	int ready_said, held_said;
 	char err[RE_CONFIG_ERR_MAX];
 };
 
@@ -104,8 +107,9 @@ extern struct re_signals re_sig;
  * loaded and open): locks, relay, controller, calibration, arming. Every
  * step is refused (exit 3, message on the console and in the log) or
  * latches a fault (exit 4) when it fails; a quit signal ends it early.
- * Return: 0 when armed ("RoboELF Ready for Use" shown) or on a quit
- * signal; EXIT_CONNECT, EXIT_USAGE or EXIT_FAULT otherwise.
+ * Return: 0 when armed (re_start_show_ready() then says "RoboELF Ready
+ * for Use") or on a quit signal; EXIT_CONNECT, EXIT_USAGE or EXIT_FAULT
+ * otherwise.
  */
 int re_start(struct app *a);
 
@@ -139,5 +143,15 @@ void re_start_show_foreign(struct app *a, unsigned mask);
  * No-op before the supervisor exists.
  */
 void re_start_show_events(struct app *a);
+
+/*
+ * re_start_show_ready() - after each armed cycle: "RoboELF Ready for Use"
+ * (console and log) once the controller's record shows that its motion
+ * thread has seen the joystick neutral since arming (ZAC mneut, program
+ * 2.10): from then on a command moves its axis. While the record shows a
+ * command held since arming, the operator is told once to release it.
+ * No-op before arming, once said, or with a fault latched.
+ */
+void re_start_show_ready(struct app *a);
 
 #endif /* RE_START_H */

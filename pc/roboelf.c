@@ -622,6 +622,7 @@ static void run(struct app *a)
 		}
 		re_start_show_foreign(a, a->sup->foreign);
 		re_start_show_events(a);
+		re_start_show_ready(a);
 		if (re_console_due(&a->con, re_io_now_ns())) {
 			re_super_status(a->sup, &st); /* only when drawn */
 			re_console_status(&a->con, &st, re_io_now_ns(), 1);

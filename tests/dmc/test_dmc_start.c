@@ -156,6 +156,7 @@ static void test_record_fields(void **state)
 	assert_int_equal(za.jraw, 0);
 	assert_int_equal(za.jcmd, 0);
 	assert_int_equal(za.mcmd, 0);
+	assert_int_equal(za.mneut, 1); /* thread 1 saw neutral (2.10) */
 	/* published every mainms: at most one step behind */
 	assert_true(dmc_h_var(h, "hbdmc") - za.hbdmc <= 1);
 	assert_true(za.hbdmc > 0);
@@ -166,6 +167,7 @@ static void test_record_fields(void **state)
 	assert_int_equal(za.jraw, 3 * 4 * 4 * 4);
 	assert_int_equal(za.jcmd, 4);
 	assert_int_equal(za.mcmd, 4);
+	assert_int_equal(za.mneut, 1);
 	assert_int_equal(za.state, 1);
 
 	DMC_H_CHECK(h, dmc_h_control(h, "joy B rev a")); /* invalid */
@@ -184,11 +186,13 @@ static void test_record_fields(void **state)
 }
 
 /* A command held while arming is ignored until the joystick has been
- * released once. */
+ * released once; the record says so (mneut 0 with the command), so that
+ * the supervisor can tell the operator, and mneut 1 once released. */
 static void test_held_at_arm(void **state)
 {
 	struct dmc_h *h = *state;
 	struct dmc_h_params p;
+	struct dmc_h_za za;
 	double a0;
 
 	dmc_h_params_default(&p);
@@ -202,11 +206,53 @@ static void test_held_at_arm(void **state)
 	assert_true(fabs(axis_pos(h, 0) - a0) < 1);
 	assert_true(dmc_h_var(h, "mcmd") == 0);
 	assert_true(dmc_h_var(h, "state") == 1);
+	DMC_H_CHECK(h, dmc_h_za(h, &za));
+	assert_int_equal(za.state, 1);
+	assert_int_equal(za.jcmd, 1);
+	assert_int_equal(za.mcmd, 0);
+	assert_int_equal(za.mneut, 0);
 	DMC_H_CHECK(h, dmc_h_control(h, "joy A neutral"));
 	dmc_h_advance(h, 100);
+	DMC_H_CHECK(h, dmc_h_za(h, &za));
+	assert_int_equal(za.jcmd, 0);
+	assert_int_equal(za.mneut, 1);
 	DMC_H_CHECK(h, dmc_h_control(h, "joy A fwd"));
 	dmc_h_advance(h, 500);
 	assert_true(axis_pos(h, 0) - a0 > 500);
+}
+
+/* Armed again after an orderly switch-off, with the joystick held: from
+ * the first record that shows the armed state, mneut is 0 (the previous
+ * arming's 1 is never published with state 1), and stays 0. */
+static void test_rearm_held(void **state)
+{
+	struct dmc_h *h = *state;
+	struct dmc_h_za za;
+	double mainms, t0;
+
+	DMC_H_CHECK(h, dmc_h_setup(h));
+	dmc_h_advance(h, 50);
+	DMC_H_CHECK(h, dmc_h_za(h, &za));
+	assert_int_equal(za.mneut, 1);
+	mainms = dmc_h_var(h, "mainms");
+	DMC_H_CHECK(h, dmc_h_set(h, "offreq", 1));
+	assert_true(dmc_h_wait_var(h, "state", 0, 3 * mainms) >= 0);
+	DMC_H_CHECK(h, dmc_h_control(h, "joy C rev"));
+	dmc_h_advance(h, 2 * mainms);
+	DMC_H_CHECK(h, dmc_h_set(h, "armreq", 1));
+	t0 = dmc_h_now(h);
+	do {
+		dmc_h_advance(h, 1);
+		DMC_H_CHECK(h, dmc_h_za(h, &za));
+	} while (za.state != 1 && dmc_h_now(h) - t0 < 1000);
+	assert_int_equal(za.state, 1);
+	assert_int_equal(za.mneut, 0);
+	dmc_h_advance(h, 200);
+	DMC_H_CHECK(h, dmc_h_za(h, &za));
+	assert_int_equal(za.state, 1);
+	assert_int_equal(za.jcmd, 6);
+	assert_int_equal(za.mcmd, 0);
+	assert_int_equal(za.mneut, 0);
 }
 
 /* Only HX + XQ #AUTO,0 clears a latched fault; the program then arms
@@ -286,6 +332,8 @@ int main(void)
 	    cmocka_unit_test_setup_teardown(test_arm, dmc_h_fx_new,
 					    dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_record_fields, dmc_h_fx_new,
+					    dmc_h_fx_free),
+	    cmocka_unit_test_setup_teardown(test_rearm_held, dmc_h_fx_new,
 					    dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_held_at_arm, dmc_h_fx_new,
 					    dmc_h_fx_free),

@@ -389,9 +389,9 @@ static int request_state(struct dmc_h *h, const char *req, double want)
 		if (st == 2) {
 			dmc_h_advance(h, 10); /* the FAULT line */
 			snprintf(h->err, sizeof(h->err),
-				 "%s refused: fault %g axis %g detail %g", req,
+				 "%s refused: fault %g axis %g detail %g line %g", req,
 				 dmc_h_var(h, "fcode"), dmc_h_var(h, "faxis"),
-				 dmc_h_var(h, "fdet"));
+				 dmc_h_var(h, "fdet"), dmc_h_var(h, "fline"));
 			return GL_ERR_CTRL;
 		}
 		dmc_h_advance(h, 1);
@@ -552,7 +552,8 @@ int dmc_h_za(struct dmc_h *h, struct dmc_h_za *za)
 	za->faxis = (int)(zb / 1000);
 	za->jraw = (int)(zc % 4096);
 	za->jcmd = (int)(zc / 4096 % 8) - 1;
-	za->mcmd = (int)(zc / 32768);
+	za->mcmd = (int)(zc / 32768 % 8);
+	za->mneut = (int)(zc / 262144);
 	return 0;
 }
 

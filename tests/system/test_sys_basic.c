@@ -23,6 +23,7 @@
 
 #include <cmocka.h>
 
+#include "base_version.h"
 #include "proc.h"
 
 #define START_MS 10000 /* galil-sim, galil-load */
@@ -119,10 +120,11 @@ static int sim_start(struct rig *r)
 	return r->ctl < 0 ? -1 : 0;
 }
 
-static int galil_load(const struct rig *r)
+/* galil-load of the DMC programs in @dir. */
+static int galil_load_dir(const struct rig *r, const char *dir)
 {
 	char exe[600], addr[64];
-	char *argv[] = {exe, (char *)"-a", addr, (char *)"dmc/", NULL};
+	char *argv[] = {exe, (char *)"-a", addr, (char *)dir, NULL};
 	struct proc p;
 	int code;
 
@@ -139,6 +141,11 @@ static int galil_load(const struct rig *r)
 			proc_output(&p, 1));
 	proc_kill(&p);
 	return code;
+}
+
+static int galil_load(const struct rig *r)
+{
+	return galil_load_dir(r, "dmc/");
 }
 
 static int rob_start(struct rig *r, const char *calib)
@@ -499,6 +506,81 @@ static void test_sys_no_program(void **state)
 	assert_relay_off();
 }
 
+/* A whole, stamped program of another release (vers 2.00, whose record
+ * has no mneut): refused before motor power, exit 3, the versions named. */
+static void test_sys_old_program(void **state)
+{
+	static char text[65536];
+	char dir[300], p[400];
+	const char *names[] = {"MANIFEST", "constants.dmc", "roboelf.dmc"};
+	char *v;
+
+	(void)state;
+	path(dir, sizeof(dir), "olddmc");
+	assert_int_equal(mkdir(dir, 0700), 0);
+	for (int i = 0; i < 3; i++) {
+		snprintf(p, sizeof(p), "dmc/%s", names[i]);
+		assert_true(slurp(p, text, sizeof(text)) > 0);
+		v = strstr(text, "\nvers=" ROBOELF_DMC_VERSION "\n");
+		if (i == 1) {
+			assert_non_null(v);
+			memcpy(v, "\nvers=2.00\n", 11);
+		}
+		snprintf(p, sizeof(p), "%s/%s", dir, names[i]);
+		assert_int_equal(write_file(p, text), 0);
+	}
+	assert_int_equal(galil_load_dir(&rig, dir), 0);
+	assert_int_equal(write_config(&rig, rig.sim.port, rig.relay, cal_file),
+			 0);
+	assert_int_equal(rob_start(&rig, "file"), 0);
+	assert_int_equal(proc_wait_exit(&rig.rob, EXIT_MS, NULL), 0);
+	assert_int_equal(proc_exit_code(&rig.rob), 3);
+	assert_non_null(strstr(proc_output(&rig.rob, PROC_STDOUT),
+			       "the controller's program is version 2.00 and "
+			       "this roboelf needs version " ROBOELF_DMC_VERSION
+			       ": load this release's dmc/ with galil-load "
+			       "(docs/technician.md)"));
+	assert_relay_off();
+	assert_true(motors_off(1000));
+}
+
+/* The joystick held from before start-up: at arming the operator is told
+ * to release it, nothing moves and "Ready" waits; released, "Ready", and
+ * then a command moves its axis. */
+static void test_sys_joystick_held(void **state)
+{
+	char logbuf[65536];
+
+	(void)state;
+	assert_int_equal(galil_load(&rig), 0);
+	assert_int_equal(write_config(&rig, rig.sim.port, rig.relay, cal_file),
+			 0);
+	ctl_ok("joy A fwd");
+	assert_int_equal(rob_start(&rig, "file"), 0);
+	assert_int_equal(
+	    proc_wait_line(&rig.rob, PROC_STDOUT,
+			   "roboelf: the joystick is held (axis A forward) "
+			   "since arming: release it to neutral; nothing moves "
+			   "until the controller has seen it released",
+			   READY_MS, NULL, 0),
+	    0);
+	assert_false(axis_moved('A', 50, 1000));
+	assert_int_equal(proc_find_line(&rig.rob, PROC_STDOUT,
+					"RoboELF Ready for Use", NULL, 0),
+			 -1);
+	ctl_ok("joy A neutral");
+	assert_ready();
+	ctl_ok("joy A fwd");
+	assert_true(axis_moved('A', 300, 3000));
+	ctl_ok("joy A neutral");
+	assert_int_equal(quit_rob(SIGTERM), 0);
+	assert_true(slurp(rig.log, logbuf, sizeof(logbuf)) > 0);
+	assert_non_null(strstr(logbuf, "WARN arm: joystick held (axis A "
+				       "forward) since arming; waiting for "
+				       "neutral"));
+	assert_non_null(strstr(logbuf, "INFO RoboELF Ready for Use"));
+}
+
 /* Nothing listening at the controller address: exit 3, relay off. */
 static void test_sys_no_controller(void **state)
 {
@@ -554,6 +636,10 @@ int main(void)
 	    cmocka_unit_test_teardown(test_sys_no_relay, teardown),
 	    cmocka_unit_test_setup_teardown(test_sys_no_program, setup_sim_only,
 					    teardown),
+	    cmocka_unit_test_setup_teardown(test_sys_old_program,
+					    setup_sim_only, teardown),
+	    cmocka_unit_test_setup_teardown(test_sys_joystick_held,
+					    setup_sim_only, teardown),
 	    cmocka_unit_test_setup_teardown(test_sys_no_controller,
 					    setup_sim_only, teardown),
 	    cmocka_unit_test_setup_teardown(test_sys_missing_calibration_file,

@@ -435,6 +435,13 @@ static void test_za_decode(void **state)
 	assert_int_equal(z.jraw, 48);
 	assert_int_equal(z.jcmd, 3);
 	assert_int_equal(z.mcmd, 3);
+	assert_int_equal(z.mneut, 0);
+	/* 2.10: the joystick seen neutral since arming, with mcmd 6 */
+	assert_int_equal(re_za_decode(0, 1, 4096 + 32768 * 6 + 262144, &z),
+			 GL_OK);
+	assert_int_equal(z.mneut, 1);
+	assert_int_equal(z.mcmd, 6);
+	assert_int_equal(z.jcmd, 0);
 	/* jcmd -1 (invalid input), jraw full 12 bits, fault 12 on axis 3 */
 	assert_int_equal(re_za_decode(999999, 2 + 120 + 3000, 4095, &z), GL_OK);
 	assert_int_equal(z.jcmd, -1);
@@ -452,6 +459,9 @@ static void test_za_decode(void **state)
 	assert_int_equal(re_za_decode(0, 4001, 0, &z), GL_ERR_RANGE);
 	assert_int_equal(re_za_decode(0, 0, 7 * 32768, &z), GL_ERR_RANGE);
 	assert_int_equal(re_za_decode(0, 0, 4096 * 8, &z), GL_OK); /* mcmd 1 */
+	assert_int_equal(re_za_decode(0, 0, 7 * 32768 + 262144, &z),
+			 GL_ERR_RANGE);
+	assert_int_equal(re_za_decode(0, 0, 2 * 262144, &z), GL_ERR_RANGE);
 	assert_int_equal(re_za_decode(-1, 0, 0, &z), GL_ERR_RANGE);
 	assert_int_equal(re_za_decode(0, -1, 0, &z), GL_ERR_RANGE);
 	assert_int_equal(re_za_decode(0, 0, -1, &z), GL_ERR_RANGE);

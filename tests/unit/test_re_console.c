@@ -219,6 +219,16 @@ static void test_status_words(void **state)
 				     "lim=- "));
 	assert_non_null(strstr(line, "ctrl=\"FAULT ENCODER axis B (code "
 				     "9)\""));
+	/* armed with a command held since arming (mneut 0): release it */
+	st.za = (struct re_za){.state = RE_DMC_ARMED, .jcmd = 1};
+	re_console_format_line(&st, line, sizeof(line));
+	assert_non_null(strstr(line, "ctrl=\"armed, release the joystick\""));
+	st.za.mneut = 1;
+	re_console_format_line(&st, line, sizeof(line));
+	assert_non_null(strstr(line, "ctrl=\"armed\""));
+	st.za = (struct re_za){.state = RE_DMC_ARMED}; /* before thread 1 */
+	re_console_format_line(&st, line, sizeof(line));
+	assert_non_null(strstr(line, "ctrl=\"armed\""));
 }
 
 /* Line @n (0-based) of @text into @out (without its newline). */
@@ -655,6 +665,7 @@ static void test_snapshot_phases(void **state)
 	st.za.state = RE_DMC_ARMED;
 	st.za.jcmd = 3;
 	st.za.mcmd = 3;
+	st.za.mneut = 1;
 	st.axis[1].moving = 1;
 	st.axis[1].vel_cps = 7990;
 	st.axis[1].enc_counts = 12345;
