@@ -10,6 +10,8 @@
 #   - the FAULT text and its recovery still on the screen 10 s after the
 #     fault;
 #   - after a resize to 80x24 mid-run: the same;
+#   - a joystick held from before the start (80x24): the board and the
+#     message say to release it, no "Ready" before, "Ready" after;
 #   - a full calibration on the board (80x24): each axis's phase, bar and
 #     time left; interrupted with Ctrl-C, which table is in force said
 #     (none before the first calibration file, the file's one after).
@@ -43,7 +45,7 @@ wait_for() {
 "$BIN/galil-sim" --port 0 --control-port 0 --relay-link "$tmp/relay" \
 	>"$tmp/sim.out" 2>"$tmp/sim.err" &
 simpid=$!
-wait_for 10 grep -q "listening" "$tmp/sim.out" || fail "galil-sim did not start"
+wait_for 10 grep -qs "listening" "$tmp/sim.out" || fail "galil-sim did not start"
 port=$(sed -n 's/.*127.0.0.1:\([0-9]*\) control.*/\1/p' "$tmp/sim.out")
 ctl=$(sed -n 's/.* control \([0-9]*\) relay.*/\1/p' "$tmp/sim.out")
 sed -e "s#port_development: .*#port_development: $tmp/relay#" \
@@ -144,6 +146,27 @@ for size in 80x24 100x30 200x60; do
 	tmux -S "$sock" kill-session -t re 2>/dev/null
 	ctlreq 'pot B ok' >/dev/null
 done
+# the joystick held from before the start (80x24): the board says to
+# release it, the message is on the screen whole, no "Ready" until released
+[ "$(ctlreq 'joy A fwd')" = ok ] || fail "joy A fwd"
+tmux -S "$sock" new-session -d -s re -x 80 -y 24 \
+	"$BIN/roboelf -c $tmp/roboelf.yaml --galil 127.0.0.1:$port --calibration file; sleep 60"
+held() { on_screen "controller armed, release the joystick"; }
+wait_for 90 held || { screen; fail "held joystick: the board does not say to release it"; }
+check_screen 80 "joystick held"
+on_screen "roboelf: the joystick is held (axis A forward) since arming: release it to neutral; nothing moves until the controller has seen it released" ||
+	{ screen; fail "held joystick: the message is not on the screen"; }
+on_screen "RoboELF Ready for Use" && { screen; fail "held joystick: Ready before the release"; }
+[ -n "${SHOW:-}" ] && { echo "--- joystick held 80x24"; cat "$tmp/screen"; }
+cp "$tmp/screen" "$tmp/screen-held.txt"
+[ "$(ctlreq 'joy A neutral')" = ok ] || fail "joy A neutral"
+released() { on_screen "RoboELF Ready for Use" && on_screen "controller armed "; }
+wait_for 5 released || { screen; fail "released joystick: no Ready"; }
+check_screen 80 "joystick released"
+tmux -S "$sock" send-keys -t re q
+wait_for 20 sh -c "! pgrep -f '^$BIN/roboelf -c $tmp/roboelf.yaml' >/dev/null" ||
+	fail "joystick held: roboelf did not quit within 20 s of q"
+tmux -S "$sock" kill-session -t re 2>/dev/null
 # with a calibration file: interrupted, the file's table is kept
 interrupt 80x24 "onto rev switch" "calibration interrupted: no new table; the table in force is still the one in '$tmp/cal.txt' (made 20" \
 	"Z), kept unchanged: the next start can load it"
@@ -157,4 +180,4 @@ said() { screen | grep -q "EXIT=2"; }
 wait_for 10 said || { screen; fail "Ctrl-D: no exit 2"; }
 screen | tr '\n' ' ' | tr -s ' ' | grep -q "no answer to the calibration question (end of input): nothing moved, motor power stays off" ||
 	{ screen; fail "Ctrl-D: no reason given"; }
-echo "console_tmux: ok (80x24, 100x30, 200x60 and a resize: no wrapped line, one header, the FAULT and its recovery on screen 10 s later; the calibration board with phases and time left, Ctrl-C in it says which table is in force; Ctrl-D at the calibration question explained, exit 2)"
+echo "console_tmux: ok (80x24, 100x30, 200x60 and a resize: no wrapped line, one header, the FAULT and its recovery on screen 10 s later; the calibration board with phases and time left, Ctrl-C in it says which table is in force; Ctrl-D at the calibration question explained, exit 2; a joystick held at arming named on the board and the screen, Ready after its release)"
