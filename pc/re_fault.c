@@ -28,10 +28,10 @@ struct re_fault_msg {
 /* clang-format off */
 static const struct re_fault_msg re_fault_table[] = {
 	{RE_F_ENCPOT, RE_FC_ENCODER,
-	 "axis {a}: potentiometer reads {f0} V but {f1} V is expected at encoder position {i0} counts (they differ by {f2} V, more than the {f3} V allowed, for {i1} cycles)",
+	 "axis {a}: potentiometer reads {f0} V but {f1} V is expected at encoder position {i0c}; they differ by {f2} V, more than the {f3} V allowed, for {i1} cycles",
 	 "keep the E-stop pressed, check the encoder and potentiometer cables of axis {a}, restart roboelf and recalibrate"},
 	{RE_F_ENC_OUTSIDE, RE_FC_ENCODER,
-	 "axis {a}: encoder position {i0} counts is outside the calibrated travel {i1} to {i2} counts",
+	 "axis {a}: encoder position {i0c} is outside the calibrated travel {i1} to {i2} counts{r12}",
 	 "keep the E-stop pressed, check the encoder cable of axis {a} and that the axis did not slip, restart roboelf and recalibrate"},
 	{RE_F_CTRL_ENCODER, RE_FC_ENCODER,
 	 "axis {a}: the controller detected an encoder failure or a blocked axis (stop code {i0})",
@@ -55,7 +55,7 @@ static const struct re_fault_msg re_fault_table[] = {
 	 "axis {a}: the controller switched the motor off: {s} (stop code {i0})",
 	 "keep the E-stop pressed, check that axis {a} moves freely and nothing blocks it, check its motor and encoder cables, then restart roboelf"},
 	{RE_F_CTRL_POSERR, RE_FC_MOTION,
-	 "axis {a}: position error of at least {i0} counts, above its limit (blocked, jammed, or its encoder stuck?)",
+	 "axis {a}: position error of at least {i0c}, above its limit (blocked, jammed, or its encoder stuck?)",
 	 "keep the E-stop pressed, check that axis {a} moves freely and nothing blocks it, then its encoder cable, then restart roboelf"},
 	{RE_F_CTRL_AMPERR, RE_FC_MOTION,
 	 "axis {a}: amplifier fault, motor power lost (stop code {i0})",
@@ -267,13 +267,84 @@ static const char *re_axis_name(const struct re_fault *f,
 	return re_axis_letters[f->axis];
 }
 
+/* What the template expander needs besides the fault. */
+struct re_view {
+	const char *const *names;
+	const struct re_fault_units *units; /* NULL: counts only */
+};
+
+/* The fault axis's counts per unit and unit name, or 0 (counts only). */
+static double re_unit_of(const struct re_fault *f, const struct re_view *v,
+			 const char **name)
+{
+	const struct re_fault_units *u = v->units;
+
+	if (!u || f->axis < 0 || f->axis >= RE_FAULT_UNIT_AXES ||
+	    !u->name[f->axis] || !(u->counts_per_unit[f->axis] > 0))
+		return 0;
+	*name = u->name[f->axis];
+	return u->counts_per_unit[f->axis];
+}
+
+/* @counts in units, 2 decimals, never "-0.00". */
+static void re_fmt_unit(char *tmp, size_t cap, double counts, double per)
+{
+	double v = counts / per;
+
+	snprintf(tmp, cap, "%.2f", v > -0.005 && v < 0 ? 0.0 : v);
+}
+
+/* "{i0c}": "<i0> counts (<in units> <unit>)"; "{r12}": " (<i1> to <i2> in
+ * units <unit>)" or nothing. Return 0 if @key is neither. */
+static int re_expand_units(struct re_out *o, const char *key, size_t klen,
+			   const struct re_fault *f, const struct re_view *v)
+{
+	const char *unit = NULL;
+	double per = re_unit_of(f, v, &unit);
+	char a[32], b[32], tmp[96];
+
+	if (klen == 3 && key[0] == 'i' && key[1] >= '0' && key[1] <= '3' &&
+	    key[2] == 'c') {
+		long long n = f->i[key[1] - '0'];
+
+		if (n == RE_VAL_UNKNOWN)
+			snprintf(tmp, sizeof(tmp), "unknown");
+		else
+			snprintf(tmp, sizeof(tmp), "%lld counts", n);
+		re_out_str(o, tmp);
+		if (per > 0 && n != RE_VAL_UNKNOWN) {
+			re_fmt_unit(a, sizeof(a), (double)n, per);
+			snprintf(tmp, sizeof(tmp), " (%s %s)", a, unit);
+			re_out_str(o, tmp);
+		}
+		return 1;
+	}
+	if (klen == 3 && key[0] == 'r' && key[1] >= '0' && key[1] <= '3' &&
+	    key[2] >= '0' && key[2] <= '3') {
+		if (per > 0) {
+			re_fmt_unit(a, sizeof(a), (double)f->i[key[1] - '0'],
+				    per);
+			re_fmt_unit(b, sizeof(b), (double)f->i[key[2] - '0'],
+				    per);
+			snprintf(tmp, sizeof(tmp), " (%s to %s %s)", a, b,
+				 unit);
+			re_out_str(o, tmp);
+		}
+		return 1;
+	}
+	return 0;
+}
+
 /* Expand one placeholder @key (without braces); return 0 if unknown. */
 static int re_expand(struct re_out *o, const char *key, size_t klen,
-		     const struct re_fault *f, const char *const *names)
+		     const struct re_fault *f, const struct re_view *v)
 {
+	const char *const *names = v->names;
 	char tmp[48];
 	int k;
 
+	if (re_expand_units(o, key, klen, f, v))
+		return 1;
 	if (klen == 1 && key[0] == 'a') {
 		re_out_str(o, re_axis_name(f, names));
 		return 1;
@@ -301,15 +372,14 @@ static int re_expand(struct re_out *o, const char *key, size_t klen,
 }
 
 static void re_out_template(struct re_out *o, const char *t,
-			    const struct re_fault *f, const char *const *names)
+			    const struct re_fault *f, const struct re_view *v)
 {
 	char one[2] = {0, 0};
 	const char *end;
 
 	while (*t) {
 		end = t[0] == '{' ? strchr(t, '}') : NULL;
-		if (end &&
-		    re_expand(o, t + 1, (size_t)(end - t - 1), f, names)) {
+		if (end && re_expand(o, t + 1, (size_t)(end - t - 1), f, v)) {
 			t = end + 1;
 			continue;
 		}
@@ -319,9 +389,8 @@ static void re_out_template(struct re_out *o, const char *t,
 }
 
 /* The FAULT line (@full) or only its "what happened" part. */
-static int re_fault_text(const struct re_fault *f,
-			 const char *const *axis_names, char *buf, size_t cap,
-			 int full)
+static int re_fault_text(const struct re_fault *f, const struct re_view *v,
+			 char *buf, size_t cap, int full)
 {
 	const struct re_fault_msg *m;
 	struct re_out o = {buf, cap, 0, 0};
@@ -337,22 +406,41 @@ static int re_fault_text(const struct re_fault *f,
 		re_out_str(&o, re_fault_class_name(m->cls));
 		re_out_str(&o, ": ");
 	}
-	re_out_template(&o, m->what, f, axis_names);
+	re_out_template(&o, m->what, f, v);
 	if (full) {
 		re_out_str(&o, ". Recovery: ");
-		re_out_template(&o, m->recovery, f, axis_names);
+		re_out_template(&o, m->recovery, f, v);
 	}
 	return o.trunc ? GL_ERR_OVERFLOW : (int)o.len;
+}
+
+int re_fault_format_units(const struct re_fault *f,
+			  const char *const *axis_names,
+			  const struct re_fault_units *units, char *buf,
+			  size_t cap)
+{
+	struct re_view v = {axis_names, units};
+
+	return re_fault_text(f, &v, buf, cap, 1);
 }
 
 int re_fault_format(const struct re_fault *f, const char *const *axis_names,
 		    char *buf, size_t cap)
 {
-	return re_fault_text(f, axis_names, buf, cap, 1);
+	return re_fault_format_units(f, axis_names, NULL, buf, cap);
+}
+
+int re_fault_what_units(const struct re_fault *f, const char *const *axis_names,
+			const struct re_fault_units *units, char *buf,
+			size_t cap)
+{
+	struct re_view v = {axis_names, units};
+
+	return re_fault_text(f, &v, buf, cap, 0);
 }
 
 int re_fault_what(const struct re_fault *f, const char *const *axis_names,
 		  char *buf, size_t cap)
 {
-	return re_fault_text(f, axis_names, buf, cap, 0);
+	return re_fault_what_units(f, axis_names, NULL, buf, cap);
 }

@@ -182,6 +182,22 @@ const char *re_fault_class_name(enum re_fclass cls);
  */
 void re_fault_set(struct re_fault *f, enum re_fault_id id, int axis);
 
+/* Axes the units below can describe (as many as the axis letters). */
+#define RE_FAULT_UNIT_AXES 8
+
+/*
+ * How encoder positions are also said in the robot's units (issue 15):
+ * per axis the unit's name ("deg", "mm") and encoder counts per unit. A
+ * NULL name or counts_per_unit <= 0: counts only. In the templates,
+ * "{i0c}" is "<i0> counts", followed by " (<i0 in units> <unit>)" when
+ * the fault's axis has a unit; "{r12}" is " (<i1> to <i2> in units
+ * <unit>)" or nothing.
+ */
+struct re_fault_units {
+	const char *name[RE_FAULT_UNIT_AXES];
+	double counts_per_unit[RE_FAULT_UNIT_AXES];
+};
+
 /*
  * re_fault_format() - the operator's FAULT line, without a newline:
  *   "FAULT <CLASS>: <what happened>. Recovery: <what to do>"
@@ -197,12 +213,30 @@ int re_fault_format(const struct re_fault *f, const char *const *axis_names,
 		    char *buf, size_t cap);
 
 /*
+ * re_fault_format_units() - re_fault_format() with positions also in the
+ * units of @units (NULL: counts only, as re_fault_format()).
+ * Return: as re_fault_format().
+ */
+int re_fault_format_units(const struct re_fault *f,
+			  const char *const *axis_names,
+			  const struct re_fault_units *units, char *buf,
+			  size_t cap);
+
+/*
  * re_fault_what() - only the "what happened" part of the fault's text (no
  * class, no recovery), e.g. for a "FILE:LINE: <what>" message.
  * Return: as re_fault_format().
  */
 int re_fault_what(const struct re_fault *f, const char *const *axis_names,
 		  char *buf, size_t cap);
+
+/*
+ * re_fault_what_units() - re_fault_what() with positions also in @units.
+ * Return: as re_fault_format().
+ */
+int re_fault_what_units(const struct re_fault *f, const char *const *axis_names,
+			const struct re_fault_units *units, char *buf,
+			size_t cap);
 
 /*
  * re_fault_template() - the raw templates of a fault (for docs and tests).

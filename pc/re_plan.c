@@ -120,6 +120,11 @@ void re_plan_super_cfg(const struct re_plan *p, const struct re_config *cfg,
 		out->encpot[i].persistence_cycles =
 		    cfg->axes[i].persistence_cycles;
 		out->axis_names[i] = names[i];
+		if (cfg->axes[i].counts_per_unit > 0) {
+			out->units.name[i] = re_unit_name(cfg->axes[i].unit);
+			out->units.counts_per_unit[i] =
+			    cfg->axes[i].counts_per_unit;
+		}
 		out->pot_input[i] = cfg->axes[i].analog.input;
 	}
 	out->fault_cmd_timeout_ms = cfg->controller.timeout_ms;

@@ -289,8 +289,8 @@ static void consequences(struct re_super *s, const struct re_fault *f)
 	    !za.fcode || own_doing(&za, det))
 		return;
 	re_ctrl_fault(&za, (long long)det, &c);
-	if (re_fault_what(&c, s->cfg.axis_names, s->then, sizeof(s->then)) ==
-	    GL_ERR_ARG)
+	if (re_fault_what_units(&c, s->cfg.axis_names, &s->cfg.units, s->then,
+				sizeof(s->then)) == GL_ERR_ARG)
 		s->then[0] = '\0';
 }
 
@@ -342,8 +342,8 @@ static void compose_line(struct re_super *s)
 	size_t cap = sizeof(s->fault_line), n;
 	char tail[RE_SUPER_LINE];
 
-	if (re_fault_format(&s->fault, s->cfg.axis_names, line, cap) ==
-	    GL_ERR_ARG)
+	if (re_fault_format_units(&s->fault, s->cfg.axis_names, &s->cfg.units,
+				  line, cap) == GL_ERR_ARG)
 		snprintf(line, cap,
 			 "FAULT PROGRAM: unknown fault %d. Recovery: quit, "
 			 "note the log and call service",
@@ -443,7 +443,8 @@ int re_super_fault(struct re_super *s, const struct re_fault *f)
 	int relay_rc;
 
 	if (s->latched) {
-		re_fault_format(f, s->cfg.axis_names, s->msg, sizeof(s->msg));
+		re_fault_format_units(f, s->cfg.axis_names, &s->cfg.units,
+				      s->msg, sizeof(s->msg));
 		re_io_logf(&s->io, RE_LOG_WARN, "while latched: %s", s->msg);
 		re_super_note(s, RE_LOG_FAULT, RE_EV_LATER, s->msg);
 		return RE_OK;

@@ -277,7 +277,9 @@ static void stall_first(struct app *a, struct re_fault *f)
 	if (f->id != RE_F_NONE) {
 		char what[512];
 
-		re_fault_format(f, a->names, what, sizeof(what));
+		re_fault_format_units(f, a->names,
+				      a->sup ? &a->sup->cfg.units : NULL, what,
+				      sizeof(what));
 		re_log_msg(&a->log, RE_LOG_WARN,
 			   "start-up: after a stop of %lld ms: %s",
 			   (long long)ms, what);

@@ -441,8 +441,8 @@ static int latched_cycle(struct re_super *s)
 	 * is logged once, as the operator cannot be shown a second FAULT. */
 	if (!s->relay_lost_logged && check_relay(s, &scratch) == RE_FAULT) {
 		s->relay_lost_logged = 1;
-		re_fault_format(&scratch, s->cfg.axis_names, s->text,
-				sizeof(s->text));
+		re_fault_format_units(&scratch, s->cfg.axis_names,
+				      &s->cfg.units, s->text, sizeof(s->text));
 		re_io_logf(&s->io, RE_LOG_WARN, "while latched: %s", s->text);
 		re_super_note(s, RE_LOG_FAULT, RE_EV_RELAY, s->text);
 	}

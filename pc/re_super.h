@@ -36,6 +36,7 @@
 
 #include "gl_record.h"
 #include "re_check.h"
+#include "re_fault.h"
 #include "re_io.h"
 #include "re_pot.h"
 
@@ -70,6 +71,8 @@ struct re_super_cfg {
 	struct re_alive_cfg alive; /* heartbeat / sample limits */
 	struct re_encpot_cfg encpot[RE_SUPER_AXES];
 	const char *axis_names[RE_SUPER_AXES];
+	struct re_fault_units
+	    units; /* positions in FAULT lines; zero: counts */
 	int pot_input[RE_SUPER_AXES]; /* analog input 1..8; 0: axis + 1 */
 	int fault_cmd_timeout_ms;     /* "pcflt=1;AB 1;MO ABC" deadline */
 	int fresh_stop_ms; /* the stop over a new connection: connect and

@@ -388,10 +388,11 @@ static int request_state(struct dmc_h *h, const char *req, double want)
 			return 0;
 		if (st == 2) {
 			dmc_h_advance(h, 10); /* the FAULT line */
-			snprintf(h->err, sizeof(h->err),
-				 "%s refused: fault %g axis %g detail %g line %g", req,
-				 dmc_h_var(h, "fcode"), dmc_h_var(h, "faxis"),
-				 dmc_h_var(h, "fdet"), dmc_h_var(h, "fline"));
+			snprintf(
+			    h->err, sizeof(h->err),
+			    "%s refused: fault %g axis %g detail %g line %g",
+			    req, dmc_h_var(h, "fcode"), dmc_h_var(h, "faxis"),
+			    dmc_h_var(h, "fdet"), dmc_h_var(h, "fline"));
 			return GL_ERR_CTRL;
 		}
 		dmc_h_advance(h, 1);

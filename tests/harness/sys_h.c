@@ -235,10 +235,37 @@ static int env_figures(struct sys_env *e)
 	e->vmax_cps = a->vmax_cps;
 	e->step_counts = a->step_counts;
 	e->er_counts = a->position_error_limit_counts;
+	for (int i = 0; i < 3; i++) {
+		e->per_unit[i] = cfg->axes[i].counts_per_unit;
+		snprintf(e->unit[i], sizeof(e->unit[i]), "%s",
+			 re_unit_name(cfg->axes[i].unit));
+	}
 	e->readback_timeout_ms =
 	    cfg->relay.readback ? cfg->relay.readback_timeout_ms : 0;
 	free(cfg);
 	return 0;
+}
+
+int sys_counts_tpl(const struct sys_env *e, int axis, char *buf, size_t cap)
+{
+	if (e->per_unit[axis] > 0) {
+		snprintf(buf, cap, "{n} counts ({n} %s)", e->unit[axis]);
+		return 2;
+	}
+	snprintf(buf, cap, "{n} counts");
+	return 1;
+}
+
+void sys_counts_text(const struct sys_env *e, int axis, long counts, char *buf,
+		     size_t cap)
+{
+	double v = e->per_unit[axis] > 0 ? counts / e->per_unit[axis] : 0;
+
+	if (e->per_unit[axis] > 0)
+		snprintf(buf, cap, "%ld counts (%.2f %s)", counts,
+			 v > -0.005 && v < 0 ? 0.0 : v, e->unit[axis]);
+	else
+		snprintf(buf, cap, "%ld counts", counts);
 }
 
 int sys_env_init(struct sys_env *e)

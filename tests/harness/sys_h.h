@@ -63,10 +63,29 @@ struct sys_env {
 	int vmin_cps, vmax_cps; /* axis A */
 	int step_counts;	/* axis A */
 	int er_counts;		/* position_error_limit_counts, A */
+	/* per axis: counts_per_unit and its unit ("deg", "mm"); 0: the
+	 * FAULT lines give counts only */
+	double per_unit[3];
+	char unit[3][4];
 	int readback_timeout_ms;
 	int keep; /* ROBOELF_KEEP set */
 	char err[SYS_ERR_MAX];
 };
+
+/*
+ * sys_counts_tpl() - how a FAULT line gives an encoder position of @axis
+ * (0..2), as a template piece: "{n} counts", or "{n} counts ({n} deg)"
+ * when the configuration gives the axis a unit (docs/operator.md 7).
+ * Return: the count of "{n}" in it (1 or 2).
+ */
+int sys_counts_tpl(const struct sys_env *e, int axis, char *buf, size_t cap);
+
+/*
+ * sys_counts_text() - the exact text a FAULT line gives for @counts on
+ * @axis: "800 counts" or "800 counts (0.80 deg)".
+ */
+void sys_counts_text(const struct sys_env *e, int axis, long counts, char *buf,
+		     size_t cap);
 
 /* One "key: value" substitution in a configuration copy: the first line
  * whose text (after indentation) starts with "key:" becomes "key: value". */

@@ -1432,14 +1432,46 @@ static double cause_calibrating(int axis, const char *req)
 /* The controller's position error (fault 4) on @axis: the limit ER. */
 static void tpl_poserr(char *tpl, size_t cap, int axis)
 {
+	char er[64];
+
+	sys_counts_text(&env, axis, env.er_counts, er, sizeof(er));
 	snprintf(
 	    tpl, cap,
-	    "FAULT MOTION: axis %c: position error of at least %d counts, "
+	    "FAULT MOTION: axis %c: position error of at least %s, "
 	    "above its limit (blocked, jammed, or its encoder stuck?)." SAFE_OK
 	    " Recovery: keep the E-stop pressed, check that axis %c moves "
 	    "freely and nothing blocks it, then its encoder cable, then "
 	    "restart roboelf",
-	    'A' + axis, env.er_counts, 'A' + axis);
+	    'A' + axis, er, 'A' + axis);
+}
+
+/* The ENCODER pot/encoder FAULT line of @axis as a template; the numbers
+ * are pot, expected, position[, in units], difference, allowed, cycles.
+ * Return: how many numbers the position takes (1, or 2 with a unit). */
+static int tpl_encpot(char *tpl, size_t cap, int axis)
+{
+	char pos[48];
+	int k = sys_counts_tpl(&env, axis, pos, sizeof(pos));
+
+	snprintf(tpl, cap,
+		 "FAULT ENCODER: axis %c: potentiometer reads {n} V "
+		 "but {n} V is expected at encoder position %s; "
+		 "they differ by {n} V, more than the {n} V allowed, "
+		 "for {n} cycles." SAFE_OK " Recovery: keep the E-stop "
+		 "pressed, check the encoder and potentiometer cables "
+		 "of axis %c, restart roboelf and recalibrate",
+		 'A' + axis, pos, 'A' + axis);
+	return k;
+}
+
+/* The position of an ENCODER pot/encoder line (matched by tpl_encpot with
+ * @k numbers for it) in units is the one in counts, to 2 decimals. */
+static void check_encpot_units(const double *num, int k, int axis,
+			       const char *line)
+{
+	if (k == 2 && fabs(num[3] - num[2] / env.per_unit[axis]) > 0.0051)
+		fail_msg("the position in %s (%.2f) is not %.0f counts: %s",
+			 env.unit[axis], num[3], num[2], line);
 }
 
 static void jam(int axis, int calibrating)
@@ -1473,7 +1505,8 @@ static void jam(int axis, int calibrating)
 static void enc_stuck(int axis, int calibrating)
 {
 	char name[48], req[32], tpl[1024], act[8], pos[8];
-	double t, d, num[6], runaway;
+	double t, d, num[7], runaway;
+	int k = 0;
 	struct row *r;
 
 	snprintf(name, sizeof(name), "7 encoder stuck %c, %s", 'A' + axis,
@@ -1488,19 +1521,13 @@ static void enc_stuck(int axis, int calibrating)
 	if (calibrating)
 		tpl_poserr(tpl, sizeof(tpl), axis);
 	else
-		snprintf(tpl, sizeof(tpl),
-			 "FAULT ENCODER: axis %c: potentiometer reads {n} V "
-			 "but {n} V is expected at encoder position {n} counts "
-			 "(they differ by {n} V, more than the {n} V allowed, "
-			 "for {n} cycles)." SAFE_OK
-			 " Recovery: keep the E-stop "
-			 "pressed, check the encoder and potentiometer cables "
-			 "of axis %c, restart roboelf and recalibrate",
-			 'A' + axis, 'A' + axis);
-	expect_cause(r, t, tpl, d + d_ctrl_to_relay(), d, num, 6);
+		k = tpl_encpot(tpl, sizeof(tpl), axis) - 1;
+	expect_cause(r, t, tpl, d + d_ctrl_to_relay(), d, num, 7);
+	if (!calibrating)
+		check_encpot_units(num, k + 1, axis, r->text);
 	if (!calibrating &&
-	    (fabs(num[0] - num[1]) <= num[4] || num[3] <= num[4] ||
-	     (int)num[5] != env.persistence + 1))
+	    (fabs(num[0] - num[1]) <= num[4 + k] || num[3 + k] <= num[4 + k] ||
+	     (int)num[5 + k] != env.persistence + 1))
 		fail_msg("the values do not show a disagreement beyond the "
 			 "tolerance for persistence + 1 cycles: %s",
 			 r->text);
@@ -1988,8 +2015,9 @@ static void test_log_full(void **state)
 	char line[TEXT_MAX], msg[TEXT_MAX], tpl[1024], how[64];
 	char *args[] = {(char *)"--log", logopt, NULL};
 	struct sys_opts o = {.re_args = args};
-	double t, t_relay, t_mo, num[6], d = (2.0 + env.persistence) * P();
+	double t, t_relay, t_mo, num[7], d = (2.0 + env.persistence) * P();
 	long long w1, w2;
+	int k;
 	int i, tmpfs = mount_logfs() == 0;
 
 	(void)state;
@@ -2035,15 +2063,10 @@ static void test_log_full(void **state)
 		     "%s: relay off %.0f ms (deadline %.0f), motors off "
 		     "%.0f ms (deadline %.0f); log retried after %lld ms",
 		     how, t_relay, d, t_mo, d + SYS_MAINMS, w2 - w1);
-	snprintf(tpl, sizeof(tpl),
-		 "FAULT ENCODER: axis A: potentiometer reads {n} V but {n} V "
-		 "is expected at encoder position {n} counts (they differ by "
-		 "{n} V, more than the {n} V allowed, for {n} cycles)." SAFE_OK
-		 " Recovery: keep the E-stop pressed, check the encoder and "
-		 "potentiometer cables of axis A, restart roboelf and "
-		 "recalibrate");
+	k = tpl_encpot(tpl, sizeof(tpl), 0);
 	not_own_request(line);
-	expect_text("the FAULT line", tpl, line, num, 6);
+	expect_text("the FAULT line", tpl, line, num, 7);
+	check_encpot_units(num, k, 0, line);
 	if (t_relay > d + SLACK_MS || t_mo > d + SYS_MAINMS + SLACK_MS)
 		fail_msg("too late: relay off %.0f ms, motors off %.0f ms",
 			 t_relay, t_mo);

@@ -1003,6 +1003,63 @@ static void test_docs_list_every_template(void **state)
 	}
 }
 
+/* Positions also in the robot's units (issue 15): "{i0c}" and "{r12}";
+ * without units, or for an axis without one, exactly the counts. */
+static void test_format_units(void **state)
+{
+	struct re_fault_units u = {{"deg", "deg", "mm"}, {1000, 1000, 250}};
+	struct re_fault f;
+	char line[512];
+
+	(void)state;
+	re_fault_set(&f, RE_F_ENC_OUTSIDE, 1);
+	f.i[0] = 52000;
+	f.i[1] = -49640;
+	f.i[2] = 49640;
+	assert_true(re_fault_what_units(&f, NULL, &u, line, sizeof(line)) > 0);
+	assert_string_equal(line, "axis B: encoder position 52000 counts "
+				  "(52.00 deg) is outside the calibrated "
+				  "travel -49640 to 49640 counts (-49.64 to "
+				  "49.64 deg)");
+	re_fault_what(&f, NULL, line, sizeof(line));
+	assert_string_equal(line, "axis B: encoder position 52000 counts is "
+				  "outside the calibrated travel -49640 to "
+				  "49640 counts");
+	u.name[1] = NULL; /* no unit for B: counts only */
+	re_fault_what_units(&f, NULL, &u, line, sizeof(line));
+	assert_string_equal(line, "axis B: encoder position 52000 counts is "
+				  "outside the calibrated travel -49640 to "
+				  "49640 counts");
+	re_fault_set(&f, RE_F_CTRL_POSERR, 2);
+	f.i[0] = 801;
+	re_fault_format_units(&f, NULL, &u, line, sizeof(line));
+	assert_non_null(strstr(line, "FAULT MOTION: axis C: position error of "
+				     "at least 801 counts (3.20 mm), above "));
+	f.i[0] = -1; /* never "-0.00" */
+	re_fault_what_units(&f, NULL, &u, line, sizeof(line));
+	assert_non_null(strstr(line, "at least -1 counts (0.00 mm), above"));
+	f.i[0] = RE_VAL_UNKNOWN;
+	re_fault_what_units(&f, NULL, &u, line, sizeof(line));
+	assert_non_null(strstr(line, "at least unknown, above"));
+	u.counts_per_unit[2] = 0; /* scale not known: counts only */
+	f.i[0] = 801;
+	re_fault_what_units(&f, NULL, &u, line, sizeof(line));
+	assert_non_null(strstr(line, "at least 801 counts, above"));
+	re_fault_set(&f, RE_F_ENCPOT, 0);
+	f.i[0] = 12345;
+	f.i[1] = 3;
+	f.f[0] = 2.5;
+	f.f[1] = 3.1;
+	f.f[2] = 0.6;
+	f.f[3] = 0.06;
+	re_fault_what_units(&f, NULL, &u, line, sizeof(line));
+	assert_string_equal(line, "axis A: potentiometer reads 2.500 V but "
+				  "3.100 V is expected at encoder position "
+				  "12345 counts (12.35 deg); they differ by "
+				  "0.600 V, more than the 0.060 V allowed, for "
+				  "3 cycles");
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -1028,6 +1085,7 @@ int main(void)
 	    cmocka_unit_test(test_cal_table),
 	    cmocka_unit_test(test_every_fault_formats),
 	    cmocka_unit_test(test_format_names_and_overflow),
+	    cmocka_unit_test(test_format_units),
 	    cmocka_unit_test(test_docs_list_every_template),
 	};
 
