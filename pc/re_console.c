@@ -89,10 +89,17 @@ void re_console_restore(struct re_console *c)
 	}
 }
 
+static void board_remove(struct re_console *c, FILE *out);
+
 void re_console_close(struct re_console *c)
 {
-	/* the board stays on the screen, under the last messages; the whole
-	 * screen scrolls again, the cursor under the board */
+	/* no fault: the board goes (left there, its "relay ON", "on" would
+	 * contradict the confirmed switch-off said above it); a latched
+	 * fault: its panel stays under the last messages (relay off, motors
+	 * off: still true), the whole screen scrolls again, the cursor under
+	 * the board */
+	if (c->tty_out && !c->fault[0])
+		board_remove(c, c->out);
 	if (c->tty_out && (c->board_lines || c->half)) {
 		fprintf(c->out, "%s\033[r\033[%d;1H\n", c->half ? "\0338" : "",
 			c->rows);

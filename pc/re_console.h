@@ -142,7 +142,11 @@ void re_console_flush_keys(struct re_console *c);
  * async-signal-safe enough to call on the way out). */
 void re_console_restore(struct re_console *c);
 
-/* re_console_close() - erase nothing, restore the terminal, flush. */
+/*
+ * re_console_close() - restore the terminal and flush. The board is erased
+ * (its values would be stale once roboelf ends) unless a fault was shown:
+ * then the board with its fault panel stays, the cursor under it.
+ */
 void re_console_close(struct re_console *c);
 
 /*

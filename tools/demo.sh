@@ -101,12 +101,35 @@ fi
 # live status board here (on the bottom lines; this narration scrolls
 # above it) while its output is also kept in a file to watch. It runs in
 # $RUN: the calibration table and the log stay there after the demo.
+# script(1) gives its pseudo-terminal the size of its standard input, which
+# is /dev/null here (the keys are the demo's): without the stty below
+# roboelf would lay its board out for 80x24 whatever this terminal's size,
+# in the middle of a taller one, over the narration.
+tty_size() { # prints "ROWS COLS" of this terminal, or "24 80"
+	local size
+	size=$(stty size </dev/tty 2>/dev/null)
+	case "$size" in [1-9]*\ [1-9]*) echo "$size" ;; *) echo "24 80" ;; esac
+}
 start_roboelf() { # start_roboelf full|file
-	(cd "$RUN" && exec script -qfec "exec '$BIN/roboelf' -c '$TOP/config/roboelf.yaml' \
+	local size
+	size=$(tty_size)
+	(cd "$RUN" && exec script -qfec "stty rows ${size% *} cols ${size#* }; \
+		exec '$BIN/roboelf' -c '$TOP/config/roboelf.yaml' \
 		--galil '$addr' --relay '$TMP/relay' --calibration $1 --log '$RUN/roboelf.log'" \
 		"$RUN/roboelf.out" </dev/null) &
 	RE_PID=$!
 }
+# resize_roboelf: this terminal was resized: so is roboelf's (its board is
+# redrawn for the new size on the SIGWINCH that stty makes the kernel send)
+resize_roboelf() {
+	local pid pts size
+	[ -n "$RE_PID" ] || return 0
+	pid=$(ps -o pid= --ppid "$RE_PID" 2>/dev/null | head -n 1)
+	pts=$(readlink "/proc/${pid// /}/fd/1" 2>/dev/null) || return 0
+	size=$(tty_size)
+	stty -F "$pts" rows "${size% *}" cols "${size#* }" 2>/dev/null
+}
+trap resize_roboelf WINCH
 # stop_roboelf: SIGTERM to roboelf itself (the child of script), which
 # quits in order and ends script quietly; the group only if it hangs.
 stop_roboelf() {

@@ -166,6 +166,11 @@ check_screen 80 "joystick released"
 tmux -S "$sock" send-keys -t re q
 wait_for 20 sh -c "! pgrep -f '^$BIN/roboelf -c $tmp/roboelf.yaml' >/dev/null" ||
 	fail "joystick held: roboelf did not quit within 20 s of q"
+# quit without a fault: the board is gone (it would show "relay ON"), the
+# switch-off's confirmation is the last word
+wait_for 5 on_screen "motor power off (relay): confirmed; bye" ||
+	{ screen; fail "q: no confirmed switch-off on the screen"; }
+[ "$(screen | grep -c '^RoboELF  mode')" = 0 ] || { screen; fail "q without a fault: a stale board is left on the screen"; }
 tmux -S "$sock" kill-session -t re 2>/dev/null
 # with a calibration file: interrupted, the file's table is kept
 interrupt 80x24 "onto rev switch" "calibration interrupted: no new table; the table in force is still the one in '$tmp/cal.txt' (made 20" \
@@ -180,4 +185,4 @@ said() { screen | grep -q "EXIT=2"; }
 wait_for 10 said || { screen; fail "Ctrl-D: no exit 2"; }
 screen | tr '\n' ' ' | tr -s ' ' | grep -q "no answer to the calibration question (end of input): nothing moved, motor power stays off" ||
 	{ screen; fail "Ctrl-D: no reason given"; }
-echo "console_tmux: ok (80x24, 100x30, 200x60 and a resize: no wrapped line, one header, the FAULT and its recovery on screen 10 s later; the calibration board with phases and time left, Ctrl-C in it says which table is in force; Ctrl-D at the calibration question explained, exit 2; a joystick held at arming named on the board and the screen, Ready after its release)"
+echo "console_tmux: ok (80x24, 100x30, 200x60 and a resize: no wrapped line, one header, the FAULT and its recovery on screen 10 s later; the calibration board with phases and time left, Ctrl-C in it says which table is in force; Ctrl-D at the calibration question explained, exit 2; a joystick held at arming named on the board and the screen, Ready after its release; no stale board after q)"
