@@ -156,7 +156,13 @@ if [ "${INTERACTIVE:-}" = 1 ]; then
 	# once it is armed: drop them
 	while IFS= read -r -s -n 1 -t 0.01 _ <&3; do :; done
 	say "keys are read now (a/z s/x d/c joysticks, space release, i p e j r faults, q quit roboelf)"
-	while IFS= read -r -s -n 1 key <&3; do
+	# bash runs a trap only between commands: a read that waits for a
+	# key would hold a resize (resize_roboelf) back until the next key
+	while :; do
+		IFS= read -r -s -n 1 -t 0.2 key <&3
+		rc=$?
+		[ "$rc" -gt 128 ] && continue # no key within 0.2 s
+		[ "$rc" -ne 0 ] && break      # end of input
 		if [ -z "$RE_PID" ]; then
 			case "$key" in
 			s|f) how=file; [ "$key" = f ] && how=full
