@@ -22,6 +22,7 @@
 #include "re_comm_steps.h"
 #include "re_comm_util.h"
 #include "re_ctl.h"
+#include "re_dmcif.h"
 
 #define STEP "firmware"
 
@@ -343,6 +344,45 @@ static int probe_record(struct re_comm *c)
 	return GL_OK;
 }
 
+/* ZAC carries the program's largest value whole, in MG _ZAC and in the
+ * record (ZA: a 4-byte signed field of the record, galil-notes 2); the
+ * program is halted here, so nothing else writes ZA. */
+static int probe_za(struct re_comm *c)
+{
+	char cmd[32], r[96] = "";
+	struct gl_record rec;
+	double mg = -1;
+	long qr = -1;
+	int rc, ok;
+
+	snprintf(cmd, sizeof(cmd), "ZA ,,%ld", RE_ZAC_MAX);
+	rc = ask(c, cmd, r, sizeof(r));
+	if (rc < 0 && rc != GL_ERR_CTRL)
+		return rc;
+	if (rc >= 0 && (rc = rc_num(c, "_ZAC", &mg)) != GL_OK)
+		return rc;
+	if (mg >= 0) {
+		rc = c->io->ops->record(c->io->ud, NULL, &rec, 0);
+		if (rc != GL_OK && rc != GL_ERR_RECORD)
+			return rc;
+		if (rc == GL_OK && rec.n_axes >= 3)
+			qr = rec.axis[2].za;
+	}
+	if ((rc = rc_cmd(c, "ZA ,,0", NULL, 0)) < 0 && rc != GL_ERR_CTRL)
+		return rc;
+	ok = mg == RE_ZAC_MAX && qr == RE_ZAC_MAX;
+	re_comm_add(c, STEP, "za-range", ok ? RE_COMM_PASS : RE_COMM_FAIL,
+		    ok ? NULL
+		       : "roboelf cannot read the program's joystick and "
+			 "motion field from this controller: report the "
+			 "model and firmware (identity) to the developers",
+		    "%s%s, then MG _ZAC and QR; reference (ZA; the record's "
+		    "user field, 4 bytes signed): %ld in both; seen %.0f and "
+		    "%ld (put back to 0)",
+		    cmd, r[0] == '?' ? r : "", RE_ZAC_MAX, mg, qr);
+	return GL_OK;
+}
+
 /* UL returns the downloaded text: galil-load's stamp still matches. */
 static int probe_upload(struct re_comm *c)
 {
@@ -406,8 +446,8 @@ static const struct {
 int rc_step_firmware(struct re_comm *c)
 {
 	int (*const probe[])(struct re_comm *) = {
-	    probe_unknown, probe_tm,  probe_mg,	    probe_dm,	  probe_handle,
-	    probe_cn,	   probe_in9, probe_record, probe_upload,
+	    probe_unknown, probe_tm,  probe_mg,	    probe_dm, probe_handle,
+	    probe_cn,	   probe_in9, probe_record, probe_za, probe_upload,
 	};
 	int rc;
 

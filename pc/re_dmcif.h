@@ -45,6 +45,10 @@ enum re_dmc_fcode {
 	RE_DMC_F_MAX = 16,
 };
 
+/* The largest ZAC the program publishes (jraw 4095, jcmd 6, mcmd 6,
+ * mneut 1): the commissioning run checks that ZA and the record carry it. */
+#define RE_ZAC_MAX (4095L + 4096L * 7 + 32768L * 6 + 262144L)
+
 struct re_za {
 	int32_t hbdmc; /* ZAA */
 	int state;     /* ZAB % 10 */

@@ -10,6 +10,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "gl_err.h"
+#include "gl_record.h"
 #include "sim.h"
 #include "test_ctrl_util.h"
 
@@ -50,6 +52,7 @@ static void test_names(void **state)
 	assert_int_equal(sim_deviation_bit("qr-header"), CTRL_DEV_QR_HEADER);
 	assert_int_equal(sim_deviation_bit("ul-trim"), CTRL_DEV_UL_TRIM);
 	assert_int_equal(sim_deviation_bit("mo-moving"), CTRL_DEV_MO_MOVING);
+	assert_int_equal(sim_deviation_bit("za-16bit"), CTRL_DEV_ZA_16BIT);
 	assert_int_equal(sim_deviation_bit("mg"), 0);
 	assert_int_equal(sim_deviation_bit(""), 0);
 }
@@ -141,12 +144,47 @@ static void test_mo_moving(void **state)
 	ctrl_set_deviate(p->c, 0);
 }
 
+/* Axis C's ZA in the record after "ZA ,,491519" (the program's largest
+ * ZAC). */
+static long qr_zac(struct tplant *p)
+{
+	uint8_t buf[512];
+	struct gl_record r;
+	size_t n;
+
+	tp_send(p, 0, "QR\r");
+	n = ctrl_output(p->c, 0, buf, sizeof(buf));
+	assert_int_equal(n, 190 + 1);
+	assert_int_equal(gl_record_decode(buf, 190, GL_LAYOUT_4000, 3, &r),
+			 GL_OK);
+	return r.axis[2].za;
+}
+
+/* za-16bit: the record's ZA keeps its low 16 bits (sign-extended); MG
+ * _ZAC is unchanged. */
+static void test_za_16bit(void **state)
+{
+	struct tplant *p = *state;
+
+	reply(p, "ZA ,,491519", "");
+	assert_int_equal(qr_zac(p), 491519);
+	reply(p, "MG _ZAC", " 491519.0000\r\n");
+	ctrl_set_deviate(p->c, CTRL_DEV_ZA_16BIT);
+	assert_int_equal(qr_zac(p), 32767);
+	reply(p, "ZA ,,98304", ""); /* 0x18000: low 16 bits 0x8000 */
+	assert_int_equal(qr_zac(p), -32768);
+	reply(p, "MG _ZAC", " 98304.0000\r\n");
+	ctrl_set_deviate(p->c, 0);
+	reply(p, "ZA ,,0", "");
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_names),     cmocka_unit_test(test_mg_join),
 	    cmocka_unit_test(test_dm_exists), cmocka_unit_test(test_qr_header),
 	    cmocka_unit_test(test_ul_trim),   cmocka_unit_test(test_mo_moving),
+	    cmocka_unit_test(test_za_16bit),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

@@ -730,7 +730,8 @@ static void test_usage_errors(void **state)
 	    "try 'galil-sim --help'\n");
 	run_expect((char *const[]){(char *)"--deviate", (char *)"mg", NULL}, 2,
 		   "galil-sim: unknown deviation 'mg' (mg-join, dm-exists, "
-		   "qr-header, ul-trim, mo-moving)\ntry 'galil-sim --help'\n");
+		   "qr-header, ul-trim, mo-moving, za-16bit)\ntry 'galil-sim "
+		   "--help'\n");
 }
 
 /* --miswire and --deviate reach the robot and the controller; TH shows

@@ -196,6 +196,11 @@ static void test_clean_robot(void **state)
 	assert_non_null(strstr(rep, "PASS  close            relay ON: bit 3 "
 				    "of _TA0 cleared after"));
 	assert_non_null(strstr(rep, "PASS  pt-tracking"));
+	assert_non_null(strstr(rep, "PASS  za-range         ZA ,,491519, then "
+				    "MG _ZAC and QR; reference (ZA; the "
+				    "record's user field, 4 bytes signed): "
+				    "491519 in both; seen 491519 and 491519 "
+				    "(put back to 0)"));
 	assert_non_null(strstr(rep, "PASS  ul-identical"));
 	assert_non_null(
 	    strstr(rep, "encoder: asked the program for +2000 counts"));
@@ -319,6 +324,11 @@ static const struct wrong wrongs[] = {
      "NOTE  dm-exists        DM cmqz[4] twice; reference (DM): silent on an "
      "array that exists (UNCONFIRMED); first ':', second ':'; dmc/ "
      "deallocates every array first (DA *[]): safe on either"},
+    {"--deviate", "za-16bit", 5,
+     "commission: FAILED at step firmware (za-range): ZA ,,491519, then MG "
+     "_ZAC and QR; reference (ZA; the record's user field, 4 bytes signed): "
+     "491519 in both; seen 491519 and 32767 (put back to 0)",
+     NULL},
     {"--deviate", "qr-header", 5,
      "commission: FAILED at step firmware (qr-record): QR; reference (QR, "
      "QZ): a record of the announced length whose header names axes A-C; "

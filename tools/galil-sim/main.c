@@ -95,7 +95,8 @@ static void usage(FILE *f)
 	    "joystick-polarity\n"
 	    "  --deviate NAME      answer differently from the reference: "
 	    "mg-join,\n"
-	    "                      dm-exists, qr-header, ul-trim, mo-moving\n"
+	    "                      dm-exists, qr-header, ul-trim, mo-moving,\n"
+	    "                      za-16bit\n"
 	    "  --bench [SECONDS]   measure virtual-time speed with 8 busy "
 	    "threads\n",
 	    DEFAULT_PORT, DEFAULT_CONTROL_PORT, DEFAULT_RELAY_LINK,
@@ -181,7 +182,8 @@ static int parse_opt(int c, const char *arg, struct opts *o)
 		if (!sim_deviation_bit(arg)) {
 			fprintf(stderr,
 				"galil-sim: unknown deviation '%s' (mg-join, "
-				"dm-exists, qr-header, ul-trim, mo-moving)\n",
+				"dm-exists, qr-header, ul-trim, mo-moving, "
+				"za-16bit)\n",
 				arg);
 			return -1;
 		}

@@ -75,6 +75,7 @@ unsigned sim_deviation_bit(const char *name)
 	    {"qr-header", CTRL_DEV_QR_HEADER},
 	    {"ul-trim", CTRL_DEV_UL_TRIM},
 	    {"mo-moving", CTRL_DEV_MO_MOVING},
+	    {"za-16bit", CTRL_DEV_ZA_16BIT},
 	};
 
 	for (size_t i = 0; i < sizeof(dev) / sizeof(dev[0]); i++)

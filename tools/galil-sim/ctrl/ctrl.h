@@ -42,6 +42,7 @@ struct ctrl_cfg {
 #define CTRL_DEV_QR_HEADER 0x04u /* QR header byte 1 reads 0x03, not 0x07 */
 #define CTRL_DEV_UL_TRIM   0x08u /* UL drops trailing spaces of each line */
 #define CTRL_DEV_MO_MOVING 0x10u /* MO accepted while an axis profiles */
+#define CTRL_DEV_ZA_16BIT  0x20u /* the record's ZA keeps 16 bits only */
 
 /* What the plant reports to the controller each sample. */
 struct ctrl_sense {

@@ -67,6 +67,8 @@ static void axis_fill(const struct ctrl *c, int i, struct gl_rec_axis *r)
 	r->analog_in = (int32_t)fmax(-32768, fmin(32767, round(an)));
 	r->hall = 0;
 	r->za = clamp32(trunc(a->za));
+	if (c->cfg.deviate & CTRL_DEV_ZA_16BIT)
+		r->za = (int16_t)(uint16_t)((uint32_t)r->za & 0xffffu);
 }
 
 /* ctrl_record() - QR into @buf. Return its length or a negative gl_err. */
