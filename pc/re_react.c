@@ -288,6 +288,12 @@ static void consequences(struct re_super *s, const struct re_fault *f)
 	    f->id == RE_F_RELAY_POWER || program_fault(s, &za, &det) != GL_OK ||
 	    !za.fcode || own_doing(&za, det))
 		return;
+	/* every amplifier without power once our relay is confirmed open:
+	 * the program saw our own cut before our pcflt=1 (the amplifier
+	 * error runs at once, pcflt waits for the next pass) */
+	if (za.fcode == RE_DMC_F_AMPERR && za.faxis == 0 &&
+	    s->confirm.relay_rc == GL_OK)
+		return;
 	re_ctrl_fault(&za, (long long)det, &c);
 	if (re_fault_what_units(&c, s->cfg.axis_names, &s->cfg.units, s->then,
 				sizeof(s->then)) == GL_ERR_ARG)

@@ -553,6 +553,34 @@ static void test_super_consequences(void **state)
 	}
 }
 
+/* The program's "motor power lost on every axis" (AMPERR on no single
+ * axis) is our own relay's doing when the relay's off is confirmed: no
+ * "Then:" (it can come before our pcflt=1: the amplifier error runs at
+ * once); with the relay's off not confirmed it is said. */
+static void test_super_power_loss_ours(void **state)
+{
+	for (int k = 0; k < 2; k++) {
+		const char *line;
+
+		setup(state);
+		assert_int_equal(run(2), RE_OK);
+		fk.fcode_val = 8;
+		fk.faxis = 0;
+		fk.relay_off_rc = k ? GL_ERR_RELAY : GL_OK;
+		fk.record_rc = GL_ERR_CLOSED;
+		assert_int_equal(step(), RE_FAULT);
+		line = re_super_fault_line(&sup);
+		assert_true(!strncmp(line, "FAULT COMM: ", 12));
+		if (k)
+			assert_non_null(strstr(line, ". Then: motor power lost "
+						     "on every axis (E-stop "
+						     "button, relay or power "
+						     "supply)."));
+		else
+			assert_null(strstr(line, "Then:"));
+	}
+}
+
 /* A closed connection: COMM fault. */
 static void test_super_comm_fault(void **state)
 {
@@ -995,6 +1023,7 @@ int main(void)
 	    cmocka_unit_test_setup(test_super_comm_fault, setup),
 	    cmocka_unit_test_setup(test_super_foreign_named, setup),
 	    cmocka_unit_test_setup(test_super_consequences, setup),
+	    cmocka_unit_test_setup(test_super_power_loss_ours, setup),
 	    cmocka_unit_test_setup(test_super_relay_lost, setup),
 	    cmocka_unit_test_setup(test_super_controller_fault, setup),
 	    cmocka_unit_test_setup(test_super_motor_off, setup),
