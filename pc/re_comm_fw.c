@@ -359,7 +359,9 @@ static int probe_za(struct re_comm *c)
 	rc = ask(c, cmd, r, sizeof(r));
 	if (rc < 0 && rc != GL_ERR_CTRL)
 		return rc;
-	if (rc >= 0 && (rc = rc_num(c, "_ZAC", &mg)) != GL_OK)
+	/* MG _ZAC refused (GL_ERR_CTRL): mg stays -1, a FAIL below */
+	if (rc >= 0 && (rc = rc_num(c, "_ZAC", &mg)) != GL_OK &&
+	    rc != GL_ERR_CTRL)
 		return rc;
 	if (mg >= 0) {
 		rc = c->io->ops->record(c->io->ud, NULL, &rec, 0);

@@ -24,10 +24,10 @@ int re_za_decode(int32_t zaa, int32_t zab, int32_t zac, struct re_za *out)
 	z.state = zab % 10;
 	z.fcode = (zab / 10) % 100;
 	z.faxis = zab / 1000;
-	z.jraw = zac % 4096;
-	z.jcmd = (zac / 4096) % 8 - 1;
-	z.mcmd = (zac / 32768) % 8;
-	z.mneut = zac / 262144;
+	z.jraw = zac % RE_ZAC_JCMD;
+	z.jcmd = (zac / RE_ZAC_JCMD) % 8 - 1;
+	z.mcmd = (zac / RE_ZAC_MCMD) % 8;
+	z.mneut = zac / RE_ZAC_MNEUT;
 	if (z.state > RE_DMC_SERVICE || z.fcode > RE_DMC_F_MAX || z.faxis > 3 ||
 	    z.mcmd > 6 || z.jcmd > 6 || z.mneut > 1)
 		return GL_ERR_RANGE;

@@ -45,9 +45,15 @@ enum re_dmc_fcode {
 	RE_DMC_F_MAX = 16,
 };
 
+/* ZAC = jraw + RE_ZAC_JCMD * (jcmd + 1) + RE_ZAC_MCMD * mcmd
+ *       + RE_ZAC_MNEUT * mneut (dmc/roboelf.dmc #MAIN, dmc-interface.md) */
+#define RE_ZAC_JCMD  4096L
+#define RE_ZAC_MCMD  32768L
+#define RE_ZAC_MNEUT 262144L
 /* The largest ZAC the program publishes (jraw 4095, jcmd 6, mcmd 6,
  * mneut 1): the commissioning run checks that ZA and the record carry it. */
-#define RE_ZAC_MAX (4095L + 4096L * 7 + 32768L * 6 + 262144L)
+#define RE_ZAC_MAX                                                             \
+	(RE_ZAC_JCMD - 1 + RE_ZAC_JCMD * 7 + RE_ZAC_MCMD * 6 + RE_ZAC_MNEUT)
 
 struct re_za {
 	int32_t hbdmc; /* ZAA */

@@ -260,17 +260,23 @@ static void foreign_from_program(struct re_super *s)
 		s->foreign |= (unsigned)m;
 }
 
-/* A program fault that our own stop caused: 12 (pcflt), or a motor found
+/* A program fault that our own stop caused: 12 (pcflt); a motor found
  * off (fault 10) whose stop code says nothing stopped it but a command:
- * 1 at rest, 4 ST, 7 AB. Our "pcflt=1;AB 1;MO ABC" can land in the
- * middle of the program's pass, after its pcflt check and before its
- * motor check: then the program latches 10 first. A motor the servo or
- * an amplifier switched off has its own code (8 ER, 12 OA ...) or fault. */
-static int own_doing(const struct re_za *za, double det)
+ * 1 at rest, 4 ST, 7 AB; every amplifier without power (8 on no single
+ * axis) once our relay's off is confirmed. Our "pcflt=1;AB 1;MO ABC" can
+ * land in the middle of the program's pass, after its pcflt check and
+ * before its motor check: then the program latches 10 first; and the
+ * amplifier error runs at once when our relay cuts the power, while pcflt
+ * waits for the next pass. A motor the servo or an amplifier switched off
+ * has its own code (8 ER, 12 OA ...) or fault. */
+static int own_doing(const struct re_super *s, const struct re_za *za,
+		     double det)
 {
 	return za->fcode == RE_DMC_F_SUPERVISOR ||
 	       (za->fcode == RE_DMC_F_MOTOROFF &&
-		(det == 1 || det == 4 || det == 7));
+		(det == 1 || det == 4 || det == 7)) ||
+	       (za->fcode == RE_DMC_F_AMPERR && za->faxis == 0 &&
+		s->confirm.relay_rc == GL_OK);
 }
 
 /* What the controller did on its own (its latched fault) when that is not
@@ -286,13 +292,7 @@ static void consequences(struct re_super *s, const struct re_fault *f)
 	/* RELAY_POWER is the program's power loss, named with its cause */
 	if (s->confirm.stop_rc < 0 || re_fault_is_ctrl(f->id) ||
 	    f->id == RE_F_RELAY_POWER || program_fault(s, &za, &det) != GL_OK ||
-	    !za.fcode || own_doing(&za, det))
-		return;
-	/* every amplifier without power once our relay is confirmed open:
-	 * the program saw our own cut before our pcflt=1 (the amplifier
-	 * error runs at once, pcflt waits for the next pass) */
-	if (za.fcode == RE_DMC_F_AMPERR && za.faxis == 0 &&
-	    s->confirm.relay_rc == GL_OK)
+	    !za.fcode || own_doing(s, &za, det))
 		return;
 	re_ctrl_fault(&za, (long long)det, &c);
 	if (re_fault_what_units(&c, s->cfg.axis_names, &s->cfg.units, s->then,
