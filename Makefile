@@ -11,6 +11,7 @@
 #   make fuzz     every libFuzzer target for FUZZ_SECONDS (default 600) each
 #   make install / uninstall   (PREFIX, DESTDIR)
 #   make deb      the Debian package build/roboelf_<version>_<arch>.deb
+#   make fresh    README's two commands in a minimal Debian 12 root (root only)
 #
 # Source layout conventions (so that adding a file needs no Makefile edit):
 #   pc/base/*.c          shared base: clock, files, YAML -> $(BUILD)/lib/libbase.a
@@ -142,21 +143,34 @@ asan: deps
 	@$(MAKE) --no-print-directory BUILD=$(BUILD)/asan SANITIZE=address,undefined \
 		CFLAGS="-O1 -g" check
 
+# The scripts run with only the commands of docs/commands.md on their PATH
+# (tools/cmdtable.sh), as the tests do (tests/run-all.sh).
+CMDPATH = $(CURDIR)/$(BUILD)/cmdpath
+.PHONY: cmdpath fresh
+cmdpath:
+	@sh tools/cmdtable.sh path $(CMDPATH)
+
 demo: deps
-	@$(MAKE) --no-print-directory all
-	@BUILD=$(BUILD) INTERACTIVE=$(INTERACTIVE) tools/demo.sh
+	@$(MAKE) --no-print-directory all cmdpath
+	@BUILD=$(BUILD) INTERACTIVE=$(INTERACTIVE) PATH=$(CMDPATH) tools/demo.sh
 
 bench: deps
-	@$(MAKE) --no-print-directory tests
-	@BUILD=$(BUILD) tests/bench.sh
+	@$(MAKE) --no-print-directory tests cmdpath
+	@BUILD=$(BUILD) PATH=$(CMDPATH) tests/bench.sh
+
+# README's two commands in a minimal Debian 12 root, the current commit
+# cloned into it (root only; SKIPPED otherwise; tools/fresh.sh)
+fresh: deps
+	@$(MAKE) --no-print-directory cmdpath
+	@BUILD=$(BUILD) PATH=$(CMDPATH) sh tools/fresh.sh
 
 # The soak: seeded random joystick use with pot noise and transient invalid
 # states (tests/system/test_sys_soak.c); make check runs it for 60 s.
 SOAK_SECONDS ?= 600
 SOAK_SEED ?= 20261125
 soak: deps
-	@$(MAKE) --no-print-directory tests
-	@BUILD=$(BUILD) ROBOELF_BIN=$(CURDIR)/$(BUILD)/bin ROBOELF_TOP=$(CURDIR) \
+	@$(MAKE) --no-print-directory tests cmdpath
+	@BUILD=$(BUILD) PATH=$(CMDPATH) ROBOELF_BIN=$(CURDIR)/$(BUILD)/bin ROBOELF_TOP=$(CURDIR) \
 		ROBOELF_SOAK_S=$(SOAK_SECONDS) ROBOELF_SOAK_SEED=$(SOAK_SEED) \
 		$(BUILD)/tests/system/test_sys_soak
 
@@ -184,8 +198,9 @@ FUZZ_LIBS := $(patsubst $(BUILD)/%,$(FUZZ_BUILD)/%,$(LIB_LOAD) $(LIB_SIM) \
              $(LIB_RE) $(LIB_DMC) $(LIB_GL) $(LIB_BASE))
 .PHONY: fuzz fuzz-build
 fuzz: deps
-	@$(MAKE) --no-print-directory fuzz-build
-	@FUZZ_BUILD=$(FUZZ_BUILD) FUZZ_SECONDS=$(FUZZ_SECONDS) tests/fuzz/run.sh $(FUZZ_NAMES)
+	@$(MAKE) --no-print-directory fuzz-build cmdpath
+	@FUZZ_BUILD=$(FUZZ_BUILD) FUZZ_SECONDS=$(FUZZ_SECONDS) PATH=$(CMDPATH) \
+		tests/fuzz/run.sh $(FUZZ_NAMES)
 fuzz-build:
 	@$(MAKE) --no-print-directory BUILD=$(FUZZ_BUILD) CC=$(FUZZ_CC) \
 		SANITIZE=address,undefined CFLAGS="-O1 -g -fsanitize=fuzzer-no-link" \
@@ -199,8 +214,12 @@ $(FUZZ_BUILD)/bin/fuzz_%: tests/fuzz/fuzz_%.c $(FUZZ_LIBS)
 -include $(wildcard $(FUZZ_BUILD)/bin/*.d)
 
 # ---- dependencies ------------------------------------------------------------
-DEB_PKGS = gcc make pkg-config libserialport-dev libyaml-dev libcmocka-dev gnuplot-nox tmux \
-           clang-format cppcheck clang libclang-rt-dev valgrind
+# Every command that make check, demo, bench, fresh and the package's scripts
+# call has its package here or is Essential (docs/commands.md, the one table;
+# tests/checks/commands.sh holds the two together).
+DEB_PKGS = gcc make binutils pkgconf libserialport-dev libyaml-dev libcmocka-dev \
+           gnuplot-nox tmux clang-format cppcheck clang libclang-rt-dev valgrind strace \
+           procps iproute2 shfmt jq git debootstrap
 deps:
 	@missing=""; for p in $(DEB_PKGS); do \
 		dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'ok installed' || missing="$$missing $$p"; \
@@ -214,6 +233,10 @@ deps:
 			echo "deps: run: sudo apt-get install$$missing"; exit 1; \
 		fi; \
 	fi
+
+.PHONY: print-deb-pkgs
+print-deb-pkgs:
+	@echo $(DEB_PKGS)
 
 # ---- network rig (tests/net, docs/link.md) ------------------------------------
 # nfq-delay (the rig's packet delayer) is built when libnetfilter-queue is

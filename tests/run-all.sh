@@ -11,13 +11,21 @@
 # A test program counts as passed only if it exits 0 AND its output has no
 # cmocka "[  FAILED  ]" or "[  ERROR   ]" line (cmocka 1.1.5 returns 0 when a
 # group setup fails) AND, for a cmocka binary, a "[  PASSED  ]" line.
-# Environment given to tests: BUILD, ROBOELF_BIN (the binaries), ROBOELF_TOP.
+# Environment given to tests: BUILD, ROBOELF_BIN (the binaries), ROBOELF_TOP,
+# and PATH: only the commands of docs/commands.md (tools/cmdtable.sh), so that
+# a test calling a command nobody declared fails on every machine, not only
+# on a fresh one (ROBOELF_SYSPATH keeps the full one for a declared tool that
+# runs helpers of its own: lintian).
 set -u
 BUILD=${BUILD:-build}
 ROBOELF_TOP=$(cd "$(dirname "$0")/.." && pwd)
 ROBOELF_BIN=$ROBOELF_TOP/$BUILD/bin
 export BUILD ROBOELF_BIN ROBOELF_TOP
 cd "$ROBOELF_TOP" || exit 1
+sh tools/cmdtable.sh path "$ROBOELF_TOP/$BUILD/cmdpath" || exit 1
+ROBOELF_SYSPATH=$PATH
+PATH=$ROBOELF_TOP/$BUILD/cmdpath
+export PATH ROBOELF_SYSPATH
 LOGDIR=$BUILD/test-logs
 mkdir -p "$LOGDIR"
 passed=0; failed=0; skipped=0; failures=""

@@ -119,13 +119,20 @@ start_roboelf() { # start_roboelf full|file
 		"$RUN/roboelf.out" </dev/null) &
 	RE_PID=$!
 }
+# child_of PID: PID's first child (roboelf is script's child); the kernel
+# lists a process's children in /proc, so no ps is needed
+child_of() {
+	local c
+	read -r c _ <"/proc/$1/task/$1/children" 2>/dev/null && echo "$c"
+}
 # resize_roboelf: this terminal was resized: so is roboelf's (its board is
 # redrawn for the new size on the SIGWINCH that stty makes the kernel send)
 resize_roboelf() {
 	local pid pts size
 	[ -n "$RE_PID" ] || return 0
-	pid=$(ps -o pid= --ppid "$RE_PID" 2>/dev/null | head -n 1)
-	pts=$(readlink "/proc/${pid// /}/fd/1" 2>/dev/null) || return 0
+	pid=$(child_of "$RE_PID")
+	[ -n "$pid" ] || return 0
+	pts=$(readlink "/proc/$pid/fd/1" 2>/dev/null) || return 0
 	size=$(tty_size)
 	stty -F "$pts" rows "${size% *}" cols "${size#* }" 2>/dev/null
 }
@@ -135,7 +142,7 @@ trap resize_roboelf WINCH
 stop_roboelf() {
 	local pid i
 	[ -n "$RE_PID" ] || return 0
-	pid=$(ps -o pid= --ppid "$RE_PID" 2>/dev/null | head -n 1)
+	pid=$(child_of "$RE_PID")
 	[ -n "$pid" ] && kill -TERM "$pid" 2>/dev/null
 	for i in $(seq 100); do
 		kill -0 "$RE_PID" 2>/dev/null || break

@@ -17,7 +17,7 @@ build)
 	command -v "${CC:-cc}" >/dev/null 2>&1 || add gcc
 	pc=${PKG_CONFIG:-pkg-config}
 	if ! command -v "$pc" >/dev/null 2>&1; then
-		add pkg-config
+		add pkgconf
 		# without pkg-config the libraries cannot be asked for
 		add libserialport-dev; add libyaml-dev; add libcmocka-dev
 	else

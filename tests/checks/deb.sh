@@ -77,7 +77,9 @@ for i in 1 2; do
 done
 [ "$(grep -c '^groupadd --system roboelf$' "$tmp/calls")" = 1 ] || fail "postinst: $(cat "$tmp/calls")"
 
-lintian "$deb" >"$tmp/lintian" 2>&1
+# lintian runs helpers of its own (nproc, file, ...), which its package
+# depends on: it gets the system's PATH back (docs/commands.md)
+PATH=${ROBOELF_SYSPATH:-$PATH} lintian "$deb" >"$tmp/lintian" 2>&1
 rc=$?
 grep -v 'running with root privileges' "$tmp/lintian"
 grep -q '^E: ' "$tmp/lintian" && fail "lintian reports errors"

@@ -24,8 +24,8 @@ case $out in *"No such file"* | *"error:"*) fail "make reached the compiler: $ou
 [ -z "$(find "$tmp/build" -name '*.o' 2>/dev/null)" ] || fail "make compiled something"
 
 out=$(make -s --no-print-directory PKG_CONFIG="$tmp/no-pkg-config" have-deps 2>&1)
-want="make: missing Debian packages: pkg-config libserialport-dev libyaml-dev libcmocka-dev
-$(hint " pkg-config libserialport-dev libyaml-dev libcmocka-dev")"
+want="make: missing Debian packages: pkgconf libserialport-dev libyaml-dev libcmocka-dev
+$(hint " pkgconf libserialport-dev libyaml-dev libcmocka-dev")"
 [ "$(printf '%s\n' "$out" | head -2)" = "$want" ] || fail "no pkg-config: '$out'"
 
 out=$(make -s --no-print-directory CLANG_FORMAT="$tmp/no-clang-format" CPPCHECK="$tmp/no-cppcheck" lint 2>&1)
