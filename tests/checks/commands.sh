@@ -45,18 +45,33 @@ JQ_CALLS='def lit: if .Type == "Lit" then .Value
 	elif .Type == "DblQuoted" then
 		((.Parts // []) | map(if .Type == "Lit" then .Value else "\u0001" end) | join(""))
 	else "\u0001" end;
-	def wrappers: ["exec", "nice", "setsid", "time", "xargs", "setpriv",
+	def wrappers: ["exec", "ip", "nice", "setsid", "time", "xargs", "setpriv",
 		"env", "command", "timeout", "chrt", "sh", "bash"];
 	.. | objects | select(.Type == "CallExpr") |
 	[(.Args // [])[] | ((.Parts // []) | map(lit) | join(""))] |
-	if (.[0] as $w | wrappers | index($w)) then . else .[0:1] end | @tsv'
+	if (.[0] as $w | wrappers | index($w)) or ($runners | index(.[0]))
+	then . else .[0:1] end | @tsv'
 JQ_FUNCS='.. | objects | select(.Type == "FuncDecl") | .Name.Value'
+# functions that run their arguments as a command ("$@" as the command, or
+# after a wrapper: inns() { ip netns exec "$NS" "$@"; }, wait_for 10 grep)
+JQ_RUNNERS='def at: .Parts | length == 1 and .[0].Type == "DblQuoted" and
+		((.[0].Parts // []) | length == 1 and .[0].Type == "ParamExp" and
+		 .[0].Param.Value == "@");
+	.. | objects | select(.Type == "FuncDecl") | . as $f |
+	select([.Body | .. | objects | select(.Type == "CallExpr") | .Args // [] |
+		select(length > 0) |
+		((.[0] | at) or ((.[0].Parts[0].Value // "") as $w |
+		 (["ip", "exec", "timeout", "env", "xargs", "chrt", "setpriv",
+		   "nice", "setsid"] | index($w)) and any(.[]; at)))] | any) |
+	$f.Name.Value'
 calls() {
 	ast=$(mktemp "$tmp/ast.XXXXXX") || return
 	shfmt --to-json <"$1" >"$ast" 2>"$ast.err" ||
 		{ echo "commands.sh: $2: shfmt cannot parse it: $(head -n 1 "$ast.err")"; return; }
 	jq -r "$JQ_FUNCS" "$ast" >>"$tmp/funcs"
-	jq -r "$JQ_CALLS" "$ast"
+	jq -r "$JQ_RUNNERS" "$ast" >>"$tmp/runners"
+	jq -r --argjson runners "$(jq -R . "$tmp/runners" | jq -s .)" \
+		"$JQ_CALLS" "$ast"
 }
 
 # command_of WORDS...: the command a call runs, following the wrappers; an
@@ -81,6 +96,11 @@ command_of() {
 		while [ $# -gt 0 ]; do case $1 in -*) shift ;; *) break ;; esac; done
 		[ $# -gt 1 ] && { shift; command_of "$@"; }
 		;;
+	ip)
+		printf '%s\n' "$c"
+		[ "${1:-}" = netns ] && [ "${2:-}" = exec ] && [ $# -ge 4 ] &&
+			{ shift 3; command_of "$@"; }
+		;;
 	sh | bash)
 		if [ "${1:-}" = -c ] && [ $# -ge 2 ]; then
 			printf '%s\n' "$c"
@@ -89,7 +109,17 @@ command_of() {
 			printf '%s\n' "$c"
 		fi
 		;;
-	*) printf '%s\n' "$c" ;;
+	*)
+		printf '%s\n' "$c"
+		# a function of the script that runs its arguments: its
+		# first word that is not a number or an option is a command
+		if grep -qxF -- "$c" "$tmp/runners"; then
+			while [ $# -gt 0 ]; do
+				case $1 in -* | [0-9]*) shift ;; *) break ;; esac
+			done
+			[ $# -gt 0 ] && command_of "$@"
+		fi
+		;;
 	esac
 }
 
@@ -133,9 +163,11 @@ scripts=$(find tests tools packaging .ci -type f ! -path '*/corpus/*' \
 for f in $scripts; do
 	head -n 1 "$f" | grep -qE '^#!(/usr)?/bin/(env )?(ba)?sh' || continue
 	: >"$tmp/funcs"
+	: >"$tmp/runners"
 	calls "$f" "$f" | check_calls "$f" >>"$tmp/undeclared"
 done
 : >"$tmp/funcs"
+: >"$tmp/runners"
 make -n -B --no-print-directory all tests check asan demo bench soak lint \
 	netrig install uninstall clean deps have-deps have-lint-deps fuzz-build \
 	2>/dev/null | grep -vE '^make(\[[0-9]+\])?: ' |

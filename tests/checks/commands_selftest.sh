@@ -2,7 +2,8 @@
 # commands_selftest.sh - commands.sh fails where it must: on a small tree
 # (a table, a Makefile with DEB_PKGS, one script) that passes, then with
 # one gap made at a time: a script calling an undeclared command, the same
-# hidden in "sh -c" and behind timeout, a declared command whose package
+# hidden in "sh -c", behind timeout and behind a function of the script
+# that runs its arguments, a declared command whose package
 # make deps does not install, and a command said to come from a package it
 # does not come from. Each must fail with its exact message.
 set -u
@@ -57,6 +58,10 @@ expect "an undeclared command in sh -c" "commands.sh: tests/t.sh calls 'pgrep', 
 tree "$tmp/t"
 printf 'timeout --kill-after=1 5 ip link\n' >>"$tmp/t/tests/t.sh"
 expect "an undeclared command behind timeout" "commands.sh: tests/t.sh calls 'ip', which docs/commands.md does not list (add it with its Debian package, and the package to DEB_PKGS)"
+
+tree "$tmp/t"
+printf 'inns() { ip netns exec x "$@"; }\ninns sysctl -w a=1\n' >>"$tmp/t/tests/t.sh"
+expect "an undeclared command through a function that runs its arguments" "commands.sh: tests/t.sh calls 'sysctl', which docs/commands.md does not list (add it with its Debian package, and the package to DEB_PKGS)"
 
 tree "$tmp/t"
 sed -i 's/^DEB_PKGS = tmux$/DEB_PKGS =/' "$tmp/t/Makefile"
