@@ -162,7 +162,7 @@ bench: deps
 # cloned into it (root only; SKIPPED otherwise; tools/fresh.sh)
 fresh: deps
 	@$(MAKE) --no-print-directory cmdpath
-	@BUILD=$(BUILD) PATH=$(CMDPATH) sh tools/fresh.sh
+	@BUILD=$(BUILD) ROBOELF_SYSPATH="$$PATH" PATH=$(CMDPATH) sh tools/fresh.sh
 
 # The soak: seeded random joystick use with pot noise and transient invalid
 # states (tests/system/test_sys_soak.c); make check runs it for 60 s.

@@ -29,8 +29,11 @@ base)
 	[ -e "$dir/base.done" ] && exit 0
 	rm -rf "$dir/base" "$dir/base.done" && mkdir -p "$dir" || die "cannot make $dir"
 	echo "debroot: building the pristine Debian $SUITE root in $dir/base (once)"
-	debootstrap --variant=minbase --include=gcc,make "$SUITE" "$dir/base" \
-		"$MIRROR" >"$dir/base.log" 2>&1 ||
+	# debootstrap runs helpers of its own (perl, wget, ...), which its
+	# package depends on: the system's PATH (docs/commands.md)
+	PATH=${ROBOELF_SYSPATH:-$PATH} debootstrap --variant=minbase \
+		--include=gcc,make "$SUITE" "$dir/base" "$MIRROR" \
+		>"$dir/base.log" 2>&1 ||
 		die "debootstrap failed: the end of $dir/base.log: $(tail -n 3 "$dir/base.log")"
 	touch "$dir/base.done"
 	;;
