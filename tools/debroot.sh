@@ -51,6 +51,9 @@ run)
 	# shellcheck disable=SC2016
 	exec unshare --mount --propagation private sh -c '
 		r=$1; shift
+		# the root a mount point of its own: "ip netns exec" remounts
+		# / as a slave, which a plain directory refuses
+		mount --bind "$r" "$r" &&
 		mount -t proc proc "$r/proc" &&
 		mount -t sysfs sys "$r/sys" &&
 		mount --rbind /dev "$r/dev" &&
