@@ -120,8 +120,51 @@ int re_ctl_stop(const struct re_io *io, int timeout_ms)
 
 /* ---- identification ------------------------------------------------------ */
 
-static int check_program(gl_link *l, struct re_ctl_info *info, char *err,
-			 size_t errlen)
+/* The seal part of the program @text (normal form, stamp line last)
+ * against what @cfg gives: the controller's program must hold exactly the
+ * values this configuration seals (re_seal.h). @seal gets the table. */
+static int check_seal(const char *text, size_t len, const struct re_config *cfg,
+		      struct re_seal *seal, char *err, size_t errlen)
+{
+	long at = re_seal_split(text, len);
+	size_t end = len;
+	char *want;
+	int n, rc;
+
+	if (at < 0) {
+		seterr(err, errlen,
+		       "the controller's program holds no seal (%s): load "
+		       "this release's dmc/ with galil-load and this "
+		       "configuration (docs/technician.md)",
+		       RE_SEAL_FIRST);
+		return GL_ERR_MISMATCH;
+	}
+	/* the stamp line is the last one: the seal ends before it */
+	while (end > 0 && text[end - 1] == '\n')
+		end--;
+	while (end > 0 && text[end - 1] != '\n')
+		end--;
+	rc = re_seal_make(text, (size_t)at, cfg, seal, err, errlen);
+	if (rc != GL_OK)
+		return rc;
+	want = malloc(RE_SEAL_TEXT_MAX);
+	if (!want)
+		return GL_ERR_NOMEM;
+	n = re_seal_emit(seal, want, RE_SEAL_TEXT_MAX);
+	rc = n < 0 ? n
+		   : re_seal_compare(seal, text + at, end - (size_t)at, want,
+				     (size_t)n, err, errlen);
+	free(want);
+	if (rc == GL_ERR_MISMATCH)
+		snprintf(err + strlen(err), errlen - strlen(err),
+			 ": load the program again with galil-load --config "
+			 "and the configuration roboelf uses");
+	return rc;
+}
+
+static int check_program(gl_link *l, const struct re_config *cfg,
+			 struct re_ctl_info *info, struct re_seal *seal,
+			 char *err, size_t errlen)
 {
 	char *buf = malloc(RE_CTL_UPLOAD_MAX);
 	int n, rc;
@@ -138,6 +181,13 @@ static int check_program(gl_link *l, struct re_ctl_info *info, char *err,
 		return n;
 	}
 	rc = gl_ident_verify(buf, (size_t)n, &info->program_id);
+	if (rc == GL_OK) {
+		n = gl_ident_normalise(buf, (size_t)n, buf, RE_CTL_UPLOAD_MAX);
+		rc = n < 0 ? GL_ERR_FORMAT
+			   : check_seal(buf, (size_t)n, cfg, seal, err, errlen);
+		free(buf);
+		return rc == GL_OK ? GL_OK : GL_ERR_MISMATCH;
+	}
 	free(buf);
 	if (rc == GL_ERR_FORMAT)
 		seterr(err, errlen,
@@ -198,7 +248,8 @@ int re_ctl_check_busy(const struct re_io *io, int wdto_ms, char *err,
 	return GL_ERR_BUSY;
 }
 
-int re_ctl_take_over(gl_link *l, struct re_ctl_info *info, char *err,
+int re_ctl_take_over(gl_link *l, const struct re_config *cfg,
+		     struct re_ctl_info *info, struct re_seal *seal, char *err,
 		     size_t errlen)
 {
 	char resp[64];
@@ -220,7 +271,7 @@ int re_ctl_take_over(gl_link *l, struct re_ctl_info *info, char *err,
 		       gl_strerror(rc));
 		return rc;
 	}
-	return check_program(l, info, err, errlen);
+	return check_program(l, cfg, info, seal, err, errlen);
 }
 
 /* ---- configuration --------------------------------------------------------
@@ -653,8 +704,13 @@ int re_ctl_write_params(const struct re_io *io, const struct re_config *cfg,
 	struct param p[N_PARAMS];
 	int n = fill_params(cfg, plan, cal, p), rc = GL_OK;
 
+	/* the program set the sealed ones itself (#SEALIN): only the
+	 * session's soft limits and the move time limit are written; every
+	 * one is read back and compared with this plan */
 	for (int k = 0; rc == GL_OK && k < n; k++)
-		rc = write_param(io, &p[k], err, errlen);
+		if (!strcmp(p[k].name, "srev") || !strcmp(p[k].name, "sfwd") ||
+		    !strcmp(p[k].name, "mvto"))
+			rc = write_param(io, &p[k], err, errlen);
 	for (int k = 0; rc == GL_OK && k < n; k++)
 		rc = check_param(io, &p[k], err, errlen);
 	return rc;

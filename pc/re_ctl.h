@@ -26,6 +26,7 @@
 #include "re_config.h"
 #include "re_io.h"
 #include "re_plan.h"
+#include "re_seal.h"
 
 #define RE_CTL_UPLOAD_MAX (4000 * 82 + 1024) /* 4000 lines of 80 + CR LF */
 #define RE_CTL_SOFT_OPEN  2147483647	     /* FL/BL "no soft limit", counts */
@@ -60,13 +61,17 @@ int re_ctl_check_busy(const struct re_io *io, int wdto_ms, char *err,
 /*
  * re_ctl_take_over() - close every other Ethernet handle (IHT=>-3) so that
  * nobody else commands the robot, then open the unsolicited-message handle
- * (after IHT, which would close it); upload the program and check
- * galil-load's identity stamp.
+ * (after IHT, which would close it); upload the program, check
+ * galil-load's identity stamp, and that the program is sealed with exactly
+ * the values @cfg gives (re_seal.h).
  * @info: [in,out] program_id filled.
- * Return: GL_OK; GL_ERR_MISMATCH (program not stamped or changed: @err
- *         tells the operator to run galil-load); a link error.
+ * @seal: [out] the seal table (the program's and this configuration's).
+ * Return: GL_OK; GL_ERR_MISMATCH (program not stamped, changed, or sealed
+ *         with other values: @err names the first and tells the operator to
+ *         run galil-load); a link error.
  */
-int re_ctl_take_over(gl_link *l, struct re_ctl_info *info, char *err,
+int re_ctl_take_over(gl_link *l, const struct re_config *cfg,
+		     struct re_ctl_info *info, struct re_seal *seal, char *err,
 		     size_t errlen);
 
 /*
@@ -110,12 +115,14 @@ int re_ctl_start_program(const struct re_io *io, struct re_ctl_info *info,
 			 char *err, size_t errlen);
 
 /*
- * re_ctl_write_params() - write every program parameter and read each
- * back: velocities, window, step, soft limits (from @cal, or wide open
- * before calibration when @cal is NULL), joystick map and valid-state
- * table, polarity, invalid-input timeout, watchdog timeout, heartbeat step,
- * power output, potentiometer inputs and zones, service speeds and the
- * longest service move (from @plan). Lines of at most 80 characters.
+ * re_ctl_write_params() - write the session's parameters, the soft limits
+ * (from @cal, or wide open before calibration when @cal is NULL) and the
+ * service moves' time limit, and read every parameter back against @plan:
+ * velocities, window, step, joystick map and valid-state table, polarity,
+ * invalid-input timeout, watchdog timeout, heartbeat step, power output,
+ * potentiometer inputs and zones, service speeds and the longest service
+ * move, which the program sets itself from its seal (#SEALIN: the supervisor
+ * checks them by its own read-back). Lines of at most 80 characters.
  * Return: GL_OK; GL_ERR_MISMATCH (read-back); a link error.
  */
 int re_ctl_write_params(const struct re_io *io, const struct re_config *cfg,

@@ -81,6 +81,7 @@ static enum re_fault_id re_ctrl_fault_id(int fcode)
 	case RE_DMC_F_FOREIGN: return RE_F_CTRL_FOREIGN_SET;
 	case RE_DMC_F_SVCMOVE: return RE_F_CTRL_SVCMOVE;
 	case RE_DMC_F_POTRANGE: return RE_F_CTRL_POTRANGE;
+	case RE_DMC_F_SEAL: return RE_F_CTRL_SEAL;
 	default: return RE_F_CTRL_UNKNOWN;
 	}
 }

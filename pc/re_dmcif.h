@@ -42,7 +42,8 @@ enum re_dmc_fcode {
 	RE_DMC_F_FOREIGN = 14,	/* heartbeat out of sequence, settings */
 	RE_DMC_F_SVCMOVE = 15,	/* a service move out of its bounds */
 	RE_DMC_F_POTRANGE = 16, /* potentiometer outside its range */
-	RE_DMC_F_MAX = 16,
+	RE_DMC_F_SEAL = 17,	/* a sealed value changed (re_seal.h) */
+	RE_DMC_F_MAX = 17,
 };
 
 /* ZAC = jraw + RE_ZAC_JCMD * (jcmd + 1) + RE_ZAC_MCMD * mcmd
@@ -71,7 +72,7 @@ struct re_za {
  * re_za_decode() - decode ZAA, ZAB, ZAC (axes A, B, C's user fields).
  * @out: [out] filled only on success.
  * Return: GL_OK; GL_ERR_RANGE when a field is negative or a decoded value is
- *         outside its range (state > 3, fcode > 16, faxis > 3, jcmd > 6,
+ *         outside its range (state > 3, fcode > 17, faxis > 3, jcmd > 6,
  *         mcmd > 6, mneut > 1, hbdmc > 999999); GL_ERR_ARG on NULL.
  */
 int re_za_decode(int32_t zaa, int32_t zab, int32_t zac, struct re_za *out);

@@ -102,6 +102,10 @@ enum re_fclass {
  *   RE_F_CTRL_STATE      PROGRAM; i0 state seen; s: the state expected
  *   RE_F_CAL_ABSOLUTE    CALIBRATION; a; s "reverse"/"forward"; f0 pot V
  *                        at that end, f1 expected V, f2 tolerance V
+ *   RE_F_CTRL_SEAL       FOREIGN; a or -1; i0 the item's number; s: what
+ *                        it is ("vmax[0] (maximum joystick velocity, axis
+ *                        A)"); f0 the value found, f1 the sealed one
+ *                        (fault 17, re_seal.h)
  */
 enum re_fault_id {
 	RE_F_NONE = 0,
@@ -149,6 +153,7 @@ enum re_fault_id {
 	RE_F_RELAY_POWER,
 	RE_F_CTRL_STATE,
 	RE_F_CAL_ABSOLUTE,
+	RE_F_CTRL_SEAL,
 	RE_F_COUNT
 };
 

@@ -12,6 +12,7 @@
 #define MAINMS_DEFAULT 10 /* dmc/constants.dmc */
 #define ACFACT	       10 /* dmc/constants.dmc: AC = DC = 10 x speed */
 #define DECEL_MS       (1000 / ACFACT) /* full speed to rest, ms */
+#define PERIOD_MIN_MS  2 /* the shortest period_ms (re_config.c) */
 
 static int max3(int a, int b, int c)
 {
@@ -82,8 +83,11 @@ void re_plan_make(const struct re_config *cfg, int mainms, struct re_plan *out)
 	out->mainms = mainms;
 	out->wdto_ms = cfg->watchdog.controller_timeout_ms;
 	/* every write adds 1; the program sees at most this many writes
-	 * between two passes before its own watchdog would trip anyway */
-	out->hbmaxd = (out->wdto_ms + fastest - 1) / fastest + 2;
+	 * between two passes before its own watchdog would trip anyway. At
+	 * the shortest period the configuration allows, not the configured
+	 * one: hbmaxd is sealed in the program (re_seal.h), and a --period
+	 * must not change it */
+	out->hbmaxd = (out->wdto_ms + PERIOD_MIN_MS - 1) / PERIOD_MIN_MS + 2;
 	out->pwrout = cfg->controller.power_output;
 	out->move_timeout_ms = cfg->calibration.move_timeout_ms;
 	out->period_ns = p_ns;

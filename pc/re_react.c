@@ -14,6 +14,7 @@
 #include "base_clock.h"
 #include "gl_err.h"
 #include "re_pot.h"
+#include "re_seal.h"
 #include "re_super.h"
 
 /* The program told to latch, and the stop (re_io.h; the DMC's own #FAULT
@@ -118,8 +119,11 @@ static void ctrl_fault_detail(struct re_super *s, struct re_fault *f)
 
 	if (s->have_za && s->za.fcode != 0 &&
 	    re_io_read(&s->io, "fdet", &fdet, s->cfg.fault_cmd_timeout_ms) ==
-		GL_OK)
+		GL_OK) {
 		re_ctrl_fault(&s->za, (long long)fdet, f);
+		re_seal_read_fault(s->cfg.seal, &s->io,
+				   s->cfg.fault_cmd_timeout_ms, f);
+	}
 }
 
 /* Faults that may be the program's own fault seen half-way (motors off by
@@ -175,6 +179,8 @@ static void program_verdict(struct re_super *s, struct re_fault *f)
 				 "program fault %d after %.1f ms", za.fcode,
 				 ns_to_ms(now_ns(s) - t0));
 			re_ctrl_fault(&za, (long long)det, f);
+			re_seal_read_fault(s->cfg.seal, &s->io,
+					   s->cfg.fault_cmd_timeout_ms, f);
 			return;
 		}
 		s->io.ops->sleep_until(s->io.ud,

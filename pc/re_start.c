@@ -168,7 +168,8 @@ static int start_link(struct app *a)
 	if (re_ctl_identify(l, &a->cfg, &a->info, a->err, sizeof(a->err)) ||
 	    re_ctl_check_busy(&a->io, a->cfg.watchdog.controller_timeout_ms,
 			      a->err, sizeof(a->err)) ||
-	    re_ctl_take_over(l, &a->info, a->err, sizeof(a->err)))
+	    re_ctl_take_over(l, &a->cfg, &a->info, &a->seal, a->err,
+			     sizeof(a->err)))
 		return fail(a, a->err);
 	a->ctl_ours = 1;
 	snprintf(id, sizeof(id), "%s, serial %ld, program id %016llX",
@@ -233,6 +234,7 @@ static int init_super(struct app *a)
 	struct re_super_cfg sc;
 
 	re_plan_super_cfg(&a->plan, &a->cfg, a->names, &sc);
+	sc.seal = &a->seal;
 	a->sup = calloc(1, sizeof(*a->sup));
 	if (!a->sup || re_super_init(a->sup, &a->io, &sc, NULL, 0) != GL_OK)
 		return fail(a, "cannot set up the supervisor");
@@ -293,6 +295,7 @@ static int latch(struct app *a, const struct re_fault *fault)
 {
 	struct re_fault f = *fault;
 
+	re_seal_read_fault(&a->seal, &a->io, a->cfg.controller.timeout_ms, &f);
 	stall_first(a, &f);
 	if (f.id != RE_F_NONE && re_super_fault(a->sup, &f) == RE_FAULT)
 		re_console_fault(&a->con, re_super_fault_line(a->sup));

@@ -40,6 +40,8 @@
 #include "re_io.h"
 #include "re_pot.h"
 
+struct re_seal;
+
 #define RE_SUPER_AXES	   3
 #define RE_SUPER_LINE	   768 /* FAULT line, bytes incl. NUL */
 #define RE_SUPER_MSGS	   8   /* unsolicited lines drained per cycle */
@@ -89,6 +91,9 @@ struct re_super_cfg {
 	 * mainms late), ns; 0: the check is off. */
 	int64_t uncmd_grace_ns;
 	const char *mode_name; /* "clinical" / "development" */
+	/* the program's sealed values (re_seal.h): a fault 17 names the
+	 * value, what was found and what was sealed; NULL: by number */
+	const struct re_seal *seal;
 };
 
 /* Per-axis view for the status board. */

@@ -45,7 +45,7 @@ static const struct dmc_cmd table[] = {
     {"CB", DMC_CMD_SIM},
     {"CC", 0},
     {"CD", 0},
-    {"CE", 0},
+    {"CE", DMC_CMD_SIM},
     {"CF", DMC_CMD_SIM},
     {"CI", 0},
     {"CM", 0},

@@ -103,9 +103,8 @@ static void test_encoder_failure(void **state)
 	struct dmc_h *h = *state;
 	double t;
 
-	DMC_H_CHECK(h, dmc_h_cmd(h, "KI 1,1,1", NULL, 0));
-	DMC_H_CHECK(h, dmc_h_cmd(h, "OT 20,20,20", NULL, 0));
-	DMC_H_CHECK(h, dmc_h_cmd(h, "OA 1,1,1", NULL, 0));
+	/* the robot's configuration: sealed with the program */
+	DMC_H_CHECK(h, dmc_h_setup_with(h, "KI 1,1,1;OT 20,20,20;OA 1,1,1"));
 	DMC_H_CHECK(h, dmc_h_control(h, "joy A fwd"));
 	dmc_h_advance(h, 300);
 	DMC_H_CHECK(h, dmc_h_control(h, "enc A stuck"));
@@ -222,7 +221,9 @@ static void test_soft_limit_fl(void **state)
 {
 	struct dmc_h *h = *state;
 
-	DMC_H_CHECK(h, dmc_h_cmd(h, "FL 4000,2147483647,2147483647", NULL, 0));
+	/* FL set before arming, as the supervisor sets it from the
+	 * calibration: a session value the arming seals */
+	DMC_H_CHECK(h, dmc_h_setup_with(h, "FL 4000,2147483647,2147483647"));
 	DMC_H_CHECK(h, dmc_h_control(h, "joy A fwd"));
 	dmc_h_advance(h, 2000);
 	assert_int_equal(dmc_h_axis(h, 0).moving, 0);
@@ -350,8 +351,8 @@ int main(void)
 	    cmocka_unit_test(test_jam_any_phase),
 	    cmocka_unit_test_setup_teardown(test_jam, dmc_h_fx_armed,
 					    dmc_h_fx_free),
-	    cmocka_unit_test_setup_teardown(test_encoder_failure,
-					    dmc_h_fx_armed, dmc_h_fx_free),
+	    cmocka_unit_test_setup_teardown(test_encoder_failure, dmc_h_fx_new,
+					    dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_latched_no_motion,
 					    dmc_h_fx_armed, dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_motion_thread_halted,
@@ -360,7 +361,7 @@ int main(void)
 					    dmc_h_fx_armed, dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_hard_limit, dmc_h_fx_armed,
 					    dmc_h_fx_free),
-	    cmocka_unit_test_setup_teardown(test_soft_limit_fl, dmc_h_fx_armed,
+	    cmocka_unit_test_setup_teardown(test_soft_limit_fl, dmc_h_fx_new,
 					    dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_cmderr, dmc_h_fx_armed,
 					    dmc_h_fx_free),

@@ -37,15 +37,16 @@ static double mg(struct dmc_h *h, const char *expr)
 	return atof(resp);
 }
 
-/* An armed robot with @p written (and @cmd, if any, sent before arming). */
+/* An armed robot with @p written (and @cmd, if any, the robot's controller
+ * settings: sent before the program is sealed). */
 static void setup_armed(struct dmc_h *h, const struct dmc_h_params *p,
 			const char *cmd)
 {
 	DMC_H_CHECK(h, dmc_h_open(h));
 	DMC_H_CHECK(h, dmc_h_start(h));
-	DMC_H_CHECK(h, dmc_h_configure(h, p));
 	if (cmd)
 		DMC_H_CHECK(h, dmc_h_cmd(h, cmd, NULL, 0));
+	DMC_H_CHECK(h, dmc_h_configure(h, p));
 	DMC_H_CHECK(h, dmc_h_arm(h));
 }
 

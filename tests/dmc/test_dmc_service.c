@@ -623,6 +623,8 @@ static void test_fast_into_zone_mvsp_rewritten(void **state)
 	while (dmc_h_var(h, "state") == 3 && dmc_h_axis(h, 0).moving &&
 	       dmc_h_now(h) - t0 < 6000)
 		dmc_h_advance(h, 1);
+	/* #FAULT stops the axis (AB 1) a few lines before it sets state 2 */
+	dmc_h_wait_var(h, "state", 2, dmc_h_var(h, "mainms"));
 	if (dmc_h_var(h, "state") != 2)
 		fail_msg("fast move ran into the near zone without a fault: "
 			 "stopped at %.0f counts (pot %.3f V), state %g",

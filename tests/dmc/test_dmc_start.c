@@ -19,8 +19,10 @@ static double axis_pos(struct dmc_h *h, int ax)
 	return dmc_h_axis(h, ax).enc;
 }
 
-/* After #AUTO: motors off, state 0, BOOT sent, every parameter failing its
- * check, the heartbeat advancing once per mainms; a pressed joystick moves
+/* After #AUTO: motors off, state 0, BOOT sent, every parameter at the value
+ * the program was sealed with (#SEALIN; dmc_h seals the tests' defaults),
+ * the soft limits still 0 (they fail check 6 until the supervisor writes
+ * them), the heartbeat advancing once per mainms; a pressed joystick moves
  * nothing. */
 static void test_safe_start(void **state)
 {
@@ -32,13 +34,15 @@ static void test_safe_start(void **state)
 	assert_true(dmc_h_unsol_has(h, "BOOT"));
 	assert_true(dmc_h_var(h, "state") == 0);
 	assert_true(dmc_h_var(h, "fcode") == 0);
-	assert_true(dmc_h_var(h, "vmax[0]") == 0);
-	assert_true(dmc_h_var(h, "vmin[2]") == 0);
-	assert_true(dmc_h_var(h, "jin[11]") == 0);
-	assert_true(dmc_h_var(h, "jval[5]") == 0);
-	assert_true(dmc_h_var(h, "jpol") == -1);
-	assert_true(dmc_h_var(h, "jto") == 0);
-	assert_true(dmc_h_var(h, "wdto") == 0);
+	assert_true(dmc_h_var(h, "vmax[0]") == 10000);
+	assert_true(dmc_h_var(h, "vmin[2]") == 2000);
+	assert_true(dmc_h_var(h, "jin[11]") == 20);
+	assert_true(dmc_h_var(h, "jval[5]") == 3072);
+	assert_true(dmc_h_var(h, "jpol") == 0);
+	assert_true(dmc_h_var(h, "jto") == 500);
+	assert_true(dmc_h_var(h, "wdto") == 125);
+	assert_true(dmc_h_var(h, "srev[0]") == 0);
+	assert_true(dmc_h_var(h, "sfwd[0]") == 0);
 	assert_true(dmc_h_var(h, "armreq") == 0);
 	assert_int_equal(ctrl_threads(h->ctrl), 1u); /* thread 0 only */
 
@@ -87,8 +91,9 @@ static void test_power_up(void **state)
 		assert_int_equal(dmc_h_axis(h, i).motor_off, 1);
 }
 
-/* An arm request before any parameter: refused with fault 1, check 1
- * (vmax of axis A), motors stay off. */
+/* An arm request before the supervisor wrote the soft limits (the other
+ * parameters are sealed in the program): refused with fault 1, check 6
+ * (srev < sfwd, axis A), motors stay off. */
 static void test_arm_without_parameters(void **state)
 {
 	struct dmc_h *h = *state;
@@ -101,11 +106,11 @@ static void test_arm_without_parameters(void **state)
 	assert_true(dmc_h_var(h, "state") == 2);
 	assert_true(dmc_h_var(h, "fcode") == 1);
 	assert_true(dmc_h_var(h, "faxis") == 1);
-	assert_true(dmc_h_var(h, "fdet") == 1);
+	assert_true(dmc_h_var(h, "fdet") == 6);
 	assert_int_equal(dmc_h_fault_lines(h, &code, &axis, &det), 1);
 	assert_int_equal(code, 1);
 	assert_int_equal(axis, 1);
-	assert_true(det == 1);
+	assert_true(det == 6);
 	assert_int_equal(ctrl_threads(h->ctrl), 1u);
 	for (int i = 0; i < DMC_H_AXES; i++)
 		assert_int_equal(dmc_h_axis(h, i).motor_off, 1);
@@ -278,7 +283,8 @@ static void test_restart_clears_latch(void **state)
 	DMC_H_CHECK(h, dmc_h_start(h));
 	assert_true(dmc_h_var(h, "state") == 0);
 	assert_true(dmc_h_var(h, "fcode") == 0);
-	assert_true(dmc_h_var(h, "vmax[0]") == 0);
+	assert_true(dmc_h_var(h, "vmax[0]") == 10000); /* sealed */
+	assert_true(dmc_h_var(h, "sfwd[0]") == 0);     /* the session's */
 	DMC_H_CHECK(h, dmc_h_configure(h, &p));
 	DMC_H_CHECK(h, dmc_h_arm(h));
 	assert_int_equal(dmc_h_axis(h, 0).motor_off, 0);

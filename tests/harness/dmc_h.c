@@ -12,6 +12,7 @@
 #include "gl_err.h"
 #include "gload_diag.h"
 #include "gload_prep.h"
+#include "re_seal.h"
 
 #define UNSOL_HANDLE 0	/* handle A: CF A, the program's MG lines */
 #define QR_HANDLE    1	/* handle B: QR for the ZA fields */
@@ -59,6 +60,108 @@ int dmc_h_load_program(const char *top, char *out, size_t cap, char *err,
 	gload_prog_free(&p);
 	gload_diags_free(&d);
 	return rc;
+}
+
+/* The parameters of @p as re_seal_make() adds them from a configuration
+ * (same order, same items), so that the tests run the seal galil-load
+ * writes, made from the test's own values. */
+static int seal_params(struct re_seal *s, const struct dmc_h_params *p)
+{
+	const struct {
+		const char *name;
+		const double *v;
+	} ax[] = {
+	    {"vmin", p->vmin},	   {"vmax", p->vmax},	{"wst", p->wst},
+	    {"wen", p->wen},	   {"stp", p->stp},	{"potin", p->potin},
+	    {"potlo", p->potlo},   {"pothi", p->pothi}, {"pnlo", p->pnlo},
+	    {"pnhi", p->pnhi},	   {"svmax", p->svmax}, {"svslow", p->svslow},
+	    {"svdmax", p->svdmax},
+	};
+	const struct {
+		const char *name;
+		double v;
+	} one[] = {{"jpol", p->jpol},
+		   {"jto", p->jto},
+		   {"wdto", p->wdto},
+		   {"hbmaxd", p->hbmaxd},
+		   {"pwrout", p->pwrout}};
+	char ref[RE_SEAL_REF_MAX];
+	int rc = GL_OK;
+
+	for (size_t k = 0; rc == GL_OK && k < sizeof(ax) / sizeof(ax[0]); k++)
+		for (int i = 0; rc == GL_OK && i < DMC_H_AXES; i++) {
+			snprintf(ref, sizeof(ref), "%s[%d]", ax[k].name, i);
+			rc = re_seal_add(s, RE_SEAL_PARAM, ref, i, ax[k].v[i],
+					 0, "test parameter");
+		}
+	for (int j = 0; rc == GL_OK && j < DMC_H_SWITCHES; j++) {
+		snprintf(ref, sizeof(ref), "jin[%d]", j);
+		rc = re_seal_add(s, RE_SEAL_PARAM, ref, j / 4, p->jin[j], 0,
+				 "test parameter");
+	}
+	for (int k = 0; rc == GL_OK && k < 6; k++) {
+		snprintf(ref, sizeof(ref), "jval[%d]", k);
+		rc = re_seal_add(s, RE_SEAL_PARAM, ref, k / 2, p->jval[k], 0,
+				 "test parameter");
+	}
+	for (size_t k = 0; rc == GL_OK && k < sizeof(one) / sizeof(one[0]); k++)
+		rc = re_seal_add(s, RE_SEAL_PARAM, one[k].name, -1, one[k].v, 0,
+				 "test parameter");
+	return rc;
+}
+
+/* The controller's settings as the simulator holds them now: the seal
+ * takes what the test configured. */
+static int seal_settings(struct dmc_h *h, struct re_seal *s)
+{
+	const struct re_seal_setting *st;
+	char ref[RE_SEAL_REF_MAX], cmd[32], resp[64];
+	int rc = GL_OK;
+
+	for (int k = 0; rc == GL_OK && (st = re_seal_setting_at(k)); k++)
+		for (int i = 0; rc == GL_OK && i < DMC_H_AXES; i++) {
+			snprintf(ref, sizeof(ref), "_%s%c", st->cmd, 'A' + i);
+			snprintf(cmd, sizeof(cmd), "MG %s", ref);
+			rc = dmc_h_cmd(h, cmd, resp, sizeof(resp));
+			if (rc == 0)
+				rc = re_seal_add(s, RE_SEAL_SETTING, ref, i,
+						 strtod(resp, NULL), st->tol,
+						 st->what);
+		}
+	return rc == GL_OK ? re_seal_add_fixed(s) : rc;
+}
+
+int dmc_h_sealed_program(struct dmc_h *h, const struct dmc_h_params *p,
+			 char *out, size_t cap, struct re_seal *seal)
+{
+	static char body[DMC_H_PROG_MAX];
+	static struct re_seal s;
+	int n = dmc_h_load_program(NULL, body, sizeof(body), h->err,
+				   sizeof(h->err)),
+	    rc, m;
+
+	if (n < 0)
+		return n;
+	rc = re_seal_start(body, (size_t)n, &s, h->err, sizeof(h->err));
+	if (rc == GL_OK)
+		rc = seal_params(&s, p);
+	if (rc == GL_OK)
+		rc = seal_settings(h, &s);
+	if (rc == GL_OK)
+		rc = re_seal_end(&s);
+	if (rc != GL_OK)
+		return rc;
+	if ((size_t)n + 1 > cap)
+		return GL_ERR_OVERFLOW;
+	memcpy(out, body, (size_t)n);
+	m = re_seal_emit(&s, out + n, cap - (size_t)n);
+	if (m < 0) {
+		snprintf(h->err, sizeof(h->err), "the seal does not fit");
+		return m;
+	}
+	if (seal)
+		*seal = s;
+	return n + m;
 }
 
 /* ---- simulator set-up -----------------------------------------------------
@@ -109,9 +212,24 @@ int dmc_h_control(struct dmc_h *h, const char *req)
 	return 0;
 }
 
+/* ER and OE on the controller, as the supervisor configures them. */
+static int write_settings(struct dmc_h *h, const struct dmc_h_params *p)
+{
+	char line[80];
+	int rc;
+
+	snprintf(line, sizeof(line), "ER %g,%g,%g", p->er[0], p->er[1],
+		 p->er[2]);
+	if ((rc = dmc_h_cmd(h, line, NULL, 0)) < 0)
+		return rc;
+	snprintf(line, sizeof(line), "OE %d,%d,%d", p->oe, p->oe, p->oe);
+	return dmc_h_cmd(h, line, NULL, 0);
+}
+
 int dmc_h_open(struct dmc_h *h)
 {
 	static char prog[DMC_H_PROG_MAX];
+	struct dmc_h_params p;
 	int n, bad = 0, rc;
 
 	memset(h, 0, sizeof(*h));
@@ -125,8 +243,13 @@ int dmc_h_open(struct dmc_h *h)
 	if ((rc = dmc_h_control(h, "relay on")) < 0 ||
 	    (rc = dmc_h_cmd(h, "CF A", NULL, 0)) < 0)
 		return rc;
-	n = dmc_h_load_program(NULL, prog, sizeof(prog), h->err,
-			       sizeof(h->err));
+	/* sealed with the default parameters and the controller's settings
+	 * as the defaults configure them (ER, OE): dmc_h_configure() seals
+	 * the program again with the test's own */
+	dmc_h_params_default(&p);
+	if ((rc = write_settings(h, &p)) < 0)
+		return rc;
+	n = dmc_h_sealed_program(h, &p, prog, sizeof(prog), &h->seal);
 	if (n < 0)
 		return n;
 	/* the controller has been on for a while before the download: its
@@ -138,6 +261,8 @@ int dmc_h_open(struct dmc_h *h)
 		return GL_ERR_CTRL;
 	}
 	sim_advance_ms(h->sim, 1);
+	h->prog_len = (size_t)n;
+	memcpy(h->prog, prog, (size_t)n);
 	return 0;
 }
 
@@ -332,40 +457,36 @@ static int set_array(struct dmc_h *h, const char *name, const double *v, int n)
 
 int dmc_h_configure(struct dmc_h *h, const struct dmc_h_params *p)
 {
-	char line[80];
-	int rc;
+	static char prog[DMC_H_PROG_MAX];
+	static struct re_seal seal;
+	int n, bad = 0, rc, running;
 
-	snprintf(line, sizeof(line), "ER %g,%g,%g", p->er[0], p->er[1],
-		 p->er[2]);
-	if ((rc = dmc_h_cmd(h, line, NULL, 0)) < 0)
+	if ((rc = write_settings(h, p)) < 0)
 		return rc;
-	snprintf(line, sizeof(line), "OE %d,%d,%d", p->oe, p->oe, p->oe);
-	if ((rc = dmc_h_cmd(h, line, NULL, 0)) < 0)
-		return rc;
-	if ((rc = set_array(h, "vmin", p->vmin, DMC_H_AXES)) < 0 ||
-	    (rc = set_array(h, "vmax", p->vmax, DMC_H_AXES)) < 0 ||
-	    (rc = set_array(h, "wst", p->wst, DMC_H_AXES)) < 0 ||
-	    (rc = set_array(h, "wen", p->wen, DMC_H_AXES)) < 0 ||
-	    (rc = set_array(h, "stp", p->stp, DMC_H_AXES)) < 0 ||
-	    (rc = set_array(h, "srev", p->srev, DMC_H_AXES)) < 0 ||
-	    (rc = set_array(h, "sfwd", p->sfwd, DMC_H_AXES)) < 0 ||
-	    (rc = set_array(h, "jin", p->jin, DMC_H_SWITCHES)) < 0 ||
-	    (rc = set_array(h, "jval", p->jval, 6)) < 0)
-		return rc;
-	if ((rc = set_checked(h, "jpol", p->jpol)) < 0 ||
-	    (rc = set_checked(h, "jto", p->jto)) < 0 ||
-	    (rc = set_checked(h, "wdto", p->wdto)) < 0 ||
-	    (rc = set_checked(h, "hbmaxd", p->hbmaxd)) < 0 ||
-	    (rc = set_checked(h, "pwrout", p->pwrout)) < 0)
-		return rc;
-	if ((rc = set_array(h, "potin", p->potin, DMC_H_AXES)) < 0 ||
-	    (rc = set_array(h, "potlo", p->potlo, DMC_H_AXES)) < 0 ||
-	    (rc = set_array(h, "pothi", p->pothi, DMC_H_AXES)) < 0 ||
-	    (rc = set_array(h, "pnlo", p->pnlo, DMC_H_AXES)) < 0 ||
-	    (rc = set_array(h, "pnhi", p->pnhi, DMC_H_AXES)) < 0 ||
-	    (rc = set_array(h, "svmax", p->svmax, DMC_H_AXES)) < 0 ||
-	    (rc = set_array(h, "svslow", p->svslow, DMC_H_AXES)) < 0 ||
-	    (rc = set_array(h, "svdmax", p->svdmax, DMC_H_AXES)) < 0)
+
+	n = dmc_h_sealed_program(h, p, prog, sizeof(prog), &seal);
+	if (n < 0)
+		return n;
+	/* the program holds the test's parameters as its seal: loaded again
+	 * (and restarted when it ran) when they are not the ones it holds */
+	if ((size_t)n != h->prog_len || memcmp(prog, h->prog, (size_t)n)) {
+		running = (ctrl_threads(h->ctrl) & 1u) != 0;
+		if ((rc = dmc_h_cmd(h, "prun=0;HX", NULL, 0)) < 0)
+			return rc;
+		if (ctrl_download(h->ctrl, prog, (size_t)n, &bad) < 0) {
+			snprintf(h->err, sizeof(h->err),
+				 "download rejected at program line %d", bad);
+			return GL_ERR_CTRL;
+		}
+		h->prog_len = (size_t)n;
+		memcpy(h->prog, prog, (size_t)n);
+		h->seal = seal;
+		if (running && (rc = dmc_h_start(h)) < 0)
+			return rc;
+	}
+	/* the session's values: the soft limits */
+	if ((rc = set_array(h, "srev", p->srev, DMC_H_AXES)) < 0 ||
+	    (rc = set_array(h, "sfwd", p->sfwd, DMC_H_AXES)) < 0)
 		return rc;
 	return 0;
 }
@@ -456,16 +577,24 @@ int dmc_h_arm(struct dmc_h *h)
 	return rc;
 }
 
-int dmc_h_setup(struct dmc_h *h)
+int dmc_h_setup_with(struct dmc_h *h, const char *settings)
 {
 	struct dmc_h_params p;
 	int rc;
 
 	dmc_h_params_default(&p);
-	if ((rc = dmc_h_open(h)) < 0 || (rc = dmc_h_start(h)) < 0 ||
-	    (rc = dmc_h_configure(h, &p)) < 0 || (rc = dmc_h_arm(h)) < 0)
+	if ((rc = dmc_h_open(h)) < 0 || (rc = dmc_h_start(h)) < 0)
+		return rc;
+	if (settings && (rc = dmc_h_cmd(h, settings, NULL, 0)) < 0)
+		return rc;
+	if ((rc = dmc_h_configure(h, &p)) < 0 || (rc = dmc_h_arm(h)) < 0)
 		return rc;
 	return 0;
+}
+
+int dmc_h_setup(struct dmc_h *h)
+{
+	return dmc_h_setup_with(h, NULL);
 }
 
 /* ---- what the program reported --------------------------------------------

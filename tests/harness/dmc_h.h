@@ -17,6 +17,7 @@
 #include <stddef.h>
 
 #include "gl_err.h"
+#include "re_seal.h"
 #include "sim.h"
 
 #define DMC_H_AXES	3
@@ -48,10 +49,13 @@ struct dmc_h_params {
 struct dmc_h {
 	struct sim *sim;
 	struct ctrl *ctrl;
-	int hb_on;		     /* 1: write hbpc every hb_period_ms */
-	double hb_period_ms;	     /* 50 (the supervisor's default period) */
-	double hb_next_ms;	     /* simulated time of the next write */
-	long hb;		     /* last value written */
+	int hb_on;		   /* 1: write hbpc every hb_period_ms */
+	double hb_period_ms;	   /* 50 (the supervisor's default period) */
+	double hb_next_ms;	   /* simulated time of the next write */
+	long hb;		   /* last value written */
+	char prog[DMC_H_PROG_MAX]; /* the program downloaded, sealed */
+	size_t prog_len;
+	struct re_seal seal;	     /* its seal table */
 	char unsol[DMC_H_UNSOL_MAX]; /* unsolicited text, NUL-terminated */
 	size_t unsol_len;
 	char err[512];
@@ -104,9 +108,23 @@ int dmc_h_start(struct dmc_h *h);
 void dmc_h_params_default(struct dmc_h_params *p);
 
 /*
- * dmc_h_configure() - what the supervisor does before arming: ER and OE
- * on the controller, then every program parameter written with ctrl_set_var
- * and read back.
+ * dmc_h_sealed_program() - the program galil-load would download with the
+ * seal made from @p and the controller's settings as they are now (the
+ * test's configuration stands in for roboelf.yaml).
+ * @out, @cap: [out] the program text (no identity line); @seal: [out]
+ * its seal table (may be NULL).
+ * Return: its length, or a gl_err code (h->err).
+ */
+int dmc_h_sealed_program(struct dmc_h *h, const struct dmc_h_params *p,
+			 char *out, size_t cap, struct re_seal *seal);
+
+/*
+ * dmc_h_configure() - what galil-load and the supervisor do before arming:
+ * ER and OE on the controller; the program sealed with @p and the
+ * controller's settings now (downloaded again, and restarted when it was
+ * running, when that differs from the program it holds: #SEALIN sets the
+ * parameters); the soft limits srev/sfwd written and read back.
+ * Settings a test changes after this call are changes to the seal.
  * Return: 0 or a gl_err code.
  */
 int dmc_h_configure(struct dmc_h *h, const struct dmc_h_params *p);
@@ -141,6 +159,13 @@ int dmc_h_move(struct dmc_h *h, int axis, double target, double speed,
  * dmc_h_configure, dmc_h_arm: an armed robot at rest.
  */
 int dmc_h_setup(struct dmc_h *h);
+
+/*
+ * dmc_h_setup_with() - dmc_h_setup() with the controller settings
+ * @settings (one command line, e.g. "OA 1,1,1;OT 20,20,20", or NULL) made
+ * before the program is sealed and armed: the test's configuration.
+ */
+int dmc_h_setup_with(struct dmc_h *h, const char *settings);
 
 /*
  * dmc_h_advance() - run @ms of simulated time; while h->hb_on, hbpc gets a

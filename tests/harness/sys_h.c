@@ -387,7 +387,9 @@ static int run_load(struct sys_case *c)
 {
 	struct sys_env *e = c->env;
 	char bin[SYS_PATH_MAX + 16], addr[32], dmc[SYS_PATH_MAX + 8];
-	char *argv[] = {bin, (char *)"-a", addr, (char *)"--start", dmc, NULL};
+	char *argv[] = {
+	    bin,    (char *)"-a", addr, (char *)"--start", (char *)"--config",
+	    c->cfg, dmc,	  NULL};
 	struct proc p;
 	int status, rc = -1;
 

@@ -321,10 +321,12 @@ static void test_default_dmc(void **state)
 
 	assert_int_equal(run(&p, none), 0);
 	assert_string_equal(proc_output(&p, PROC_STDERR), "");
-	assert_true(strncmp(proc_output(&p, PROC_STDOUT),
-			    "DMC programs: dmc (no files given)\nsource: 2 "
-			    "files, ",
-			    52) == 0);
+	assert_true(
+	    strncmp(proc_output(&p, PROC_STDOUT),
+		    "DMC programs: dmc (no files given)\nsealed: ", 43) == 0);
+	assert_non_null(strstr(proc_output(&p, PROC_STDOUT),
+			       " values from config/roboelf.yaml\nsource: 2 "
+			       "files and the seal, "));
 	identity_of(proc_output(&p, PROC_STDOUT), id);
 	assert_string_equal(id, want_id);
 	proc_kill(&p);

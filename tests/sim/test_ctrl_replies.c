@@ -174,8 +174,11 @@ static void test_queries(void **state)
 	reply(p, "MT ?,?,?", " 1, 1, 1\r\n");
 	reply(p, "MTC=?", " 1\r\n");
 	reply(p, "MG _MTA", " 1.0000\r\n");
-	refused(p, "MT 2");
-	refused(p, "MTA=-1");
+	/* the motor type is settable (a stale tool's MT -1 reverses the
+	 * servo: the seal catches it) */
+	reply(p, "MTA=-1", "");
+	reply(p, "MG _MTA", " -1.0000\r\n");
+	reply(p, "MT 1", "");
 	reply(p, "MG _XQ,_TA", " -1.0000 0.0000\r\n");
 	p->in.amp_power = 0;
 	tp_step(p, 1);

@@ -120,14 +120,19 @@ static int sim_start(struct rig *r)
 	return r->ctl < 0 ? -1 : 0;
 }
 
-/* galil-load of the DMC programs in @dir. */
-static int galil_load_dir(const struct rig *r, const char *dir)
+/* galil-load of the DMC programs in @dir, sealed with the rig's
+ * configuration (written here first; the case may write it again with
+ * other paths, which the seal does not hold). */
+static int galil_load_dir(struct rig *r, const char *dir)
 {
 	char exe[600], addr[64];
-	char *argv[] = {exe, (char *)"-a", addr, (char *)dir, NULL};
+	char *argv[] = {exe,	(char *)"-a", addr, (char *)"--config",
+			r->cfg, (char *)dir,  NULL};
 	struct proc p;
 	int code;
 
+	if (write_config(r, r->sim.port, r->relay, cal_file) < 0)
+		return -1;
 	snprintf(exe, sizeof(exe), "%s/galil-load", bin);
 	snprintf(addr, sizeof(addr), "127.0.0.1:%d", r->sim.port);
 	if (proc_spawn(&p, argv, NULL) < 0)
@@ -143,7 +148,7 @@ static int galil_load_dir(const struct rig *r, const char *dir)
 	return code;
 }
 
-static int galil_load(const struct rig *r)
+static int galil_load(struct rig *r)
 {
 	return galil_load_dir(r, "dmc/");
 }

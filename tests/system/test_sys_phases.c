@@ -263,7 +263,9 @@ static const char *tail(const struct proc *p, enum proc_stream s, size_t n)
 static int galil_load(struct sys_case *c)
 {
 	char bin[SYS_PATH_MAX + 16], addr[32], dmc[SYS_PATH_MAX + 8];
-	char *argv[] = {bin, (char *)"-a", addr, (char *)"--start", dmc, NULL};
+	char *argv[] = {
+	    bin,    (char *)"-a", addr, (char *)"--start", (char *)"--config",
+	    c->cfg, dmc,	  NULL};
 	struct proc p;
 	int rc = -1;
 

@@ -453,9 +453,12 @@ static void test_za_decode(void **state)
 	assert_int_equal(z.state, RE_DMC_SERVICE);
 	assert_int_equal(z.fcode, 16);
 	assert_int_equal(z.faxis, 2);
+	/* the seal's fault (17, version 2.20) */
+	assert_int_equal(re_za_decode(0, 2 + 170 + 1000, 0, &z), GL_OK);
+	assert_int_equal(z.fcode, 17);
 	/* Out of range fields */
 	assert_int_equal(re_za_decode(0, 4, 0, &z), GL_ERR_RANGE);
-	assert_int_equal(re_za_decode(0, 170, 0, &z), GL_ERR_RANGE);
+	assert_int_equal(re_za_decode(0, 180, 0, &z), GL_ERR_RANGE);
 	assert_int_equal(re_za_decode(0, 4001, 0, &z), GL_ERR_RANGE);
 	assert_int_equal(re_za_decode(0, 0, 7 * 32768, &z), GL_ERR_RANGE);
 	assert_int_equal(re_za_decode(0, 0, 4096 * 8, &z), GL_OK); /* mcmd 1 */
@@ -492,7 +495,8 @@ static void test_ctrl_fault_mapping(void **state)
 	    {14, RE_F_CTRL_FOREIGN_SET, RE_FC_FOREIGN},
 	    {15, RE_F_CTRL_SVCMOVE, RE_FC_MOTION},
 	    {16, RE_F_CTRL_POTRANGE, RE_FC_ENCODER},
-	    {17, RE_F_CTRL_UNKNOWN, RE_FC_PROGRAM},
+	    {17, RE_F_CTRL_SEAL, RE_FC_FOREIGN},
+	    {18, RE_F_CTRL_UNKNOWN, RE_FC_PROGRAM},
 	    {0, RE_F_CTRL_UNKNOWN, RE_FC_PROGRAM},
 	};
 	struct re_za z = {0};

@@ -17,7 +17,10 @@
 
 #include "base_file.h"
 #include "base_version.h"
+#include "dmc_h.h"
+#include "re_config.h"
 #include "re_dmcif.h"
+#include "re_seal.h"
 
 /* The supervisor's names of the codes, in the enum's words. */
 static const struct {
@@ -32,6 +35,7 @@ static const struct {
     {RE_DMC_F_THREAD, "THREAD"},   {RE_DMC_F_SUPERVISOR, "SUPERVISOR"},
     {RE_DMC_F_UNCMD, "UNCMD"},	   {RE_DMC_F_FOREIGN, "FOREIGN"},
     {RE_DMC_F_SVCMOVE, "SVCMOVE"}, {RE_DMC_F_POTRANGE, "POTRANGE"},
+    {RE_DMC_F_SEAL, "SEAL"},
 };
 #define N_NAMES (sizeof(names) / sizeof(names[0]))
 
@@ -56,10 +60,36 @@ static void test_enum_complete(void **state)
 		assert_int_equal(names[i].code, (int)i + 1);
 }
 
+/* dmc/roboelf.dmc and the seal galil-load appends to it (made from
+ * config/roboelf.yaml): every #FAULT the controller can raise. */
+static char *program_source(void)
+{
+	static char body[DMC_H_PROG_MAX];
+	static struct re_seal seal;
+	struct re_config cfg;
+	char *src = slurp("dmc/roboelf.dmc"), *all, err[512], path[1024];
+	const char *top = getenv("ROBOELF_TOP");
+	size_t n = strlen(src);
+	int len, m;
+
+	len = dmc_h_load_program(NULL, body, sizeof(body), err, sizeof(err));
+	if (len < 0)
+		fail_msg("dmc/: %s", err);
+	snprintf(path, sizeof(path), "%s/config/roboelf.yaml", top ? top : ".");
+	if (re_config_load_file(path, &cfg, err, sizeof(err)) != 0 ||
+	    re_seal_make(body, (size_t)len, &cfg, &seal, err, sizeof(err)))
+		fail_msg("the seal: %s", err);
+	all = realloc(src, n + RE_SEAL_TEXT_MAX);
+	assert_non_null(all);
+	m = re_seal_emit(&seal, all + n, RE_SEAL_TEXT_MAX);
+	assert_true(m > 0);
+	return all;
+}
+
 /* The program raises exactly the codes the supervisor knows. */
 static void test_dmc_raises_known_codes(void **state)
 {
-	char *src = slurp("dmc/roboelf.dmc");
+	char *src = program_source();
 	int seen[RE_DMC_F_MAX + 1] = {0};
 
 	(void)state;

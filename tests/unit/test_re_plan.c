@@ -66,8 +66,9 @@ static void test_plan_defaults(void **state)
 	assert_int_equal(p.axis[0].svdmax_counts, 110000 + 1000 + 4000);
 	assert_int_equal(p.axis[2].svdmax_counts, 88000 + 1000 + 4000);
 	assert_int_equal(p.wdto_ms, 200);
-	/* ceil(200 / min(50, 10)) + 2 */
-	assert_int_equal(p.hbmaxd, 22);
+	/* ceil(200 / 2) + 2: at the shortest period, whatever the configured
+	 * one (the program holds it sealed) */
+	assert_int_equal(p.hbmaxd, 102);
 	assert_int_equal(p.pwrout, 0);
 	assert_int_equal(p.move_timeout_ms, 30000);
 	assert_int_equal(p.period_ns, 50 * MS);
@@ -110,7 +111,7 @@ static void test_plan_variant(void **state)
 	 * than near_margin_counts' 0.08 V) */
 	near(p.axis[1].pnlo_v, 1.0 + 0.5 + 2400 * 8.0 / 100000 + 0.005);
 	near(p.axis[1].potlo_v, 1.0 - 0.5 - 0.08);
-	assert_int_equal(p.hbmaxd, 125 / 2 + 1 + 2); /* ceil(62.5) + 2 */
+	assert_int_equal(p.hbmaxd, 125 / 2 + 1 + 2); /* ceil(125 / 2) + 2 */
 	assert_int_equal(p.pwrout, 3);
 	/* the heartbeat limit follows the slower of the period and mainms */
 	assert_int_equal(p.hb_limit_ns, (int64_t)(2.5 * 30 * MS));

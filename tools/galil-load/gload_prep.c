@@ -316,6 +316,18 @@ static int prep_dir(struct gload_prog *p, const char *dir,
 	for (i = 0; i < n && rc != GL_ERR_NOMEM; i++) {
 		int r;
 
+		if (!strcmp(names[i], GLOAD_SEAL_ENTRY)) {
+			snprintf(p->seal_where, sizeof(p->seal_where), "%s:%d",
+				 mpath, mlines[i]);
+			if (i != n - 1) {
+				gload_diags_add(d, p->order++, mpath, mlines[i],
+						"%s must be the last entry",
+						GLOAD_SEAL_ENTRY);
+				rc = GL_ERR_FORMAT;
+			}
+			p->seal = 1;
+			continue;
+		}
 		fpath = join_path(dir, names[i]);
 		r = fpath ? prep_file(p, fpath, mlines[i], mpath, d)
 			  : GL_ERR_NOMEM;

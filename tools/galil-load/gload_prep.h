@@ -28,8 +28,9 @@
 #include "gl_ident.h"
 #include "gload_diag.h"
 
-#define GLOAD_MANIFEST "MANIFEST"
-#define GLOAD_FILE_MAX (4L * 1024 * 1024) /* bytes; far above 4000 x 80 */
+#define GLOAD_MANIFEST	 "MANIFEST"
+#define GLOAD_SEAL_ENTRY "@seal" /* manifest entry: the seal goes here */
+#define GLOAD_FILE_MAX	 (4L * 1024 * 1024) /* bytes; far above 4000 x 80 */
 
 /* One preprocessed line and where it came from. */
 struct gload_line {
@@ -55,6 +56,10 @@ struct gload_prog {
 	size_t body_len; /* bytes of @text before the stamp line */
 	uint64_t id;	 /* identity (hash of the body) */
 	char stamp[GL_IDENT_LINE_SIZE];
+	/* the manifest's last entry is GLOAD_SEAL_ENTRY: the seal generated
+	 * from the configuration follows the files (gload_seal.h) */
+	int seal;
+	char seal_where[128]; /* "dmc/MANIFEST:3", for messages */
 };
 
 /*
@@ -72,9 +77,12 @@ int gload_prep_buffer(struct gload_prog *p, const char *path, const char *buf,
 
 /*
  * gload_prep_path() - read a .dmc file, or a directory's MANIFEST and the
- * files it lists in order, and preprocess them into @p.
+ * files it lists in order, and preprocess them into @p. A manifest whose
+ * last entry is GLOAD_SEAL_ENTRY sets @p->seal (the caller appends the
+ * seal); anywhere else that entry is an error.
  * @path: a file or a directory.
- * @d: [out] "cannot open 'x': reason", "DIR/MANIFEST:3: cannot open ...".
+ * @d: [out] "cannot open 'x': reason", "DIR/MANIFEST:3: cannot open ...",
+ *     "DIR/MANIFEST:2: @seal must be the last entry".
  * Return: GL_OK, GL_ERR_NOENT (something could not be read; see @d),
  *         GL_ERR_FORMAT (an empty manifest), GL_ERR_NOMEM.
  */

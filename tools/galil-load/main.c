@@ -26,6 +26,8 @@
 #include "gload_check.h"
 #include "gload_dl.h"
 #include "gload_prep.h"
+#include "gload_seal.h"
+#include "re_config.h"
 
 #define DEFAULT_TIMEOUT_MS 5000 /* gclib's default [galil-notes 1.6] */
 #define STOP_MS		   3000 /* default --stop-wait: axes stopped after ST */
@@ -54,6 +56,7 @@ struct opts {
 	char **paths;
 	int npaths;
 	const char *dmc;	    /* --dmc DIR */
+	const char *config;	    /* --config FILE: what the seal holds */
 	int version;		    /* --version */
 	int dmc_default;	    /* no files given: dmc_dir was chosen */
 	char *dmc_path[1];	    /* paths when --dmc or the default */
@@ -94,6 +97,9 @@ static const char usage_text[] =
     "                             255.255.255.255)\n"
     "      --find-port PORT       its UDP port (default 50000)\n"
     "      --dmc DIR              the program directory (as DIR above)\n"
+    "      --config FILE          the configuration the program is sealed\n"
+    "                             with (default ./config/roboelf.yaml, else\n"
+    "                             the installed /etc/roboelf/roboelf.yaml)\n"
     "  -h, --help                 this text\n"
     "      --version              the release, the DMC interface and the\n"
     "                             identity of the DMC programs\n"
@@ -230,7 +236,8 @@ enum {
 	OPT_FIND_ADDR,
 	OPT_FIND_PORT,
 	OPT_VERSION,
-	OPT_DMC
+	OPT_DMC,
+	OPT_CONFIG
 };
 
 static const struct option long_opts[] = {
@@ -251,6 +258,7 @@ static const struct option long_opts[] = {
     {"help", no_argument, NULL, 'h'},
     {"version", no_argument, NULL, OPT_VERSION},
     {"dmc", required_argument, NULL, OPT_DMC},
+    {"config", required_argument, NULL, OPT_CONFIG},
     {NULL, 0, NULL, 0},
 };
 
@@ -268,6 +276,7 @@ static int parse_opt(struct opts *o, int ch, const char *arg)
 	case 'h': return -1;
 	case OPT_VERSION: o->version = 1; return 0;
 	case OPT_DMC: o->dmc = arg; return 0;
+	case OPT_CONFIG: o->config = arg; return 0;
 	case 'm':
 		o->model = dmc_model_find(arg);
 		return o->model ? 0
@@ -427,8 +436,11 @@ out_err:
 static void print_sizes(const struct gload_prog *p,
 			const struct gload_stats *st, const struct opts *o)
 {
-	printf("source: %d file%s, %ld lines, %zu bytes\n", p->nfiles,
-	       p->nfiles == 1 ? "" : "s", p->src_lines, p->src_bytes);
+	int files = p->nfiles - (p->seal ? 1 : 0); /* the seal is no file */
+
+	printf("source: %d file%s%s, %ld lines, %zu bytes\n", files,
+	       files == 1 ? "" : "s", p->seal ? " and the seal" : "",
+	       p->src_lines, p->src_bytes);
 	printf("program: %d lines, %zu bytes with the identity line '%s'\n",
 	       st->lines, p->text_len, p->stamp);
 	printf("check: ok (%s%s: %d/%d lines, %d/%d labels, %d/%d "
@@ -437,6 +449,41 @@ static void print_sizes(const struct gload_prog *p,
 	       o->model->confirmed ? "" : ", unconfirmed limits", st->lines,
 	       o->model->max_lines, st->labels, o->model->max_labels, st->vars,
 	       o->model->max_vars);
+}
+
+/* The seal the manifest asks for, from --config or the configuration found
+ * where roboelf looks for it. Return 0 or an exit code. */
+static int seal(const struct opts *o, struct gload_prog *p, int quiet)
+{
+	static char found[PATH_MAX + 1];
+	char err[RE_CONFIG_ERR_MAX];
+	const char *cfg = o->config;
+	int n = 0, rc;
+
+	if (!cfg && gload_seal_find_config(found, sizeof(found)) < 0) {
+		fprintf(stderr,
+			"galil-load: %s: the program is sealed with the "
+			"robot's configuration, and there is none here "
+			"(./config/roboelf.yaml) nor at %s: give it with "
+			"--config FILE\n",
+			p->seal_where, found);
+		return GLOAD_EXIT_USAGE;
+	}
+	if (!cfg)
+		cfg = found;
+	rc = gload_seal_append(p, cfg, &n, err, sizeof(err));
+	if (rc != GL_OK) {
+		fprintf(stderr,
+			"galil-load: cannot seal the program with "
+			"'%s': %s\n",
+			cfg, err);
+		return rc == GL_ERR_CONFIG || rc == GL_ERR_SYS
+			   ? GLOAD_EXIT_USAGE
+			   : GLOAD_EXIT_CHECK;
+	}
+	if (!quiet)
+		printf("sealed: %d values from %s\n", n, cfg);
+	return 0;
 }
 
 /* --version: the release, the interface, and the identity a download of
@@ -460,6 +507,8 @@ static int print_version(const struct opts *o)
 	for (i = 0; i < o->npaths; i++)
 		if (gload_prep_path(&p, o->paths[i], &d) != GL_OK)
 			ok = 0;
+	if (ok && p.seal && seal(o, &p, 1) != 0)
+		ok = 0;
 	if (ok && (gload_check(&p, o->model, &d, &st) != 0 || d.n > 0 ||
 		   gload_prog_finish(&p) != GL_OK))
 		ok = 0;
@@ -485,6 +534,8 @@ static int prepare(const struct opts *o, struct gload_prog *p)
 	for (i = 0; i < o->npaths; i++)
 		if (gload_prep_path(p, o->paths[i], &d) != GL_OK)
 			rc = GLOAD_EXIT_CHECK;
+	if (rc == 0 && p->seal)
+		rc = seal(o, p, 0);
 	if (rc == 0) {
 		n = gload_check(p, o->model, &d, &st);
 		if (n != 0 || d.n > 0)

@@ -31,6 +31,7 @@ static void ctrl_axis_defaults(struct ctrl_axis_par *p)
 	p->sd = 256000;
 	p->kp = 6;
 	p->kd = 64;
+	p->mt = 1;
 	p->tl = 9.9982;
 	p->il = 9.9982;
 	p->ov = 0.9438;

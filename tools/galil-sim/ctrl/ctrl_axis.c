@@ -64,6 +64,7 @@ static const struct ctrl_par_desc par_table[] = {
     {"KD", 0, 4095.875, 0.125, CTRL_NUM_GAIN, 1},
     {"KI", 0, 255.999, 0, CTRL_NUM_GAIN, 1},
     {"KP", 0, 1023.875, 0.125, CTRL_NUM_GAIN, 1},
+    {"MT", -2.5, 2.5, 0.5, CTRL_NUM_PF, 0},
     {"OF", -9.9982, 9.9982, 0, CTRL_NUM_GAIN, 1},
     {"OV", 0, 9.9982, 0, CTRL_NUM_GAIN, 1},
     {"SD", 1024, 1073740800, 1024, CTRL_NUM_INT, 1},
@@ -73,10 +74,7 @@ static const struct ctrl_par_desc par_table[] = {
 };
 
 static const struct ctrl_ipar_desc ipar_table[] = {
-    {"LD", 0, 3},
-    {"OA", 0, 1},
-    {"OE", 0, 3},
-    {"OT", 1, 32000},
+    {"CE", 0, 15}, {"LD", 0, 3}, {"OA", 0, 1}, {"OE", 0, 3}, {"OT", 1, 32000},
 };
 
 const struct ctrl_par_desc *ctrl_par_find(const char *name)
@@ -111,6 +109,7 @@ double *ctrl_par_ptr(struct ctrl_axis_par *p, const struct ctrl_par_desc *d)
 	case 'K' << 8 | 'D': return &p->kd;
 	case 'K' << 8 | 'I': return &p->ki;
 	case 'K' << 8 | 'P': return &p->kp;
+	case 'M' << 8 | 'T': return &p->mt;
 	case 'O' << 8 | 'F': return &p->of;
 	case 'O' << 8 | 'V': return &p->ov;
 	case 'S' << 8 | 'D': return &p->sd;
@@ -123,6 +122,7 @@ double *ctrl_par_ptr(struct ctrl_axis_par *p, const struct ctrl_par_desc *d)
 int *ctrl_ipar_ptr(struct ctrl_axis_par *p, const struct ctrl_ipar_desc *d)
 {
 	switch (d->name[0] << 8 | d->name[1]) {
+	case 'C' << 8 | 'E': return &p->ce;
 	case 'L' << 8 | 'D': return &p->ld;
 	case 'O' << 8 | 'A': return &p->oa;
 	case 'O' << 8 | 'E': return &p->oe;
@@ -208,8 +208,6 @@ int ctrl_axis_operand(struct ctrl *c, const char *n, int i, double *v)
 		*v = !ax->lim_r;
 	else if (!strcmp(n, "HM"))
 		*v = ctrl_axis_home(c, i);
-	else if (!strcmp(n, "MT"))
-		*v = 1; /* servo motor; MT is not settable */
 	else if (!strcmp(n, "PA"))
 		*v = ax->pa_last;
 	else if (!strcmp(n, "PR"))

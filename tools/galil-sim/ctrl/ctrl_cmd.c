@@ -54,6 +54,7 @@ static const struct cmd_ent cmd_table[] = {
     {"BP", GE, 0},
     {"BV", GE, 0},
     {"CB", GE, 0},
+    {"CE", AX, F_ASSIGN},
     {"CF", GE, 0},
     {"CN", GE, 0},
     {"CO", GE, 0},
@@ -89,7 +90,7 @@ static const struct cmd_ent cmd_table[] = {
     {"MG", cmd_mg, 0},
     {"MO", AX, 0},
     {"MR", FL, F_PROG | F_ASSIGN},
-    {"MT", GE, F_ASSIGN},
+    {"MT", AX, F_ASSIGN},
     {"NO", GE, 0},
     {"OA", AX, F_ASSIGN},
     {"OB", GE, 0},
@@ -779,42 +780,6 @@ static int cmd_settings(struct ctrl_xc *x, const char *name, const char *a)
 }
 
 /*
- * MT (command reference MT): every simulated axis is a servo, type 1.
- * Only queries are simulated: "MT ?,?", "MTA=?"; setting a type is TC 1.
- */
-static int cmd_mt(struct ctrl_xc *x, const char *a)
-{
-	struct ctrl *c = x->c;
-	int n = 0;
-
-	a = ctrl_skip(a);
-	if (ctrl_axis_letter(a[0]) >= 0 && *ctrl_skip(a + 1) == '=') {
-		if (ctrl_axis_letter(a[0]) >= CTRL_AXES)
-			return 6;
-		if (strcmp(ctrl_skip(ctrl_skip(a + 1) + 1), "?"))
-			return 1;
-		ctrl_buf_puts(&c->tmp, " 1\r\n");
-		return 0;
-	}
-	for (;;) {
-		if (*a == '?')
-			ctrl_buf_puts(&c->tmp, n++ ? ", 1" : " 1");
-		else if (*a != ',' && *a != '\0')
-			return 1; /* MT n: not simulated */
-		a = ctrl_skip(*a == '?' ? a + 1 : a);
-		if (*a == '\0')
-			break;
-		if (*a++ != ',')
-			return 1;
-		a = ctrl_skip(a);
-	}
-	if (!n)
-		return 1;
-	ctrl_buf_puts(&c->tmp, "\r\n");
-	return 0;
-}
-
-/*
  * ID (command reference ID: "FW, firmware revision" then one line per
  * board): the ^R^V text, the 4-axis DMC board and the AMP-43040 amplifier
  * the under-voltage status (_TA0 bit 3) belongs to. Rev numbers: choice.
@@ -892,7 +857,6 @@ static int cmd_general(struct ctrl_xc *x, const char *name, const char *a)
 	case 'L' << 8 | 'Z':
 	case 'E' << 8 | 'O':
 	case 'C' << 8 | 'N': return cmd_settings(x, name, a);
-	case 'M' << 8 | 'T': return cmd_mt(x, a);
 	case 'I' << 8 | 'D': return *ctrl_skip(a) ? 1 : cmd_id(x);
 	}
 	return cmd_misc(x, name, a);

@@ -223,7 +223,10 @@ struct ctrl_axis_par {
 	double kp, ki, kd, tl, il, of, ov; /* gains; volts */
 	double er;			   /* counts, -1 = off */
 	double fl, bl;			   /* soft limits, counts */
+	double mt; /* motor type: 1 servo, -1 reversed servo, 2.. stepper */
 	int oe, oa, ot, ld;
+	int ce; /* encoder configuration: stored (galil-sim models quadrature)
+		 */
 	double tw; /* MC timeout, ms (-1 = off) */
 	int motor_off;
 };

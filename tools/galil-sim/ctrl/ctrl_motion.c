@@ -445,6 +445,12 @@ static void servo(struct ctrl_axis *a)
 	t = (4 * a->p.kp * e + 4 * a->p.kd * (e - a->err_prev)) *
 		DAC_V_PER_COUNT +
 	    ki_v + a->p.of;
+	/* MT -1 (-1.5): a servo of reversed polarity drives the other way;
+	 * MT 2 and above: a stepper, whose pulses this servo does not take */
+	if (a->p.mt < 0)
+		t = -t;
+	if (fabs(a->p.mt) >= 2)
+		t = 0;
 	a->torque = fmax(-a->p.tl, fmin(a->p.tl, t));
 	a->err_prev = e;
 }
