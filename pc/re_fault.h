@@ -102,6 +102,13 @@ enum re_fclass {
  *   RE_F_CTRL_STATE      PROGRAM; i0 state seen; s: the state expected
  *   RE_F_CAL_ABSOLUTE    CALIBRATION; a; s "reverse"/"forward"; f0 pot V
  *                        at that end, f1 expected V, f2 tolerance V
+ *   RE_F_READBACK        FOREIGN; a or -1; i0 the item; s: what it is; f0
+ *                        the value read, f1 the supervisor's own (the
+ *                        seal read back against its plan)
+ *   RE_F_XC_DECODE       INPUT; s: the supervisor's decode of the joystick
+ *                        and the program's, the switches closed, how long
+ *   RE_F_XC_MOTION       MOTION; a; s: what the axis does against the
+ *                        supervisor's decode; f0 its speed, f1 the bound
  *   RE_F_CTRL_SEAL       FOREIGN; a or -1; i0 the item's number; s: what
  *                        it is ("vmax[0] (maximum joystick velocity, axis
  *                        A)"); f0 the value found, f1 the sealed one
@@ -154,6 +161,9 @@ enum re_fault_id {
 	RE_F_CTRL_STATE,
 	RE_F_CAL_ABSOLUTE,
 	RE_F_CTRL_SEAL,
+	RE_F_READBACK,
+	RE_F_XC_DECODE,
+	RE_F_XC_MOTION,
 	RE_F_COUNT
 };
 

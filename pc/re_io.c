@@ -135,6 +135,25 @@ static int real_record(void *ud, const char *prefix, struct gl_record *rec,
 	return rc;
 }
 
+static int real_record_text(void *ud, const char *prefix, struct gl_record *rec,
+			    char *text, size_t cap, int timeout_ms)
+{
+	struct re_io_real *r = ud;
+	short ev = 0;
+	bool idle;
+	int rc;
+
+	if (!r->link)
+		return GL_ERR_CLOSED;
+	idle = look_take(r, RE_LOOK_CMD, gl_link_fd(r->link), &ev) &&
+	       !(ev & LOOK_EVENTS);
+	r->last_run_ns = re_io_now_ns();
+	rc = gl_link_record_text(r->link, prefix, rec, timeout_ms, idle, text,
+				 cap);
+	r->last_run_ns = re_io_now_ns();
+	return rc;
+}
+
 static int real_command(void *ud, const char *cmd, char *resp, size_t cap,
 			int timeout_ms)
 {
@@ -356,6 +375,7 @@ static void real_sleep_until(void *ud, int64_t t_ns)
 
 static const struct re_io_ops real_ops = {
     .record = real_record,
+    .record_text = real_record_text,
     .command = real_command,
     .ctrl_error = real_ctrl_error,
     .message = real_message,

@@ -37,6 +37,11 @@ struct re_io_ops {
 	/* gl_link_record(): one "[prefix;]QR" round trip. */
 	int (*record)(void *ud, const char *prefix, struct gl_record *rec,
 		      int timeout_ms);
+	/* gl_link_record_text(): the same with data-answering commands in
+	 * the prefix (the seal's read-back), their text in @text. Optional:
+	 * NULL when the back-end cannot (no read-back then). */
+	int (*record_text)(void *ud, const char *prefix, struct gl_record *rec,
+			   char *text, size_t cap, int timeout_ms);
 	/* gl_link_command(): one command line and its reply. */
 	int (*command)(void *ud, const char *cmd, char *resp, size_t cap,
 		       int timeout_ms);

@@ -139,3 +139,24 @@ void re_plan_super_cfg(const struct re_plan *p, const struct re_config *cfg,
 	out->mode_name =
 	    cfg->mode == RE_MODE_CLINICAL ? "clinical" : "development";
 }
+
+void re_plan_xcheck_cfg(const struct re_plan *p, const struct re_config *cfg,
+			const char *const *names, struct re_xcheck_cfg *out)
+{
+	int ms = p->mainms > 0 ? p->mainms : MAINMS_DEFAULT;
+
+	memset(out, 0, sizeof(*out));
+	for (int j = 0; j < RE_JOY_INPUTS; j++)
+		out->inputs[j] = cfg->joystick.inputs[j];
+	out->active_low = cfg->joystick.active_low ? 1 : 0;
+	for (int i = 0; i < RE_AXES; i++) {
+		out->vmin_cps[i] = cfg->axes[i].vmin_cps;
+		out->vmax_cps[i] = cfg->axes[i].vmax_cps;
+		out->wst_ms[i] = cfg->axes[i].accel_start_ms;
+		out->wen_ms[i] = cfg->axes[i].accel_end_ms;
+		out->axis_names[i] = names[i];
+	}
+	/* thread 1's loop (loopms = mainms in dmc/constants.dmc), two main
+	 * passes until ZAC carries it, one period until the record */
+	out->lag_ns = (int64_t)3 * ms * BASE_NS_PER_MS + p->period_ns;
+}

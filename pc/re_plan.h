@@ -70,4 +70,13 @@ void re_plan_make(const struct re_config *cfg, int mainms, struct re_plan *out);
 void re_plan_super_cfg(const struct re_plan *p, const struct re_config *cfg,
 		       const char *const *names, struct re_super_cfg *out);
 
+/*
+ * re_plan_xcheck_cfg() - the settings of the supervisor's own joystick
+ * decode and motion check (re_xcheck.h): the wiring, the ramps, and the
+ * program's reporting lag (loopms + 2 mainms + the period).
+ * @names: [in] the axis names (must outlive @out).
+ */
+void re_plan_xcheck_cfg(const struct re_plan *p, const struct re_config *cfg,
+			const char *const *names, struct re_xcheck_cfg *out);
+
 #endif /* RE_PLAN_H */

@@ -11,6 +11,8 @@
 #include <string.h>
 
 #include "gl_err.h"
+#include "re_check.h"
+#include "re_plan.h"
 
 #define LINE_MAX_CHARS 80	  /* one program line [galil-notes 3.4] */
 #define SOFT_WIDE      2000000000 /* srev/sfwd before calibration */
@@ -923,4 +925,145 @@ void re_seal_read_fault(const struct re_seal *s, const struct re_io *io,
 			sealed = NAN;
 	}
 	re_seal_fault(s, found, sealed, f);
+}
+
+/* ---- the supervisor's read-back ---------------------------------------- */
+
+#define SOFT_OPEN 2147483647.0 /* FL/BL opened (re_ctl.h RE_CTL_SOFT_OPEN) */
+
+static int item_index(const struct re_seal *s, const char *ref)
+{
+	for (int i = 0; i < s->n; i++)
+		if (!strcmp(s->item[i].ref, ref))
+			return i;
+	return -1;
+}
+
+static double value_of(const struct re_seal *s, const char *ref)
+{
+	int i = item_index(s, ref);
+
+	return i >= 0 ? s->item[i].value : NAN;
+}
+
+/* A session item's value for @state: its name and axis say which. */
+static double session_value(const struct re_seal *s,
+			    const struct re_seal_item *it, int state,
+			    const double *rev, const double *fwd)
+{
+	char ref[RE_SEAL_REF_MAX];
+	double speed, acfact = value_of(s, "acfact");
+	int i = it->axis;
+
+	snprintf(ref, sizeof(ref), "%s[%d]", state == 1 ? "vmax" : "svmax", i);
+	speed = value_of(s, ref);
+	if (!strncmp(it->ref, "srev", 4))
+		return rev ? floor(rev[i] + 0.5) : -SOFT_WIDE;
+	if (!strncmp(it->ref, "sfwd", 4))
+		return fwd ? floor(fwd[i] + 0.5) : SOFT_WIDE;
+	if (!strncmp(it->ref, "_FL", 3))
+		return fwd && state == 1 ? floor(fwd[i] + 0.5) : SOFT_OPEN;
+	if (!strncmp(it->ref, "_BL", 3))
+		return rev && state == 1 ? floor(rev[i] + 0.5) : -SOFT_OPEN;
+	if (!strncmp(it->ref, "_AC", 3) || !strncmp(it->ref, "_DC", 3))
+		return floor(acfact * speed / 1024) * 1024;
+	return speed; /* vla vlb vlc */
+}
+
+void re_seal_expect(const struct re_seal *s, int state, const double *soft_rev,
+		    const double *soft_fwd, double *out)
+{
+	for (int i = 0; i < s->n; i++) {
+		const struct re_seal_item *it = &s->item[i];
+
+		switch (it->kind) {
+		case RE_SEAL_SESSION:
+			out[i] =
+			    session_value(s, it, state, soft_rev, soft_fwd);
+			break;
+		case RE_SEAL_THREAD: out[i] = -1; break;
+		default: out[i] = it->value; break;
+		}
+	}
+}
+
+/* Whether @v read for item @it differs from @want. */
+static int differs(const struct re_seal *s, const struct re_seal_item *it,
+		   double want, double v, int state)
+{
+	if (it->kind == RE_SEAL_THREAD) {
+		if (!strcmp(it->ref, "_XQ1") && state == 1)
+			return v < s->t1_first || v > s->t1_last;
+		return v >= 0;
+	}
+	if (it->tol < 0) /* an upper bound */
+		return v > want - it->tol + 1e-6;
+	return fabs(v - want) >
+	       (it->tol > 0 ? it->tol : 0) + 1e-3 + 1e-6 * fabs(want);
+}
+
+int re_seal_judge(const struct re_seal *s, const double *expect, int first,
+		  int count, const char *text, size_t len, int session_ok,
+		  int state, int *bad, double *found)
+{
+	const char *p = text, *end = text + len;
+	char num[40];
+
+	for (int k = 0; k < count; k++) {
+		const struct re_seal_item *it = &s->item[first + k];
+		size_t n = 0;
+		double v;
+		char *e;
+
+		while (p < end &&
+		       (*p == ' ' || *p == '\r' || *p == '\n' || *p == ','))
+			p++;
+		while (p < end && n + 1 < sizeof(num) && *p != ' ' &&
+		       *p != '\r' && *p != '\n' && *p != ',')
+			num[n++] = *p++;
+		num[n] = '\0';
+		v = strtod(num, &e);
+		if (!n || *e)
+			return GL_ERR_PROTO;
+		if (it->kind == RE_SEAL_SESSION && !session_ok)
+			continue;
+		if (differs(s, it, expect[first + k], v, state)) {
+			*bad = first + k + 1;
+			*found = v;
+			return RE_FAULT;
+		}
+	}
+	return RE_OK;
+}
+
+int re_seal_chunk_text(const struct re_seal *s, int first, int count, char *buf,
+		       size_t cap)
+{
+	size_t n = (size_t)snprintf(buf, cap, "MG ");
+
+	for (int k = 0; k < count && n < cap; k++)
+		n += (size_t)snprintf(buf + n, cap - n, "%s%s", k ? "," : "",
+				      s->item[first + k].ref);
+	return n < cap ? (int)n : GL_ERR_OVERFLOW;
+}
+
+int re_seal_chunks(const struct re_seal *s, size_t max_chars, int *first,
+		   int *count, int cap)
+{
+	int n = 0;
+
+	for (int i = 0; i < s->n;) {
+		size_t len = 3 + strlen(s->item[i].ref);
+		int c = 1;
+
+		if (n >= cap || len > max_chars)
+			return GL_ERR_OVERFLOW;
+		while (i + c < s->n &&
+		       len + 1 + strlen(s->item[i + c].ref) <= max_chars)
+			len += 1 + strlen(s->item[i + c++].ref);
+		first[n] = i;
+		count[n++] = c;
+		i += c;
+	}
+	return n;
 }

@@ -36,7 +36,6 @@
 #include "re_config.h"
 #include "re_fault.h"
 #include "re_io.h"
-#include "re_plan.h"
 
 #define RE_SEAL_MAX	 200   /* items */
 #define RE_SEAL_REF_MAX	 16    /* "vmax[0]", "_KPA", bytes incl. NUL */
@@ -174,6 +173,52 @@ void re_seal_read_fault(const struct re_seal *s, const struct re_io *io,
  */
 int re_seal_compare(const struct re_seal *s, const char *have, size_t hlen,
 		    const char *want, size_t wlen, char *err, size_t errlen);
+
+/*
+ * re_seal_expect() - what the supervisor expects every item to read, from
+ * its own configuration (the table's literals) and, for the session items,
+ * its own plan for @state (1 armed, 3 service): the soft limits srev/sfwd
+ * and FL/BL from @soft_rev/@soft_fwd (counts, per axis; NULL: wide open,
+ * as before calibration), AC and DC = acfact x the speed limit rounded
+ * down to 1024, the speed limits vmax (armed) or svmax (service). Never
+ * the controller's copy (ssn[]).
+ * @out: [out] @s->n values; a thread item: -1, and for _XQ1 when armed
+ *       the first line of thread 1's code (re_seal_judge() knows).
+ */
+void re_seal_expect(const struct re_seal *s, int state, const double *soft_rev,
+		    const double *soft_fwd, double *out);
+
+/*
+ * re_seal_judge() - compare what the controller answered to "MG r1,...,rn"
+ * for items @first .. @first + @count - 1 with @expect (re_seal_expect()).
+ * @text: [in] the MG reply text, @len bytes (numbers separated by blanks).
+ * @session_ok: judge the session items too (the program has been in the
+ *              state @expect was made for); else they are skipped.
+ * @state: the program's state in the same reply (for _XQ1).
+ * @bad: [out] on RE_FAULT: the item's number (1-based); @found its value.
+ * Return: RE_OK, RE_FAULT, or GL_ERR_PROTO when @text does not hold
+ *         @count numbers.
+ */
+int re_seal_judge(const struct re_seal *s, const double *expect, int first,
+		  int count, const char *text, size_t len, int session_ok,
+		  int state, int *bad, double *found);
+
+/*
+ * re_seal_chunks() - split the table into MG requests that fit the
+ * controller's line after the heartbeat: "MG r1,r2,..." of at most
+ * @max_chars characters each.
+ * @first, @count: [out] per chunk, the first item (0-based) and how many.
+ * Return: the number of chunks (<= @cap), or GL_ERR_OVERFLOW.
+ */
+int re_seal_chunks(const struct re_seal *s, size_t max_chars, int *first,
+		   int *count, int cap);
+
+/*
+ * re_seal_chunk_text() - "MG r1,...,rn" for items @first .. + @count.
+ * Return: its length, or GL_ERR_OVERFLOW.
+ */
+int re_seal_chunk_text(const struct re_seal *s, int first, int count, char *buf,
+		       size_t cap);
 
 /*
  * re_seal_split() - where the seal part starts in a program text (the body

@@ -107,9 +107,33 @@ static int start_relay(struct app *a)
  * the critical reply-age limit. None, or one above the limit, refuses a
  * clinical start and is a warning in development mode. A loopback
  * controller (the simulator on this PC) has no cable: not checked. */
+/* The one supported network: the controller on a direct link (its own
+ * interface or a cable; no gateway). Clinical: refused otherwise. */
+static int check_direct(struct app *a, const struct gl_route_info *ri,
+			const char *host)
+{
+	char what[400];
+
+	if (!ri->gateway) {
+		progress(a, "route to the controller: a direct link on %s",
+			 ri->ifname[0] ? ri->ifname : "an unnamed interface");
+		return 0;
+	}
+	snprintf(what, sizeof(what),
+		 "the controller '%s' is reached through a gateway (on %s): "
+		 "the one supported network is a direct link, the controller "
+		 "on an interface of its own or a cable (docs/technician.md)",
+		 host, ri->ifname[0] ? ri->ifname : "an unnamed interface");
+	if (a->cfg.mode == RE_MODE_CLINICAL)
+		return fail(a, what);
+	progress(a, "warning: %s", what);
+	return 0;
+}
+
 static int check_route(struct app *a)
 {
 	int fd = gl_link_fd(a->real.link), ms = 0, rc;
+	struct gl_route_info ri;
 	int crit = (int)(a->cfg.watchdog.critical_factor * a->cfg.period_ms);
 	int limit = gl_route_rto_limit_ms(crit, a->cfg.period_ms);
 	char host[256], port[16], what[700];
@@ -119,7 +143,10 @@ static int check_route(struct app *a)
 	if (gl_link_addr_split(a->cfg.controller.address, host, sizeof(host),
 			       port, sizeof(port)) != GL_OK)
 		snprintf(host, sizeof(host), "%s", a->cfg.controller.address);
-	rc = gl_route_rto_min_ms(fd, 1000, &ms);
+	rc = gl_route_get(fd, 1000, &ri);
+	ms = ri.rto_min_ms;
+	if (rc == GL_OK && check_direct(a, &ri, host))
+		return EXIT_CONNECT;
 	if (rc == GL_OK && ms > 0 && ms <= limit) {
 		progress(a,
 			 "route to the controller: rto_min %d ms (limit %d "
@@ -234,7 +261,9 @@ static int init_super(struct app *a)
 	struct re_super_cfg sc;
 
 	re_plan_super_cfg(&a->plan, &a->cfg, a->names, &sc);
+	re_plan_xcheck_cfg(&a->plan, &a->cfg, a->names, &a->xcheck);
 	sc.seal = &a->seal;
+	sc.xcheck = &a->xcheck;
 	a->sup = calloc(1, sizeof(*a->sup));
 	if (!a->sup || re_super_init(a->sup, &a->io, &sc, NULL, 0) != GL_OK)
 		return fail(a, "cannot set up the supervisor");

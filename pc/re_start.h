@@ -72,6 +72,7 @@ struct app {
 	struct re_ctl_info info;
 	struct re_plan plan;
 	struct re_seal seal; /* the program's sealed values (re_seal.h) */
+	struct re_xcheck_cfg xcheck; /* the own joystick decode (re_xcheck.h) */
 	struct re_calset *cal;
 	struct re_super *sup;
 	struct re_rec *rec;    /* flight recorder (issue 16), NULL: none */

@@ -28,6 +28,30 @@ static double pot_of(const struct re_super *s, int i)
 	return re_pot_of(&s->rec, i, s->cfg.pot_input[i]);
 }
 
+/* The read-back's chunks ("MG r1,...", each fitting the line after the
+ * heartbeat "hbpc=999999999;" and before ";QR"), and the expectation for
+ * the safe state. */
+static int readback_init(struct re_super *s)
+{
+	const size_t room = GL_LINE_MAX - sizeof("hbpc=999999999;;QR") + 1;
+	int n;
+
+	if (!s->cfg.seal || !s->io.ops->record_text)
+		return GL_OK;
+	n = re_seal_chunks(s->cfg.seal, room < 63 ? room : 63, s->rb_first,
+			   s->rb_count, RE_SEAL_MAX);
+	if (n < 0)
+		return n;
+	for (int k = 0; k < n; k++)
+		if (re_seal_chunk_text(s->cfg.seal, s->rb_first[k],
+				       s->rb_count[k], s->rb_chunk[k],
+				       sizeof(s->rb_chunk[k])) < 0)
+			return GL_ERR_OVERFLOW;
+	s->rb_n = n;
+	re_seal_expect(s->cfg.seal, 0, NULL, NULL, s->seal_expect);
+	return GL_OK;
+}
+
 int re_super_init(struct re_super *s, const struct re_io *io,
 		  const struct re_super_cfg *cfg,
 		  const struct re_caltable *const *tables, int expect)
@@ -49,7 +73,32 @@ int re_super_init(struct re_super *s, const struct re_io *io,
 	s->deadline_ns = s->t0_ns + cfg->period_ns; /* no previous cycle */
 	s->last_good_ns = s->t0_ns;
 	re_alive_reset(&s->alive);
-	return GL_OK;
+	re_xcheck_reset(&s->xc, s->t0_ns);
+	return readback_init(s);
+}
+
+/* What the read-back expects from now on: the session's values of
+ * @expect, with the soft limits of @tables (armed) or wide open. */
+static void seal_expect(struct re_super *s,
+			const struct re_caltable *const *tables, int expect)
+{
+	double rev[RE_SUPER_AXES], fwd[RE_SUPER_AXES];
+	int have = tables && expect == RE_DMC_ARMED;
+
+	if (!s->rb_n)
+		return;
+	for (int i = 0; have && i < s->cfg.n_axes; i++) {
+		have = tables[i] != NULL;
+		if (have) {
+			rev[i] = tables[i]->soft_rev;
+			fwd[i] = tables[i]->soft_fwd;
+		}
+	}
+	re_seal_expect(s->cfg.seal, expect, have ? rev : NULL,
+		       have ? fwd : NULL, s->seal_expect);
+	s->seal_state = expect;
+	s->state_cycles = 0;
+	s->rb_have = 0;
 }
 
 void re_super_start(struct re_super *s, const struct re_caltable *const *tables,
@@ -65,6 +114,8 @@ void re_super_start(struct re_super *s, const struct re_caltable *const *tables,
 	s->expect = expect;
 	s->armed = expect == RE_DMC_ARMED;
 	s->own_mask = 0;
+	seal_expect(s, tables, expect);
+	re_xcheck_reset(&s->xc, now_ns(s));
 	/* the handles known stay from the first record on (just after the
 	 * take-over closed the others): a program that connects between two
 	 * phases, e.g. just before the first armed cycle, is still new */
@@ -204,6 +255,24 @@ static void hb_prefix_next(struct re_super *s, long hb)
 	s->prefix_hb = hb;
 }
 
+/* The round trip with the next chunk of the seal read back on the same
+ * line: "hbpc=N;MG r1,...,rn;QR". */
+static int record_readback(struct re_super *s, int tmo)
+{
+	size_t n = (size_t)s->prefix_len, m = strlen(s->rb_chunk[s->rb_next]);
+	int rc;
+
+	memcpy(s->rb_line, s->prefix, n);
+	s->rb_line[n] = ';';
+	memcpy(s->rb_line + n + 1, s->rb_chunk[s->rb_next], m + 1);
+	rc = s->io.ops->record_text(s->io.ud, s->rb_line, &s->rec, s->rb_reply,
+				    sizeof(s->rb_reply), tmo);
+	s->rb_have = rc == GL_OK;
+	s->rb_cur = s->rb_next;
+	s->rb_next = (s->rb_next + 1) % s->rb_n;
+	return rc;
+}
+
 /* The round trip and the PC-side watchdog verdict on it. */
 static int exchange(struct re_super *s, struct re_fault *f)
 {
@@ -212,7 +281,8 @@ static int exchange(struct re_super *s, struct re_fault *f)
 
 	s->hbpc = (s->hbpc + 1) % RE_HBPC_WRAP;
 	hb_prefix_next(s, s->hbpc);
-	rc = s->io.ops->record(s->io.ud, s->prefix, &s->rec, tmo);
+	rc = s->rb_n ? record_readback(s, tmo)
+		     : s->io.ops->record(s->io.ud, s->prefix, &s->rec, tmo);
 	now = now_ns(s);
 	s->link_ok = rc == GL_OK;
 	/* The round trip waits at most tmo: a return later than that by more
@@ -394,6 +464,34 @@ static void drain_messages(struct re_super *s)
 	}
 }
 
+/* The chunk of the seal this reply read back, against the supervisor's
+ * own plan; the session's values only once the program has shown the
+ * state they were made for in two records in a row. */
+static int check_readback(struct re_super *s, struct re_fault *f)
+{
+	int bad = 0, v;
+	double found = 0;
+
+	if (!s->rb_n || !s->rb_have || !s->have_za)
+		return RE_OK;
+	s->state_cycles = s->seal_state && s->za.state == s->seal_state
+			      ? s->state_cycles + 1
+			      : 0;
+	v = re_seal_judge(s->cfg.seal, s->seal_expect, s->rb_first[s->rb_cur],
+			  s->rb_count[s->rb_cur], s->rb_reply,
+			  strlen(s->rb_reply), s->state_cycles >= 2,
+			  s->za.state, &bad, &found);
+	if (v == GL_ERR_PROTO)
+		return check_error(f, RE_F_COMM, -1, "the seal's read-back", v);
+	if (v != RE_FAULT)
+		return RE_OK;
+	re_fault_set(f, RE_F_READBACK, -1);
+	f->i[0] = bad;
+	re_seal_fault(s->cfg.seal, found, s->seal_expect[bad - 1], f);
+	f->id = RE_F_READBACK;
+	return RE_FAULT;
+}
+
 /* Checks on a fresh record, in priority order. */
 static int check_record(struct re_super *s, struct re_fault *f)
 {
@@ -413,9 +511,18 @@ static int check_record(struct re_super *s, struct re_fault *f)
 	if (v == RE_FAULT)
 		return v;
 	v = check_encpot(s, f);
+	if (v == RE_FAULT)
+		return v;
+	v = check_readback(s, f);
 	if (v == RE_FAULT || !s->expect)
 		return v;
-	return check_uncmd(s, f);
+	v = check_uncmd(s, f);
+	if (v == RE_FAULT || !s->cfg.xcheck)
+		return v;
+	v = re_xcheck_step(&s->xc, s->cfg.xcheck, &s->rec, &s->za, now_ns(s),
+			   f);
+	return v < 0 ? check_error(f, RE_F_CONFIG, -1, "the joystick decode", v)
+		     : v;
 }
 
 static int latched_cycle(struct re_super *s)

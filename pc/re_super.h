@@ -39,8 +39,8 @@
 #include "re_fault.h"
 #include "re_io.h"
 #include "re_pot.h"
-
-struct re_seal;
+#include "re_seal.h"
+#include "re_xcheck.h"
 
 #define RE_SUPER_AXES	   3
 #define RE_SUPER_LINE	   768 /* FAULT line, bytes incl. NUL */
@@ -92,8 +92,13 @@ struct re_super_cfg {
 	int64_t uncmd_grace_ns;
 	const char *mode_name; /* "clinical" / "development" */
 	/* the program's sealed values (re_seal.h): a fault 17 names the
-	 * value, what was found and what was sealed; NULL: by number */
+	 * value, what was found and what was sealed, and the cycle reads
+	 * them back (a slice per cycle) against the supervisor's own plan;
+	 * NULL: by number, no read-back */
 	const struct re_seal *seal;
+	/* the supervisor's own decode of the joystick and its check of the
+	 * motion (re_xcheck.h); NULL: off */
+	const struct re_xcheck_cfg *xcheck;
 };
 
 /* Per-axis view for the status board. */
@@ -218,6 +223,19 @@ struct re_super {
 	void (*rec_cycle)(void *ud, const struct re_super *s);
 	const char *(*rec_fault)(void *ud, const struct re_super *s);
 	void *rec_ud;
+	/* the diverse checks: the supervisor's joystick decode, and the seal
+	 * read back a chunk per cycle ("hbpc=N;MG r1,...") against
+	 * seal_expect (made for the state @seal_state) */
+	struct re_xcheck xc;
+	double seal_expect[RE_SEAL_MAX];
+	int seal_state;		   /* RE_DMC_ARMED / _SERVICE / 0 */
+	int state_cycles;	   /* records in a row showing seal_state */
+	int rb_n, rb_next, rb_cur; /* chunks; next to send; in the reply */
+	int rb_have;		   /* rb_reply holds chunk rb_cur */
+	int rb_first[RE_SEAL_MAX], rb_count[RE_SEAL_MAX];
+	char rb_chunk[RE_SEAL_MAX][64];
+	char rb_line[96];
+	char rb_reply[512];
 	/* scratch, preallocated */
 	char prefix[32]; /* "hbpc=N" of the last request ... */
 	long prefix_hb;	 /* ... its N ... */

@@ -95,7 +95,7 @@ static const struct dmc_cmd table[] = {
     {"HV", 0},
     {"HX", DMC_CMD_SIM},
     {"IA", 0},
-    {"ID", DMC_CMD_SIM},
+    {"ID", DMC_CMD_SIM | DMC_CMD_READ},
     {"IF", DMC_CMD_KEYWORD | DMC_CMD_SIM},
     {"IH", DMC_CMD_SIM},
     {"II", 0},
@@ -111,7 +111,7 @@ static const struct dmc_cmd table[] = {
     {"KI", DMC_CMD_SIM},
     {"KP", DMC_CMD_SIM},
     {"KS", 0},
-    {"LA", DMC_CMD_SIM},
+    {"LA", DMC_CMD_SIM | DMC_CMD_READ},
     {"LC", 0},
     {"LD", DMC_CMD_SIM},
     {"LE", 0},
@@ -120,14 +120,14 @@ static const struct dmc_cmd table[] = {
     {"LL", DMC_CMD_SIM},
     {"LM", 0},
     {"LR", 0},
-    {"LS", DMC_CMD_SIM},
-    {"LV", DMC_CMD_SIM},
+    {"LS", DMC_CMD_SIM | DMC_CMD_READ},
+    {"LV", DMC_CMD_SIM | DMC_CMD_READ},
     {"LZ", DMC_CMD_SIM},
     {"MB", 0},
     {"MC", DMC_CMD_SIM},
     {"ME", 0},
     {"MF", DMC_CMD_SIM},
-    {"MG", DMC_CMD_SIM},
+    {"MG", DMC_CMD_SIM | DMC_CMD_READ},
     {"MO", DMC_CMD_SIM},
     {"MR", DMC_CMD_SIM},
     {"MT", DMC_CMD_SIM},
@@ -153,49 +153,49 @@ static const struct dmc_cmd table[] = {
     {"PV", 0},
     {"PW", 0},
     {"QD", 0},
-    {"QH", 0},
+    {"QH", DMC_CMD_READ},
     {"QQ", 0},
-    {"QR", DMC_CMD_SIM},
+    {"QR", DMC_CMD_SIM | DMC_CMD_READ},
     {"QS", 0},
-    {"QU", 0},
-    {"QZ", DMC_CMD_SIM},
+    {"QU", DMC_CMD_READ},
+    {"QZ", DMC_CMD_SIM | DMC_CMD_READ},
     {"RA", 0},
     {"RC", 0},
     {"RD", 0},
     {"RE", DMC_CMD_SIM},
     {"RI", DMC_CMD_SIM},
-    {"RL", 0},
-    {"RP", DMC_CMD_SIM},
+    {"RL", DMC_CMD_READ},
+    {"RP", DMC_CMD_SIM | DMC_CMD_READ},
     {"RS", 0},
     {"SA", 0},
     {"SB", DMC_CMD_SIM},
-    {"SC", DMC_CMD_SIM},
+    {"SC", DMC_CMD_SIM | DMC_CMD_READ},
     {"SD", DMC_CMD_SIM},
     {"SH", DMC_CMD_SIM},
     {"SL", 0},
     {"SM", 0},
     {"SP", DMC_CMD_SIM},
     {"ST", DMC_CMD_SIM},
-    {"TA", DMC_CMD_SIM},
-    {"TB", DMC_CMD_SIM},
-    {"TC", DMC_CMD_SIM},
-    {"TD", DMC_CMD_SIM},
-    {"TE", DMC_CMD_SIM},
-    {"TH", DMC_CMD_SIM},
-    {"TI", DMC_CMD_SIM},
+    {"TA", DMC_CMD_SIM | DMC_CMD_READ},
+    {"TB", DMC_CMD_SIM | DMC_CMD_READ},
+    {"TC", DMC_CMD_SIM | DMC_CMD_READ},
+    {"TD", DMC_CMD_SIM | DMC_CMD_READ},
+    {"TE", DMC_CMD_SIM | DMC_CMD_READ},
+    {"TH", DMC_CMD_SIM | DMC_CMD_READ},
+    {"TI", DMC_CMD_SIM | DMC_CMD_READ},
     {"TK", 0},
     {"TL", DMC_CMD_SIM},
     {"TM", DMC_CMD_SIM},
     {"TN", 0},
-    {"TP", DMC_CMD_SIM},
+    {"TP", DMC_CMD_SIM | DMC_CMD_READ},
     {"TR", 0},
-    {"TS", DMC_CMD_SIM},
-    {"TT", DMC_CMD_SIM},
-    {"TV", DMC_CMD_SIM},
+    {"TS", DMC_CMD_SIM | DMC_CMD_READ},
+    {"TT", DMC_CMD_SIM | DMC_CMD_READ},
+    {"TV", DMC_CMD_SIM | DMC_CMD_READ},
     {"TW", DMC_CMD_SIM},
     {"TZ", 0},
     {"UI", 0},
-    {"UL", DMC_CMD_SIM},
+    {"UL", DMC_CMD_SIM | DMC_CMD_READ},
     {"US", 0},
     {"VA", 0},
     {"VD", 0},
@@ -206,7 +206,7 @@ static const struct dmc_cmd table[] = {
     {"VR", 0},
     {"VS", 0},
     {"VV", 0},
-    {"WH", DMC_CMD_SIM},
+    {"WH", DMC_CMD_SIM | DMC_CMD_READ},
     {"WT", DMC_CMD_SIM},
     {"XQ", DMC_CMD_SIM},
     {"YA", 0},
@@ -241,4 +241,65 @@ size_t dmc_cmd_count(void)
 const struct dmc_cmd *dmc_cmd_at(size_t i)
 {
 	return i < N_CMDS ? &table[i] : NULL;
+}
+
+/* The end of the statement at @s: the next ';' outside a string. */
+static const char *stmt_end(const char *s)
+{
+	int q = 0;
+
+	for (; *s && (q || *s != ';'); s++)
+		if (*s == '"')
+			q = !q;
+	return s;
+}
+
+/* Whether the statement [s, e) only reads: a command marked
+ * DMC_CMD_READ, an interrogation (every argument '?': "KP ?,?",
+ * "KPA=?"), a variable read ("name=" or "name=?"), or a control
+ * character request (^R^V). */
+static int stmt_is_read(const char *s, const char *e)
+{
+	const struct dmc_cmd *c;
+	const char *eq;
+	int only_q = 1, any = 0;
+
+	while (s < e && *s == ' ')
+		s++;
+	while (e > s && e[-1] == ' ')
+		e--;
+	if (s == e || (unsigned char)*s < 0x20)
+		return 1;
+	eq = memchr(s, '=', (size_t)(e - s));
+	if (eq) {
+		for (const char *p = eq + 1; p < e; p++)
+			if (*p != ' ' && *p != '?')
+				return 0;
+		return 1;
+	}
+	c = (e - s >= 2) ? dmc_cmd_find(s) : NULL;
+	if (!c)
+		return 0;
+	if (c->flags & DMC_CMD_READ)
+		return 1;
+	for (const char *p = s + 2; p < e; p++) {
+		if (*p == '?')
+			any = 1;
+		else if (*p != ' ' && *p != ',')
+			only_q = 0;
+	}
+	return any && only_q;
+}
+
+int dmc_cmd_line_is_read(const char *line)
+{
+	for (const char *s = line;;) {
+		const char *e = stmt_end(s);
+
+		if (!stmt_is_read(s, e))
+			return 0;
+		if (!*e)
+			return 1;
+		s = e + 1;
+	}
 }

@@ -17,6 +17,7 @@
 
 #define DMC_CMD_SIM	1u /* galil-sim runs it (else it answers '?', TC 1) */
 #define DMC_CMD_KEYWORD 2u /* a keyword the checker treats apart (IF) */
+#define DMC_CMD_READ	4u /* only reports: changes nothing on the controller */
 
 struct dmc_cmd {
 	char name[3];	/* two upper-case letters */
@@ -34,5 +35,17 @@ const struct dmc_cmd *dmc_cmd_find(const char *s);
  * (0 <= i < dmc_cmd_count(), in alphabetical order), NULL past the end. */
 size_t dmc_cmd_count(void);
 const struct dmc_cmd *dmc_cmd_at(size_t i);
+
+/*
+ * dmc_cmd_line_is_read() - whether a host command line only reads: every
+ * ';'-separated statement is a command marked DMC_CMD_READ (MG, TP, QR,
+ * LS ...), an interrogation whose arguments are all '?' ("KP ?,?",
+ * "KPA=?"), a variable read ("hbpc=" or "hbpc=?") or a control-character
+ * request (^R^V). Anything else - an assignment, a setting, motion, XQ,
+ * HX - writes. galil-load refuses writes on a running robot (docs/
+ * galil-load.md).
+ * Return: 1 or 0.
+ */
+int dmc_cmd_line_is_read(const char *line);
 
 #endif /* DMC_CMD_H */

@@ -611,6 +611,13 @@ int gl_link_record(gl_link *l, const char *prefix, struct gl_record *rec,
 int gl_link_record_seen(gl_link *l, const char *prefix, struct gl_record *rec,
 			int timeout_ms, bool seen_idle)
 {
+	return gl_link_record_text(l, prefix, rec, timeout_ms, seen_idle, NULL,
+				   0);
+}
+
+int gl_link_record_text(gl_link *l, const char *prefix, struct gl_record *rec,
+			int timeout_ms, bool seen_idle, char *text, size_t cap)
+{
 	char line[GL_LINE_MAX + 1];
 	struct xfer x = {.line = line, .seen_idle = seen_idle};
 	struct gl_reply r;
@@ -640,6 +647,12 @@ int gl_link_record_seen(gl_link *l, const char *prefix, struct gl_record *rec,
 		return rc;
 	if (r.n_err)
 		return fetch_tc1(l);
+	if (text && cap) {
+		if (r.text_len >= cap || r.truncated)
+			return GL_ERR_OVERFLOW;
+		memcpy(text, r.text, r.text_len);
+		text[r.text_len] = '\0';
+	}
 	return gl_record_decode(r.bin, r.bin_len, l->layout, l->n_axes, rec);
 }
 

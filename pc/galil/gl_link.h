@@ -115,6 +115,16 @@ int gl_link_record_seen(gl_link *l, const char *prefix, struct gl_record *rec,
 			int timeout_ms, bool seen_idle);
 
 /*
+ * gl_link_record_text() - gl_link_record_seen() whose prefix may hold
+ * commands that answer data (e.g. "hbpc=17;MG vmax[0],_KPA"): their text
+ * goes to @text (NUL-terminated, at most @cap - 1 bytes; the final CR LF
+ * removed), the record is decoded as usual.
+ * Return: as gl_link_record(); GL_ERR_OVERFLOW when the text did not fit.
+ */
+int gl_link_record_text(gl_link *l, const char *prefix, struct gl_record *rec,
+			int timeout_ms, bool seen_idle, char *text, size_t cap);
+
+/*
  * gl_link_ctrl_request() - send a control-character request of the command
  * reference and read its reply: ^R^V (0x12 0x16, firmware revision), ^R^S
  * (0x12 0x13, master reset) or ^L^K (0x0C 0x0B, lock; printable arguments

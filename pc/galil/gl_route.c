@@ -13,6 +13,8 @@
 #include <sys/socket.h>
 #include <unistd.h>
 #include <arpa/inet.h>
+#include <net/if.h>
+#include <stdio.h>
 #include <linux/netlink.h>
 #include <linux/rtnetlink.h>
 #include <netinet/in.h>
@@ -39,29 +41,49 @@ static int metric_rto_min(const struct rtattr *m, int len, int *out)
 	return len == 0 ? GL_OK : GL_ERR_PROTO;
 }
 
-static int parse_route(const struct nlmsghdr *h, int *out)
+static int parse_route(const struct nlmsghdr *h, struct gl_route_info *out)
 {
 	const struct rtmsg *rt = NLMSG_DATA(h);
 	const struct rtattr *a;
-	int len = (int)h->nlmsg_len - (int)NLMSG_LENGTH(sizeof(*rt));
+	int len = (int)h->nlmsg_len - (int)NLMSG_LENGTH(sizeof(*rt)), rc;
+	uint32_t oif;
 
 	if (len < 0)
 		return GL_ERR_PROTO;
 	a = (const struct rtattr *)((const char *)rt +
 				    NLMSG_ALIGN(sizeof(*rt)));
-	for (; RTA_OK(a, len); a = RTA_NEXT(a, len))
-		if (a->rta_type == RTA_METRICS)
-			return metric_rto_min(RTA_DATA(a), (int)RTA_PAYLOAD(a),
-					      out);
+	for (; RTA_OK(a, len); a = RTA_NEXT(a, len)) {
+		if (a->rta_type == RTA_METRICS) {
+			rc = metric_rto_min(RTA_DATA(a), (int)RTA_PAYLOAD(a),
+					    &out->rto_min_ms);
+			if (rc != GL_OK)
+				return rc;
+		} else if (a->rta_type == RTA_GATEWAY) {
+			out->gateway = 1;
+		} else if (a->rta_type == RTA_OIF &&
+			   RTA_PAYLOAD(a) >= sizeof(oif)) {
+			memcpy(&oif, RTA_DATA(a), sizeof(oif));
+			out->oif = (int)oif;
+		}
+	}
 	return len == 0 ? GL_OK : GL_ERR_PROTO;
 }
 
 int gl_route_parse(const void *buf, size_t len, int *rto_min_ms)
 {
+	struct gl_route_info info;
+	int rc = gl_route_parse_info(buf, len, &info);
+
+	*rto_min_ms = info.rto_min_ms;
+	return rc;
+}
+
+int gl_route_parse_info(const void *buf, size_t len, struct gl_route_info *out)
+{
 	const struct nlmsghdr *h = buf;
 	unsigned int left = len > ANSWER_MAX ? ANSWER_MAX : (unsigned int)len;
 
-	*rto_min_ms = 0;
+	memset(out, 0, sizeof(*out));
 	for (; NLMSG_OK(h, left); h = NLMSG_NEXT(h, left)) {
 		if (h->nlmsg_type == NLMSG_ERROR) {
 			const struct nlmsgerr *e = NLMSG_DATA(h);
@@ -72,7 +94,7 @@ int gl_route_parse(const void *buf, size_t len, int *rto_min_ms)
 			return GL_ERR_SYS;
 		}
 		if (h->nlmsg_type == RTM_NEWROUTE)
-			return parse_route(h, rto_min_ms);
+			return parse_route(h, out);
 	}
 	return GL_ERR_PROTO;
 }
@@ -113,7 +135,8 @@ static int build_req(struct route_req *r, const struct sockaddr_storage *peer)
 	return GL_OK;
 }
 
-static int ask(const struct route_req *r, int timeout_ms, int *out)
+static int ask(const struct route_req *r, int timeout_ms,
+	       struct gl_route_info *out)
 {
 	char buf[ANSWER_MAX] __attribute__((aligned(NLMSG_ALIGNTO)));
 	struct sockaddr_nl kernel = {.nl_family = AF_NETLINK};
@@ -134,7 +157,7 @@ static int ask(const struct route_req *r, int timeout_ms, int *out)
 		goto out_close;
 	n = recv(pfd.fd, buf, sizeof(buf), 0);
 	if (n > 0)
-		rc = gl_route_parse(buf, (size_t)n, out);
+		rc = gl_route_parse_info(buf, (size_t)n, out);
 out_close : {
 	int keep = errno;
 
@@ -170,16 +193,30 @@ int gl_route_rto_limit_ms(int crit_ms, int period_ms)
 	return crit_ms > period_ms ? (crit_ms - period_ms) / 3 : 0;
 }
 
-int gl_route_rto_min_ms(int fd, int timeout_ms, int *rto_min_ms)
+int gl_route_get(int fd, int timeout_ms, struct gl_route_info *out)
 {
 	struct sockaddr_storage peer;
 	socklen_t plen = sizeof(peer);
 	struct route_req r;
+	int rc;
 
-	*rto_min_ms = 0;
+	memset(out, 0, sizeof(*out));
 	if (getpeername(fd, (struct sockaddr *)&peer, &plen) < 0)
 		return GL_ERR_ARG;
 	if (build_req(&r, &peer) != GL_OK)
 		return GL_ERR_ARG;
-	return ask(&r, timeout_ms, rto_min_ms);
+	rc = ask(&r, timeout_ms, out);
+	if (rc == GL_OK && out->oif > 0 &&
+	    !if_indextoname((unsigned)out->oif, out->ifname))
+		snprintf(out->ifname, sizeof(out->ifname), "#%d", out->oif);
+	return rc;
+}
+
+int gl_route_rto_min_ms(int fd, int timeout_ms, int *rto_min_ms)
+{
+	struct gl_route_info info;
+	int rc = gl_route_get(fd, timeout_ms, &info);
+
+	*rto_min_ms = info.rto_min_ms;
+	return rc;
 }

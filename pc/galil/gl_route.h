@@ -17,6 +17,28 @@
 /* Linux's default minimum retransmission timeout (TCP_RTO_MIN), ms. */
 #define GL_ROUTE_DEFAULT_RTO_MIN_MS 200
 
+/* What the kernel's route to the controller says. */
+struct gl_route_info {
+	int rto_min_ms;	 /* 0: the route sets none */
+	int gateway;	 /* 1: through a gateway (not a direct link) */
+	int oif;	 /* the interface's index, 0: not given */
+	char ifname[16]; /* its name ("eth1"), "" when not known */
+};
+
+/*
+ * gl_route_get() - the route the kernel uses to reach the peer of the
+ * connected socket @fd: rto_min, whether it goes through a gateway (the
+ * one supported network is a direct link: docs/technician.md), and the
+ * interface. As gl_route_rto_min_ms() otherwise.
+ */
+int gl_route_get(int fd, int timeout_ms, struct gl_route_info *out);
+
+/*
+ * gl_route_parse_info() - gl_route_parse() with the gateway and the
+ * interface index (the name is left "").
+ */
+int gl_route_parse_info(const void *buf, size_t len, struct gl_route_info *out);
+
 /*
  * gl_route_rto_min_ms() - the rto_min of the route the kernel uses to reach
  * the peer of the connected socket @fd (IPv4 or IPv6): one RTM_GETROUTE

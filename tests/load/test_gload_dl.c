@@ -664,13 +664,63 @@ static void test_commands(void **state)
 	assert_int_equal(run(&p, ok), 0);
 	assert_string_equal(proc_output(&p, PROC_STDOUT),
 			    " 17.0000\n 4242.0000\n");
-	assert_string_equal(fk.log, "x=17\nMG x\nMG _BN\n");
+	/* a write is preceded by the look at the program (none runs) */
+	assert_string_equal(fk.log, "MG _XQ0\nx=17\nMG x\nMG _BN\n");
 	proc_kill(&p);
 	assert_int_equal(run(&p, bad), 4);
 	assert_string_equal(proc_output(&p, PROC_STDOUT), " 17.0000\n");
 	assert_string_equal(proc_output(&p, PROC_STDERR),
 			    "galil-load: controller rejected 'FOO': 1 "
 			    "Unrecognized command\n");
+	proc_kill(&p);
+}
+
+static void log_clear(void)
+{
+	pthread_mutex_lock(&fk.mu);
+	fk.log_len = 0;
+	fk.log[0] = '\0';
+	pthread_mutex_unlock(&fk.mu);
+}
+
+/* -c on an armed program: reads pass; a write is refused with exit 5 and
+ * why, and not sent; with --force it is sent, with what follows said. */
+static void test_commands_armed(void **state)
+{
+	static const char *const reads[] = {"-c", "MG x", "-c",	    "x=?", "-c",
+					    "x=", "-c",	  "MG _BN", NULL};
+	static const char *const write[] = {"-c", "MG x",   "-c", "x=17",
+					    "-c", "MG _BN", NULL};
+	static const char *const force[] = {"--force", "-c", "x=17", NULL};
+	struct proc p;
+
+	(void)state;
+	fk.running[0] = fk.running[1] = 1;
+	fk.supervised = 1;
+	fk.var_x = 5;
+	run(&p, reads);
+	assert_log("MG x\nx=?\nx=\nMG _BN\n");
+	proc_kill(&p);
+	log_clear();
+	assert_int_equal(run(&p, write), 5);
+	assert_log("MG x\nMG _XQ0\nMG state\n");
+	assert_string_equal(
+	    proc_output(&p, PROC_STDERR),
+	    "galil-load: 'x=17' writes to the controller, and its program is "
+	    "armed: a write could change how the robot moves or is stopped. "
+	    "Refused (reads such as MG, TP and 'KP ?,?' are allowed); quit "
+	    "roboelf first, or give --force to send it anyway (the program "
+	    "latches a fault if it changes a sealed value)\n");
+	assert_int_equal(fk.var_x, 5);
+	proc_kill(&p);
+	assert_int_equal(run(&p, force), 0);
+	assert_true(
+	    has(&p, PROC_STDOUT,
+		"warning: --force: sending 'x=17' to a program that is "
+		"armed: if it changes a sealed value, the program stops "
+		"the robot and latches fault 17, and roboelf cuts motor "
+		"power\n"));
+	assert_int_equal(fk.var_x, 17);
 	proc_kill(&p);
 }
 
@@ -784,6 +834,8 @@ int main(void)
 	    cmocka_unit_test_setup_teardown(test_start_and_burn_fail, fk_start,
 					    fk_stop),
 	    cmocka_unit_test_setup_teardown(test_commands, fk_start, fk_stop),
+	    cmocka_unit_test_setup_teardown(test_commands_armed, fk_start,
+					    fk_stop),
 	    cmocka_unit_test_setup_teardown(test_busy_refused, fk_start,
 					    fk_stop),
 	    cmocka_unit_test_setup_teardown(test_load_while_jogging, fk_start,

@@ -92,6 +92,31 @@ static void test_cmd_find(void **state)
 	assert_null(dmc_cmd_find("B"));
 }
 
+/* What galil-load lets through to a running robot: reads only. */
+static void test_line_is_read(void **state)
+{
+	static const char *const reads[] = {
+	    "MG state",	   "MG _XQ0,_XQ1", "TPA",	 "TP",
+	    "KP ?,?,?",	   "KPA=?",	   "hbpc=",	 "hbpc=?",
+	    "MG x;TPB;QZ", "\x12\x16",	   "LS",	 "MG \"a;b\"",
+	    "SC",	   "TE ABC",	   "MG vmax[0]", "vmax[0]=?",
+	};
+	static const char *const writes[] = {
+	    "x=17",	    "vmax[0]=9000", "KP 7",  "KPA=7",	 "ER 30000",
+	    "XQ #MOTION,2", "HX",	    "HX1",   "SH ABC",	 "BG A",
+	    "MG x;x=1",	    "OE 0",	    "CN 1",  "jin[0]=3", "LD 3,3,3",
+	    "KP ?,7",	    "ST A",	    "MT -1", "AB 1",
+	};
+
+	(void)state;
+	for (size_t i = 0; i < sizeof(reads) / sizeof(reads[0]); i++)
+		if (!dmc_cmd_line_is_read(reads[i]))
+			fail_msg("'%s' taken for a write", reads[i]);
+	for (size_t i = 0; i < sizeof(writes) / sizeof(writes[0]); i++)
+		if (dmc_cmd_line_is_read(writes[i]))
+			fail_msg("'%s' taken for a read", writes[i]);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -99,6 +124,7 @@ int main(void)
 	    cmocka_unit_test(test_split),
 	    cmocka_unit_test(test_models),
 	    cmocka_unit_test(test_cmd_find),
+	    cmocka_unit_test(test_line_is_read),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

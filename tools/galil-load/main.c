@@ -19,10 +19,12 @@
 
 #include "base_paths.h"
 #include "base_version.h"
+#include "dmc_cmd.h"
 #include "dmc_rule.h"
 #include "gl_disc.h"
 #include "gl_err.h"
 #include "gl_link.h"
+#include "gl_proto.h"
 #include "gload_check.h"
 #include "gload_dl.h"
 #include "gload_prep.h"
@@ -917,6 +919,52 @@ static void print_reply(const char *s)
 	putchar('\n');
 }
 
+/* The RoboELF program's state: 1 armed or 3 service while it runs, else
+ * -1 (no program, halted, or not ours: no "state" variable). */
+static int running_state(gl_link *l, const struct opts *o)
+{
+	char resp[64];
+	double v;
+	int rc =
+	    gl_link_command(l, "MG _XQ0", resp, sizeof(resp), o->timeout_ms);
+
+	if (rc < 0 || !gl_parse_double(resp, (size_t)rc, NULL, &v) || v < 0)
+		return -1;
+	rc = gl_link_command(l, "MG state", resp, sizeof(resp), o->timeout_ms);
+	if (rc < 0 || !gl_parse_double(resp, (size_t)rc, NULL, &v))
+		return -1;
+	return v == 1 || v == 3 ? (int)v : -1;
+}
+
+/* A command that writes, on a program in service or armed: refused
+ * without --force (a write may change how the robot moves or is stopped;
+ * docs/safety.md H12); reads (MG, TP, "KP ?,?", "name=") pass. */
+static int check_write(gl_link *l, const struct opts *o, const char *c)
+{
+	char sh[2 * GL_LINE_MAX + 8];
+	int st;
+
+	if (dmc_cmd_line_is_read(c) || (st = running_state(l, o)) < 0)
+		return 0;
+	if (!o->force) {
+		fprintf(stderr,
+			"galil-load: '%s' writes to the controller, and its "
+			"program is %s: a write could change how the robot "
+			"moves or is stopped. Refused (reads such as MG, TP "
+			"and 'KP ?,?' are allowed); quit roboelf first, or "
+			"give --force to send it anyway (the program latches "
+			"a fault if it changes a sealed value)\n",
+			shown(c, sh),
+			st == 1 ? "armed" : "in its service state");
+		return GLOAD_EXIT_BUSY;
+	}
+	printf("warning: --force: sending '%s' to a program that is %s: if "
+	       "it changes a sealed value, the program stops the robot and "
+	       "latches fault 17, and roboelf cuts motor power\n",
+	       shown(c, sh), st == 1 ? "armed" : "in its service state");
+	return 0;
+}
+
 static int run_commands(gl_link *l, const struct opts *o)
 {
 	static char resp[64 * 1024];
@@ -932,6 +980,8 @@ static int run_commands(gl_link *l, const struct opts *o)
 			  : o->timeout_ms;
 		if (tmo < o->timeout_ms)
 			tmo = o->timeout_ms;
+		if ((rc = check_write(l, o, c)) != 0)
+			return rc;
 		if (gl_link_ctrl_kind(c) > GL_CTRL_NONE)
 			rc =
 			    gl_link_ctrl_request(l, c, resp, sizeof(resp), tmo);
