@@ -97,11 +97,12 @@ struct re_comm {
 	/* out */
 	struct re_comm_item item[RE_COMM_ITEMS];
 	int n;
-	const char *failed_step;      /* NULL when every step passed */
-	bool power_on_seen;	      /* motor power was switched on */
-	long hbpc;		      /* the heartbeat in the service state */
-	char model[64];		      /* in: ^R^V (re_ctl_identify()) */
-	long serial;		      /* in: MG _BN */
+	const char *failed_step; /* NULL when every step passed */
+	bool power_on_seen;	 /* motor power was switched on */
+	long hbpc;		 /* the heartbeat in the service state */
+	int guard;	/* the probes run under #PRWD: every wait writes hbpc */
+	char model[64]; /* in: ^R^V (re_ctl_identify()) */
+	long serial;	/* in: MG _BN */
 	char id_text[RE_COMM_IDTEXT]; /* ID */
 	char th_text[RE_COMM_IDTEXT]; /* TH */
 	double noise_v[RE_AXES][RE_COMM_NOISE_N];

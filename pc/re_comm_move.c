@@ -541,11 +541,16 @@ int rc_step_motion(struct re_comm *c)
 	if (rc == GL_OK && !c->failed_step &&
 	    re_ctl_off(c->io, &c->hbpc, err, sizeof(err)) != GL_OK)
 		rc = GL_ERR_TIMEOUT;
-	/* the bounded direct probes need the program halted */
+	/* the bounded direct probes need the program halted, and run under
+	 * its probe watchdog (#PRWD): a run that dies leaves nothing on */
 	if (rc == GL_OK && !c->failed_step &&
 	    (rc = re_ctl_halt(c->io, err, sizeof(err))) == GL_OK &&
-	    (rc = probe_mo_moving(c)) == GL_OK)
-		rc = probe_pt(c);
+	    (rc = rc_guard(c, 1)) == GL_OK) {
+		if ((rc = probe_mo_moving(c)) == GL_OK)
+			rc = probe_pt(c);
+		if (rc_guard(c, 0) != GL_OK && rc == GL_OK)
+			rc = GL_ERR_CTRL;
+	}
 	if (rc_safe(c) != GL_OK && rc == GL_OK)
 		rc = GL_ERR_RELAY;
 	if (torque(c, tl, 1) != GL_OK && rc == GL_OK)

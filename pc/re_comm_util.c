@@ -78,8 +78,31 @@ double rc_now_ms(struct re_comm *c)
 void rc_sleep_ms(struct re_comm *c, int ms)
 {
 	int64_t t = c->io->ops->now_ns(c->io->ud) + (int64_t)ms * 1000000;
+	char hb[32];
 
+	if (c->guard) { /* alive for #PRWD (dmc/roboelf.dmc) */
+		c->hbpc = (c->hbpc + 1) % RE_HBPC_WRAP;
+		snprintf(hb, sizeof(hb), "hbpc=%ld", c->hbpc);
+		rc_cmd(c, hb, NULL, 0);
+	}
 	c->io->ops->sleep_until(c->io->ud, t);
+}
+
+int rc_guard(struct re_comm *c, int on)
+{
+	int rc;
+
+	if (!on) {
+		c->guard = 0;
+		return rc_cmd(c, "HX0", NULL, 0) < 0 ? GL_ERR_CTRL : GL_OK;
+	}
+	rc = rc_cmd(c, "XQ #PRWD,0", NULL, 0);
+	if (rc < 0)
+		return rc;
+	c->guard = 1;
+	rc_sleep_ms(c, 20); /* #PRWD sets its constants, then watches */
+	rc_sleep_ms(c, 20);
+	return GL_OK;
 }
 
 int rc_link_fail(struct re_comm *c, const char *step, const char *what, int rc)

@@ -70,4 +70,14 @@ int rc_link_fail(struct re_comm *c, const char *step, const char *what, int rc);
  */
 int rc_safe(struct re_comm *c);
 
+/*
+ * rc_guard() - the direct probes under the program's probe watchdog:
+ * @on 1 starts #PRWD in thread 0 (the program halted) and makes every
+ * rc_sleep_ms() write the next hbpc first, so that a commissioning run that
+ * dies mid-probe leaves the motors on at most wdto + mainms; @on 0 ends it
+ * (HX0).
+ * Return: GL_OK, or the link's error (GL_ERR_CTRL: no #PRWD, load dmc/).
+ */
+int rc_guard(struct re_comm *c, int on);
+
 #endif /* RE_COMM_UTIL_H */

@@ -102,17 +102,12 @@ static int start_relay(struct app *a)
 	return 0;
 }
 
-/* The route's minimum retransmission time (docs/link.md): a frame lost on
- * the cable must be resent soon enough that the reply still comes within
- * the critical reply-age limit. None, or one above the limit, refuses a
- * clinical start and is a warning in development mode. A loopback
- * controller (the simulator on this PC) has no cable: not checked. */
 /* The one supported network: the controller on a direct link (its own
  * interface or a cable; no gateway). Clinical: refused otherwise. */
 static int check_direct(struct app *a, const struct gl_route_info *ri,
 			const char *host)
 {
-	char what[400];
+	char what[800];
 
 	if (!ri->gateway) {
 		progress(a, "route to the controller: a direct link on %s",
@@ -130,6 +125,11 @@ static int check_direct(struct app *a, const struct gl_route_info *ri,
 	return 0;
 }
 
+/* The route's minimum retransmission time (docs/link.md): a frame lost on
+ * the cable must be resent soon enough that the reply still comes within
+ * the critical reply-age limit. None, or one above the limit, refuses a
+ * clinical start and is a warning in development mode. A loopback
+ * controller (the simulator on this PC) has no cable: not checked. */
 static int check_route(struct app *a)
 {
 	int fd = gl_link_fd(a->real.link), ms = 0, rc;

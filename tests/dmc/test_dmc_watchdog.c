@@ -193,12 +193,127 @@ static void test_pcflt(void **state)
 	assert_true(dmc_h_var(h, "fcode") == 12);
 }
 
+/*
+ * The request window: the supervisor writes "hbpc=n;REQ=1" on one line,
+ * goes on writing its heartbeat every 10 ms and dies 0..39 ms after the
+ * request (the heartbeat stops; a kill at 40 instants of the window, in
+ * which the program takes the request: its checks hold thread 0 for tens
+ * of ms). Wherever it dies, every motor is off within wdto + mainms (+1
+ * sample) of that last write, whether the program put them on or not:
+ * the request is dated by the look before the write (#HBSEEN), not by the
+ * pass that saw it after its parameter and seal checks.
+ */
+static void test_request_window(void **state)
+{
+	static const char *const req[2] = {"svcreq", "armreq"};
+	double worst[2] = {0, 0};
+	int went_on[2] = {0, 0};
+
+	(void)state;
+	for (int r = 0; r < 2; r++)
+		for (int d = 0; d < 40; d++) {
+			static struct dmc_h h;
+			struct dmc_h_params p;
+			char line[48];
+			double wdto, mainms, t_last, t;
+
+			dmc_h_params_default(&p);
+			DMC_H_CHECK(&h, dmc_h_open(&h));
+			DMC_H_CHECK(&h, dmc_h_start(&h));
+			DMC_H_CHECK(&h, dmc_h_configure(&h, &p));
+			wdto = dmc_h_var(&h, "wdto");
+			mainms = dmc_h_var(&h, "mainms");
+			h.hb_on = 1;
+			dmc_h_advance(&h, 100 + d % 11);
+			h.hb_on = 0;
+			snprintf(line, sizeof(line), "hbpc=%ld;%s=1", ++h.hb,
+				 req[r]);
+			DMC_H_CHECK(&h, dmc_h_cmd(&h, line, NULL, 0));
+			t_last = dmc_h_now(&h);
+			/* it goes on writing every 10 ms (its cycle while the
+			 * program takes the request) and dies d ms after the
+			 * request: its last write is the last one before d */
+			for (int w = 10; w <= d; w += 10) {
+				dmc_h_advance(&h, 10);
+				DMC_H_CHECK(
+				    &h, dmc_h_set(&h, "hbpc", (double)++h.hb));
+				t_last = dmc_h_now(&h);
+			}
+			dmc_h_advance(&h, d % 10);
+			for (t = dmc_h_now(&h) - t_last; t < wdto + mainms + 1;
+			     t = dmc_h_now(&h) - t_last) {
+				dmc_h_advance(&h, 1);
+				went_on[r] += !dmc_h_axis(&h, 0).motor_off;
+			}
+			for (int i = 0; i < DMC_H_AXES; i++)
+				if (!dmc_h_axis(&h, i).motor_off)
+					fail_msg(
+					    "%s, died %d ms after it: axis "
+					    "%c on %.0f ms after the last "
+					    "write (wdto %.0f, mainms "
+					    "%.0f)",
+					    req[r], d, 'A' + i, t, wdto,
+					    mainms);
+			t = dmc_h_wait_motor_off(&h, 7, 0);
+			if (t > worst[r])
+				worst[r] = t;
+			assert_true(dmc_h_var(&h, "state") == 2);
+			assert_true(dmc_h_var(&h, "fcode") == 2);
+			dmc_h_close(&h);
+		}
+	print_message("measured: 40 instants each, the motors went on %s "
+		      "and %s, and were off within wdto + mainms + 1 of the "
+		      "last write in every case\n",
+		      went_on[0] ? "in service" : "never in service",
+		      went_on[1] ? "armed" : "never armed");
+}
+
+/*
+ * The commissioning run's direct probes under #PRWD: the program halted,
+ * #PRWD started, axis A moving under direct commands while the probe
+ * writes hbpc every 10 ms; the probe dies at 20 instants of a 300-count
+ * move: the motors are off within wdto + mainms (+1) of its last write,
+ * with "PROBE WATCHDOG".
+ */
+static void test_probe_watchdog(void **state)
+{
+	(void)state;
+	for (int d = 0; d < 20; d++) {
+		static struct dmc_h h;
+		double wdto, mainms, t_last = 0, t;
+
+		DMC_H_CHECK(&h, dmc_h_open(&h));
+		DMC_H_CHECK(&h, dmc_h_cmd(&h, "XQ #PRWD,0", NULL, 0));
+		dmc_h_advance(&h, 30);
+		wdto = dmc_h_var(&h, "wdto");
+		mainms = dmc_h_var(&h, "mainms");
+		DMC_H_CHECK(
+		    &h, dmc_h_cmd(&h, "SH A;SPA=1000;PRA=300;BG A", NULL, 0));
+		for (int k = 0; k <= d; k++) {
+			DMC_H_CHECK(&h, dmc_h_set(&h, "hbpc", (double)++h.hb));
+			t_last = dmc_h_now(&h);
+			dmc_h_advance(&h, 10);
+		}
+		t = dmc_h_wait_motor_off(&h, 7, wdto + mainms + 1);
+		if (t < 0)
+			fail_msg("probe died after %d writes: a motor still on "
+				 "%.0f ms after the last",
+				 d + 1, dmc_h_now(&h) - t_last);
+		t = dmc_h_now(&h) - t_last;
+		assert_true(t <= wdto + mainms + 1);
+		assert_true(dmc_h_unsol_has(&h, "PROBE WATCHDOG"));
+		dmc_h_close(&h);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test_setup_teardown(test_heartbeat_stopped,
 					    dmc_h_fx_armed, dmc_h_fx_free),
 	    cmocka_unit_test(test_request_after_death),
+	    cmocka_unit_test(test_request_window),
+	    cmocka_unit_test(test_probe_watchdog),
 	    cmocka_unit_test_setup_teardown(test_heartbeat_slow_ok,
 					    dmc_h_fx_armed, dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_thread0_halted, dmc_h_fx_armed,
