@@ -429,8 +429,8 @@ static int probe_upload(struct re_comm *c)
 static const struct {
 	const char *name, *text;
 } unprobed[] = {
-    {"at-negvar", "AT -var with a negated variable (UNCONFIRMED): dmc/ uses "
-		  "variables holding the negative value (AT mainat)"},
+    {"at-negvar", "AT -var with a negated variable (UNCONFIRMED): dmc/ does "
+		  "not use it; it waits with the documented literal AT -10"},
     {"re1", "the automatic subroutines return with RE1 (reference: RE): "
 	    "tests/dmc on galil-sim; every routine makes safe before it "
 	    "returns"},

@@ -114,7 +114,8 @@ static const char *re_svc_reason(long long det)
 	return det >= 1 && det <= 7 ? why[det] : why[0];
 }
 
-/* Fault 14's detail: 1 the heartbeat, 3 wdto or jto, 4 OE. */
+/* Fault 14's detail: 1 the heartbeat, 3 wdto or jto, 4 OE, 5 the
+ * program's state set from outside. */
 static void re_foreign(long long det, struct re_fault *f)
 {
 	if (det == 1) {
@@ -124,6 +125,8 @@ static void re_foreign(long long det, struct re_fault *f)
 	snprintf(f->s, sizeof(f->s), "%s",
 		 det == 3   ? "the watchdog or the joystick timeout"
 		 : det == 4 ? "off-on-error switched off"
+		 : det == 5 ? "the program's state, set to a value it never "
+			      "sets itself"
 			    : "which one is not known");
 }
 

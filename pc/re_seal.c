@@ -689,8 +689,10 @@ static void emit_checks(struct emit *e, const struct re_seal *s,
 	put(e, "EN\n");
 	/* #SEAL: slice sls (rotating), one line of jumps; each slice ends
 	 * with EN, or goes on to the next one for #SEALA (sall=1) */
-	put(e, "#SEAL\nsls=sls+1;sses=(state=1)|(state=3);sall=0\n");
-	put(e, "JP #SEALB,sls<%d\nsls=0\n#SEALB\n", k);
+	/* the slice number starts again from 0 when it is outside 0..k-1
+	 * or not whole: a written sls never skips a slice for long */
+	put(e, "#SEAL\nsls=@INT[sls]+1;sses=(state=1)|(state=3);sall=0\n");
+	put(e, "JP #SEALB,(sls>=0)&(sls<%d)\nsls=0\n#SEALB\n", k);
 	for (int j = 0; j < k; j++)
 		put(e, "JP #SL%d,sls=%d%s", j, j,
 		    (j % 5 == 4 || j == k - 1) ? "\n" : ";");

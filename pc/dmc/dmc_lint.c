@@ -37,7 +37,7 @@ struct symtab {
 struct lint {
 	const struct dmc_model *m;
 	struct dmc_lint *r;
-	struct symtab labels, refs, vars;
+	struct symtab labels, refs, vars, targets;
 	int *ifs; /* line of each open IF */
 	int nifs, capifs;
 	int nlines;
@@ -234,8 +234,14 @@ static void check_assignment(struct lint *c, int line, const char *s, size_t n,
 
 	while (i < n && s[i] == ' ')
 		i++;
-	if (check_var_name(c, line, s, wl) && s[i] != '[')
-		sym_add(c, &c->vars, s, wl, line);
+	if (check_var_name(c, line, s, wl)) {
+		struct sym *e = sym_add(c, &c->targets, s, wl, line);
+
+		if (e && s[i] == '[')
+			e->cmd[0] = '[';
+		if (s[i] != '[')
+			sym_add(c, &c->vars, s, wl, line);
+	}
 	if (eq)
 		check_expr(c, line, eq + 1, n - (size_t)(eq + 1 - s));
 }
@@ -604,6 +610,37 @@ static void check_vars(struct lint *c)
 		       c->m->max_vars);
 }
 
+/* The names assigned, distinct, in order of first assignment, copied out
+ * (@c->r->targets). */
+static void list_targets(struct lint *c)
+{
+	struct symtab *t = &c->targets;
+	struct dmc_lint *r = c->r;
+	int i, n = 0;
+
+	if (t->n > 1)
+		qsort(t->v, (size_t)t->n, sizeof(*t->v), sym_cmp_name);
+	for (i = 0; i < t->n; i++)
+		if (i == 0 || strcmp(t->v[i].name, t->v[n - 1].name))
+			t->v[n++] = t->v[i];
+	if (n > 1)
+		qsort(t->v, (size_t)n, sizeof(*t->v), sym_cmp_seq);
+	if (n == 0)
+		return;
+	r->targets = calloc((size_t)n, sizeof(*r->targets));
+	if (!r->targets) {
+		c->nomem = 1;
+		return;
+	}
+	for (i = 0; i < n; i++) {
+		snprintf(r->targets[i].name, sizeof(r->targets[i].name), "%s",
+			 t->v[i].name);
+		r->targets[i].line = t->v[i].line;
+		r->targets[i].array = t->v[i].cmd[0] == '[';
+	}
+	r->ntargets = n;
+}
+
 /* What can only be judged on the whole program. */
 static void check_end(struct lint *c, int extra_lines)
 {
@@ -621,6 +658,7 @@ static void check_end(struct lint *c, int extra_lines)
 		       m->title, m->max_lines);
 	check_labels(c);
 	check_vars(c);
+	list_targets(c);
 }
 
 /* The next line of @text from *@pos (LF, CR LF or CR ends it). */
@@ -679,6 +717,7 @@ int dmc_lint_text(const char *text, size_t len, const struct dmc_model *m,
 	free(c.labels.v);
 	free(c.refs.v);
 	free(c.vars.v);
+	free(c.targets.v);
 	free(c.ifs);
 	return c.nomem ? DMC_LINT_NOMEM : out->n;
 }
@@ -686,5 +725,6 @@ int dmc_lint_text(const char *text, size_t len, const struct dmc_model *m,
 void dmc_lint_free(struct dmc_lint *r)
 {
 	free(r->v);
+	free(r->targets);
 	memset(r, 0, sizeof(*r));
 }

@@ -23,7 +23,8 @@
 #include "dmc_model.h"
 #include "dmc_rule.h"
 
-#define DMC_LINT_MSG_SIZE 200 /* bytes of a message, with its NUL */
+#define DMC_LINT_MSG_SIZE  200 /* bytes of a message, with its NUL */
+#define DMC_LINT_NAME_SIZE 9   /* a variable's name (8 characters), NUL */
 #define DMC_LINT_NOMEM	  (-1)
 
 struct dmc_finding {
@@ -35,12 +36,21 @@ struct dmc_finding {
 	char msg[DMC_LINT_MSG_SIZE];
 };
 
+/* A variable or array the program assigns ("x=", "a[i]="), where first. */
+struct dmc_target {
+	char name[DMC_LINT_NAME_SIZE]; /* truncated if longer (a finding) */
+	int line;		       /* 1-based line of the first one */
+	int array;		       /* 1 when assigned as name[index] */
+};
+
 struct dmc_lint {
 	struct dmc_finding *v; /* in line order, then detection order */
 	int n, cap;
 	int lines;  /* program lines, with the caller's extra lines */
 	int labels; /* labels defined */
 	int vars;   /* distinct scalar variables assigned */
+	struct dmc_target *targets; /* every name assigned, distinct, in */
+	int ntargets;		    /* order of first assignment */
 };
 
 /*
@@ -51,14 +61,16 @@ struct dmc_lint {
  *               the controller (galil-load's identity line: 1), counted
  *               against the model's line limit.
  * @out: [out] zero-initialised (or after dmc_lint_free()); receives the
- *       findings and the counts. Free with dmc_lint_free().
+ *       findings, the counts and the names the program assigns (what a
+ *       test of foreign writes walks). Free with dmc_lint_free().
  * Return: the number of findings (>= 0; 0 = clean), or DMC_LINT_NOMEM
  *         (@out then holds what was found before memory ran out).
  */
 int dmc_lint_text(const char *text, size_t len, const struct dmc_model *m,
 		  int extra_lines, struct dmc_lint *out);
 
-/* dmc_lint_free() - free the findings; @r is left zeroed and reusable. */
+/* dmc_lint_free() - free the findings and the names; @r is left zeroed
+ * and reusable. */
 void dmc_lint_free(struct dmc_lint *r);
 
 #endif /* DMC_LINT_H */

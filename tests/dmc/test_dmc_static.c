@@ -1,6 +1,6 @@
 /*
- * test_dmc_static.c - dmc/ fits a DMC-4030 (issue 4, point 9) and starts
- * safely from a bare XQ (point 1).
+ * test_dmc_static.c - dmc/ fits a DMC-4030 and starts safely from a bare
+ * XQ; its loops wait with literal periods equal to its constants.
  *
  * The limits come from galil-notes.md 3.4 (DMC-40x0): 80 characters per
  * line, 4000 lines, labels '#' + up to 7 characters starting with a letter
@@ -366,12 +366,60 @@ static void test_bare_xq(void **state)
 	dmc_h_close(&h);
 }
 
+/* The value of constant @name in #CONSTS ("name=value"), or NAN. */
+static double const_value(const char *name)
+{
+	char pat[32];
+	const char *p;
+
+	snprintf(pat, sizeof(pat), "\n%s=", name);
+	p = strstr(prog, pat);
+	return p ? atof(p + strlen(pat)) : NAN;
+}
+
+/* The loops wait with a literal (a variable would let a client stall the
+ * thread that checks everything): "AT -n" in #MAIN and #PRWD is -mainms,
+ * in #MOTION -loopms; no AT takes a variable. */
+static void test_loop_periods(void **state)
+{
+	double mainms = const_value("mainms"), loopms = const_value("loopms");
+	const char *routine = "", *p = prog;
+	int seen = 0;
+
+	(void)state;
+	assert_false(isnan(mainms) || isnan(loopms));
+	while (p && *p) {
+		const char *eol = strchr(p, '\n');
+		size_t n = eol ? (size_t)(eol - p) : strlen(p);
+
+		if (n == 5 && !strncmp(p, "#MAIN", 5))
+			routine = "#MAIN";
+		else if (n == 5 && !strncmp(p, "#PRWD", 5))
+			routine = "#PRWD";
+		else if (n == 7 && !strncmp(p, "#MOTION", 7))
+			routine = "#MOTION";
+		if (n > 3 && !strncmp(p, "AT ", 3) && strncmp(p, "AT 0", n)) {
+			double want = !strcmp(routine, "#MOTION") ? loopms
+								  : mainms;
+
+			if (p[3] != '-' || !isdigit((unsigned char)p[4]) ||
+			    atof(p + 4) != want)
+				fail_msg("'%.*s' in %s: want the literal AT -%g",
+					 (int)n, p, routine, want);
+			seen++;
+		}
+		p = eol ? eol + 1 : NULL;
+	}
+	assert_int_equal(seen, 3);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_source_lines), cmocka_unit_test(test_lines),
 	    cmocka_unit_test(test_lint_clean),	 cmocka_unit_test(test_labels),
 	    cmocka_unit_test(test_statements),	 cmocka_unit_test(test_bare_xq),
+	    cmocka_unit_test(test_loop_periods),
 	};
 
 	return cmocka_run_group_tests(tests, setup_prog, NULL);

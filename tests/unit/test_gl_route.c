@@ -1,7 +1,8 @@
 /*
- * test_gl_route.c - gl_route: the rto_min metric parsed from hand-built
- * rtnetlink answers (present, absent, an error answer, truncated, no route),
- * and one live lookup of the loopback route (no rto_min: 0).
+ * test_gl_route.c - gl_route: the rto_min metric, the gateway and the
+ * interface parsed from hand-built rtnetlink answers (present, absent, an
+ * error answer, truncated, no route), and live lookups of the loopback
+ * route (no rto_min: 0; a direct link on "lo").
  */
 #include <errno.h>
 #include <setjmp.h>
@@ -152,12 +153,76 @@ static void test_live_loopback(void **state)
 	close(lfd);
 }
 
+/* Append a 4-byte attribute to answer @a (built by build()). */
+static void add_u32(struct answer *a, unsigned short type, uint32_t v)
+{
+	struct rtattr *r =
+	    (struct rtattr *)((char *)a + NLMSG_ALIGN(a->h.nlmsg_len));
+
+	r->rta_type = type;
+	r->rta_len = RTA_LENGTH(4);
+	memcpy(RTA_DATA(r), &v, 4);
+	a->h.nlmsg_len = NLMSG_ALIGN(a->h.nlmsg_len) + RTA_SPACE(4);
+}
+
+/* A route through a gateway on interface 3; a direct one on interface 2;
+ * neither attribute: no gateway, interface 0. */
+static void test_parse_gateway(void **state)
+{
+	struct answer a;
+	struct gl_route_info ri;
+
+	(void)state;
+	build(&a, 20);
+	add_u32(&a, RTA_GATEWAY, htonl(0x0a000001));
+	add_u32(&a, RTA_OIF, 3);
+	assert_int_equal(gl_route_parse_info(&a, a.h.nlmsg_len, &ri), GL_OK);
+	assert_int_equal(ri.gateway, 1);
+	assert_int_equal(ri.oif, 3);
+	assert_int_equal(ri.rto_min_ms, 20);
+	assert_string_equal(ri.ifname, "");
+	build(&a, 0);
+	add_u32(&a, RTA_OIF, 2);
+	assert_int_equal(gl_route_parse_info(&a, a.h.nlmsg_len, &ri), GL_OK);
+	assert_int_equal(ri.gateway, 0);
+	assert_int_equal(ri.oif, 2);
+	build(&a, -1);
+	assert_int_equal(gl_route_parse_info(&a, a.h.nlmsg_len, &ri), GL_OK);
+	assert_int_equal(ri.gateway, 0);
+	assert_int_equal(ri.oif, 0);
+}
+
+/* A live lookup: to 127.0.0.1 the route is a direct link on "lo". */
+static void test_live_direct(void **state)
+{
+	struct sockaddr_in sa = {.sin_family = AF_INET};
+	socklen_t len = sizeof(sa);
+	int lfd = socket(AF_INET, SOCK_STREAM, 0);
+	int fd = socket(AF_INET, SOCK_STREAM, 0);
+	struct gl_route_info ri;
+
+	(void)state;
+	sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+	assert_true(lfd >= 0 && fd >= 0);
+	assert_int_equal(bind(lfd, (struct sockaddr *)&sa, sizeof(sa)), 0);
+	assert_int_equal(listen(lfd, 1), 0);
+	assert_int_equal(getsockname(lfd, (struct sockaddr *)&sa, &len), 0);
+	assert_int_equal(connect(fd, (struct sockaddr *)&sa, sizeof(sa)), 0);
+	assert_int_equal(gl_route_get(fd, 1000, &ri), GL_OK);
+	assert_int_equal(ri.gateway, 0);
+	assert_string_equal(ri.ifname, "lo");
+	close(fd);
+	close(lfd);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_parse_rto_min),
 	    cmocka_unit_test(test_parse_absent),
 	    cmocka_unit_test(test_parse_error_answer),
+	    cmocka_unit_test(test_parse_gateway),
+	    cmocka_unit_test(test_live_direct),
 	    cmocka_unit_test(test_parse_malformed),
 	    cmocka_unit_test(test_live_loopback),
 	};

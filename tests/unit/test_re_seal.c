@@ -2,7 +2,8 @@
  * test_re_seal.c - the seal table and its program part (pc/re_seal.h):
  * what is sealed with which value, the emitted lines (80 characters, the
  * slices, one finder line per item), the comparison roboelf makes at
- * start-up and the FAULT details it fills, and the refusals.
+ * start-up and the FAULT details it fills, its read-back while running,
+ * and the refusals.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -17,6 +18,7 @@
 
 #include "dmc_h.h"
 #include "gl_err.h"
+#include "re_check.h"
 #include "re_config.h"
 #include "re_seal.h"
 
@@ -74,11 +76,11 @@ static void test_table(void **state)
 	it = item(&seal, "vers", &k);
 	assert_int_equal(k, 1);
 	assert_int_equal(it->kind, RE_SEAL_CONST);
-	assert_string_equal(it->lit, "2.2");
-	it = item(&seal, "mainat", NULL);
-	assert_true(it->value == -10);
+	assert_string_equal(it->lit, "2.21");
+	it = item(&seal, "rampov", NULL);
+	assert_true(it->value == 1.25);
 	it = item(&seal, "vmax[0]", &k);
-	assert_int_equal(k, 26);
+	assert_int_equal(k, 26); /* after the 22 constants and 3 vmin */
 	assert_int_equal(it->kind, RE_SEAL_PARAM);
 	assert_true(it->value == c.axes[0].vmax_cps);
 	assert_int_equal(it->axis, 0);
@@ -249,9 +251,105 @@ static void test_refusals(void **state)
 	assert_string_equal(err, "the program has no #MOTION before #POSERR");
 }
 
+/* The reply to "MG r1,...,rn" for items @first.. + @count, from @v. */
+static size_t reply(const double *v, int first, int count, char *buf,
+		    size_t cap)
+{
+	size_t n = 0;
+
+	for (int i = first; i < first + count; i++)
+		n += (size_t)snprintf(buf + n, cap - n, " %.4f", v[i]);
+	return n;
+}
+
+/* The read-back: the table split into chunks that fit a line; every
+ * chunk of what the plan expects holds; one value changed in a chunk is
+ * that item with the value found; session items are judged only once the
+ * program is in the state the plan was made for; a short reply is a
+ * protocol error. */
+static void test_readback(void **state)
+{
+	struct re_config c;
+	static double want[RE_SEAL_MAX], got[RE_SEAL_MAX];
+	int first[64], count[64], n, bad = 0, k = 0, total = 0;
+	double found = 0;
+	char buf[4096];
+	size_t len;
+
+	(void)state;
+	re_config_defaults(&c);
+	make(&c, &seal, text);
+	re_seal_expect(&seal, 1, NULL, NULL, want);
+	n = re_seal_chunks(&seal, 60, first, count, 64);
+	assert_true(n > 10);
+	for (int i = 0; i < n; i++) {
+		char mg[128];
+
+		assert_true(re_seal_chunk_text(&seal, first[i], count[i], mg,
+					       sizeof(mg)) <= 60);
+		total += count[i];
+	}
+	assert_int_equal(total, seal.n);
+	memcpy(got, want, sizeof(got));
+	item(&seal, "_XQ1", &k); /* armed: thread 1 runs its own code */
+	got[k - 1] = seal.t1_first;
+	for (int i = 0; i < n; i++) {
+		len = reply(got, first[i], count[i], buf, sizeof(buf));
+		assert_int_equal(re_seal_judge(&seal, want, first[i], count[i],
+					       buf, len, 1, 1, &bad, &found),
+				 RE_OK);
+	}
+	for (int i = 0; i < n; i++) /* thread 1 not running while armed */
+		if (k - 1 >= first[i] && k - 1 < first[i] + count[i]) {
+			got[k - 1] = -1;
+			len = reply(got, first[i], count[i], buf, sizeof(buf));
+			assert_int_equal(re_seal_judge(&seal, want, first[i],
+						       count[i], buf, len, 1,
+						       1, &bad, &found),
+					 RE_FAULT);
+			assert_int_equal(bad, k);
+			got[k - 1] = seal.t1_first;
+		}
+	item(&seal, "jin[0]", &k);
+	for (int i = 0; i < n; i++)
+		if (k - 1 >= first[i] && k - 1 < first[i] + count[i]) {
+			got[k - 1] = 3;
+			len = reply(got, first[i], count[i], buf, sizeof(buf));
+			assert_int_equal(re_seal_judge(&seal, want, first[i],
+						       count[i], buf, len, 1,
+						       1, &bad, &found),
+					 RE_FAULT);
+			assert_int_equal(bad, k);
+			assert_true(found == 3);
+			got[k - 1] = want[k - 1];
+			len = reply(got, first[i], count[i], buf, sizeof(buf));
+			len = (size_t)(strrchr(buf, ' ') - buf); /* one short */
+			assert_int_equal(re_seal_judge(&seal, want, first[i],
+						       count[i], buf, len,
+						       1, 1, &bad, &found),
+					 GL_ERR_PROTO);
+		}
+	item(&seal, "vla", &k); /* a session item: wrong before the session */
+	got[k - 1] = 0;
+	for (int i = 0; i < n; i++)
+		if (k - 1 >= first[i] && k - 1 < first[i] + count[i]) {
+			len = reply(got, first[i], count[i], buf, sizeof(buf));
+			assert_int_equal(re_seal_judge(&seal, want, first[i],
+						       count[i], buf, len, 0,
+						       1, &bad, &found),
+					 RE_OK);
+			assert_int_equal(re_seal_judge(&seal, want, first[i],
+						       count[i], buf, len, 1,
+						       1, &bad, &found),
+					 RE_FAULT);
+			assert_int_equal(bad, k);
+		}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+	    cmocka_unit_test(test_readback),
 	    cmocka_unit_test(test_table),    cmocka_unit_test(test_emit),
 	    cmocka_unit_test(test_compare),  cmocka_unit_test(test_fault),
 	    cmocka_unit_test(test_refusals),
