@@ -25,7 +25,7 @@
 
 #define DMC_LINT_MSG_SIZE  200 /* bytes of a message, with its NUL */
 #define DMC_LINT_NAME_SIZE 9   /* a variable's name (8 characters), NUL */
-#define DMC_LINT_NOMEM	  (-1)
+#define DMC_LINT_NOMEM	   (-1)
 
 struct dmc_finding {
 	enum dmc_rule_id rule;

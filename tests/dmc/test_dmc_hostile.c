@@ -31,14 +31,14 @@
 #include "dmc_h.h"
 #include "dmc_lint.h"
 
-#define LIST_MAX     160
-#define ELEM_MAX     32	 /* elements of one array tried at most */
-#define WINDOW_MS    400 /* after the write, before the heartbeat stops */
-#define POS_TOL	     2	 /* counts: the same end as without the write */
-#define ARM_JOG_MS   60	 /* the write comes this far up A's ramp */
-#define SVC_MOVE_MS  80	 /* ... this far into the service move */
-#define HB_LATE_MS   2	 /* the motors go off no later than without it */
-#define CHANGES	     6	 /* values written in place of each one */
+#define LIST_MAX    160
+#define ELEM_MAX    32	/* elements of one array tried at most */
+#define WINDOW_MS   400 /* after the write, before the heartbeat stops */
+#define POS_TOL	    2	/* counts: the same end as without the write */
+#define ARM_JOG_MS  60	/* the write comes this far up A's ramp */
+#define SVC_MOVE_MS 80	/* ... this far into the service move */
+#define HB_LATE_MS  2	/* the motors go off no later than without it */
+#define CHANGES	    6	/* values written in place of each one */
 
 enum phase { ARMED, JOGGING, SERVICE, MOVING, PHASES };
 
@@ -135,10 +135,11 @@ static void read_list(void)
 		if (!in || strncmp(line, "| `", 3))
 			continue;
 		if (row_allow(line, &a) < 0)
-			fail_msg("%s:%d: no allowance (%s, %s, %s or %s) in the "
-				 "last cell",
-				 path, lineno, allow_word[0], allow_word[1],
-				 allow_word[2], allow_word[3]);
+			fail_msg(
+			    "%s:%d: no allowance (%s, %s, %s or %s) in the "
+			    "last cell",
+			    path, lineno, allow_word[0], allow_word[1],
+			    allow_word[2], allow_word[3]);
 		cell_end = strchr(b, '|');
 		while ((b = strchr(b, '`')) && b < cell_end) {
 			char *e = strchr(b + 1, '`');
@@ -287,8 +288,8 @@ static int no_worse(const struct outcome *o, const struct outcome *r,
 		if (a == ALLOW_RAMP && i == 0 && travel > fabs(dr))
 			dr = dr < 0 ? -travel : travel;
 		all_off &= o->motor_off[i];
-		if (fabs(d) > POS_TOL && (d * dr <= 0 ||
-					  fabs(d) > fabs(dr) + POS_TOL)) {
+		if (fabs(d) > POS_TOL &&
+		    (d * dr <= 0 || fabs(d) > fabs(dr) + POS_TOL)) {
 			snprintf(why, cap,
 				 "axis %c went %+.0f counts (allowed: %+.0f)",
 				 'A' + i, d, dr);
@@ -301,8 +302,10 @@ static int no_worse(const struct outcome *o, const struct outcome *r,
 	}
 	if (o->state != r->state && !all_off &&
 	    !(a == ALLOW_STATE && o->state >= 0 && o->state <= 3)) {
-		snprintf(why, cap, "state %g (without the write: %g), a motor "
-			 "on", o->state, r->state);
+		snprintf(why, cap,
+			 "state %g (without the write: %g), a motor "
+			 "on",
+			 o->state, r->state);
 		return 0;
 	}
 	if (a != ALLOW_WDTO)
@@ -445,8 +448,8 @@ static void every_name(enum phase ph)
 
 	assert_non_null(h);
 	enter(h, ph);
-	assert_true(dmc_lint_text(h->prog, h->prog_len,
-				  dmc_model_find("40x0"), 1, &lint) >= 0);
+	assert_true(dmc_lint_text(h->prog, h->prog_len, dmc_model_find("40x0"),
+				  1, &lint) >= 0);
 	assert_true(lint.ntargets > 20);
 	for (int k = 0; k < lint.ntargets; k++) {
 		const struct dmc_target *tg = &lint.targets[k];
@@ -456,8 +459,7 @@ static void every_name(enum phase ph)
 
 		for (int i = 0; i < (tg->array ? ELEM_MAX : 1); i++) {
 			if (tg->array)
-				snprintf(el, sizeof(el), "%s[%d]", tg->name,
-					 i);
+				snprintf(el, sizeof(el), "%s[%d]", tg->name, i);
 			else
 				snprintf(el, sizeof(el), "%s", tg->name);
 			v = mg(h, el, &ok);
@@ -535,8 +537,8 @@ static void test_list_held(void **state)
 	(void)state;
 	assert_non_null(h);
 	enter(h, ARMED);
-	assert_true(dmc_lint_text(h->prog, h->prog_len,
-				  dmc_model_find("40x0"), 1, &lint) >= 0);
+	assert_true(dmc_lint_text(h->prog, h->prog_len, dmc_model_find("40x0"),
+				  1, &lint) >= 0);
 	for (int i = 0; i < list.n; i++) {
 		int k;
 
@@ -591,8 +593,8 @@ static int group_setup(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	    cmocka_unit_test(test_armed),   cmocka_unit_test(test_jogging),
-	    cmocka_unit_test(test_service), cmocka_unit_test(test_moving),
+	    cmocka_unit_test(test_armed),     cmocka_unit_test(test_jogging),
+	    cmocka_unit_test(test_service),   cmocka_unit_test(test_moving),
 	    cmocka_unit_test(test_list_held),
 	};
 

@@ -399,13 +399,14 @@ static void test_loop_periods(void **state)
 		else if (n == 7 && !strncmp(p, "#MOTION", 7))
 			routine = "#MOTION";
 		if (n > 3 && !strncmp(p, "AT ", 3) && strncmp(p, "AT 0", n)) {
-			double want = !strcmp(routine, "#MOTION") ? loopms
-								  : mainms;
+			double want =
+			    !strcmp(routine, "#MOTION") ? loopms : mainms;
 
 			if (p[3] != '-' || !isdigit((unsigned char)p[4]) ||
 			    atof(p + 4) != want)
-				fail_msg("'%.*s' in %s: want the literal AT -%g",
-					 (int)n, p, routine, want);
+				fail_msg(
+				    "'%.*s' in %s: want the literal AT -%g",
+				    (int)n, p, routine, want);
 			seen++;
 		}
 		p = eol ? eol + 1 : NULL;

@@ -29,8 +29,8 @@
 #include "re_seal.h"
 #include "sys_h.h"
 
-#define SLACK_MS      25   /* scheduling allowance on a busy 2-core box */
-#define HOLD_MS	      300  /* no motion over this after the safe state */
+#define SLACK_MS      25  /* scheduling allowance on a busy 2-core box */
+#define HOLD_MS	      300 /* no motion over this after the safe state */
 #define FAULT_WAIT_MS 5000
 #define TRAVEL_BOUND  1500 /* counts axis A may run after the write */
 
@@ -48,9 +48,11 @@ static double d_write_to_relay(void)
 }
 
 struct hcase {
-	const char *write; /* one line from the other client */
-	int jog;	   /* 1: the joystick jogs A forward meanwhile */
+	const char *write;    /* one line from the other client */
+	int jog;	      /* 1: the joystick jogs A forward meanwhile */
 	const char *named[4]; /* the FAULT line names one of these */
+	double bound_ms;      /* relay off after the write; 0: the seal's */
+	double travel;	      /* counts A may run after it; 0: TRAVEL_BOUND */
 };
 
 /* A fresh armed robot, a raw client's write, the FAULT, the safe state. */
@@ -59,6 +61,8 @@ static void hostile(const struct hcase *h)
 	struct sys_case c;
 	char line[2048], row[2600];
 	double t0, t_relay, a0, a1;
+	double bound = h->bound_ms > 0 ? h->bound_ms : d_write_to_relay();
+	double travel = h->travel > 0 ? h->travel : TRAVEL_BOUND;
 	int fd, named = -1;
 	char st[2048];
 
@@ -92,10 +96,11 @@ static void hostile(const struct hcase *h)
 	for (int k = 0; k < 4 && h->named[k]; k++)
 		if (strstr(line, h->named[k]))
 			named = k;
-	snprintf(row, sizeof(row), "%s | armed%s | relay off %.0f ms "
+	snprintf(row, sizeof(row),
+		 "%s | armed%s | relay off %.0f ms "
 		 "(bound %.0f), A ran %.0f counts | %s",
-		 h->write, h->jog ? ", A jogging" : "", t_relay - t0,
-		 d_write_to_relay(), a1 - a0, line);
+		 h->write, h->jog ? ", A jogging" : "", t_relay - t0, bound,
+		 a1 - a0, line);
 	print_message("[ ROW      ] %s\n", row);
 	close(fd);
 	sys_case_stop(&c);
@@ -106,19 +111,21 @@ static void hostile(const struct hcase *h)
 	    strncmp(line, "FAULT INPUT: ", 13) &&
 	    strncmp(line, "FAULT MOTION: ", 14))
 		fail_msg("not a FOREIGN, INPUT or MOTION fault: %s", line);
-	if (t_relay - t0 > d_write_to_relay())
+	if (t_relay - t0 > bound)
 		fail_msg("relay off %.0f ms after the write (bound %.0f)",
-			 t_relay - t0, d_write_to_relay());
-	if (a1 - a0 > TRAVEL_BOUND || a0 - a1 > TRAVEL_BOUND / 10)
+			 t_relay - t0, bound);
+	if (a1 - a0 > travel || a0 - a1 > TRAVEL_BOUND / 10)
 		fail_msg("axis A ran %.0f counts after the write", a1 - a0);
 }
 
 /* The joystick's wiring swapped (A forward would run A backwards). */
 static void test_jin_swapped(void **state)
 {
-	static const struct hcase h = {
-	    "jin[0]=3;jin[1]=4;jin[2]=1;jin[3]=2", 1,
-	    {"jin[0]", "jin[1]", "jin[2]", "jin[3]"}};
+	static const struct hcase h = {"jin[0]=3;jin[1]=4;jin[2]=1;jin[3]=2",
+				       1,
+				       {"jin[0]", "jin[1]", "jin[2]", "jin[3]"},
+				       0,
+				       0};
 
 	(void)state;
 	hostile(&h);
@@ -127,8 +134,11 @@ static void test_jin_swapped(void **state)
 /* The speed limits raised while A jogs. */
 static void test_speed_raised(void **state)
 {
-	static const struct hcase h = {"vla=100000;vmax[0]=40000", 1,
-				       {"vla", "vmax[0]", NULL, NULL}};
+	static const struct hcase h = {"vla=100000;vmax[0]=40000",
+				       1,
+				       {"vla", "vmax[0]", NULL, NULL},
+				       0,
+				       0};
 
 	(void)state;
 	hostile(&h);
@@ -137,8 +147,11 @@ static void test_speed_raised(void **state)
 /* The ramp removed. */
 static void test_ramp_removed(void **state)
 {
-	static const struct hcase h = {"wst[0]=0;wen[0]=1;vmin[0]=8000", 0,
-				       {"wst[0]", "wen[0]", "vmin[0]", NULL}};
+	static const struct hcase h = {"wst[0]=0;wen[0]=1;vmin[0]=8000",
+				       0,
+				       {"wst[0]", "wen[0]", "vmin[0]", NULL},
+				       0,
+				       0};
 
 	(void)state;
 	hostile(&h);
@@ -148,8 +161,11 @@ static void test_ramp_removed(void **state)
 static void test_protections_loosened(void **state)
 {
 	static const struct hcase h = {
-	    "ER 30000,30000,30000;OA 0,0,0;TL 9.99,9.99,9.99", 0,
-	    {"_ERA", "_OAA", "_TLA", "_ERB"}};
+	    "ER 30000,30000,30000;OA 0,0,0;TL 9.99,9.99,9.99",
+	    0,
+	    {"_ERA", "_OAA", "_TLA", "_ERB"},
+	    0,
+	    0};
 
 	(void)state;
 	hostile(&h);
@@ -161,7 +177,9 @@ static void test_limits_opened(void **state)
 	static const struct hcase h = {
 	    "sfwd[0]=2000000000;FL 2147483647,2147483647,2147483647;LD 3,3,3",
 	    1,
-	    {"sfwd[0]", "_FLA", "_LDA", NULL}};
+	    {"sfwd[0]", "_FLA", "_LDA", NULL},
+	    0,
+	    0};
 
 	(void)state;
 	hostile(&h);
@@ -170,8 +188,8 @@ static void test_limits_opened(void **state)
 /* The controller's watchdog stretched, with its copy. */
 static void test_watchdog_stretched(void **state)
 {
-	static const struct hcase h = {"wdto=5000;wdtoa=5000", 0,
-				       {"wdto", NULL, NULL, NULL}};
+	static const struct hcase h = {
+	    "wdto=5000;wdtoa=5000", 0, {"wdto", NULL, NULL, NULL}, 0, 0};
 
 	(void)state;
 	hostile(&h);
@@ -180,8 +198,8 @@ static void test_watchdog_stretched(void **state)
 /* The heartbeat's sequence window opened. */
 static void test_heartbeat_window(void **state)
 {
-	static const struct hcase h = {"hbmaxd=999999999", 0,
-				       {"hbmaxd", NULL, NULL, NULL}};
+	static const struct hcase h = {
+	    "hbmaxd=999999999", 0, {"hbmaxd", NULL, NULL, NULL}, 0, 0};
 
 	(void)state;
 	hostile(&h);
@@ -190,8 +208,8 @@ static void test_heartbeat_window(void **state)
 /* The motion thread started a second time. */
 static void test_second_motion_thread(void **state)
 {
-	static const struct hcase h = {"XQ #MOTION,2", 1,
-				       {"_XQ2", NULL, NULL, NULL}};
+	static const struct hcase h = {
+	    "XQ #MOTION,2", 1, {"_XQ2", NULL, NULL, NULL}, 0, 0};
 
 	(void)state;
 	hostile(&h);
@@ -201,10 +219,10 @@ static void test_second_motion_thread(void **state)
 static void test_settings(void **state)
 {
 	static const struct hcase h[] = {
-	    {"KP 1000,1000,1000", 0, {"_KPA", NULL, NULL, NULL}},
-	    {"CN 1", 0, {"_CN0", NULL, NULL, NULL}},
-	    {"LD 3,3,3", 0, {"_LDA", NULL, NULL, NULL}},
-	    {"DC 1024,1024,1024", 0, {"_DCA", NULL, NULL, NULL}},
+	    {"KP 1000,1000,1000", 0, {"_KPA", NULL, NULL, NULL}, 0, 0},
+	    {"CN 1", 0, {"_CN0", NULL, NULL, NULL}, 0, 0},
+	    {"LD 3,3,3", 0, {"_LDA", NULL, NULL, NULL}, 0, 0},
+	    {"DC 1024,1024,1024", 0, {"_DCA", NULL, NULL, NULL}, 0, 0},
 	};
 
 	(void)state;
@@ -218,7 +236,36 @@ static void test_ownership_forged(void **state)
 {
 	static const struct hcase h = {"own[1]=1;vlb=100000;PR ,-3000;BG B",
 				       0,
-				       {"vlb", "axis B", NULL, NULL}};
+				       {"vlb", "axis B", NULL, NULL},
+				       0,
+				       0};
+
+	(void)state;
+	hostile(&h);
+}
+
+/* The program's own state rewritten: the ramp's time base moved back, so
+ * the program would start A's rise at once. The program bounds the rise
+ * (rampov x the slope from the speed A runs at); roboelf's own ramp check,
+ * from its own first sight of the command, stops it: the speed must pass
+ * vover x the ramp beyond TV's 256-sample average, for two cycles
+ * (bound: 1 s). */
+static void test_ramp_time_base(void **state)
+{
+	static const struct hcase h = {
+	    "tcmd=-1000000", 1, {"ramp", NULL, NULL, NULL}, 1000, 3000};
+
+	(void)state;
+	hostile(&h);
+}
+
+/* An idle axis's ownership forged, then moved by the client at the speed
+ * the program allows it: the program takes the move for its own; roboelf
+ * sees an axis run that no command moves. */
+static void test_owned_move(void **state)
+{
+	static const struct hcase h = {
+	    "own[1]=1;PR ,-3000;BG B", 0, {"axis B", "B:", NULL, NULL}, 0, 0};
 
 	(void)state;
 	hostile(&h);
@@ -238,8 +285,8 @@ static void test_galil_load_refused(void **state)
 			(char *)"-c",
 			(char *)"jin[0]=3;jin[1]=4",
 			NULL};
-	char *reads[] = {bin,	       (char *)"-a", addr, (char *)"-c",
-			 (char *)"MG hbmaxd", NULL};
+	char *reads[] = {bin,	       (char *)"-a",	    addr,
+			 (char *)"-c", (char *)"MG hbmaxd", NULL};
 	struct proc p;
 
 	(void)state;
@@ -299,6 +346,8 @@ int main(void)
 	    cmocka_unit_test(test_second_motion_thread),
 	    cmocka_unit_test(test_settings),
 	    cmocka_unit_test(test_ownership_forged),
+	    cmocka_unit_test(test_ramp_time_base),
+	    cmocka_unit_test(test_owned_move),
 	    cmocka_unit_test(test_galil_load_refused),
 	};
 

@@ -304,8 +304,8 @@ static void test_readback(void **state)
 			got[k - 1] = -1;
 			len = reply(got, first[i], count[i], buf, sizeof(buf));
 			assert_int_equal(re_seal_judge(&seal, want, first[i],
-						       count[i], buf, len, 1,
-						       1, &bad, &found),
+						       count[i], buf, len, 1, 1,
+						       &bad, &found),
 					 RE_FAULT);
 			assert_int_equal(bad, k);
 			got[k - 1] = seal.t1_first;
@@ -316,8 +316,8 @@ static void test_readback(void **state)
 			got[k - 1] = 3;
 			len = reply(got, first[i], count[i], buf, sizeof(buf));
 			assert_int_equal(re_seal_judge(&seal, want, first[i],
-						       count[i], buf, len, 1,
-						       1, &bad, &found),
+						       count[i], buf, len, 1, 1,
+						       &bad, &found),
 					 RE_FAULT);
 			assert_int_equal(bad, k);
 			assert_true(found == 3);
@@ -325,8 +325,8 @@ static void test_readback(void **state)
 			len = reply(got, first[i], count[i], buf, sizeof(buf));
 			len = (size_t)(strrchr(buf, ' ') - buf); /* one short */
 			assert_int_equal(re_seal_judge(&seal, want, first[i],
-						       count[i], buf, len,
-						       1, 1, &bad, &found),
+						       count[i], buf, len, 1, 1,
+						       &bad, &found),
 					 GL_ERR_PROTO);
 		}
 	item(&seal, "vla", &k); /* a session item: wrong before the session */
@@ -335,12 +335,12 @@ static void test_readback(void **state)
 		if (k - 1 >= first[i] && k - 1 < first[i] + count[i]) {
 			len = reply(got, first[i], count[i], buf, sizeof(buf));
 			assert_int_equal(re_seal_judge(&seal, want, first[i],
-						       count[i], buf, len, 0,
-						       1, &bad, &found),
+						       count[i], buf, len, 0, 1,
+						       &bad, &found),
 					 RE_OK);
 			assert_int_equal(re_seal_judge(&seal, want, first[i],
-						       count[i], buf, len, 1,
-						       1, &bad, &found),
+						       count[i], buf, len, 1, 1,
+						       &bad, &found),
 					 RE_FAULT);
 			assert_int_equal(bad, k);
 		}
@@ -349,10 +349,9 @@ static void test_readback(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-	    cmocka_unit_test(test_readback),
-	    cmocka_unit_test(test_table),    cmocka_unit_test(test_emit),
-	    cmocka_unit_test(test_compare),  cmocka_unit_test(test_fault),
-	    cmocka_unit_test(test_refusals),
+	    cmocka_unit_test(test_readback), cmocka_unit_test(test_table),
+	    cmocka_unit_test(test_emit),     cmocka_unit_test(test_compare),
+	    cmocka_unit_test(test_fault),    cmocka_unit_test(test_refusals),
 	};
 
 	return cmocka_run_group_tests(tests, setup, NULL);
