@@ -267,6 +267,13 @@ static int init_super(struct app *a)
 	a->sup = calloc(1, sizeof(*a->sup));
 	if (!a->sup || re_super_init(a->sup, &a->io, &sc, NULL, 0) != GL_OK)
 		return fail(a, "cannot set up the supervisor");
+	if (a->sup->rb_n > 0)
+		progress(
+		    a,
+		    "checked twice: roboelf reads the program's %d sealed "
+		    "values back, all every %d cycles (%d ms), and decodes "
+		    "the joystick itself",
+		    a->seal.n, a->sup->rb_n, a->sup->rb_n * a->cfg.period_ms);
 	if (a->rec) { /* flight recorder (issue 16) */
 		char serial[24];
 

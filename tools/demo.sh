@@ -107,7 +107,7 @@ fi
 # in the middle of a taller one, over the narration.
 tty_size() { # prints "ROWS COLS" of this terminal, or "24 80"
 	local size
-	size=$(stty size </dev/tty 2>/dev/null)
+	size=$(stty size 2>/dev/null </dev/tty)
 	case "$size" in [1-9]*\ [1-9]*) echo "$size" ;; *) echo "24 80" ;; esac
 }
 start_roboelf() { # start_roboelf full|file

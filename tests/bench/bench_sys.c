@@ -224,7 +224,23 @@ struct loop_fig {
 	double wd_worst_ms; /* -1 n/a */
 	double late[3];	    /* p50, p99, max ms; -1 n/a */
 	double syscalls;    /* per cycle (perf raw_syscalls), -1 n/a */
+	int rb_values;	    /* sealed values roboelf reads back, -1 n/a */
+	int rb_cycles;	    /* cycles to read them all, -1 n/a */
 };
+
+/* roboelf's start-up line "checked twice: ... the program's N sealed
+ * values back, all every K cycles (T ms) ..." (wrapped on two lines). */
+static void readback_figures(const struct proc *re, struct loop_fig *f)
+{
+	const char *out = proc_output(re, PROC_STDOUT);
+	const char *p = out ? strstr(out, "the program's ") : NULL;
+	const char *q = p ? strstr(p, "every ") : NULL;
+
+	f->rb_values = f->rb_cycles = -1;
+	if (!p || !q || sscanf(p, "the program's %d", &f->rb_values) != 1 ||
+	    sscanf(q, "every %d", &f->rb_cycles) != 1)
+		f->rb_values = f->rb_cycles = -1;
+}
 
 /* ---- system calls per cycle: perf stat on the tracepoint ---------------- */
 
@@ -452,6 +468,7 @@ static int loop_run(struct sys_env *e, const struct opts *o, int period,
 	f->syscalls = calls >= 0 && f->cycles > 0 ? calls / f->cycles : -1;
 	proc_find_line(&c.re, PROC_STDOUT, "FAULT ", f->fault,
 		       sizeof(f->fault));
+	readback_figures(&c.re, f);
 	proc_signal(&c.re, SIGTERM);
 	proc_wait_exit(&c.re, 5000, NULL);
 	status_figures(&c, f);
@@ -533,6 +550,10 @@ static void add_loop(const struct loop_fig *f)
 	add("loop", item, "tripped", "", is50 ? "50 ms loop" : "", "no");
 	add("loop", item, "cycles measured", "", "", "%.0f in %.1f s",
 	    f->cycles, f->seconds);
+	if (f->rb_cycles > 0)
+		add("loop", item, "seal read back: all values every", "ms",
+		    "none", "%d (%d values, a chunk a cycle, %d cycles)",
+		    f->rb_cycles * f->period_ms, f->rb_values, f->rb_cycles);
 	add_loop_cycle(f, item, is50);
 }
 
