@@ -533,32 +533,39 @@ static void test_list_held(void **state)
 {
 	struct dmc_h *h = calloc(1, sizeof(*h));
 	struct dmc_lint lint = {0};
+	char why[256] = "";
 
 	(void)state;
 	assert_non_null(h);
 	enter(h, ARMED);
 	assert_true(dmc_lint_text(h->prog, h->prog_len, dmc_model_find("40x0"),
 				  1, &lint) >= 0);
-	for (int i = 0; i < list.n; i++) {
+	for (int i = 0; i < list.n && !why[0]; i++) {
 		int k;
 
 		for (k = 0; k < lint.ntargets; k++)
 			if (!strcmp(lint.targets[k].name, list.name[i]))
 				break;
 		if (k == lint.ntargets)
-			fail_msg("docs/safety.md lists '%s', which the program "
-				 "does not assign",
+			snprintf(why, sizeof(why),
+				 "docs/safety.md lists '%s', which the "
+				 "program does not assign",
 				 list.name[i]);
-		if (phases_done == PHASES && list.tried[i] &&
-		    list.caught[i] == list.tried[i])
-			fail_msg("docs/safety.md lists '%s' as unnoticed, and "
+		/* with a part of the values (make asan) a listed name may
+		 * be caught every time: only the full set says it is stale */
+		else if (phases_done == PHASES && values_tried == CHANGES &&
+			 list.tried[i] && list.caught[i] == list.tried[i])
+			snprintf(why, sizeof(why),
+				 "docs/safety.md lists '%s' as unnoticed, and "
 				 "all %d writes of it were caught",
 				 list.name[i], list.tried[i]);
 	}
-	assert_int_equal(phases_done, PHASES);
 	dmc_lint_free(&lint);
 	dmc_h_close(h);
 	free(h);
+	if (why[0])
+		fail_msg("%s", why);
+	assert_int_equal(phases_done, PHASES);
 }
 
 static int group_setup(void **state)
