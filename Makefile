@@ -17,7 +17,12 @@
 #   pc/base/*.c          shared base: clock, files, YAML -> $(BUILD)/lib/libbase.a
 #   pc/galil/*.c         Galil link library (gl_*)       -> $(BUILD)/lib/libgl.a
 #   pc/dmc/*.c           the DMC language front end      -> $(BUILD)/lib/libdmc.a
-#   pc/re_*.c            supervisor modules              -> $(BUILD)/lib/libre.a
+#   pc/super/*.c         the safety core: the cycle, its checks, the fault
+#                        reaction, the relay, the log, the locks, real time
+#                                                         -> $(BUILD)/lib/libsuper.a
+#   pc/{config,calib,rec,console,start,comm}/*.c  the rest of the supervisor:
+#                        configuration and plan, calibration, recorder and
+#                        traces, console, start-up, commissioning -> libre.a
 #   pc/roboelf.c         supervisor main                 -> $(BUILD)/bin/roboelf
 #   tools/galil-sim/**.c simulator (main.c = main)       -> libsim.a + galil-sim
 #                        (ctrl/ the interpreter, plant/ the robot, net/ the ports)
@@ -25,10 +30,11 @@
 #   tests/harness/*.c    test helpers                    -> libharness.a
 #   tests/stub/*.c       the misbehaving socket stub     -> $(BUILD)/bin/galil-stub
 #   tests/<dir>/test_*.c one cmocka binary each          -> $(BUILD)/tests/<dir>/test_*
-#     linked with: libload libsim libre libdmc libgl libbase libharness (only
+#     linked with: libload libsim libre libsuper libdmc libgl libbase libharness (only
 #     what is used is pulled in), plus extra linker flags from an optional
 #     tests/<dir>/test_*.ldflags file (e.g. -Wl,--wrap=sp_open).
-# Layering (checked by tests/checks/layers.sh): base <- galil, dmc <- re <- roboelf;
+# Layering (checked by tests/checks/layers.sh): base <- galil, dmc <- super <- config
+# <- calib, rec <- console <- start, comm <- roboelf;
 # base, galil, dmc <- galil-load and galil-sim; nothing includes upward.
 
 CC ?= cc
@@ -59,13 +65,15 @@ ALL_LDFLAGS = $(LDFLAGS) $(SAN)
 LIBS = $(PKG_LIBS) -lpthread -lm
 
 SIM_DIRS := tools/galil-sim $(wildcard tools/galil-sim/*/)
-INC_DIRS := pc $(wildcard pc/base pc/galil pc/dmc) $(patsubst %/,%,$(SIM_DIRS)) \
+RE_DIRS := pc/config pc/calib pc/rec pc/console pc/start pc/comm
+INC_DIRS := pc $(wildcard pc/base pc/galil pc/dmc) pc/super $(RE_DIRS) $(patsubst %/,%,$(SIM_DIRS)) \
             tools/galil-load tests/harness tests/stub
 
 BASE_SRC := $(wildcard pc/base/*.c)
 GL_SRC := $(wildcard pc/gl_*.c pc/galil/*.c)
 DMC_SRC := $(wildcard pc/dmc/*.c)
-RE_SRC := $(wildcard pc/re_*.c)
+SUPER_SRC := $(wildcard pc/super/*.c)
+RE_SRC := $(wildcard $(addsuffix /*.c,$(RE_DIRS)))
 SIM_SRC := $(filter-out tools/galil-sim/main.c,$(wildcard $(addsuffix /*.c,$(patsubst %/,%,$(SIM_DIRS)))))
 LOAD_SRC := $(filter-out tools/galil-load/main.c,$(wildcard tools/galil-load/*.c))
 HARN_SRC := $(wildcard tests/harness/*.c)
@@ -76,11 +84,13 @@ obj = $(patsubst %.c,$(BUILD)/obj/%.o,$(1))
 LIB_BASE := $(if $(BASE_SRC),$(BUILD)/lib/libbase.a)
 LIB_GL := $(BUILD)/lib/libgl.a
 LIB_DMC := $(if $(DMC_SRC),$(BUILD)/lib/libdmc.a)
+LIB_SUPER := $(BUILD)/lib/libsuper.a
 LIB_RE := $(BUILD)/lib/libre.a
 LIB_SIM := $(BUILD)/lib/libsim.a
 LIB_LOAD := $(BUILD)/lib/libload.a
 LIB_HARN := $(BUILD)/lib/libharness.a
-LINK_LIBS := $(LIB_HARN) $(LIB_LOAD) $(LIB_SIM) $(LIB_RE) $(LIB_DMC) $(LIB_GL) $(LIB_BASE)
+LINK_LIBS := $(LIB_HARN) $(LIB_LOAD) $(LIB_SIM) $(LIB_RE) $(LIB_SUPER) $(LIB_DMC) $(LIB_GL) \
+             $(LIB_BASE)
 
 BINS := $(if $(wildcard pc/roboelf.c),$(BUILD)/bin/roboelf) \
         $(if $(wildcard tools/galil-load/main.c),$(BUILD)/bin/galil-load) \
@@ -109,19 +119,21 @@ endef
 $(if $(LIB_BASE),$(eval $(call mklib,$(LIB_BASE),$(BASE_SRC))))
 $(eval $(call mklib,$(LIB_GL),$(GL_SRC)))
 $(if $(LIB_DMC),$(eval $(call mklib,$(LIB_DMC),$(DMC_SRC))))
+$(eval $(call mklib,$(LIB_SUPER),$(SUPER_SRC)))
 $(eval $(call mklib,$(LIB_RE),$(RE_SRC)))
 $(eval $(call mklib,$(LIB_SIM),$(SIM_SRC)))
 $(eval $(call mklib,$(LIB_LOAD),$(LOAD_SRC)))
 $(eval $(call mklib,$(LIB_HARN),$(HARN_SRC)))
 
-$(BUILD)/bin/roboelf: $(call obj,pc/roboelf.c) $(LIB_RE) $(LIB_DMC) $(LIB_GL) $(LIB_BASE)
+$(BUILD)/bin/roboelf: $(call obj,pc/roboelf.c) $(LIB_RE) $(LIB_SUPER) $(LIB_DMC) $(LIB_GL) $(LIB_BASE)
 	@mkdir -p $(@D)
 	$(CC) $(ALL_LDFLAGS) -o $@ $^ $(LIBS)
-$(BUILD)/bin/galil-load: $(call obj,tools/galil-load/main.c) $(LIB_LOAD) $(LIB_RE) $(LIB_DMC) $(LIB_GL) \
+$(BUILD)/bin/galil-load: $(call obj,tools/galil-load/main.c) $(LIB_LOAD) $(LIB_RE) $(LIB_SUPER) $(LIB_DMC) $(LIB_GL) \
 		$(LIB_BASE)
 	@mkdir -p $(@D)
 	$(CC) $(ALL_LDFLAGS) -o $@ $^ $(LIBS)
-$(BUILD)/bin/galil-sim: $(call obj,tools/galil-sim/main.c) $(LIB_SIM) $(LIB_RE) $(LIB_DMC) $(LIB_GL) $(LIB_BASE)
+$(BUILD)/bin/galil-sim: $(call obj,tools/galil-sim/main.c) $(LIB_SIM) $(LIB_RE) $(LIB_SUPER) $(LIB_DMC) $(LIB_GL) \
+		$(LIB_BASE)
 	@mkdir -p $(@D)
 	$(CC) $(ALL_LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/bin/galil-stub: $(call obj,$(STUB_SRC)) $(LIB_GL) $(LIB_BASE)
@@ -196,7 +208,7 @@ FUZZ_SAN = -fsanitize=fuzzer,address,undefined \
 FUZZ_NAMES := $(patsubst tests/fuzz/fuzz_%.c,%,$(wildcard tests/fuzz/fuzz_*.c))
 FUZZ_BINS := $(addprefix $(FUZZ_BUILD)/bin/fuzz_,$(FUZZ_NAMES))
 FUZZ_LIBS := $(patsubst $(BUILD)/%,$(FUZZ_BUILD)/%,$(LIB_LOAD) $(LIB_SIM) \
-             $(LIB_RE) $(LIB_DMC) $(LIB_GL) $(LIB_BASE))
+             $(LIB_RE) $(LIB_SUPER) $(LIB_DMC) $(LIB_GL) $(LIB_BASE))
 .PHONY: fuzz fuzz-build
 fuzz: deps
 	@$(MAKE) --no-print-directory fuzz-build cmdpath

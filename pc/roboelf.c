@@ -48,6 +48,7 @@
 #include "re_check.h"
 #include "re_comm.h"
 #include "re_comm_report.h"
+#include "re_comm_start.h"
 #include "re_config.h"
 #include "re_console.h"
 #include "re_ctl.h"
@@ -924,7 +925,7 @@ static void comm_date(char *buf, size_t cap)
 	strftime(buf, cap, "%Y-%m-%d %H:%M:%S UTC", &tm);
 }
 
-/* After re_start_commission(): the steps, the report, the summary. */
+/* After re_comm_start(): the steps, the report, the summary. */
 static int comm_steps(struct app *a)
 {
 	static struct re_comm c;
@@ -970,7 +971,7 @@ static int commission(struct app *a)
 	re_lock_init(&a->lock_relay);
 	re_io_bind(&a->io, &a->real);
 	install_signals();
-	rc = re_start_commission(a);
+	rc = re_comm_start(a);
 	if (!rc)
 		rc = comm_steps(a);
 	cleanup(a);

@@ -7,17 +7,17 @@
 #   sh tests/checks/docs.sh --list [ROOT]  print what was extracted, check nothing
 #
 # What must be documented:
-#   (a) every FAULT line: each entry of re_fault_table in pc/re_fault.c, as the
+#   (a) every FAULT line: each entry of re_fault_table in pc/super/re_fault.c, as the
 #       operator sees it ("FAULT <CLASS>: <what>. Recovery: <recovery>", with
 #       the {a} {s} {i0} ... placeholders as written in the table), verbatim on
 #       one line of docs/operator.md; and every other "FAULT <CLASS>: ..."
-#       string literal in pc/*.c (printf conversions such as %d may stand for
+#       string literal in pc/**.c (printf conversions such as %d may stand for
 #       anything in the doc: the pieces between them must appear, in order, on
 #       one line). A "FAULT <CLASS>: ... Recovery: ..." line at the start of a
 #       line of docs/operator.md that the code cannot print is reported as
 #       stale.
 #   (b) every key of every `static const struct field NAME[]` table in
-#       pc/re_config.c (the YAML keys the loader accepts), back-quoted in
+#       pc/config/re_config.c (the YAML keys the loader accepts), back-quoted in
 #       docs/config.md (`key` or `parent.key`).
 #   (c) every long option (`struct option` tables) and short option (the
 #       getopt_long option string) of pc/roboelf.c, tools/galil-load/main.c and
@@ -124,7 +124,7 @@ tokens() {
 # fault_table: "ID<TAB>CLASS<TAB>what<TAB>recovery" per re_fault_table entry;
 # the class is the name re_fclass_names gives it.
 fault_table() {
-	tokens pc/re_fault.c | awk -F '\t' '
+	tokens pc/super/re_fault.c | awk -F '\t' '
 	# re_fclass_names: [ RE_FC_X ] = "NAME"
 	$1 == "P" && $2 == "[" { st = 1; next }
 	st == 1 && $1 == "W" && $2 ~ /^RE_FC_/ { fc = $2; st = 2; next }
@@ -151,10 +151,10 @@ fault_table() {
 	}'
 }
 
-# other_faults: "FILE<TAB>literal" for every string literal of pc/*.c that
+# other_faults: "FILE<TAB>literal" for every string literal of pc/**.c that
 # starts like a FAULT line.
 other_faults() {
-	for f in pc/*.c; do
+	for f in pc/*.c pc/*/*.c; do
 		tokens "$f" | awk -F '\t' -v f="$f" '
 		$1 == "S" && $2 ~ /^FAULT [A-Z]+: / { print f "\t" $2 }'
 	done
@@ -162,11 +162,11 @@ other_faults() {
 
 check_faults() {
 	doc=docs/operator.md
-	need_file pc/re_fault.c || return
+	need_file pc/super/re_fault.c || return
 	fault_table >"$TMPD/faults"
 	other_faults >"$TMPD/other"
 	if [ ! -s "$TMPD/faults" ]; then
-		fail "no FAULT templates found in re_fault_table of pc/re_fault.c (the extraction no longer matches the code)"
+		fail "no FAULT templates found in re_fault_table of pc/super/re_fault.c (the extraction no longer matches the code)"
 		return
 	fi
 	if [ "$LIST" = 1 ]; then
@@ -185,7 +185,7 @@ check_faults() {
 		for (j = 1; j <= nl && !found; j++)
 			if (index(line[j], want)) found = 1
 		if (!found)
-			printf "docs.sh: FAULT message %s (\"%s\") is in pc/re_fault.c but not in %s\n", $1, want, doc
+			printf "docs.sh: FAULT message %s (\"%s\") is in pc/super/re_fault.c but not in %s\n", $1, want, doc
 		next
 	}
 	{	# a printf-style literal: pieces between conversions, in order
@@ -238,11 +238,11 @@ check_faults() {
 # ---- (b) configuration keys --------------------------------------------------
 
 # config_keys: "TABLE<TAB>key" for every entry of every
-# `static const struct field NAME[] = { ... };` table of pc/re_config.c:
+# `static const struct field NAME[] = { ... };` table of pc/config/re_config.c:
 # the first string literal of the entry ({ "key", ... } or IK("key", ...)),
 # else the second macro argument (I(struct s, key, ...): #m is the key).
 config_keys() {
-	tokens pc/re_config.c | awk -F '\t' '
+	for f in pc/config/re_config*.c; do tokens "$f"; done | awk -F '\t' '
 	{ t[++n] = $1; v[n] = $2 }
 	END {
 		for (i = 1; i + 6 <= n; i++) {
@@ -289,10 +289,10 @@ config_keys() {
 
 check_config() {
 	doc=docs/config.md
-	need_file pc/re_config.c || return
+	need_file pc/config/re_config.c || return
 	config_keys >"$TMPD/keys"
 	if [ ! -s "$TMPD/keys" ]; then
-		fail "no configuration keys found in the 'struct field' tables of pc/re_config.c (the extraction no longer matches the code)"
+		fail "no configuration keys found in the 'struct field' tables of pc/config/re_config.c (the extraction no longer matches the code)"
 		return
 	fi
 	if [ "$LIST" = 1 ]; then
@@ -302,7 +302,7 @@ check_config() {
 	need_file "$doc" || return
 	out=$(while IFS='	' read -r tab key; do
 		if ! grep -Eq "\`([A-Za-z0-9_]+\.)*$key\`" "$doc"; then
-			echo "docs.sh: config field '$key' ($tab) is in pc/re_config.c but not in $doc"
+			echo "docs.sh: config field '$key' ($tab) is in pc/config/re_config.c but not in $doc"
 		fi
 	done <"$TMPD/keys")
 	report "$out"

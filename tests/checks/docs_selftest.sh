@@ -45,8 +45,8 @@ drop() {
 
 # ---- 1. synthetic tree ---------------------------------------------------------
 S=$TMP/syn
-mkdir -p "$S/pc" "$S/tools/galil-load" "$S/tools/galil-sim" "$S/docs"
-cat >"$S/pc/re_fault.c" <<'EOF'
+mkdir -p "$S/pc/super" "$S/pc/config" "$S/tools/galil-load" "$S/tools/galil-sim" "$S/docs"
+cat >"$S/pc/super/re_fault.c" <<'EOF'
 /* "FAULT FAKE: in a comment. Recovery: never counted" */
 static const char *const re_fclass_names[RE_FC_COUNT] = {
     [RE_FC_NONE] = "NONE",
@@ -64,14 +64,14 @@ static const struct re_fault_msg re_fault_table[] = {
 };
 static int n = sizeof(re_fault_table) / sizeof(re_fault_table[0]);
 EOF
-cat >"$S/pc/re_super.c" <<'EOF'
+cat >"$S/pc/super/re_super.c" <<'EOF'
 static void f(char *b, int id)
 {
 	snprintf(b, 9, "FAULT PROGRAM: unknown fault %d. Recovery: quit, "
 		 "note the log", id);
 }
 EOF
-cat >"$S/pc/re_config.c" <<'EOF'
+cat >"$S/pc/config/re_config.c" <<'EOF'
 #define I(s, m, lo, hi) { #m, FT_INT, offsetof(s, m), lo, hi, 0, NULL, NULL }
 #define IK(key, s, m, lo, hi) { key, FT_INT, offsetof(s, m), lo, hi, 0, NULL, NULL }
 static const struct field sub_fields[] = {
@@ -155,19 +155,19 @@ fi
 gap() { rm -rf "$TMP/g"; cp -R "$S" "$TMP/g"; }
 gap; drop "$TMP/g/docs/operator.md" 'FAULT MOTION: axis'
 expect_fail "synthetic: FAULT line removed" "$TMP/g" \
-	'docs.sh: FAULT message RE_F_ONE ("FAULT MOTION: axis {a}: it moved {i0} counts ("quoted"). Recovery: keep the E-stop pressed, then restart roboelf") is in pc/re_fault.c but not in docs/operator.md'
+	'docs.sh: FAULT message RE_F_ONE ("FAULT MOTION: axis {a}: it moved {i0} counts ("quoted"). Recovery: keep the E-stop pressed, then restart roboelf") is in pc/super/re_fault.c but not in docs/operator.md'
 gap; sed 's/then restart roboelf/then restart/' "$S/docs/operator.md" >"$TMP/g/docs/operator.md"
 expect_fail "synthetic: recovery text changed in the doc" "$TMP/g" \
-	'docs.sh: FAULT message RE_F_ONE ("FAULT MOTION: axis {a}: it moved {i0} counts ("quoted"). Recovery: keep the E-stop pressed, then restart roboelf") is in pc/re_fault.c but not in docs/operator.md'
+	'docs.sh: FAULT message RE_F_ONE ("FAULT MOTION: axis {a}: it moved {i0} counts ("quoted"). Recovery: keep the E-stop pressed, then restart roboelf") is in pc/super/re_fault.c but not in docs/operator.md'
 gap; drop "$TMP/g/docs/operator.md" 'unknown fault'
 expect_fail "synthetic: printf FAULT line removed" "$TMP/g" \
-	'docs.sh: FAULT message "FAULT PROGRAM: unknown fault %d. Recovery: quit, note the log" is in pc/re_super.c but not in docs/operator.md'
+	'docs.sh: FAULT message "FAULT PROGRAM: unknown fault %d. Recovery: quit, note the log" is in pc/super/re_super.c but not in docs/operator.md'
 gap; echo 'FAULT MOTION: it flew away. Recovery: catch it' >>"$TMP/g/docs/operator.md"
 expect_fail "synthetic: stale FAULT line in the doc" "$TMP/g" \
 	'docs.sh: "FAULT MOTION: it flew away. Recovery: catch it" is in docs/operator.md:7 but the code has no such FAULT message (stale)'
 gap; drop "$TMP/g/docs/config.md" '`sub.depth_mm`'
 expect_fail "synthetic: config key removed" "$TMP/g" \
-	"docs.sh: config field 'depth_mm' (sub_fields) is in pc/re_config.c but not in docs/config.md"
+	"docs.sh: config field 'depth_mm' (sub_fields) is in pc/config/re_config.c but not in docs/config.md"
 gap; drop "$TMP/g/docs/roboelf.1" '\-h'
 expect_fail "synthetic: short option removed" "$TMP/g" \
 	'docs.sh: option -h is in pc/roboelf.c but not in docs/roboelf.1'
@@ -177,9 +177,9 @@ expect_fail "synthetic: long option removed" "$TMP/g" \
 gap; rm "$TMP/g/docs/galil-load.1"
 expect_fail "synthetic: man page missing" "$TMP/g" \
 	"docs.sh: cannot read 'docs/galil-load.1'"
-gap; : >"$TMP/g/pc/re_config.c"
+gap; : >"$TMP/g/pc/config/re_config.c"
 expect_fail "synthetic: no config table found" "$TMP/g" \
-	"docs.sh: no configuration keys found in the 'struct field' tables of pc/re_config.c (the extraction no longer matches the code)"
+	"docs.sh: no configuration keys found in the 'struct field' tables of pc/config/re_config.c (the extraction no longer matches the code)"
 
 # ---- 2. the real tree ----------------------------------------------------------
 R=$TMP/real
@@ -204,14 +204,14 @@ first=$(awk -F '\t' '$1 == "fault" { print $2 "\t" $3; exit }' "$TMP/rlist")
 fid=${first%%	*}; fline=${first#*	}
 real; drop "$TMP/r2/docs/operator.md" "$fline"
 expect_fail "real: FAULT line $fid removed from operator.md" "$TMP/r2" \
-	"docs.sh: FAULT message $fid (\"$fline\") is in pc/re_fault.c but not in docs/operator.md"
+	"docs.sh: FAULT message $fid (\"$fline\") is in pc/super/re_fault.c but not in docs/operator.md"
 
 # a FAULT template added to the code
 real; awk '{ print } /re_fault_table\[\] = \{/ {
 	print "\t{RE_F_SELFTEST, RE_FC_MOTION, \"a new message\", \"a new recovery\"}," }' \
-	"$R/pc/re_fault.c" >"$TMP/r2/pc/re_fault.c"
+	"$R/pc/super/re_fault.c" >"$TMP/r2/pc/super/re_fault.c"
 expect_fail "real: FAULT template added to re_fault.c" "$TMP/r2" \
-	'docs.sh: FAULT message RE_F_SELFTEST ("FAULT MOTION: a new message. Recovery: a new recovery") is in pc/re_fault.c but not in docs/operator.md'
+	'docs.sh: FAULT message RE_F_SELFTEST ("FAULT MOTION: a new message. Recovery: a new recovery") is in pc/super/re_fault.c but not in docs/operator.md'
 
 # a FAULT printf line added elsewhere in pc/
 real; printf 'static const char *x = "FAULT COMM: lost %%s. Recovery: "\n\t"check it";\n' \
@@ -223,11 +223,11 @@ expect_fail "real: printf FAULT line added in pc/" "$TMP/r2" \
 key=$(awk -F '\t' '$1 == "config" && $2 == "log_fields" { print $3; exit }' "$TMP/rlist")
 real; drop "$TMP/r2/docs/config.md" "\`$key\`"
 expect_fail "real: config key '$key' removed from config.md" "$TMP/r2" \
-	"docs.sh: config field '$key' (log_fields) is in pc/re_config.c but not in docs/config.md"
+	"docs.sh: config field '$key' (log_fields) is in pc/config/re_config.c but not in docs/config.md"
 real; awk '{ print } /static const struct field log_fields\[\] = \{/ {
-	print "\tB(struct re_config_log, selftest_compress)," }' "$R/pc/re_config.c" >"$TMP/r2/pc/re_config.c"
+	print "\tB(struct re_config_log, selftest_compress)," }' "$R/pc/config/re_config.c" >"$TMP/r2/pc/config/re_config.c"
 expect_fail "real: config key added to re_config.c" "$TMP/r2" \
-	"docs.sh: config field 'selftest_compress' (log_fields) is in pc/re_config.c but not in docs/config.md"
+	"docs.sh: config field 'selftest_compress' (log_fields) is in pc/config/re_config.c but not in docs/config.md"
 
 # options: the last long option of each program removed from its man page,
 # and a new option added to roboelf

@@ -6,8 +6,11 @@
 # module Y when X uses a global symbol Y defines (nm). The modules must form
 # a directed acyclic graph, and each library may use only the libraries
 # below it (docs/architecture.md):
-#   0 base (pc/base)  1 galil (pc/galil), dmc (pc/dmc)  2 re (pc/re_*)
-#   3 roboelf (pc/roboelf.c), galil-load, galil-sim (tools/)
+#   0 base (pc/base)  1 galil (pc/galil), dmc (pc/dmc)
+#   2 super (pc/super): the safety core, over base, galil and dmc only
+#   3 config (pc/config)  4 calib (pc/calib), rec (pc/rec)
+#   5 console (pc/console)  6 start (pc/start)  7 comm (pc/comm)
+#   8 roboelf (pc/roboelf.c), galil-load, galil-sim (tools/)
 #
 # Usage: layers.sh [--list]    (BUILD selects the build tree, default build)
 #   --list  also print every dependency.
@@ -40,14 +43,28 @@ function lib(m) {
 	if (m ~ /^pc\/base\//) return "base"
 	if (m ~ /^pc\/galil\// || m ~ /^pc\/gl_/) return "galil"
 	if (m ~ /^pc\/dmc\//) return "dmc"
-	if (m ~ /^pc\/re_/) return "re"
+	if (m ~ /^pc\/super\//) return "super"
+	if (m ~ /^pc\/config\//) return "config"
+	if (m ~ /^pc\/calib\//) return "calib"
+	if (m ~ /^pc\/rec\//) return "rec"
+	if (m ~ /^pc\/console\//) return "console"
+	if (m ~ /^pc\/start\//) return "start"
+	if (m ~ /^pc\/comm\//) return "comm"
 	if (m == "pc/roboelf") return "roboelf"
 	if (m ~ /^tools\/galil-load\//) return "galil-load"
 	if (m ~ /^tools\/galil-sim\//) return "galil-sim"
 	return "other"
 }
 function rank(l) {
-	return l == "base" ? 0 : (l == "galil" || l == "dmc") ? 1 : l == "re" ? 2 : 3
+	if (l == "base") return 0
+	if (l == "galil" || l == "dmc") return 1
+	if (l == "super") return 2
+	if (l == "config") return 3
+	if (l == "calib" || l == "rec") return 4
+	if (l == "console") return 5
+	if (l == "start") return 6
+	if (l == "comm") return 7
+	return 8
 }
 BEGIN { n = 0 }
 NR == FNR { def[$1] = mod($2); next }
@@ -66,6 +83,11 @@ NR == FNR { def[$1] = mod($2); next }
 	}
 }
 END {
+	for (i = 0; i < n; i++)
+		if (lib(name[i]) == "other") {
+			print "layers.sh: " name[i] " is in no folder of the layering"
+			bad++
+		}
 	# transitive closure (Warshall), then the loops are the groups of
 	# modules that reach each other
 	for (k = 0; k < n; k++) for (i = 0; i < n; i++) if (r[i, k])

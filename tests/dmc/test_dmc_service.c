@@ -201,7 +201,7 @@ static void test_enter(void **state)
 	DMC_H_CHECK(h, dmc_h_set(h, "svcreq", 1));
 	t = dmc_h_wait_var(h, "state", 3, 100);
 	print_message("measured: svcreq -> state 3 in %.0f ms\n", t);
-	/* the supervisor's deadline: ARM_WAIT_MS in pc/re_ctl.c */
+	/* the supervisor's deadline: ARM_WAIT_MS in pc/start/re_ctl.c */
 	assert_true(t >= 0 && t <= 1000);
 	dmc_h_advance(h, 5);
 	assert_true(dmc_h_var(h, "svcreq") == 0);

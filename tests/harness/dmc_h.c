@@ -13,6 +13,7 @@
 #include "gload_diag.h"
 #include "gload_prep.h"
 #include "re_seal.h"
+#include "re_sealmake.h"
 
 #define UNSOL_HANDLE 0	/* handle A: CF A, the program's MG lines */
 #define QR_HANDLE    1	/* handle B: QR for the ZA fields */

@@ -163,8 +163,8 @@ static void print_table(void)
 /* ---- exact texts -----------------------------------------------------------
  */
 
-/* Recovery texts and confirmations, as roboelf prints them (pc/re_fault.c,
- * pc/re_react.c; docs/operator.md section 7). */
+/* Recovery texts and confirmations, as roboelf prints them
+ * (pc/super/re_fault.c, pc/super/re_react.c; docs/operator.md section 7). */
 #define SAFE_OK                                                                \
 	" Safe state confirmed: motor power off (relay open), motors off."
 #define REC_FOREIGN                                                            \

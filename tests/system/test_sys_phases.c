@@ -1473,8 +1473,8 @@ static const struct fclass fclasses[FK_COUNT] = {
 
 /* The potentiometer's absolute range the program checks (fault 16):
  * potlo = reverse_v - absolute_tolerance_v - near_margin_counts x gain,
- * gain = (forward_v - reverse_v) / travel_counts (pc/re_plan.c), with the
- * defaults 0.5 V, 0.25 V, 4.0 V and NEAR_MARGIN. roboelf refuses a
+ * gain = (forward_v - reverse_v) / travel_counts (pc/config/re_plan.c), with
+ * the defaults 0.5 V, 0.25 V, 4.0 V and NEAR_MARGIN. roboelf refuses a
  * configuration whose potlo is below 0.1 V (an open wiper must stay a
  * fault): on the short robot potlo is 0.125 V for C, so an open wiper
  * (0 V) is outside the range. */

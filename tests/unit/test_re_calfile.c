@@ -1,6 +1,6 @@
 /*
- * test_re_calfile.c - the calibration file (pc/re_calfile.c): the exact text
- * of a small file (CRC checked against zlib's crc32, computed outside this
+ * test_re_calfile.c - the calibration file (pc/calib/re_calfile.c): the exact
+ * text of a small file (CRC checked against zlib's crc32, computed outside this
  * test), a bit-exact save/load round trip of big tables, every refusal with
  * its exact message and line, and the atomic save: a child process killed
  * at each step of the save, and killed at random moments while saving in a

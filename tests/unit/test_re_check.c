@@ -1,6 +1,6 @@
 /*
- * test_re_check.c - the supervisor's safety checks (pc/re_check.c) as pure
- * functions: interpolation at the table ends and between points, tolerance
+ * test_re_check.c - the supervisor's safety checks (pc/super/re_check.c) as
+ * pure functions: interpolation at the table ends and between points, tolerance
  * edges, persistence counts, watchdog thresholds at exactly 1.5x / 2.5x the
  * period +- 1 ms, liveness, ZA decoding, controller faults, motor-off
  * detection, calibration checks and the exact FAULT lines.

@@ -1,5 +1,5 @@
 /*
- * test_re_config.c - the configuration loader (pc/re_config.c).
+ * test_re_config.c - the configuration loader (pc/config/re_config.c).
  *
  * Every malformed file in tests/data/config/bad_*.yaml is listed below with
  * the exact message and position it must produce; the default file must load

@@ -1,7 +1,7 @@
 /*
  * test_re_dmcif.c - the DMC contract holds on both sides: the program's
  * fault codes as dmc/roboelf.dmc raises them (#FAULT(n,...)), as the
- * supervisor names them (enum re_dmc_fcode, pc/re_dmcif.h), and as
+ * supervisor names them (enum re_dmc_fcode, pc/super/re_dmcif.h), and as
  * docs/dmc-interface.md lists them ("| n | NAME |") are the same set with
  * the same names. Sources are read from ROBOELF_TOP (default ".").
  */
@@ -21,6 +21,7 @@
 #include "re_config.h"
 #include "re_dmcif.h"
 #include "re_seal.h"
+#include "re_sealmake.h"
 
 /* The supervisor's names of the codes, in the enum's words. */
 static const struct {

@@ -1,5 +1,5 @@
 /*
- * test_re_log.c - the failure log (pc/re_log.c): exact line format, the
+ * test_re_log.c - the failure log (pc/super/re_log.c): exact line format, the
  * fsync of FAULT entries (fsync is wrapped with -Wl,--wrap=fsync to see that
  * it is called on the log after the line was written), rotation at the size
  * limit, the rate limit of repeated events, and bad arguments.

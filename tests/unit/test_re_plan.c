@@ -1,6 +1,6 @@
 /*
  * test_re_plan.c - every limit the supervisor and the controller program
- * work with, derived from the configuration (pc/re_plan.c): the
+ * work with, derived from the configuration (pc/config/re_plan.c): the
  * potentiometer zones in volts, the service speeds and the longest move,
  * the heartbeat step, the watchdog, settle and grace times, and the
  * supervisor's settings made from them. Exact values for the shipped

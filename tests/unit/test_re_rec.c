@@ -1,6 +1,6 @@
 /*
  * test_re_rec.c - the flight recorder's pieces that need no supervisor
- * (pc/re_rec.c; the cycle itself is tested in test_re_super.c):
+ * (pc/rec/re_rec.c; the cycle itself is tested in test_re_super.c):
  * the ring's size and its refusals; no system call in the cycle's copy
  * nor in a fault's note (a seccomp filter); the dump written atomically: a
  * child that writes a 3 MB trace over and over is SIGKILLed at 40 pseudo-random

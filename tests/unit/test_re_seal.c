@@ -1,5 +1,5 @@
 /*
- * test_re_seal.c - the seal table and its program part (pc/re_seal.h):
+ * test_re_seal.c - the seal table and its program part (pc/super/re_seal.h):
  * what is sealed with which value, the emitted lines (80 characters, the
  * slices, one finder line per item), the comparison roboelf makes at
  * start-up and the FAULT details it fills, its read-back while running,
@@ -21,6 +21,7 @@
 #include "re_check.h"
 #include "re_config.h"
 #include "re_seal.h"
+#include "re_sealmake.h"
 
 static char body[DMC_H_PROG_MAX];
 static int body_len;

@@ -1,5 +1,5 @@
 /*
- * test_re_trace.c - the trace format (pc/re_trace.c): the exact text of a
+ * test_re_trace.c - the trace format (pc/rec/re_trace.c): the exact text of a
  * small trace (its CRC checked against zlib's crc32 value computed outside
  * this test), a round trip through a wrapped ring, every refusal with its
  * exact message and line (truncated, wrong version, garbage, huge counts,

@@ -1,6 +1,6 @@
 /*
  * test_re_xcheck.c - the supervisor's own joystick decode and motion check
- * (pc/re_xcheck.h) on records made by hand: the decode with both
+ * (pc/super/re_xcheck.h) on records made by hand: the decode with both
  * polarities and the input banks; the program's decode agreeing, lagging
  * within the allowance, and disagreeing (the fault names both readings);
  * an axis against the command, another axis running, the commanded one

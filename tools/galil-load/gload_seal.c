@@ -12,6 +12,7 @@
 #include "gl_err.h"
 #include "re_config.h"
 #include "re_seal.h"
+#include "re_sealmake.h"
 
 #define SOURCE_CONFIG "config/roboelf.yaml"
 #define SYSTEM_CONFIG "roboelf/roboelf.yaml"

@@ -1,7 +1,7 @@
 /*
  * gload_seal.h - the seal: the program part that holds every value which
  * decides how the robot moves or is stopped as a literal, generated from
- * the configuration (pc/re_seal.h, docs/dmc-interface.md "The seal") and
+ * the configuration (pc/super/re_seal.h, docs/dmc-interface.md "The seal") and
  * appended where the manifest says GLOAD_SEAL_ENTRY. roboelf regenerates it
  * from its own configuration and refuses a controller whose program was
  * sealed with other values.

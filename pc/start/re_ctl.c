@@ -18,6 +18,7 @@
 #include "base_version.h"
 #include "gl_err.h"
 #include "gl_ident.h"
+#include "re_sealmake.h"
 
 #define LINE_MAX_CHARS	GL_LINE_MAX
 #define POLL_MS		10

@@ -15,16 +15,12 @@
 #include "gl_err.h"
 #include "gl_link.h"
 #include "gl_route.h"
-#include "re_comm_find.h"
 
 struct re_signals re_sig;
 
 /* ---- start-up ------------------------------------------------------------ */
 
-static void progress(struct app *a, const char *fmt, ...)
-    __attribute__((format(printf, 2, 3)));
-
-static void progress(struct app *a, const char *fmt, ...)
+void re_start_progress(struct app *a, const char *fmt, ...)
 {
 	char text[512];
 	va_list ap;
@@ -39,8 +35,7 @@ static void progress(struct app *a, const char *fmt, ...)
 
 static int64_t stalled_ms(const struct app *a);
 
-/* The start refused with @what; a stop just before is named first. */
-static int fail(struct app *a, const char *what)
+int re_start_fail(struct app *a, const char *what)
 {
 	int64_t ms = stalled_ms(a);
 
@@ -70,21 +65,21 @@ static int take_locks(struct app *a)
 				   sizeof(key)) != GL_OK) {
 		snprintf(a->err, sizeof(a->err), "bad controller address '%s'",
 			 a->cfg.controller.address);
-		return fail(a, a->err);
+		return re_start_fail(a, a->err);
 	}
 	if (re_lock_acquire(&a->lock_ctl, "controller", key, a->err,
 			    sizeof(a->err)) != GL_OK)
-		return fail(a, a->err);
+		return re_start_fail(a, a->err);
 	if (re_lock_relay_key(port, key, sizeof(key)) != GL_OK) {
 		snprintf(a->err, sizeof(a->err),
 			 "cannot open the E-stop relay '%s': %s (is galil-sim "
 			 "running, or the relay plugged in?)",
 			 port, strerror(errno));
-		return fail(a, a->err);
+		return re_start_fail(a, a->err);
 	}
 	if (re_lock_acquire(&a->lock_relay, "relay", key, a->err,
 			    sizeof(a->err)) != GL_OK)
-		return fail(a, a->err);
+		return re_start_fail(a, a->err);
 	return 0;
 }
 
@@ -94,10 +89,11 @@ static int start_relay(struct app *a)
 	struct re_relay_cfg rc;
 
 	re_config_relay_cfg(&a->cfg, &rc);
-	progress(a, "opening the E-stop relay '%s' (motor power stays off)",
-		 rc.port);
+	re_start_progress(
+	    a, "opening the E-stop relay '%s' (motor power stays off)",
+	    rc.port);
 	if (re_relay_open(&a->relay, &rc, a->err, sizeof(a->err)) != GL_OK)
-		return fail(a, a->err);
+		return re_start_fail(a, a->err);
 	a->real.relay = a->relay;
 	return 0;
 }
@@ -110,8 +106,9 @@ static int check_direct(struct app *a, const struct gl_route_info *ri,
 	char what[800];
 
 	if (!ri->gateway) {
-		progress(a, "route to the controller: a direct link on %s",
-			 ri->ifname[0] ? ri->ifname : "an unnamed interface");
+		re_start_progress(
+		    a, "route to the controller: a direct link on %s",
+		    ri->ifname[0] ? ri->ifname : "an unnamed interface");
 		return 0;
 	}
 	snprintf(what, sizeof(what),
@@ -120,8 +117,8 @@ static int check_direct(struct app *a, const struct gl_route_info *ri,
 		 "on an interface of its own or a cable (docs/technician.md)",
 		 host, ri->ifname[0] ? ri->ifname : "an unnamed interface");
 	if (a->cfg.mode == RE_MODE_CLINICAL)
-		return fail(a, what);
-	progress(a, "warning: %s", what);
+		return re_start_fail(a, what);
+	re_start_progress(a, "warning: %s", what);
 	return 0;
 }
 
@@ -148,10 +145,11 @@ static int check_route(struct app *a)
 	if (rc == GL_OK && check_direct(a, &ri, host))
 		return EXIT_CONNECT;
 	if (rc == GL_OK && ms > 0 && ms <= limit) {
-		progress(a,
-			 "route to the controller: rto_min %d ms (limit %d "
-			 "ms)",
-			 ms, limit);
+		re_start_progress(
+		    a,
+		    "route to the controller: rto_min %d ms (limit %d "
+		    "ms)",
+		    ms, limit);
 		return 0;
 	}
 	if (rc != GL_OK)
@@ -168,24 +166,33 @@ static int check_route(struct app *a)
 			 host, ms ? ms : GL_ROUTE_DEFAULT_RTO_MIN_MS, limit,
 			 host, limit < 5 ? limit : 5);
 	if (a->cfg.mode == RE_MODE_CLINICAL)
-		return fail(a, what);
-	progress(a, "warning: %s", what);
+		return re_start_fail(a, what);
+	re_start_progress(a, "warning: %s", what);
 	return 0;
 }
 
-/* Connect, identify, refuse a controller another supervisor runs, close
- * the other connections, check the program's identity. */
-static int start_link(struct app *a)
+/* Connect (@b->find on a refusal), check the route, identify, refuse a
+ * controller another supervisor runs; with @b->take_over close the other
+ * connections and check the program's identity and seal. */
+static int start_link(struct app *a, const struct re_bringup *b)
 {
 	char e[GL_ERRTEXT_LEN];
 	char id[256];
 	gl_link *l;
 
-	progress(a, "connecting to the controller at %s",
-		 a->cfg.controller.address);
+	re_start_progress(a, "connecting to the controller at %s",
+			  a->cfg.controller.address);
 	if (gl_link_open(&l, a->cfg.controller.address,
-			 a->cfg.controller.connect_timeout_ms, e) != GL_OK)
-		return fail(a, e);
+			 a->cfg.controller.connect_timeout_ms, e) != GL_OK) {
+		if (!b->find)
+			return re_start_fail(a, e);
+		if (b->find(a, e))
+			return EXIT_CONNECT; /* said why */
+		if (gl_link_open(&l, a->cfg.controller.address,
+				 a->cfg.controller.connect_timeout_ms,
+				 e) != GL_OK)
+			return re_start_fail(a, e);
+	}
 	gl_link_set_timeout(l, a->cfg.controller.timeout_ms);
 	a->real.link = l;
 	a->real.address = a->cfg.controller.address;
@@ -195,15 +202,37 @@ static int start_link(struct app *a)
 	if (re_ctl_identify(l, &a->cfg, &a->info, a->err, sizeof(a->err)) ||
 	    re_ctl_check_busy(&a->io, a->cfg.watchdog.controller_timeout_ms,
 			      a->err, sizeof(a->err)) ||
-	    re_ctl_take_over(l, &a->cfg, &a->info, &a->seal, a->err,
-			     sizeof(a->err)))
-		return fail(a, a->err);
+	    (b->take_over && re_ctl_take_over(l, &a->cfg, &a->info, &a->seal,
+					      a->err, sizeof(a->err))))
+		return re_start_fail(a, a->err);
 	a->ctl_ours = 1;
-	snprintf(id, sizeof(id), "%s, serial %ld, program id %016llX",
-		 a->info.model, a->info.serial,
-		 (unsigned long long)a->info.program_id);
-	progress(a, "controller %s", id);
+	if (b->take_over)
+		snprintf(id, sizeof(id), "%s, serial %ld, program id %016llX",
+			 a->info.model, a->info.serial,
+			 (unsigned long long)a->info.program_id);
+	else
+		snprintf(id, sizeof(id), "%s, serial %ld", a->info.model,
+			 a->info.serial);
+	re_start_progress(a, "controller %s", id);
 	return 0;
+}
+
+int re_start_bringup(struct app *a, const struct re_bringup *b)
+{
+	int rc = take_locks(a);
+
+	re_sig.cont_real = &a->real;
+	if (!rc && !re_sig.quit) {
+		rc = start_relay(a);
+		if (!rc && b->after)
+			rc = b->after(a);
+	}
+	if (!rc && !re_sig.quit) {
+		rc = start_link(a, b);
+		if (!rc && b->after)
+			rc = b->after(a);
+	}
+	return rc;
 }
 
 /* In development mode (the simulator, a bench) an amplifier check that
@@ -216,7 +245,7 @@ static int amp_check(struct app *a, int want_on, int timeout_ms)
 			     sizeof(a->err)) == GL_OK)
 		return 0;
 	if (a->cfg.mode == RE_MODE_CLINICAL)
-		return fail(a, a->err);
+		return re_start_fail(a, a->err);
 	re_console_msg(&a->con,
 		       "roboelf: warning: %s (development mode: "
 		       "continuing)",
@@ -230,15 +259,15 @@ static int amp_check(struct app *a, int want_on, int timeout_ms)
 static int prepare_controller(struct app *a)
 {
 	re_plan_make(&a->cfg, 0, &a->plan);
-	progress(a, "halting the controller program; every motor off");
+	re_start_progress(a, "halting the controller program; every motor off");
 	if (re_ctl_halt(&a->io, a->err, sizeof(a->err)) ||
 	    re_ctl_configure(&a->io, &a->cfg, &a->plan, a->err, sizeof(a->err)))
-		return fail(a, a->err);
-	progress(a, "controller configured and read back");
+		return re_start_fail(a, a->err);
+	re_start_progress(a, "controller configured and read back");
 	if (amp_check(a, 0, 200))
 		return EXIT_CONNECT;
 	if (re_ctl_start_program(&a->io, &a->info, a->err, sizeof(a->err)))
-		return fail(a, a->err);
+		return re_start_fail(a, a->err);
 	re_plan_make(&a->cfg, a->info.mainms, &a->plan);
 	return 0;
 }
@@ -249,10 +278,11 @@ static int power_on(struct app *a)
 		snprintf(a->err, sizeof(a->err),
 			 "cannot switch motor power on: %s",
 			 re_relay_errmsg(a->relay));
-		return fail(a, a->err);
+		return re_start_fail(a, a->err);
 	}
 	a->powered = 1;
-	progress(a, "motor power on (relay closed); the motors are off");
+	re_start_progress(a,
+			  "motor power on (relay closed); the motors are off");
 	return amp_check(a, 1, 500);
 }
 
@@ -266,9 +296,9 @@ static int init_super(struct app *a)
 	sc.xcheck = &a->xcheck;
 	a->sup = calloc(1, sizeof(*a->sup));
 	if (!a->sup || re_super_init(a->sup, &a->io, &sc, NULL, 0) != GL_OK)
-		return fail(a, "cannot set up the supervisor");
+		return re_start_fail(a, "cannot set up the supervisor");
 	if (a->sup->rb_n > 0)
-		progress(
+		re_start_progress(
 		    a,
 		    "checked twice: roboelf reads the program's %d sealed "
 		    "values back, all every %d cycles (%d ms), and decodes "
@@ -357,7 +387,7 @@ static int check_stall(struct app *a)
 			 "debugger); motor power was not switched on; start "
 			 "it again",
 			 (long long)ms, (long long)re_start_stall_limit_ms(a));
-		return fail(a, a->err);
+		return re_start_fail(a, a->err);
 	}
 	re_fault_set(&f, RE_F_NONE, -1);
 	stall_first(a, &f);
@@ -552,7 +582,8 @@ static int calib_load(struct app *a)
 	char serial[32];
 
 	re_calib_cfg_from(&a->cfg, &a->plan, a->names, &cc);
-	progress(a, "loading calibration '%s'", a->cfg.calibration.file);
+	re_start_progress(a, "loading calibration '%s'",
+			  a->cfg.calibration.file);
 	fill_expect(a, &cc, &e, serial);
 	if (re_calfile_load(a->cfg.calibration.file, &e, a->cal, a->err,
 			    sizeof(a->err)) == GL_OK)
@@ -591,7 +622,7 @@ static int choose_calibration(struct app *a)
 	}
 	a->cal = calloc(1, sizeof(*a->cal));
 	if (!a->cal)
-		return fail(a, "out of memory");
+		return re_start_fail(a, "out of memory");
 	if (how == RE_CALIB_FILE) {
 		rc = calib_load(a);
 		if (rc > 1)
@@ -600,11 +631,12 @@ static int choose_calibration(struct app *a)
 	}
 	a->calib = how;
 	if (how == RE_CALIB_FULL)
-		progress(a, "full calibration chosen: every axis will move to "
-			    "its reverse and forward limit switches, then to "
-			    "the centre of its travel");
+		re_start_progress(
+		    a, "full calibration chosen: every axis will move to "
+		       "its reverse and forward limit switches, then to "
+		       "the centre of its travel");
 	else
-		progress(
+		re_start_progress(
 		    a,
 		    "calibration from the file: every axis will move "
 		    "to the centre of its calibrated travel (A %.0f, "
@@ -625,7 +657,8 @@ static void save_calibration(struct app *a)
 			   a->err);
 		return;
 	}
-	progress(a, "calibration saved to '%s'", a->cfg.calibration.file);
+	re_start_progress(a, "calibration saved to '%s'",
+			  a->cfg.calibration.file);
 	drop_backup(a);
 }
 
@@ -641,11 +674,12 @@ static void say_table_in_force(struct app *a, const struct re_calib_cfg *cc)
 	int rc;
 
 	if (a->calib != RE_CALIB_FULL) {
-		progress(a,
-			 "calibration interrupted: the table in force is "
-			 "still the one loaded from '%s' (made %s), "
-			 "unchanged",
-			 file, a->cal->date);
+		re_start_progress(
+		    a,
+		    "calibration interrupted: the table in force is "
+		    "still the one loaded from '%s' (made %s), "
+		    "unchanged",
+		    file, a->cal->date);
 		return;
 	}
 	old = calloc(1, sizeof(*old));
@@ -653,23 +687,26 @@ static void say_table_in_force(struct app *a, const struct re_calib_cfg *cc)
 	rc = old ? re_calfile_load(file, &e, old, a->err, sizeof(a->err))
 		 : GL_ERR_NOMEM;
 	if (rc == GL_OK)
-		progress(a,
-			 "calibration interrupted: no new table; the table "
-			 "in force is still the one in '%s' (made %s), "
-			 "kept unchanged: the next start can load it",
-			 file, old->date);
+		re_start_progress(
+		    a,
+		    "calibration interrupted: no new table; the table "
+		    "in force is still the one in '%s' (made %s), "
+		    "kept unchanged: the next start can load it",
+		    file, old->date);
 	else if (rc == GL_ERR_NOENT)
-		progress(a,
-			 "calibration interrupted: no table is in force "
-			 "('%s' does not exist): the next start needs a "
-			 "full calibration",
-			 file);
+		re_start_progress(
+		    a,
+		    "calibration interrupted: no table is in force "
+		    "('%s' does not exist): the next start needs a "
+		    "full calibration",
+		    file);
 	else
-		progress(a,
-			 "calibration interrupted: no table is in force "
-			 "('%s' was not changed but cannot be used: %s): "
-			 "the next start needs a full calibration",
-			 file, a->err);
+		re_start_progress(
+		    a,
+		    "calibration interrupted: no table is in force "
+		    "('%s' was not changed but cannot be used: %s): "
+		    "the next start needs a full calibration",
+		    file, a->err);
 	free(old);
 }
 
@@ -683,11 +720,12 @@ static int run_calibration(struct app *a, struct re_calib *c,
 	int rc, filled = 0;
 
 	if (a->calib == RE_CALIB_FULL) {
-		progress(a, "full calibration: every axis end to end");
+		re_start_progress(a, "full calibration: every axis end to end");
 		rc = re_calib_full(c, &a->io, cc, a->cal, &f, &secs, &filled);
 	} else {
-		progress(a, "checking the robot against the file, moving to "
-			    "the centre");
+		re_start_progress(
+		    a, "checking the robot against the file, moving to "
+		       "the centre");
 		rc = re_calib_check_robot(c, &a->io, cc, a->cal, &f);
 	}
 	if (rc == RE_FAULT)
@@ -713,7 +751,7 @@ static int calibrate(struct app *a)
 	int rc;
 
 	if (re_calib_new(&c) != GL_OK)
-		return fail(a, "out of memory");
+		return re_start_fail(a, "out of memory");
 	re_calib_cfg_from(&a->cfg, &a->plan, a->names, &cc);
 	cc.stop = &re_sig.quit;
 	cc.sampler = (struct re_calib_sampler){sample_cb, own_cb, tables_cb, a};
@@ -742,7 +780,7 @@ static int arm(struct app *a)
 	re_super_start(a->sup, NULL, a->hbpc, 0);
 	if (a->calib == RE_CALIB_FULL)
 		save_calibration(a);
-	progress(a, "soft limits from the calibration; arming");
+	re_start_progress(a, "soft limits from the calibration; arming");
 	rc = re_ctl_arm(&a->io, a->cal, &a->hbpc, &f, a->err, sizeof(a->err));
 	if (rc == RE_FAULT)
 		return latch(a, &f);
@@ -760,13 +798,12 @@ typedef int (*startup_step)(struct app *a);
 int re_start(struct app *a)
 {
 	static const startup_step steps[] = {
-	    start_relay,	start_link, choose_calibration,
-	    prepare_controller, init_super, power_on,
-	    enter_service,	calibrate,  arm,
+	    choose_calibration, prepare_controller, init_super, power_on,
+	    enter_service,	calibrate,	    arm,
 	};
-	int rc = take_locks(a);
+	static const struct re_bringup b = {NULL, 1, check_stall};
+	int rc = re_start_bringup(a, &b);
 
-	re_sig.cont_real = &a->real;
 	/* a stop while the operator chooses is no stall: nothing is on */
 	for (size_t i = 0;
 	     !rc && !re_sig.quit && i < sizeof(steps) / sizeof(steps[0]); i++) {
@@ -806,102 +843,4 @@ void re_start_show_ready(struct app *a)
 		   "neutral",
 		   a->names[k / 2], k % 2 ? "reverse" : "forward");
 	a->held_said = 1;
-}
-
-/* The controller for the commissioning run: connected, identified, not
- * run by another supervisor; halted, every motor read back off,
- * configured and read back; the relay open and off. Its program is not
- * checked (commissioning may come before the first galil-load). */
-/* The configured address did not answer (@why): list the controllers
- * that answer the discovery probe and, on a terminal, let the technician
- * pick one (never chosen silently). Return 0 with a->cfg's address set to
- * the choice, or EXIT_CONNECT. */
-static int commission_find(struct app *a, const char *why)
-{
-	static struct re_comm_found list[RE_COMM_FIND_MAX];
-	const char *bc = a->o.find_addr ? a->o.find_addr : RE_COMM_FIND_BCAST;
-	int port = a->o.find_port ? a->o.find_port : RE_COMM_FIND_PORT;
-	char line[32], *end;
-	long k;
-	int n;
-
-	progress(a,
-		 "%s; looking for Galil controllers (discovery probe to "
-		 "UDP %s:%d, %d ms)",
-		 why, bc, port, RE_COMM_FIND_MS);
-	n = re_comm_find(bc, (unsigned)port, RE_COMM_FIND_MS, list,
-			 RE_COMM_FIND_MAX, a->err, sizeof(a->err));
-	if (n < 0)
-		return fail(a, a->err);
-	if (n == 0)
-		return fail(a, "no Galil controller answered: check the "
-			       "controller's power and Ethernet cable, and "
-			       "controller.address in the configuration");
-	for (int i = 0; i < n; i++)
-		re_console_msg(&a->con, "  %d) %s  %s", i + 1, list[i].addr,
-			       list[i].what);
-	if (!a->con.tty_in)
-		return fail(a, "the configured controller does not answer; "
-			       "the controllers listed above do: run again "
-			       "with --galil ADDRESS");
-	re_console_msg(&a->con, "connect to which one (1-%d, Enter: none)?", n);
-	if (!fgets(line, sizeof(line), stdin) ||
-	    (k = strtol(line, &end, 10)) < 1 || k > n || (*end && *end != '\n'))
-		return fail(a, "no controller chosen");
-	snprintf(a->cfg.controller.address, sizeof(a->cfg.controller.address),
-		 "%s", list[k - 1].addr);
-	progress(a,
-		 "using %s (chosen from the list; set "
-		 "controller.address or --galil for the next time)",
-		 a->cfg.controller.address);
-	return 0;
-}
-
-static int commission_link(struct app *a)
-{
-	char e[GL_ERRTEXT_LEN];
-	gl_link *l;
-
-	progress(a, "connecting to the controller at %s",
-		 a->cfg.controller.address);
-	if (gl_link_open(&l, a->cfg.controller.address,
-			 a->cfg.controller.connect_timeout_ms, e) != GL_OK) {
-		if (commission_find(a, e))
-			return EXIT_CONNECT; /* said why */
-		if (gl_link_open(&l, a->cfg.controller.address,
-				 a->cfg.controller.connect_timeout_ms,
-				 e) != GL_OK)
-			return fail(a, e);
-	}
-	gl_link_set_timeout(l, a->cfg.controller.timeout_ms);
-	a->real.link = l;
-	a->real.address = a->cfg.controller.address;
-	a->real.cmd_timeout_ms = a->cfg.controller.timeout_ms;
-	if (check_route(a))
-		return EXIT_CONNECT;
-	if (re_ctl_identify(l, &a->cfg, &a->info, a->err, sizeof(a->err)) ||
-	    re_ctl_check_busy(&a->io, a->cfg.watchdog.controller_timeout_ms,
-			      a->err, sizeof(a->err)))
-		return fail(a, a->err);
-	a->ctl_ours = 1;
-	progress(a, "controller %s, serial %ld", a->info.model, a->info.serial);
-	re_plan_make(&a->cfg, 0, &a->plan);
-	progress(a, "halting the controller program; every motor off");
-	if (re_ctl_halt(&a->io, a->err, sizeof(a->err)) ||
-	    re_ctl_configure(&a->io, &a->cfg, &a->plan, a->err, sizeof(a->err)))
-		return fail(a, a->err);
-	progress(a, "controller configured and read back; motor power off");
-	return 0;
-}
-
-int re_start_commission(struct app *a)
-{
-	int rc = take_locks(a);
-
-	re_sig.cont_real = &a->real;
-	if (!rc)
-		rc = start_relay(a);
-	if (!rc)
-		rc = commission_link(a);
-	return rc;
 }

@@ -18,10 +18,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "re_dmcif.h"
 #include "re_relay.h"
 
-#define RE_AXES		  3   /* A, B (rotary), C (linear) */
-#define RE_JOY_INPUTS	  12  /* 6 commands x 2 redundant switches */
 #define RE_NAME_MAX	  16  /* axis name, bytes including the NUL */
 #define RE_ADDR_MAX	  128 /* controller address, bytes incl. NUL */
 #define RE_MODEL_MAX	  32  /* controller model, bytes incl. NUL */
@@ -158,7 +157,7 @@ struct re_config_recorder {
 	char dir[RE_PATH_MAX]; /* where traces go; "": the log's directory */
 };
 
-/* Real-time set-up of the supervisor's thread (issue 17, pc/re_rt.h). */
+/* Real-time set-up of the supervisor's thread (issue 17, pc/super/re_rt.h). */
 struct re_config_realtime {
 	int priority;	  /* SCHED_FIFO 1..99; 0: not requested */
 	int cpu;	  /* pin the cycle to this CPU; -1: not pinned */

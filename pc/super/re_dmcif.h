@@ -14,6 +14,10 @@
 
 #include "re_fault.h"
 
+/* The program's axes and joystick switch inputs (dmc/roboelf.dmc). */
+#define RE_AXES	      3	 /* A, B (rotary), C (linear) */
+#define RE_JOY_INPUTS 12 /* 6 commands x 2 redundant switches */
+
 /* ---- data record: the program's ZA fields and the axes ------------------- */
 
 enum re_dmc_state {

@@ -115,15 +115,37 @@ extern struct re_signals re_sig;
  */
 int re_start(struct app *a);
 
+/* How the bring-up connects: @find, on a connection refused (@why), may
+ * find another controller, set a->cfg's address and return 0 (else it
+ * says why and returns non-zero; NULL: the start is refused); @take_over
+ * closes the other connections and checks the program's identity and
+ * seal; @after runs after each stage (the stall check), or NULL. */
+struct re_bringup {
+	int (*find)(struct app *a, const char *why);
+	int take_over;
+	int (*after)(struct app *a);
+};
+
 /*
- * re_start_commission() - what the commissioning run (roboelf --commission)
- * needs before its first step: the locks, the relay opened and off, the
- * controller connected, identified (the configured model), not run by
- * another supervisor, halted with every motor read back off, configured
- * and read back. Its program is not checked. Refusals as re_start().
- * Return: 0, EXIT_CONNECT.
+ * re_start_bringup() - the bring-up the supervised start and the
+ * commissioning run share: the locks (one supervisor per controller and
+ * relay), the relay opened and off, the controller connected, its route
+ * checked, identified (the configured model) and not run by another
+ * supervisor, then as @b says. A quit signal ends it early with 0.
+ * Return: 0, or EXIT_CONNECT (said on the console and in the log).
  */
-int re_start_commission(struct app *a);
+int re_start_bringup(struct app *a, const struct re_bringup *b);
+
+/*
+ * re_start_progress() - a start-up line on the console ("roboelf: ...")
+ * and in the log, and roboelf known to have run now.
+ * re_start_fail() - the start refused with @what, on the console and in
+ * the log; a stop of roboelf just before is named first.
+ * Return (fail): EXIT_CONNECT.
+ */
+void re_start_progress(struct app *a, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+int re_start_fail(struct app *a, const char *what);
 
 /*
  * re_start_stall_limit_ms() - the critical reply-age limit, ms: a stop of

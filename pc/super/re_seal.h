@@ -23,7 +23,8 @@
  * item's number, its axis and the value found. The supervisor checks the
  * same table from its own plan (re_seal_expect) by its own read-back.
  *
- * re_seal_make() builds the table, re_seal_emit() the DMC text galil-load
+ * re_seal_make() (re_sealmake.h, from the configuration) builds the table,
+ * re_seal_emit() the DMC text galil-load
  * appends to the program; roboelf regenerates it and compares it with what
  * the controller holds. Pure (no I/O, no printing, no allocation) but
  * re_seal_read_fault(), which reads two values through a struct re_io.
@@ -33,7 +34,6 @@
 
 #include <stddef.h>
 
-#include "re_config.h"
 #include "re_fault.h"
 #include "re_io.h"
 
@@ -81,20 +81,6 @@ struct re_seal {
 	struct re_seal_item item[RE_SEAL_MAX];
 	int t1_first, t1_last; /* program lines thread 1 may be on (armed) */
 };
-
-/*
- * re_seal_make() - the seal of the program @body (the preprocessed program
- * text up to, not including, the seal part: its #CONSTS and the lines of
- * #MOTION .. #POSERR) for the configuration @cfg, with the plan derived for
- * the program's own mainms: re_seal_start(), the parameters and settings
- * from @cfg, re_seal_end().
- * @out: [out] the table; item i (0-based) is the program's item i + 1.
- * @err: [out] on failure, e.g. "the program has no #CONSTS".
- * Return: GL_OK; GL_ERR_FORMAT (a constant that is not a number or 0-NAME,
- *         a label missing, no mainms); GL_ERR_OVERFLOW (too many items).
- */
-int re_seal_make(const char *body, size_t len, const struct re_config *cfg,
-		 struct re_seal *out, char *err, size_t errlen);
 
 /*
  * re_seal_start(), re_seal_add(), re_seal_end() - the same table built by
