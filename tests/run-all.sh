@@ -4,6 +4,15 @@
 # ends with one line "N passed, N failed, N skipped" counting test programs.
 # With arguments (e.g. "net"), only those test directories run, no checks.
 #
+# Independent programs run side by side (ROBOELF_JOBS at once, default the
+# number of CPUs): the unit, loader, simulator and DMC tests (in-process or
+# in virtual time) and the checks that judge files. The real-time ones run
+# alone, one after another, once the others are done: the system tests,
+# the network rig, and the checks that time a host or drive roboelf against
+# galil-sim in real time (realtime.sh, console_tmux.sh, install.sh). Each
+# program's log is printed whole, in the order of the list, never
+# interleaved.
+#
 # A program that exits 77 was SKIPPED (e.g. tests/net without root): it is
 # reported as such, never counted as passed; with ROBOELF_NO_SKIP=1 a skip
 # counts as a failure (make netrig).
@@ -18,17 +27,18 @@
 # runs helpers of its own: lintian).
 set -u
 BUILD=${BUILD:-build}
-ROBOELF_TOP=$(cd "$(dirname "$0")/.." && pwd)
-ROBOELF_BIN=$ROBOELF_TOP/$BUILD/bin
-export BUILD ROBOELF_BIN ROBOELF_TOP
-cd "$ROBOELF_TOP" || exit 1
-sh tools/cmdtable.sh path "$ROBOELF_TOP/$BUILD/cmdpath" || exit 1
-ROBOELF_SYSPATH=$PATH
-PATH=$ROBOELF_TOP/$BUILD/cmdpath
-export PATH ROBOELF_SYSPATH
+if [ "${1:-}" != --one ]; then # a child (--one) has all this from its parent
+	ROBOELF_TOP=$(cd "$(dirname "$0")/.." && pwd)
+	ROBOELF_BIN=$ROBOELF_TOP/$BUILD/bin
+	export BUILD ROBOELF_BIN ROBOELF_TOP
+	cd "$ROBOELF_TOP" || exit 1
+	sh tools/cmdtable.sh path "$ROBOELF_TOP/$BUILD/cmdpath" || exit 1
+	ROBOELF_SYSPATH=$PATH
+	PATH=$ROBOELF_TOP/$BUILD/cmdpath
+	export PATH ROBOELF_SYSPATH
+fi
 LOGDIR=$BUILD/test-logs
 mkdir -p "$LOGDIR"
-passed=0; failed=0; skipped=0; failures=""
 # Per-program deadline (s): a hung test fails with exit 124 instead of hanging
 # the run; system tests get more, and so does the fuzz check, which builds
 # its targets first (ROBOELF_TEST_TIMEOUT overrides both).
@@ -38,14 +48,31 @@ deadline() {
 	*) echo "${ROBOELF_TEST_TIMEOUT:-180}" ;;
 	esac
 }
-run() { # run NAME KIND CMD... ; KIND = cmocka | script
-	name=$1; kind=$2; shift 2
-	log=$LOGDIR/$(echo "$name" | tr / _).log
-	echo "=== $name"
+# The real-time programs: alone, after the others.
+alone() {
+	case $1 in
+	system/* | net/* | checks/realtime.sh | checks/console_tmux.sh | checks/install.sh) return 0 ;;
+	*) return 1 ;;
+	esac
+}
+logof() { echo "$LOGDIR/$(echo "$1" | tr / _).log"; }
+# The command of NAME: a cmocka binary, or a check script in its shell.
+cmdof() {
+	case $1 in
+	checks/*)
+		s=tests/$1
+		if head -1 "$s" | grep -q bash; then echo "bash $s"; else echo "sh $s"; fi ;;
+	*) echo "$BUILD/tests/$1" ;;
+	esac
+}
+# exec1 NAME: run it into its log; its verdict line into NAME's .res file
+# ("ok", "SKIPPED (...)" or "FAILED (...)"; then the exit status, seconds).
+exec1() {
+	name=$1; log=$(logof "$name")
 	start=$(date +%s)
-	timeout --kill-after=10 "$(deadline "$name")" "$@" >"$log" 2>&1
+	# shellcheck disable=SC2046 # the command's words
+	timeout --kill-after=10 "$(deadline "$name")" $(cmdof "$name") >"$log" 2>&1
 	rc=$?
-	cat "$log"
 	res=ok
 	if [ "$rc" -eq 77 ]; then
 		res="SKIPPED ($(grep -m1 '^SKIP' "$log"))"
@@ -55,11 +82,26 @@ run() { # run NAME KIND CMD... ; KIND = cmocka | script
 		res="FAILED (exit $rc)"
 	elif grep -qE '^\[  (FAILED|ERROR)   ?\]' "$log"; then
 		res="FAILED (cmocka reported a failure)"
-	elif [ "$kind" = cmocka ] && ! grep -q '^\[  PASSED  \]' "$log"; then
-		res="FAILED (no cmocka summary)"
-	elif grep -q '^\[  PASSED  \] 0 test' "$log"; then
-		res="FAILED (no test ran)"
+	else
+		case $name in
+		checks/*) ;;
+		*) grep -q '^\[  PASSED  \]' "$log" || res="FAILED (no cmocka summary)" ;;
+		esac
+		[ "$res" = ok ] && grep -q '^\[  PASSED  \] 0 test' "$log" && res="FAILED (no test ran)"
 	fi
+	printf '%s\n%s\n%s\n' "$res" "$rc" "$(( $(date +%s) - start ))" >"$log.res"
+}
+if [ "${1:-}" = --one ]; then # a child of the side-by-side run
+	exec1 "$2"
+	exit 0
+fi
+passed=0; failed=0; skipped=0; failures=""
+# report NAME: its log and verdict, and the counts
+report() {
+	name=$1; log=$(logof "$name")
+	echo "=== $name"
+	cat "$log"
+	{ read -r res; read -r rc; read -r secs; } <"$log.res"
 	if [ "$res" = ok ]; then
 		passed=$((passed + 1))
 	elif [ "$rc" -eq 77 ] && [ "${ROBOELF_NO_SKIP:-0}" != 1 ]; then
@@ -67,20 +109,35 @@ run() { # run NAME KIND CMD... ; KIND = cmocka | script
 	else
 		failed=$((failed + 1)); failures="$failures $name"
 	fi
-	echo "=== $name: $res ($(( $(date +%s) - start )) s)"
+	echo "=== $name: $res ($secs s)"
 }
+list=""
 dirs=${*:-unit load sim dmc system net}
 for dir in $dirs; do
 	for t in "$BUILD/tests/$dir"/test_*; do
-		[ -x "$t" ] || continue
-		run "$dir/$(basename "$t")" cmocka "$t"
+		[ -x "$t" ] && list="$list $dir/$(basename "$t")"
 	done
 done
-checks="tests/checks/*.sh"
-[ $# -gt 0 ] && checks=""
-for s in $checks; do
-	[ -f "$s" ] || continue
-	run "checks/$(basename "$s")" script "$(head -1 "$s" | grep -q bash && echo bash || echo sh)" "$s"
+if [ $# -eq 0 ]; then
+	for s in tests/checks/*.sh; do
+		[ -f "$s" ] && list="$list checks/$(basename "$s")"
+	done
+fi
+jobs=${ROBOELF_JOBS:-$(nproc)}
+pool=""; rt=""
+for n in $list; do
+	rm -f "$(logof "$n").res"
+	if alone "$n"; then rt="$rt $n"; else pool="$pool $n"; fi
+done
+t0=$(date +%s)
+# shellcheck disable=SC2086 # one name per word
+[ -n "$pool" ] && printf '%s\n' $pool | xargs -P "$jobs" -n 1 sh "$ROBOELF_TOP/tests/run-all.sh" --one
+for n in $pool; do report "$n"; done
+echo "=== side by side ($jobs at once): $(echo $pool | wc -w) programs in $(( $(date +%s) - t0 )) s"
+for n in $rt; do
+	echo "=== $n (alone)"
+	exec1 "$n"
+	report "$n"
 done
 [ -n "$failures" ] && echo "failed:$failures"
 echo "$passed passed, $failed failed, $skipped skipped"
