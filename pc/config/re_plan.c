@@ -94,7 +94,12 @@ void re_plan_make(const struct re_config *cfg, int mainms, struct re_plan *out)
 	/* never slower than the period: the watchdog limits are the
 	 * period's */
 	out->sample_ns = (int64_t)fastest * BASE_NS_PER_MS;
-	out->sample_limit_ns = (int64_t)(crit * (double)p_ns);
+	re_wdog_limits(
+	    &(struct re_wdog_cfg){p_ns, cfg->watchdog.noncritical_factor, crit},
+	    &out->wdog);
+	/* the record's sample number frozen for longer than the critical
+	 * reply age: the controller's clock has stopped */
+	out->sample_limit_ns = out->wdog.crit_ns;
 	out->hb_limit_ns = (int64_t)(crit * (double)(ms * BASE_NS_PER_MS > p_ns
 							 ? ms * BASE_NS_PER_MS
 							 : p_ns));
@@ -114,9 +119,7 @@ void re_plan_super_cfg(const struct re_plan *p, const struct re_config *cfg,
 	memset(out, 0, sizeof(*out));
 	out->n_axes = RE_AXES;
 	out->period_ns = p->period_ns;
-	out->wdog.period_ns = p->period_ns;
-	out->wdog.noncrit_factor = cfg->watchdog.noncritical_factor;
-	out->wdog.crit_factor = cfg->watchdog.critical_factor;
+	out->wdog = p->wdog;
 	out->alive.sample_limit_ns = p->sample_limit_ns;
 	out->alive.hb_limit_ns = p->hb_limit_ns;
 	for (int i = 0; i < RE_AXES; i++) {

@@ -44,7 +44,8 @@ struct re_plan {
 	int64_t period_ns;   /* supervisor cycle */
 	int64_t sample_ns;   /* cycle while calibrating: the period
 			      * or RE_PLAN_SAMPLE_MS, the shorter */
-	int64_t hb_limit_ns; /* program heartbeat frozen: fault */
+	struct re_wdog_lim wdog; /* reply-age limits: the one derivation */
+	int64_t hb_limit_ns;	 /* program heartbeat frozen: fault */
 	int64_t sample_limit_ns; /* record sample number frozen: fault */
 	int64_t uncmd_grace_ns;	 /* motion not commanded: fault after */
 	int settle_ms;		 /* wait for the program's own verdict */

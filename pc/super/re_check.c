@@ -118,29 +118,28 @@ int re_check_encpot(const struct re_caltable *t,
 
 /* ---- watchdog ------------------------------------------------------------*/
 
-int re_wdog_limits(const struct re_wdog_cfg *cfg, int64_t *noncrit_ns,
-		   int64_t *crit_ns)
+int re_wdog_limits(const struct re_wdog_cfg *cfg, struct re_wdog_lim *out)
 {
-	if (!cfg || cfg->period_ns <= 0 || !isfinite(cfg->noncrit_factor) ||
-	    !isfinite(cfg->crit_factor) || cfg->noncrit_factor < 1.0 ||
+	if (!cfg || !out || cfg->period_ns <= 0 ||
+	    !isfinite(cfg->noncrit_factor) || !isfinite(cfg->crit_factor) ||
+	    cfg->noncrit_factor < 1.0 ||
 	    cfg->crit_factor < cfg->noncrit_factor || cfg->crit_factor > 1e6)
 		return GL_ERR_ARG;
-	if (noncrit_ns)
-		*noncrit_ns =
-		    llround(cfg->noncrit_factor * (double)cfg->period_ns);
-	if (crit_ns)
-		*crit_ns = llround(cfg->crit_factor * (double)cfg->period_ns);
+	out->noncrit_ns = llround(cfg->noncrit_factor * (double)cfg->period_ns);
+	out->crit_ns = llround(cfg->crit_factor * (double)cfg->period_ns);
 	return GL_OK;
 }
 
-int re_check_reply_age(const struct re_wdog_cfg *cfg, int64_t last_good_ns,
+int re_check_reply_age(const struct re_wdog_lim *lim, int64_t last_good_ns,
 		       int64_t now_ns, int64_t *age_ns, struct re_fault *fault)
 {
 	int64_t warn_ns, crit_ns, age;
 
-	if (re_wdog_limits(cfg, &warn_ns, &crit_ns) != GL_OK ||
+	if (!lim || lim->noncrit_ns <= 0 || lim->crit_ns < lim->noncrit_ns ||
 	    now_ns < last_good_ns)
 		return GL_ERR_ARG;
+	warn_ns = lim->noncrit_ns;
+	crit_ns = lim->crit_ns;
 	age = now_ns - last_good_ns;
 	if (age_ns)
 		*age_ns = age;

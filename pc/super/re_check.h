@@ -136,12 +136,19 @@ struct re_wdog_cfg {
 	double crit_factor;    /* e.g. 2.5: above -> RE_FAULT */
 };
 
+/* The two reply-age limits, ns: derived once (re_wdog_limits(), called by
+ * the plan, pc/config/re_plan.c) and read from there everywhere. */
+struct re_wdog_lim {
+	int64_t noncrit_ns; /* above: RE_WARN (log only) */
+	int64_t crit_ns;    /* above: RE_FAULT */
+};
+
 /*
- * re_wdog_limits() - the two limits in ns, rounded to the nearest ns.
+ * re_wdog_limits() - the two limits in ns, rounded to the nearest ns: the
+ * one place they are computed from the factors and the period.
  * Return: GL_OK, GL_ERR_ARG when period <= 0 or not 1 <= noncrit <= crit.
  */
-int re_wdog_limits(const struct re_wdog_cfg *cfg, int64_t *noncrit_ns,
-		   int64_t *crit_ns);
+int re_wdog_limits(const struct re_wdog_cfg *cfg, struct re_wdog_lim *out);
 
 /*
  * re_check_reply_age() - the PC side of the watchdog (GalilWatchdog).
@@ -150,9 +157,10 @@ int re_wdog_limits(const struct re_wdog_cfg *cfg, int64_t *noncrit_ns,
  * the verdict is still RE_OK; at exactly 2.5 x period still RE_WARN.
  * @age_ns: [out] the age, may be NULL.
  * @fault: [out] RE_F_WDOG_REPLY on RE_FAULT (ms values), may be NULL.
- * Return: the verdict, or GL_ERR_ARG (bad cfg, now < last_good).
+ * Return: the verdict, or GL_ERR_ARG (not 0 < noncrit <= crit, now <
+ *         last_good).
  */
-int re_check_reply_age(const struct re_wdog_cfg *cfg, int64_t last_good_ns,
+int re_check_reply_age(const struct re_wdog_lim *lim, int64_t last_good_ns,
 		       int64_t now_ns, int64_t *age_ns, struct re_fault *fault);
 
 /*

@@ -62,8 +62,11 @@ int re_super_init(struct re_super *s, const struct re_io *io,
 		return GL_ERR_ARG;
 	s->io = *io;
 	s->cfg = *cfg;
-	if (re_wdog_limits(&cfg->wdog, &s->noncrit_ns, &s->crit_ns) != GL_OK)
+	if (cfg->wdog.noncrit_ns <= 0 ||
+	    cfg->wdog.crit_ns < cfg->wdog.noncrit_ns)
 		return GL_ERR_ARG;
+	s->noncrit_ns = cfg->wdog.noncrit_ns;
+	s->crit_ns = cfg->wdog.crit_ns;
 	for (int i = 0; tables && i < cfg->n_axes; i++)
 		s->table[i] = tables[i];
 	s->expect = expect;

@@ -69,7 +69,7 @@ struct re_event {
 struct re_super_cfg {
 	int n_axes;		   /* 1..RE_SUPER_AXES */
 	int64_t period_ns;	   /* cycle period */
-	struct re_wdog_cfg wdog;   /* reply-age limits */
+	struct re_wdog_lim wdog;   /* reply-age limits (the plan's) */
 	struct re_alive_cfg alive; /* heartbeat / sample limits */
 	struct re_encpot_cfg encpot[RE_SUPER_AXES];
 	const char *axis_names[RE_SUPER_AXES];

@@ -285,7 +285,8 @@ static void test_encpot_bad_args(void **state)
 /* ---- watchdog
  * --------------------------------------------------------------*/
 
-static const struct re_wdog_cfg wd = {50 * MS, 1.5, 2.5};
+static const struct re_wdog_cfg wdc = {50 * MS, 1.5, 2.5};
+static const struct re_wdog_lim wd = {75 * MS, 125 * MS};
 
 static int age_verdict(int64_t age_ns)
 {
@@ -296,12 +297,12 @@ static int age_verdict(int64_t age_ns)
 
 static void test_wdog_thresholds(void **state)
 {
-	int64_t warn, crit;
+	struct re_wdog_lim lim;
 
 	(void)state;
-	assert_int_equal(re_wdog_limits(&wd, &warn, &crit), GL_OK);
-	assert_int_equal(warn, 75 * MS);
-	assert_int_equal(crit, 125 * MS);
+	assert_int_equal(re_wdog_limits(&wdc, &lim), GL_OK);
+	assert_int_equal(lim.noncrit_ns, 75 * MS);
+	assert_int_equal(lim.crit_ns, 125 * MS);
 	assert_int_equal(age_verdict(0), RE_OK);
 	assert_int_equal(age_verdict(74 * MS), RE_OK);
 	assert_int_equal(age_verdict(75 * MS), RE_OK); /* exactly 1.5 x */
@@ -336,23 +337,26 @@ static void test_wdog_fault_text(void **state)
 static void test_wdog_other_periods_and_args(void **state)
 {
 	struct re_wdog_cfg c = {2 * MS, 1.5, 2.5};
-	int64_t warn, crit;
+	struct re_wdog_lim lim, bad = {5 * MS, 3 * MS};
 
 	(void)state;
-	assert_int_equal(re_wdog_limits(&c, &warn, &crit), GL_OK);
-	assert_int_equal(warn, 3 * MS);
-	assert_int_equal(crit, 5 * MS);
-	assert_int_equal(re_check_reply_age(&c, 0, 5 * MS, NULL, NULL),
+	assert_int_equal(re_wdog_limits(&c, &lim), GL_OK);
+	assert_int_equal(lim.noncrit_ns, 3 * MS);
+	assert_int_equal(lim.crit_ns, 5 * MS);
+	assert_int_equal(re_check_reply_age(&lim, 0, 5 * MS, NULL, NULL),
 			 RE_WARN);
-	assert_int_equal(re_check_reply_age(&c, 0, 5 * MS + 1, NULL, NULL),
+	assert_int_equal(re_check_reply_age(&lim, 0, 5 * MS + 1, NULL, NULL),
 			 RE_FAULT);
+	/* limits in the wrong order are a caller bug */
+	assert_int_equal(re_check_reply_age(&bad, 0, 1 * MS, NULL, NULL),
+			 GL_ERR_ARG);
 	c.noncrit_factor = 0.9;
-	assert_int_equal(re_wdog_limits(&c, &warn, &crit), GL_ERR_ARG);
+	assert_int_equal(re_wdog_limits(&c, &lim), GL_ERR_ARG);
 	c.noncrit_factor = 3.0; /* above critical */
-	assert_int_equal(re_wdog_limits(&c, &warn, &crit), GL_ERR_ARG);
+	assert_int_equal(re_wdog_limits(&c, &lim), GL_ERR_ARG);
 	c.noncrit_factor = 1.5;
 	c.period_ns = 0;
-	assert_int_equal(re_wdog_limits(&c, &warn, &crit), GL_ERR_ARG);
+	assert_int_equal(re_wdog_limits(&c, &lim), GL_ERR_ARG);
 	/* Time going backwards is a caller bug. */
 	assert_int_equal(re_check_reply_age(&wd, 10 * MS, 9 * MS, NULL, NULL),
 			 GL_ERR_ARG);

@@ -292,9 +292,8 @@ static struct re_super_cfg make_cfg(void)
 	memset(&c, 0, sizeof(c));
 	c.n_axes = 3;
 	c.period_ns = PERIOD_MS * MS;
-	c.wdog.period_ns = c.period_ns;
-	c.wdog.noncrit_factor = 1.5;
-	c.wdog.crit_factor = 2.5;
+	c.wdog.noncrit_ns = 3 * c.period_ns / 2; /* 1.5 and 2.5 periods */
+	c.wdog.crit_ns = 5 * c.period_ns / 2;
 	c.alive.hb_limit_ns = 125 * MS;
 	c.alive.sample_limit_ns = 125 * MS;
 	for (int i = 0; i < 3; i++) {
