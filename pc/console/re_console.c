@@ -323,33 +323,19 @@ static const char *cmd_text(int k)
 	return k <= 6 ? cmd_names[k] : "?";
 }
 
-/* The controller program's fault codes in words (docs/dmc-interface.md). */
-static const char *const fcode_names[RE_DMC_F_MAX + 1] = {
-    "none",	  "PARAMETER",
-    "WATCHDOG",	  "INPUT",
-    "JAM",	  "LIMIT",
-    "COMMAND",	  "TCP",
-    "AMPLIFIER",  "ENCODER",
-    "MOTOR OFF",  "THREAD",
-    "SUPERVISOR", "UNCOMMANDED MOTION",
-    "SETTINGS",	  "SERVICE MOVE",
-    "POT RANGE",
-};
-
 static void ctrl_text(const struct re_status *st, char *buf, size_t cap)
 {
 	int f = st->have_za ? st->za.fcode : 0;
+	const char *w = re_dmc_fcode_words(f);
 
 	if (!st->have_za)
 		snprintf(buf, cap, "no data");
 	else if ((st->za.state == RE_DMC_FAULT || f) && st->za.faxis >= 1 &&
 		 st->za.faxis <= 3)
-		snprintf(buf, cap, "FAULT %s axis %c (code %d)",
-			 f >= 0 && f <= RE_DMC_F_MAX ? fcode_names[f] : "?",
+		snprintf(buf, cap, "FAULT %s axis %c (code %d)", w ? w : "?",
 			 (char)('A' + st->za.faxis - 1), f);
 	else if (st->za.state == RE_DMC_FAULT || f)
-		snprintf(buf, cap, "FAULT %s (code %d)",
-			 f >= 0 && f <= RE_DMC_F_MAX ? fcode_names[f] : "?", f);
+		snprintf(buf, cap, "FAULT %s (code %d)", w ? w : "?", f);
 	else if (st->za.state == RE_DMC_ARMED && !st->za.mneut &&
 		 st->za.jcmd > 0)
 		snprintf(buf, cap, "armed, release the joystick");

@@ -186,3 +186,37 @@ int re_ctrl_fault(const struct re_za *za, long long fdet,
 	}
 	return GL_OK;
 }
+
+/* One row per controller fault code: the contract's name, the words. */
+static const struct {
+	const char *name, *words;
+} FCODES[RE_DMC_F_MAX + 1] = {
+    [RE_DMC_F_NONE] = {"none", "none"},
+    [RE_DMC_F_PARAM] = {"PARAM", "PARAMETER"},
+    [RE_DMC_F_WATCHDOG] = {"WATCHDOG", "WATCHDOG"},
+    [RE_DMC_F_INPUT] = {"INPUT", "INPUT"},
+    [RE_DMC_F_POSERR] = {"POSERR", "JAM"},
+    [RE_DMC_F_LIMIT] = {"LIMIT", "LIMIT"},
+    [RE_DMC_F_CMDERR] = {"CMDERR", "COMMAND"},
+    [RE_DMC_F_TCPERR] = {"TCPERR", "TCP"},
+    [RE_DMC_F_AMPERR] = {"AMPERR", "AMPLIFIER"},
+    [RE_DMC_F_ENCODER] = {"ENCODER", "ENCODER"},
+    [RE_DMC_F_MOTOROFF] = {"MOTOROFF", "MOTOR OFF"},
+    [RE_DMC_F_THREAD] = {"THREAD", "THREAD"},
+    [RE_DMC_F_SUPERVISOR] = {"SUPERVISOR", "SUPERVISOR"},
+    [RE_DMC_F_UNCMD] = {"UNCMD", "UNCOMMANDED MOTION"},
+    [RE_DMC_F_FOREIGN] = {"FOREIGN", "SETTINGS"},
+    [RE_DMC_F_SVCMOVE] = {"SVCMOVE", "SERVICE MOVE"},
+    [RE_DMC_F_POTRANGE] = {"POTRANGE", "POT RANGE"},
+    [RE_DMC_F_SEAL] = {"SEAL", "SEALED VALUE CHANGED"},
+};
+
+const char *re_dmc_fcode_name(int code)
+{
+	return code >= 0 && code <= RE_DMC_F_MAX ? FCODES[code].name : NULL;
+}
+
+const char *re_dmc_fcode_words(int code)
+{
+	return code >= 0 && code <= RE_DMC_F_MAX ? FCODES[code].words : NULL;
+}

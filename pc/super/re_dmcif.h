@@ -90,6 +90,17 @@ int re_za_decode(int32_t zaa, int32_t zab, int32_t zac, struct re_za *out);
 const char *re_stop_reason(int stop_code);
 
 /*
+ * re_dmc_fcode_name() - the controller fault @code's name in the contract
+ * (docs/dmc-interface.md "Fault codes", the legend of dmc/roboelf.dmc):
+ * "PARAM" .. "SEAL"; "none" for 0.
+ * re_dmc_fcode_words() - the same fault in the operator's words, for the
+ * status board: "PARAMETER", "JAM", "MOTOR OFF" ...
+ * Return: static text; NULL for a code outside 0..RE_DMC_F_MAX.
+ */
+const char *re_dmc_fcode_name(int code);
+const char *re_dmc_fcode_words(int code);
+
+/*
  * re_fault_is_ctrl() - @id is a fault the controller program latched (one
  * that re_ctrl_fault() produces).
  * Return: 1 or 0.

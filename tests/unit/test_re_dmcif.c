@@ -52,13 +52,55 @@ static char *slurp(const char *rel)
 	return buf;
 }
 
-/* Every code 1..RE_DMC_F_MAX is named once, in order. */
+/* Every code 1..RE_DMC_F_MAX is named once, in order, and the supervisor
+ * names it so (re_dmc_fcode_name), with words for the board. */
 static void test_enum_complete(void **state)
 {
 	(void)state;
 	assert_int_equal(N_NAMES, RE_DMC_F_MAX);
-	for (size_t i = 0; i < N_NAMES; i++)
+	for (size_t i = 0; i < N_NAMES; i++) {
 		assert_int_equal(names[i].code, (int)i + 1);
+		assert_string_equal(re_dmc_fcode_name(names[i].code),
+				    names[i].name);
+		assert_non_null(re_dmc_fcode_words(names[i].code));
+	}
+	assert_string_equal(re_dmc_fcode_name(0), "none");
+	assert_null(re_dmc_fcode_name(RE_DMC_F_MAX + 1));
+	assert_null(re_dmc_fcode_words(-1));
+}
+
+/* The legend at the top of dmc/roboelf.dmc: lines "'  N NAME  what",
+ * after the line that opens it, one per code 1..RE_DMC_F_MAX in order,
+ * each with the supervisor's name. */
+static void test_dmc_legend(void **state)
+{
+	char *src = slurp("dmc/roboelf.dmc");
+	const char *p = strstr(src, "' Fault codes (fcode");
+	int next = 1;
+
+	(void)state;
+	if (!p)
+		fail_msg(
+		    "dmc/roboelf.dmc has no legend \"' Fault codes (fcode\"");
+	/* to the first line that is a bare "'" */
+	for (p = strchr(p, '\n'); p && p[1] == '\'' && p[2] != '\n';
+	     p = strchr(p + 1, '\n')) {
+		char name[32];
+		int code, k;
+
+		if (sscanf(p + 2, " %d %31s%n", &code, name, &k) != 2)
+			continue; /* a continued line, the blank end */
+		if (code != next)
+			fail_msg("the legend gives code %d where %d belongs",
+				 code, next);
+		if (strcmp(name, re_dmc_fcode_name(code)))
+			fail_msg("the legend names code %d '%s', the "
+				 "supervisor '%s'",
+				 code, name, re_dmc_fcode_name(code));
+		next++;
+	}
+	assert_int_equal(next - 1, RE_DMC_F_MAX);
+	free(src);
 }
 
 /* dmc/roboelf.dmc and the seal galil-load appends to it (made from
@@ -150,6 +192,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_enum_complete),
+	    cmocka_unit_test(test_dmc_legend),
 	    cmocka_unit_test(test_dmc_raises_known_codes),
 	    cmocka_unit_test(test_docs_agree),
 	    cmocka_unit_test(test_version_agrees),
