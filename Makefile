@@ -193,7 +193,7 @@ lint: have-lint-deps
 		--suppress=missingIncludeSystem $(addprefix -I,$(INC_DIRS)) \
 		pc tools tests
 
-# ---- fuzzing (issue 18, docs/fuzzing.md) ------------------------------------
+# ---- fuzzing (docs/fuzzing.md) -----------------------------------------------
 # One libFuzzer target per tests/fuzz/fuzz_<name>.c, built with clang and
 # -fsanitize=fuzzer,address,undefined into $(FUZZ_BUILD) (its own libraries,
 # never the normal objects). `make fuzz` runs each for FUZZ_SECONDS on a copy
@@ -269,7 +269,7 @@ netrig: deps
 	@BUILD=$(BUILD) ROBOELF_NETRIG=long ROBOELF_NO_SKIP=1 tests/run-all.sh net
 
 # ---- install -----------------------------------------------------------------
-# The installed places (issue 17): base_paths.c is built with DATADIR and
+# The installed places: base_paths.c is built with DATADIR and
 # SYSCONFDIR (and rebuilt when they change); roboelf and galil-load look there
 # for what is not in the directory they are started in (docs/technician.md,
 # "Installation"). The docs tree is installed as it is, links intact.
@@ -311,7 +311,7 @@ uninstall:
 	rm -f $(addprefix "$(DESTDIR)$(PREFIX)/share/man/man5/",$(notdir $(MAN5)))
 	rm -rf "$(DESTDIR)$(DATADIR)" "$(DESTDIR)$(DOCDIR)"
 
-# ---- missing packages and the Debian package (issue 17) ---------------------
+# ---- missing packages and the Debian package ---------------------
 # have-deps: before compiling, name the missing Debian packages and `make deps`
 # (tools/have-deps.sh) instead of a raw compiler error; have-lint-deps: the
 # same for make lint. make deb: the programs built again with the Debian build

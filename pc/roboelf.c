@@ -68,7 +68,7 @@ static void on_signal(int sig)
 	re_sig.quit = sig;
 }
 
-/* SIGUSR1: write a trace of the flight recorder now (issue 16). */
+/* SIGUSR1: write a trace of the flight recorder now. */
 static volatile sig_atomic_t trace_asked;
 
 static void on_usr1(int sig)
@@ -492,7 +492,7 @@ static void retry_log(struct app *a, int64_t *next_ns)
 			       a->cfg.log.path, strerror(errno));
 }
 
-/* ---- the flight recorder (issue 16) -------------------------------------- */
+/* ---- the flight recorder -------------------------------------- */
 
 /* The ring sized from the configuration; traces next to the log unless
  * recorder.dir says otherwise. */
@@ -628,10 +628,10 @@ static void run(struct app *a)
 			re_super_status(a->sup, &st); /* only when drawn */
 			re_console_status(&a->con, &st, re_io_now_ns(), 1);
 		}
-		re_io_flush_log(&a->real); /* after the cycle (issue 17) */
+		re_io_flush_log(&a->real); /* after the cycle */
 		retry_log(a, &next_retry);
 		/* the keyboard when the wait saw input, or every
-		 * KEY_POLL_MS when it did not look (issue 17) */
+		 * KEY_POLL_MS when it did not look */
 		look = re_io_key_look(&a->real);
 		if (look == 1 || (look < 0 && re_io_now_ns() >= next_key)) {
 			next_key = re_io_now_ns() + KEY_POLL_MS * 1000000LL;
@@ -699,7 +699,7 @@ static void power_off(struct app *a, int latched)
 		   "stop: %s%s", what, latched ? " (fault latched)" : "");
 }
 
-/* ---- real time (issue 17) ------------------------------------------------ */
+/* ---- real time ------------------------------------------------ */
 
 /* SCHED_FIFO, locked memory and a CPU as configured, for this thread only
  * (the recorder's writer thread, started before, keeps the normal policy);
@@ -874,7 +874,7 @@ static int show_calibration(struct app *a)
 		   : EXIT_USAGE;
 }
 
-/* --show-trace: the trace checked, summarised and drawn (issue 16). */
+/* --show-trace: the trace checked, summarised and drawn. */
 static int show_trace(struct app *a)
 {
 	struct re_traceshow_win w;

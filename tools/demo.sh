@@ -233,7 +233,7 @@ wait_line "$RUN/roboelf.out" 'FAULT ENCODER:' 5 || die "the potentiometer fault 
 [ "$(ctl relay)" = off ] || die "the relay is still on after the fault"
 say "relay: $(ctl relay); $(grep -o -m1 'FAULT ENCODER:.*' "$RUN/roboelf.out" | tr -d '\r')"
 
-# The flight recorder (issue 16): the fault's trace is written
+# The flight recorder: the fault's trace is written
 # recorder.after_fault_s (2 s) after the fault; kept in $BUILD/demo and drawn.
 say "waiting for the flight recorder's trace of the fault (written 2 s after it)"
 wait_line "$RUN/roboelf.log" 'trace: .* written' 10 || die "no trace of the fault was written"

@@ -2,7 +2,7 @@
 # have-deps.sh - before compiling (make, make tests, make install, make deb)
 # or linting (make lint): name the Debian packages that are missing and the
 # command that installs them, instead of letting the compiler fail on a
-# missing header (issue 17). Exit 0 when nothing is missing, 1 otherwise.
+# missing header. Exit 0 when nothing is missing, 1 otherwise.
 #
 #   have-deps.sh build   the compiler, pkg-config and the libraries
 #   have-deps.sh lint    clang-format and cppcheck

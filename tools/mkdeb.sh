@@ -1,7 +1,7 @@
 #!/bin/sh
 # mkdeb.sh - make deb: the Debian package $BUILD/roboelf_<version>_<arch>.deb,
 # built with the standard Debian tools (dpkg-buildflags, dpkg-shlibdeps,
-# dpkg-deb) from packaging/deb/ (issue 17; docs/technician.md,
+# dpkg-deb) from packaging/deb/ (docs/technician.md,
 # "Installation").
 #
 # The programs are built again with the Debian build flags (hardening, and

@@ -1533,7 +1533,7 @@ void re_config_relay_cfg(const struct re_config *cfg, struct re_relay_cfg *out)
 	out->off_deadline_ms = r->off_deadline_ms;
 	out->readback = r->readback;
 	out->readback_timeout_ms = r->readback_timeout_ms;
-	/* every second cycle, as before the one look (issue 17): a
+	/* every second cycle, as before the one look: a
 	 * silent board is then found within R + 3P (docs/safety.md); 1.5
 	 * periods, so that a cycle's jitter never makes it every third */
 	out->query_ms = cfg->period_ms + cfg->period_ms / 2;

@@ -150,14 +150,14 @@ struct re_config_log {
 	int keep;	/* rotated files kept: PATH.1 .. PATH.n */
 };
 
-/* The flight recorder (issue 16, docs/trace-format.md). */
+/* The flight recorder (docs/trace-format.md). */
 struct re_config_recorder {
 	double seconds;	       /* a trace holds this much before a fault, s */
 	double after_fault_s;  /* and this much after it, s (< seconds) */
 	char dir[RE_PATH_MAX]; /* where traces go; "": the log's directory */
 };
 
-/* Real-time set-up of the supervisor's thread (issue 17, pc/super/re_rt.h). */
+/* Real-time set-up of the supervisor's thread (pc/super/re_rt.h). */
 struct re_config_realtime {
 	int priority;	  /* SCHED_FIFO 1..99; 0: not requested */
 	int cpu;	  /* pin the cycle to this CPU; -1: not pinned */

@@ -219,7 +219,7 @@ void re_console_status(struct re_console *c, const struct re_status *st,
 
 /*
  * re_console_due() - would re_console_status(@c, ..., @now_ns, 0) draw?
- * The caller fills the status only then (issue 17: it is drawn at most
+ * The caller fills the status only then (it is drawn at most
  * every RE_CONSOLE_BOARD_NS, the cycle runs far more often).
  * Return: 1 when a frame is due, 0 when not.
  */

@@ -320,7 +320,7 @@ static int chan_write(gl_link *l, struct gl_chan *ch, const void *buf,
  * Read what is there (one recv) into the parser. @deadline < 0: do not wait.
  * When waiting is allowed the socket is polled first: a reply awaited is
  * rarely there yet, and poll + recv is one system call fewer than a recv
- * that finds nothing, then poll, then recv (issue 17: the lean cycle).
+ * that finds nothing, then poll, then recv (the lean cycle).
  * Return: GL_OK (bytes fed), GL_ERR_AGAIN (nothing without waiting),
  *         GL_ERR_TIMEOUT, GL_ERR_CLOSED, GL_ERR_SYS.
  */

@@ -105,8 +105,8 @@ int gl_link_record(gl_link *l, const char *prefix, struct gl_record *rec,
  * @seen_idle: true when that look, just before this call, showed no input
  *             (nor an error or hang-up): the read that looks for stray
  *             bytes before the request and the one that looks for surplus
- *             after the reply are left out (two system calls per cycle,
- *             issue 17). Surplus that came with the reply is still found;
+ *             after the reply are left out (two system calls fewer per
+ *             cycle). Surplus that came with the reply is still found;
  *             later surplus is found by the caller's next look, before the
  *             next request. false: exactly gl_link_record().
  * Return: as gl_link_record().
@@ -236,7 +236,7 @@ int gl_link_message(gl_link *l, char *line, size_t cap);
 /*
  * gl_link_message_queued() - as gl_link_message(), but only lines already
  * received: no system call. For a caller that polled gl_link_msg_fd() just
- * before and saw no input (issue 17: one look per cycle).
+ * before and saw no input (one look per cycle).
  * Return: as gl_link_message(), never GL_ERR_SYS.
  */
 int gl_link_message_queued(gl_link *l, char *line, size_t cap);

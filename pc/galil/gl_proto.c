@@ -5,7 +5,7 @@
  * input. Each state has its own small step function; step functions return
  * 0 (continue), 1 (the reply is complete) or GL_ERR_PROTO. A record's body
  * (known length, any byte value) is taken in one copy of what has arrived
- * instead (issue 17: byte by byte it was half of the supervisor cycle's
+ * instead (byte by byte it was half of the supervisor cycle's
  * instructions), with the same checks at the same byte.
  */
 #include <errno.h>

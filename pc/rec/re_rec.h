@@ -1,5 +1,5 @@
 /*
- * re_rec.h - the flight recorder (issue 16): every supervisor cycle is
+ * re_rec.h - the flight recorder: every supervisor cycle is
  * copied into a ring buffer allocated at start-up; after a fault (once
  * after_fault_s more has been recorded) and on request the ring is written
  * to a trace file (docs/trace-format.md) next to the log.

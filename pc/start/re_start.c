@@ -304,7 +304,7 @@ static int init_super(struct app *a)
 		    "values back, all every %d cycles (%d ms), and decodes "
 		    "the joystick itself",
 		    a->seal.n, a->sup->rb_n, a->sup->rb_n * a->cfg.period_ms);
-	if (a->rec) { /* flight recorder (issue 16) */
+	if (a->rec) { /* flight recorder */
 		char serial[24];
 
 		snprintf(serial, sizeof(serial), "%ld", a->info.serial);
@@ -519,7 +519,7 @@ static int sample_cb(void *ud, const struct gl_record **rec)
 	if (re_sig.quit)
 		return GL_ERR_AGAIN;
 	re_super_wait(a->sup);
-	a->real.defer_log = 1; /* no file write in the cycle (issue 17) */
+	a->real.defer_log = 1; /* no file write in the cycle */
 	v = re_super_cycle(a->sup);
 	a->real.defer_log = 0;
 	re_start_show_foreign(a, a->sup->foreign);
@@ -531,7 +531,7 @@ static int sample_cb(void *ud, const struct gl_record **rec)
 		re_super_status(a->sup, &st); /* only when drawn */
 		re_console_status(&a->con, &st, re_io_now_ns(), 1);
 	}
-	re_io_flush_log(&a->real); /* after the cycle (issue 17) */
+	re_io_flush_log(&a->real); /* after the cycle */
 	if (v == RE_FAULT) {
 		re_console_fault(&a->con, re_super_fault_line(a->sup));
 		return RE_FAULT;

@@ -45,7 +45,7 @@ struct opts {
 	const char *relay;
 	const char *log;
 	const char *show_cal;
-	const char *show_trace; /* --show-trace FILE (issue 16) */
+	const char *show_trace; /* --show-trace FILE */
 	const char *window;	/* --window FROM:TO */
 	int config_searched;	/* no -c: find_config() chose it */
 	const char *dmc;	/* --dmc DIR: the DMC programs (--version) */
@@ -75,8 +75,8 @@ struct app {
 	struct re_xcheck_cfg xcheck; /* the own joystick decode (re_xcheck.h) */
 	struct re_calset *cal;
 	struct re_super *sup;
-	struct re_rec *rec;    /* flight recorder (issue 16), NULL: none */
-	struct re_rt_state rt; /* real time in force (issue 17) */
+	struct re_rec *rec;    /* flight recorder, NULL: none */
+	struct re_rt_state rt; /* real time in force */
 	const char *names[RE_AXES];
 	long hbpc;
 	int calib;   /* the operator's choice: RE_CALIB_FULL / _FILE */

@@ -201,7 +201,7 @@ void re_fault_set(struct re_fault *f, enum re_fault_id id, int axis);
 #define RE_FAULT_UNIT_AXES 8
 
 /*
- * How encoder positions are also said in the robot's units (issue 15):
+ * How encoder positions are also said in the robot's units:
  * per axis the unit's name ("deg", "mm") and encoder counts per unit. A
  * NULL name or counts_per_unit <= 0: counts only. In the templates,
  * "{i0c}" is "<i0> counts", followed by " (<i0 in units> <unit>)" when

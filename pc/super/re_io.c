@@ -21,7 +21,7 @@ int64_t re_io_now_ns(void)
 	return base_now_ns();
 }
 
-/* ---- the one look before a cycle (issue 17) ------------------------------ */
+/* ---- the one look before a cycle ------------------------------ */
 
 #define LOOK_EVENTS (POLLIN | POLLERR | POLLHUP | POLLNVAL)
 

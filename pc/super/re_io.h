@@ -88,7 +88,7 @@ struct re_io {
 #define RE_IO_LOGQ     16  /* log events queued between two flushes */
 #define RE_IO_LOGQ_LEN 512 /* longer queued texts are cut */
 
-/* One INFO/WARN event queued inside a cycle (issue 17: no file write in
+/* One INFO/WARN event queued inside a cycle (no file write in
  * the cycle), with the times it happened at. */
 struct re_io_logq_ent {
 	enum re_log_level lvl;
@@ -97,7 +97,7 @@ struct re_io_logq_ent {
 	char text[RE_IO_LOGQ_LEN];
 };
 
-/* The descriptors of the cycle's one look (issue 17). */
+/* The descriptors of the cycle's one look. */
 enum re_io_look_fd {
 	RE_LOOK_CMD,   /* the command socket: stray bytes before a request */
 	RE_LOOK_MSG,   /* the message socket */
@@ -108,7 +108,7 @@ enum re_io_look_fd {
 };
 
 /*
- * What the wait before a cycle saw (issue 17: one look per cycle). The
+ * What the wait before a cycle saw (one look per cycle). The
  * wait (ops->sleep_until) is a ppoll() over every descriptor the cycle
  * reads; a descriptor that shows an event is noted and left out for the
  * rest of the wait. Each reader then takes its entry once, and skips its

@@ -424,7 +424,7 @@ static void log_fault(struct re_super *s)
 	    (unsigned long long)s->cycles, ns_to_ms(s->age_last_ns));
 	if (n < cap)
 		n += snapshot(s, t + n, cap - n);
-	if (n < cap && s->rec_fault) { /* flight recorder (issue 16) */
+	if (n < cap && s->rec_fault) { /* flight recorder */
 		const char *note = s->rec_fault(s->rec_ud, s);
 
 		if (note)

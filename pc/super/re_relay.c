@@ -518,7 +518,7 @@ static int link_open_fd(struct re_relay *r, int *fd)
 }
 
 /* One poll() with timeout 0 looks at the descriptor (POLLNVAL: it is
- * gone) and at the inotify watch of the path together (issue 17: one
+ * gone) and at the inotify watch of the path together (one
  * system call per cycle when nothing happened). */
 static int link_check(struct re_relay *r)
 {

@@ -224,7 +224,7 @@ void re_relay_fds(const re_relay *r, int *fd, int *watch_fd);
 
 /*
  * re_relay_check_seen() - re_relay_check() with the poll() already done
- * by the caller (issue 17: one look per cycle over every descriptor).
+ * by the caller (one look per cycle over every descriptor).
  * @fd_revents, @watch_revents: what that poll, of re_relay_fds()' @fd
  *       (events 0) and @watch_fd (POLLIN), returned for them just before.
  * Return: as re_relay_check().

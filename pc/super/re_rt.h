@@ -1,6 +1,6 @@
 /*
  * re_rt.h - the supervisor's real-time set-up and the host latency
- * self-test (issue 17; docs/supervisor.md "Real time").
+ * self-test (docs/supervisor.md "Real time").
  *
  * re_rt_setup() asks, for the calling thread only, for what the
  * configuration's `realtime` section names: SCHED_FIFO at a priority,

@@ -220,7 +220,7 @@ static int check_stall(struct re_super *s, struct re_fault *f)
 }
 
 /* "hbpc=N" into @buf (32 bytes; N < RE_HBPC_WRAP, 10 digits at most)
- * without snprintf: the one command text built every cycle (issue 17).
+ * without snprintf: the one command text built every cycle.
  * Return: its length. */
 static int hb_prefix(char *buf, long hb)
 {
@@ -586,7 +586,7 @@ static int cycle_checks(struct re_super *s)
 	return warn ? RE_WARN : RE_OK;
 }
 
-/* flight recorder (issue 16): the hooks, and the one call per cycle */
+/* flight recorder: the hooks, and the one call per cycle */
 void re_super_recorder(struct re_super *s,
 		       void (*cycle)(void *ud, const struct re_super *s),
 		       const char *(*fault)(void *ud, const struct re_super *s),
@@ -608,7 +608,7 @@ int re_super_cycle(struct re_super *s)
 		v = cycle_checks(s);
 		s->last_end_ns = s->latched ? 0 : now_ns(s);
 	}
-	if (s->rec_cycle) /* flight recorder (issue 16): a copy, no I/O */
+	if (s->rec_cycle) /* flight recorder: a copy, no I/O */
 		s->rec_cycle(s->rec_ud, s);
 	return v;
 }

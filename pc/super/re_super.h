@@ -217,7 +217,7 @@ struct re_super {
 	int log_failing;
 	enum re_log_level pending_lvl;
 	char pending[2048];
-	/* flight recorder (issue 16; re_super_recorder()): @rec_cycle at the
+	/* flight recorder (re_super_recorder()): @rec_cycle at the
 	 * end of every cycle, @rec_fault when a fault latches (its text is
 	 * added to the FAULT log entry); NULL: none */
 	void (*rec_cycle)(void *ud, const struct re_super *s);
@@ -306,7 +306,7 @@ void re_super_own(struct re_super *s, unsigned mask);
 int64_t re_super_wait(struct re_super *s);
 
 /*
- * re_super_recorder() - the flight recorder's hooks (issue 16): @cycle is
+ * re_super_recorder() - the flight recorder's hooks: @cycle is
  * called at the end of every re_super_cycle() (also latched ones), after
  * any fault reaction in it; @fault when a fault latches, after the stop,
  * the relay and the motors were confirmed and before the FAULT log entry

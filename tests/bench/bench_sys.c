@@ -21,12 +21,12 @@
  *     program threads, in-process sim_advance_ms());
  *  4. fault reaction times: test_sys_faults run with ROBOELF_REPEAT=N,
  *     median / p99 / max per fault in ms and in supervisor periods;
- *  5. the flight recorder (issue 16): its cost per cycle (re_rec_take()
+ *  5. the flight recorder: its cost per cycle (re_rec_take()
  *     on a filled supervisor, 10^6 times in-process), its system calls
  *     per cycle (strace -c of this program run with --rec-loop N against
  *     --rec-loop 0), and the dump of a full 30 s ring at 10 ms (text and
  *     durable write, ms and bytes);
- *  6. user instructions per cycle (issue 17): roboelf under valgrind's
+ *  6. user instructions per cycle: roboelf under valgrind's
  *     callgrind at 50 ms with S / 3 and S seconds of joystick use, the
  *     instructions collected in its supervisor loop, the difference over
  *     the difference of the cycles run (--only instr: this figure alone).
@@ -557,7 +557,7 @@ static void add_loop(const struct loop_fig *f)
 	add_loop_cycle(f, item, is50);
 }
 
-/* ---- user instructions per cycle: callgrind (issue 17) ------------------- */
+/* ---- user instructions per cycle: callgrind ------------------- */
 
 /* This VM, like many, has no hardware performance counters (perf stat -e
  * instructions:u is "not supported"), so the instructions are counted by
@@ -717,13 +717,13 @@ static void instr(struct sys_env *e, const struct opts *o)
 		    "n/a (%.40s)", why);
 		return;
 	}
-	add("loop", item, "user instructions per cycle", "", "5 k (issue 17)",
-	    "%.0f", (b.ir - a.ir) / (double)(b.cycles - a.cycles));
+	add("loop", item, "user instructions per cycle", "", "5 k", "%.0f",
+	    (b.ir - a.ir) / (double)(b.cycles - a.cycles));
 	add("loop", item, "instructions / cycles, 2 runs", "", "",
 	    "%.0f/%ld, %.0f/%ld", a.ir, a.cycles, b.ir, b.cycles);
 	add("loop",
 	    "period 50 ms: the cycle alone (re_super_wait + re_super_cycle)",
-	    "user instructions per cycle", "", "5 k (issue 17)", "%.0f",
+	    "user instructions per cycle", "", "5 k", "%.0f",
 	    (b.cyc_ir - a.cyc_ir) / (double)(b.cycles - a.cycles));
 	printf("bench: the cycle's instructions by function: "
 	       "callgrind_annotate --inclusive=yes %s\n",
@@ -944,7 +944,7 @@ static void print_table(void)
 		       rows[i].value, rows[i].unit, rows[i].original);
 }
 
-/* ---- calibration against its physical bounds (issue 17) ----------------- */
+/* ---- calibration against its physical bounds ----------------- */
 
 /* The sweep (travel / vmax of the slowest axis: the axes move together)
  * and the least a calibration from the centre can take at vmax: half the
@@ -975,7 +975,7 @@ static void calib_bounds(const struct sys_env *e)
 	    "%.2f", e->calib_s / sweep);
 }
 
-/* ---- the flight recorder (issue 16) ------------------------------------- */
+/* ---- the flight recorder ------------------------------------- */
 
 static int64_t rb_now(void *ud)
 {

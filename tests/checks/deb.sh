@@ -1,5 +1,5 @@
 #!/bin/sh
-# deb.sh - the Debian package (issue 17): `make deb` builds
+# deb.sh - the Debian package: `make deb` builds
 # $BUILD/roboelf_<version>_<arch>.deb; `dpkg -c` lists the programs, the man
 # pages, the conffiles /etc/roboelf/roboelf.yaml and the group's real-time
 # limits, the DMC programs, the docs tree and the relay's udev rule, all

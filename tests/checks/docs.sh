@@ -1,6 +1,6 @@
 #!/bin/sh
 # docs.sh - fail when something the programs can print or accept is not
-# documented (issue 9). Run by `make check` (tests/run-all.sh) from the repo
+# documented. Run by `make check` (tests/run-all.sh) from the repo
 # root; POSIX sh and awk only.
 #
 #   sh tests/checks/docs.sh [ROOT]       check the tree at ROOT (default .)

@@ -1,7 +1,7 @@
 #!/bin/sh
 # have_deps.sh - before `make deps`, `make` and `make lint` name the missing
 # Debian packages and the `make deps` command instead of failing in the
-# compiler (issue 17; tools/have-deps.sh). The missing tools are simulated
+# compiler (tools/have-deps.sh). The missing tools are simulated
 # with the Makefile's PKG_CONFIG, CLANG_FORMAT and CPPCHECK variables (a
 # pkg-config that knows only libserialport; names that do not exist), so
 # nothing on this machine is changed.

@@ -1,5 +1,5 @@
 #!/bin/sh
-# install.sh - an installation works outside the source tree (issue 17):
+# install.sh - an installation works outside the source tree:
 # `make install DESTDIR=$tmp/root PREFIX=/usr`, then the installed roboelf
 # and galil-load, started in an empty directory with ROBOELF_ROOT=$tmp/root
 # (the staged installation's root, base_paths.h), find the installed DMC

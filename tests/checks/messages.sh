@@ -1,5 +1,5 @@
 #!/bin/sh
-# messages.sh - the start-up messages issue 15 listed as wrong, each
+# messages.sh - start-up messages that once said something untrue, each
 # reproduced with the built roboelf and held to its exact text and exit
 # code (no controller, no relay needed):
 #   - port 99999 is refused by the configuration check (exit 2), before

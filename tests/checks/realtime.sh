@@ -1,5 +1,5 @@
 #!/bin/sh
-# realtime.sh - roboelf's real-time set-up seen from outside (issue 17).
+# realtime.sh - roboelf's real-time set-up seen from outside.
 #   1. As root (CI): `roboelf --check-host=1` reports SCHED_FIFO 50 in force
 #      (read back from the kernel), wake-up figures and a verdict, exit 0.
 #   2. Without the right (user 65534 via setpriv, RLIMIT_RTPRIO 0): a 5 ms

@@ -1,6 +1,6 @@
 #!/bin/sh
-# safety_trace.sh - docs/safety.md's traceability must name tests that exist
-# (issue 9). Run by `make check` (tests/run-all.sh) from the repository root.
+# safety_trace.sh - docs/safety.md's traceability must name tests that exist.
+# Run by `make check` (tests/run-all.sh) from the repository root.
 #
 #  - every `binary:function` reference in docs/safety.md must be a function
 #    "static void function(" in tests/*/binary.c;

@@ -1,6 +1,6 @@
 /*
  * test_dmc_faults.c - error routines, the latched fault and the "stops by
- * itself" property (issue 4, points 4, 6 and 7).
+ * itself" property.
  */
 #include <math.h>
 #include <setjmp.h>

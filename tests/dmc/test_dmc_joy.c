@@ -1,8 +1,8 @@
 /*
- * test_dmc_joy.c - joystick decode and the invalid-state timeout (issue 4,
- * point 3): valid states are all released or exactly one command with both
- * switches; anything else stops motion at once, a valid state within jto
- * resumes, an invalid state held longer than jto is fault 3 INPUT.
+ * test_dmc_joy.c - joystick decode and the invalid-state timeout: valid states
+ * are all released or exactly one command with both switches; anything else
+ * stops motion at once, a valid state within jto resumes, an invalid state held
+ * longer than jto is fault 3 INPUT.
  */
 #include <math.h>
 #include <setjmp.h>

@@ -1,8 +1,8 @@
 /*
- * test_dmc_params.c - the parameter check at arm (issue 4, point 2;
- * docs/dmc-interface.md "Parameter checks"): each broken parameter is
- * refused with fault 1 PARAM, fdet = the number of the failed check and
- * faxis = its axis, the motors stay off and one FAULT line is sent.
+ * test_dmc_params.c - the parameter check at arm (docs/dmc-interface.md
+ * "Parameter checks"): each broken parameter is refused with fault 1 PARAM,
+ * fdet = the number of the failed check and faxis = its axis, the motors stay
+ * off and one FAULT line is sent.
  */
 #include <math.h>
 #include <setjmp.h>

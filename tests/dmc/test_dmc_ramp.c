@@ -1,6 +1,6 @@
 /*
- * test_dmc_ramp.c - the motion ramp and incremental position control
- * (issue 4, point 4): from the first sight of a command the axis runs at
+ * test_dmc_ramp.c - the motion ramp and incremental position control:
+ * from the first sight of a command the axis runs at
  * vmin until wst, accelerates linearly to vmax at wen, then holds vmax;
  * one axis at a time; reversing goes through a stop and restarts the ramp;
  * targets never pass the soft limits.

@@ -1,6 +1,6 @@
 /*
  * test_dmc_start.c - safe start, arming and the data record fields
- * (issue 4, points 1, 2, 7 and 8; docs/dmc-interface.md "Arming sequence").
+ * (docs/dmc-interface.md "Arming sequence").
  */
 #include <math.h>
 #include <setjmp.h>

@@ -1,6 +1,6 @@
 /*
  * test_dmc_watchdog.c - the controller side of the PC watchdog and the
- * program heartbeat (issue 4, point 5): if hbpc does not change within
+ * program heartbeat: if hbpc does not change within
  * wdto while armed, every axis is stopped and switched off and fault 2
  * WATCHDOG is latched; thread 1 backs thread 0 up; pcflt latches 12.
  */

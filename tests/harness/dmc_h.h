@@ -244,7 +244,8 @@ int dmc_h_fx_free(void **state);
 			fail_msg("%s: %s", #expr, (h)->err);                   \
 	} while (0)
 
-/* dmc_h_ramp_vel() - the velocity formula of issue 4 at @t_ms after the
+/* dmc_h_ramp_vel() - the ramp's velocity formula (docs/dmc-interface.md
+ * "Motion rules") at @t_ms after the
  * first sight of a command, for axis @ax of @p. */
 double dmc_h_ramp_vel(const struct dmc_h_params *p, int ax, double t_ms);
 

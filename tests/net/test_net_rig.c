@@ -1,5 +1,5 @@
 /*
- * test_net_rig.c - the network cases of issue 18 on a virtual cable:
+ * test_net_rig.c - the network cases (docs/link.md) on a virtual cable:
  * galil-sim in its own network namespace behind a veth pair
  * (tests/net/netns_rig.sh), roboelf, galil-load and the relay on the host.
  * The rig's second veth pair carries only galil-sim's control port, so the

@@ -1,7 +1,7 @@
 /*
  * test_ctrl_replies.c - replies of the simulated DMC-4030 that host code and
  * the commissioning run read, each as the DMC-4000 command reference shows
- * it (issue 14): MG of several values, formats after {N}, {$m.n} overflow,
+ * it: MG of several values, formats after {N}, {$m.n} overflow,
  * TS of an idle axis and its bits, _HM and CN, TH of a connected handle,
  * "SPA?" queries, MT ?, CN ?, _XQ and _TA without index, ID, and RS / TR
  * refused with TC 1 (not simulated).

@@ -90,7 +90,8 @@ static void test_table_commands_in_sim(void **state)
 }
 
 /*
- * An unimplemented command of each family of issue 14, written the way
+ * An unimplemented command of each family galil-sim leaves out (axis
+ * setup, homing, contour, vector, ECAM ...), written the way
  * real programs write them, answers '?' and TC1 "1 Unrecognized command";
  * none becomes a variable (HMA=1 leaves no variable HMA behind).
  */

@@ -1,6 +1,6 @@
 /*
  * test_sim_speed.c - galil-sim in virtual time must run at least 50 times
- * faster than real time with 8 program threads busy (issue 3). The figure is
+ * faster than real time with 8 program threads busy. The figure is
  * printed; make bench prints a longer measurement (galil-sim --bench).
  *
  * The best of three 2-second runs is taken so that one descheduling on a

@@ -1,5 +1,5 @@
 /*
- * test_sys_faults.c - the fault-injection matrix (issue 8) on the whole
+ * test_sys_faults.c - the fault-injection matrix on the whole
  * system: galil-sim running dmc/ (downloaded by galil-load), roboelf
  * supervising it through the virtual relay.
  *
@@ -18,7 +18,7 @@
  *  - that the controller obeyed the supervisor's stop command (the log
  *    entry does not say "rejected"), where the controller is reachable;
  *  - roboelf exits 4 (fault latched) on SIGTERM afterwards, and the FAULT
- *    entry names a flight-recorder trace (issue 16) that parses and holds
+ *    entry names a flight-recorder trace that parses and holds
  *    the cycles before the fault and the fault cycle.
  *
  * Environment: ROBOELF_REPEAT=N repeats each case N times (make bench);
@@ -215,7 +215,7 @@ static void expect_fault(struct sys_case *c, const struct expect *x,
 }
 
 /* After a fault: the operator quits; a latched fault exits 4. */
-/* The flight recorder (issue 16): the FAULT entry names a trace, written
+/* The flight recorder: the FAULT entry names a trace, written
  * at the latest when roboelf quit; it parses strictly and holds cycles
  * before the fault and the fault cycle (phase FAULT, the fault's id). */
 static void check_trace(struct sys_case *c, const char *name)

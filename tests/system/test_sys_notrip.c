@@ -1,6 +1,6 @@
 /*
- * test_sys_notrip.c - what must NOT trip the supervisor or the controller
- * (issue 8): transient invalid joystick states shorter than the timeout,
+ * test_sys_notrip.c - what must NOT trip the supervisor or the controller:
+ * transient invalid joystick states shorter than the timeout,
  * potentiometer noise at half the encoder/pot tolerance, reply delays
  * between the non-critical and the critical watchdog limits. The long
  * randomised session of joystick use is the soak, test_sys_soak.c.

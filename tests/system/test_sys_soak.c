@@ -1,5 +1,5 @@
 /*
- * test_sys_soak.c - the soak (issue 18): a randomised, seeded session of
+ * test_sys_soak.c - the soak: a randomised, seeded session of
  * joystick use on galil-sim with potentiometer noise at half the
  * encoder/pot tolerance on every axis and transient invalid joystick
  * states shorter than half the invalid-input timeout J. Nothing in it may

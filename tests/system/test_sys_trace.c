@@ -1,5 +1,5 @@
 /*
- * test_sys_trace.c - the flight recorder on the whole system (issue 16):
+ * test_sys_trace.c - the flight recorder on the whole system:
  * galil-sim running dmc/, roboelf supervising it.
  *
  *  - a potentiometer offset step and a link stall (watchdog): the FAULT log

@@ -573,7 +573,7 @@ static void test_link_record(void **state)
 }
 
 /* TEST_link_record_seen: a caller that looks at the socket itself
- * (gl_link_record_seen, issue 17). Seen idle, a terminator too many that
+ * (gl_link_record_seen). Seen idle, a terminator too many that
  * comes after the reply is not read by the call (no surplus read), but the
  * caller's next look shows it and the next call, told so, refuses it
  * (PROTO, broken) before sending; one in the same write as the reply is

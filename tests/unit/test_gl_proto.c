@@ -483,7 +483,7 @@ static void test_proto_malformed(void **state)
 }
 
 /* TEST_proto_record_length_field: a record's body is taken in one copy
- * (issue 17), yet a length field that disagrees stops the parser right
+ * yet a length field that disagrees stops the parser right
  * after it, as byte by byte: the rest of the input is not consumed. */
 static void test_proto_record_length_field(void **state)
 {

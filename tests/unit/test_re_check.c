@@ -1011,7 +1011,7 @@ static void test_docs_list_every_template(void **state)
 	}
 }
 
-/* Positions also in the robot's units (issue 15): "{i0c}" and "{r12}";
+/* Positions also in the robot's units: "{i0c}" and "{r12}";
  * without units, or for an axis without one, exactly the counts. */
 static void test_format_units(void **state)
 {

@@ -139,7 +139,7 @@ static const struct bad_case bad_cases[] = {
     {"bad_period_low.yaml", 2, 12,
      "'period_ms' must be between 2 and 100, got 1"},
     /* found by tests/fuzz/fuzz_config.c: 4 x period_ms overflowed int
-     * (undefined behaviour) before the range check (issue 18) */
+     * (undefined behaviour) before the range check */
     {"bad_period_overflow.yaml", 2, 12,
      "'period_ms' must be between 2 and 100, got 1326439257"},
     {"bad_protocol_byte.yaml", 4, 22,

@@ -119,7 +119,7 @@ static void test_stalled_reader_never_blocks(void **state)
 
 /* re_console_due() says when re_console_status() draws: at once, then once
  * per RE_CONSOLE_LINE_NS without a terminal (the caller fills the status
- * only then, issue 17). */
+ * only then). */
 static void test_status_due(void **state)
 {
 	static struct re_console c;

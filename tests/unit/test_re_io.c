@@ -1,11 +1,11 @@
 /*
- * test_re_io.c - the log queue of the real io (issue 17: no file write in
+ * test_re_io.c - the log queue of the real io (no file write in
  * the cycle): INFO/WARN events logged while defer_log is set leave the file
  * untouched until re_io_flush_log(), which writes them in order with the
  * times they happened at; an overflow is counted and said; a FAULT flushes
  * the queue first and is on disk at once.
  *
- * And the one look before a cycle (issue 17): the wait (ops->sleep_until)
+ * And the one look before a cycle: the wait (ops->sleep_until)
  * is a ppoll() over the cycle's descriptors that ends at its deadline, not
  * before, whatever shows input; what it saw is handed out once
  * (re_io_key_look: 1 input, 0 none, -1 not looked at).

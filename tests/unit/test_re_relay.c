@@ -855,7 +855,7 @@ static void test_sp_readback(void **state)
 	re_relay_close(r);
 }
 
-/* The checks' state query goes out at most every query_ms (issue 17: a
+/* The checks' state query goes out at most every query_ms (a
  * fixed rate, not every cycle), answered or not; and at least twice within
  * readback_timeout_ms. */
 static void test_sp_readback_rate(void **state)

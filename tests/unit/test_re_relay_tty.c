@@ -919,7 +919,7 @@ static void test_check_stat_on_event(void **state)
 }
 
 /* re_relay_check_seen(): the caller's own poll of re_relay_fds() (the
- * supervisor's one look per cycle, issue 17). Nothing seen: no stat();
+ * supervisor's one look per cycle). Nothing seen: no stat();
  * the watch's event: the events read and the node stat()ed (a changed
  * mode refused); a hang-up or an invalid descriptor seen: refused. */
 static void test_check_seen(void **state)

@@ -1,5 +1,5 @@
 /*
- * test_re_rt.c - the real-time set-up and the host latency probe (issue 17).
+ * test_re_rt.c - the real-time set-up and the host latency probe.
  *
  * With permission (root, as in CI): SCHED_FIFO at the asked priority and
  * locked memory are in force, read back from the kernel (sched_getscheduler

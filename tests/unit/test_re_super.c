@@ -346,7 +346,7 @@ static const char *fault_log(void)
 
 /* ---- tests --------------------------------------------------------------- */
 
-/* The heartbeat text counted up in place (issue 17: no division per
+/* The heartbeat text counted up in place (no division per
  * cycle): carries, a value set from outside, and the wrap. */
 static void test_super_hbpc_text(void **state)
 {
@@ -905,7 +905,7 @@ static void read_trace(const char *path, struct re_trace_hdr *h,
 	free(buf);
 }
 
-/* The flight recorder on the cycle (issue 16): no allocation in any cycle
+/* The flight recorder on the cycle: no allocation in any cycle
  * (the ring is allocated at start-up), the FAULT log entry names the
  * trace, which is written only once after_fault_s has passed, and holds
  * the cycles before the fault, the fault cycle and those after it, with
