@@ -477,7 +477,7 @@ static void retry_log(struct app *a, int64_t *next_ns)
 {
 	int64_t now = re_io_now_ns();
 
-	if (!a->sup->log_failing || now < *next_ns)
+	if (!re_super_view(a->sup)->log_failing || now < *next_ns)
 		return;
 	*next_ns = now + 1000000000LL;
 	if (re_super_retry(a->sup) == GL_OK)
@@ -621,7 +621,7 @@ static void run(struct app *a)
 			/* keys typed before the fault do not act after it */
 			re_console_flush_keys(&a->con);
 		}
-		re_start_show_foreign(a, a->sup->foreign);
+		re_start_show_foreign(a, re_super_view(a->sup)->foreign);
 		re_start_show_events(a);
 		re_start_show_ready(a);
 		if (re_console_due(&a->con, re_io_now_ns())) {
@@ -654,10 +654,12 @@ static void run(struct app *a)
 	    "stats: cycles=%llu overruns=%llu period=%.1f ms "
 	    "late p50=%.3f p99=%.3f max=%.3f ms; reply age worst=%.1f ms; "
 	    "status frames dropped=%llu",
-	    (unsigned long long)a->sup->cycles,
-	    (unsigned long long)a->sup->overruns, ms_of_ns(a->sup->period_ns),
+	    (unsigned long long)re_super_view(a->sup)->cycles,
+	    (unsigned long long)re_super_view(a->sup)->overruns,
+	    ms_of_ns(re_super_view(a->sup)->period_ns),
 	    re_super_late_ms(a->sup, 50), re_super_late_ms(a->sup, 99),
-	    re_super_late_ms(a->sup, 100), ms_of_ns(a->sup->age_worst_ns),
+	    re_super_late_ms(a->sup, 100),
+	    ms_of_ns(re_super_view(a->sup)->age_worst_ns),
 	    (unsigned long long)a->con.dropped);
 }
 
@@ -795,7 +797,7 @@ static int check_host(struct app *a)
 /* Return: 1 when a fault was latched. */
 static int cleanup(struct app *a)
 {
-	int latched = a->sup && a->sup->latched;
+	int latched = a->sup && re_super_view(a->sup)->latched;
 
 	re_io_flush_log(&a->real);
 	power_off(a, latched);
@@ -804,7 +806,7 @@ static int cleanup(struct app *a)
 	re_lock_release(&a->lock_ctl);
 	re_console_close(&a->con);
 	re_log_close(&a->log);
-	free(a->sup);
+	re_super_free(a->sup);
 	free(a->cal);
 	a->sup = NULL;
 	a->cal = NULL;

@@ -23,7 +23,7 @@ make --no-print-directory BUILD="$BUILD" "$BUILD/obj/tests/bench/bench_sys.o"
 mkdir -p "$BUILD/bench"
 # shellcheck disable=SC2046
 $CC -o "$BUILD/bench/bench_sys" "$BUILD/obj/tests/bench/bench_sys.o" \
-	"$BUILD/lib/libharness.a" "$BUILD/lib/libre.a" \
+	"$BUILD/lib/libharness.a" "$BUILD/lib/libre.a" "$BUILD/lib/libsuper.a" \
 	$(ls "$BUILD/lib/libdmc.a" 2>/dev/null) "$BUILD/lib/libgl.a" \
 	$(ls "$BUILD/lib/libbase.a" 2>/dev/null) \
 	$(pkg-config --libs libserialport yaml-0.1) -lpthread -lm

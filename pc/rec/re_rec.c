@@ -19,7 +19,7 @@
 
 static void *writer(void *arg);
 
-static int64_t sup_now(const struct re_super *s)
+static int64_t sup_now(const struct re_super_view *s)
 {
 	return s->io.ops->now_ns(s->io.ud);
 }
@@ -114,28 +114,34 @@ out_free:
 	return rc;
 }
 
-static void take_cb(void *ud, const struct re_super *s)
+static void take_cb(void *ud, const struct re_super_view *s)
 {
 	re_rec_take(ud, s);
 }
 
-static const char *note_cb(void *ud, const struct re_super *s)
+static const char *note_cb(void *ud, const struct re_super_view *s)
 {
 	return re_rec_fault_note(ud, s);
 }
 
-void re_rec_attach(struct re_rec *r, struct re_super *s, const char *serial)
+void re_rec_begin(struct re_rec *r, const struct re_super_view *v,
+		  const char *serial)
 {
 	if (!r->t0_ns)
-		r->t0_ns = sup_now(s);
+		r->t0_ns = sup_now(v);
 	if (serial && *serial)
 		snprintf(r->hdr.serial, sizeof(r->hdr.serial), "%s", serial);
+}
+
+void re_rec_attach(struct re_rec *r, struct re_super *s, const char *serial)
+{
+	re_rec_begin(r, re_super_view(s), serial);
 	re_super_recorder(s, take_cb, note_cb, r);
 }
 
 /* ---- the cycle: one copy ------------------------------------------------ */
 
-static int32_t phase_of(const struct re_super *s)
+static int32_t phase_of(const struct re_super_view *s)
 {
 	if (s->latched)
 		return RE_TPH_FAULT;
@@ -148,7 +154,7 @@ static int32_t phase_of(const struct re_super *s)
  * from its sample counter (1 sample = 1 ms at TM 1000, the time unit of
  * its counts/s), so that the PC's wake-up jitter does not show as noise in
  * the commanded velocity; 0 when unknown. */
-static void take_axis(struct re_rec *r, const struct re_super *s, int i,
+static void take_axis(struct re_rec *r, const struct re_super_view *s, int i,
 		      double dt_s, struct re_trace_axis *x)
 {
 	const struct gl_rec_axis *a = &s->rec.axis[i];
@@ -171,7 +177,7 @@ static void take_axis(struct re_rec *r, const struct re_super *s, int i,
 	r->prev_ref[i] = a->ref_pos;
 }
 
-static void take_za(const struct re_super *s, struct re_trace_rec *x)
+static void take_za(const struct re_super_view *s, struct re_trace_rec *x)
 {
 	x->hbdmc = s->za.hbdmc;
 	x->joy_raw = s->za.jraw;
@@ -181,7 +187,7 @@ static void take_za(const struct re_super *s, struct re_trace_rec *x)
 	x->fcode = s->za.fcode;
 }
 
-void re_rec_take(struct re_rec *r, const struct re_super *s)
+void re_rec_take(struct re_rec *r, const struct re_super_view *s)
 {
 	struct re_trace_rec *x = &r->ring[r->head];
 	int64_t now = sup_now(s);
@@ -241,7 +247,7 @@ static void trace_name(struct re_rec *r, char *path, size_t cap)
 		 ++r->stamp_seq);
 }
 
-const char *re_rec_fault_note(struct re_rec *r, const struct re_super *s)
+const char *re_rec_fault_note(struct re_rec *r, const struct re_super_view *s)
 {
 	if (r->fault_pending)
 		return NULL;

@@ -97,6 +97,15 @@ struct re_rec {
 int re_rec_init(struct re_rec *r, const struct re_rec_cfg *cfg);
 
 /*
+ * re_rec_begin() - the trace's time zero (the supervisor's clock, @v's
+ * io) unless already set, and the controller's @serial (NULL or "":
+ * unchanged), without hooking into a supervisor (re_rec_attach() does
+ * both; tests drive re_rec_take() by hand with a view).
+ */
+void re_rec_begin(struct re_rec *r, const struct re_super_view *v,
+		  const char *serial);
+
+/*
  * re_rec_attach() - record @s's cycles from now (re_super_recorder()) and
  * name controller @serial (NULL or "": "-") in the traces. t_s counts from
  * the first attach.
@@ -107,7 +116,7 @@ void re_rec_attach(struct re_rec *r, struct re_super *s, const char *serial);
  * re_rec_take() - the cycle hook: copy @s's last cycle into the ring.
  * No allocation, no system call (the time is the supervisor's own clock).
  */
-void re_rec_take(struct re_rec *r, const struct re_super *s);
+void re_rec_take(struct re_rec *r, const struct re_super_view *s);
 
 /*
  * re_rec_fault_note() - the fault hook: the fault's trace is due
@@ -115,7 +124,7 @@ void re_rec_take(struct re_rec *r, const struct re_super *s);
  * Return: "trace PATH (written after_fault_s after the fault)", or NULL when
  *         a fault is already pending.
  */
-const char *re_rec_fault_note(struct re_rec *r, const struct re_super *s);
+const char *re_rec_fault_note(struct re_rec *r, const struct re_super_view *s);
 
 /*
  * re_rec_request() - a trace of the ring as it is now (SIGUSR1, a key),

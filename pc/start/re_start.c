@@ -294,16 +294,17 @@ static int init_super(struct app *a)
 	re_plan_xcheck_cfg(&a->plan, &a->cfg, a->names, &a->xcheck);
 	sc.seal = &a->seal;
 	sc.xcheck = &a->xcheck;
-	a->sup = calloc(1, sizeof(*a->sup));
+	a->sup = re_super_new();
 	if (!a->sup || re_super_init(a->sup, &a->io, &sc, NULL, 0) != GL_OK)
 		return re_start_fail(a, "cannot set up the supervisor");
-	if (a->sup->rb_n > 0)
+	if (re_super_view(a->sup)->rb_n > 0)
 		re_start_progress(
 		    a,
 		    "checked twice: roboelf reads the program's %d sealed "
 		    "values back, all every %d cycles (%d ms), and decodes "
 		    "the joystick itself",
-		    a->seal.n, a->sup->rb_n, a->sup->rb_n * a->cfg.period_ms);
+		    a->seal.n, re_super_view(a->sup)->rb_n,
+		    re_super_view(a->sup)->rb_n * a->cfg.period_ms);
 	if (a->rec) { /* flight recorder */
 		char serial[24];
 
@@ -316,7 +317,7 @@ static int init_super(struct app *a)
 /* The critical reply-age limit, ms: a stop longer than this is a stall. */
 int64_t re_start_stall_limit_ms(const struct app *a)
 {
-	return a->sup ? a->sup->crit_ns / 1000000
+	return a->sup ? re_super_view(a->sup)->crit_ns / 1000000
 		      : (int64_t)(a->cfg.watchdog.critical_factor *
 				  a->cfg.period_ms);
 }
@@ -346,8 +347,9 @@ static void stall_first(struct app *a, struct re_fault *f)
 		char what[512];
 
 		re_fault_format_units(f, a->names,
-				      a->sup ? &a->sup->cfg.units : NULL, what,
-				      sizeof(what));
+				      a->sup ? &re_super_view(a->sup)->cfg.units
+					     : NULL,
+				      what, sizeof(what));
 		re_log_msg(&a->log, RE_LOG_WARN,
 			   "start-up: after a stop of %lld ms: %s",
 			   (long long)ms, what);
@@ -522,10 +524,10 @@ static int sample_cb(void *ud, const struct gl_record **rec)
 	a->real.defer_log = 1; /* no file write in the cycle */
 	v = re_super_cycle(a->sup);
 	a->real.defer_log = 0;
-	re_start_show_foreign(a, a->sup->foreign);
+	re_start_show_foreign(a, re_super_view(a->sup)->foreign);
 	re_start_show_events(a);
-	re_calib_progress(a->calrun, a->calcfg, &a->sup->rec, re_io_now_ns(),
-			  &prog);
+	re_calib_progress(a->calrun, a->calcfg, &re_super_view(a->sup)->rec,
+			  re_io_now_ns(), &prog);
 	re_console_calib(&a->con, &prog);
 	if (re_console_due(&a->con, re_io_now_ns())) {
 		re_super_status(a->sup, &st); /* only when drawn */
@@ -536,7 +538,7 @@ static int sample_cb(void *ud, const struct gl_record **rec)
 		re_console_fault(&a->con, re_super_fault_line(a->sup));
 		return RE_FAULT;
 	}
-	*rec = &a->sup->rec;
+	*rec = &re_super_view(a->sup)->rec;
 	return GL_OK;
 }
 
@@ -774,7 +776,7 @@ static int arm(struct app *a)
 
 	/* the cycle wrote the heartbeat since the service began: go on
 	 * from its last value (a value behind it is out of sequence) */
-	a->hbpc = a->sup->hbpc;
+	a->hbpc = re_super_view(a->sup)->hbpc;
 	if (re_ctl_off(&a->io, &a->hbpc, a->err, sizeof(a->err)) != GL_OK)
 		return latch_err(a);
 	re_super_start(a->sup, NULL, a->hbpc, 0);
@@ -818,7 +820,7 @@ int re_start(struct app *a)
 
 void re_start_show_ready(struct app *a)
 {
-	const struct re_super *s = a->sup;
+	const struct re_super_view *s = a->sup ? re_super_view(a->sup) : NULL;
 	int k;
 
 	if (a->ready_said || !s || !s->armed || s->latched || !s->have_za ||

@@ -15,7 +15,7 @@
 #include "gl_err.h"
 #include "re_pot.h"
 #include "re_seal.h"
-#include "re_super.h"
+#include "re_super_int.h"
 
 /* The program told to latch, and the stop (re_io.h; the DMC's own #FAULT
  * uses the same two commands), in one line: pcflt first, so that the
@@ -24,7 +24,7 @@
 
 static int64_t now_ns(const struct re_super *s)
 {
-	return s->io.ops->now_ns(s->io.ud);
+	return s->pub.io.ops->now_ns(s->pub.io.ud);
 }
 
 static double ns_to_ms(int64_t ns)
@@ -39,12 +39,12 @@ static double ns_to_ms(int64_t ns)
 static void log_keep(struct re_super *s, enum re_log_level lvl,
 		     const char *text)
 {
-	if (s->io.ops->log(s->io.ud, lvl, text) == GL_OK)
+	if (s->pub.io.ops->log(s->pub.io.ud, lvl, text) == GL_OK)
 		return;
-	if (s->log_failing && s->pending_lvl == RE_LOG_FAULT &&
+	if (s->pub.log_failing && s->pending_lvl == RE_LOG_FAULT &&
 	    lvl != RE_LOG_FAULT)
 		return;
-	s->log_failing = 1;
+	s->pub.log_failing = 1;
 	s->pending_lvl = lvl;
 	snprintf(s->pending, sizeof(s->pending), "%s", text);
 }
@@ -81,11 +81,11 @@ int re_super_retry(struct re_super *s)
 {
 	int rc;
 
-	if (!s->log_failing)
+	if (!s->pub.log_failing)
 		return GL_OK;
-	rc = s->io.ops->log(s->io.ud, s->pending_lvl, s->pending);
+	rc = s->pub.io.ops->log(s->pub.io.ud, s->pending_lvl, s->pending);
 	if (rc == GL_OK)
-		s->log_failing = 0;
+		s->pub.log_failing = 0;
 	return rc;
 }
 
@@ -96,16 +96,17 @@ int re_super_retry(struct re_super *s)
 static int send_stop(struct re_super *s, const char *cmd)
 {
 	int64_t t0 = now_ns(s);
-	int rc = s->io.ops->command(s->io.ud, cmd, s->resp, sizeof(s->resp),
-				    s->cfg.fault_cmd_timeout_ms);
+	int rc =
+	    s->pub.io.ops->command(s->pub.io.ud, cmd, s->resp, sizeof(s->resp),
+				   s->pub.cfg.fault_cmd_timeout_ms);
 
 	s->confirm.stop_fresh = 0;
 	if ((rc == GL_ERR_BROKEN || rc == GL_ERR_CLOSED ||
 	     rc == GL_ERR_TIMEOUT || rc == GL_ERR_SYS || rc == GL_ERR_PROTO) &&
-	    s->io.ops->stop_fresh && s->cfg.fresh_stop_ms > 0) {
-		rc = s->io.ops->stop_fresh(s->io.ud, cmd, s->resp,
-					   sizeof(s->resp),
-					   s->cfg.fresh_stop_ms);
+	    s->pub.io.ops->stop_fresh && s->pub.cfg.fresh_stop_ms > 0) {
+		rc = s->pub.io.ops->stop_fresh(s->pub.io.ud, cmd, s->resp,
+					       sizeof(s->resp),
+					       s->pub.cfg.fresh_stop_ms);
 		s->confirm.stop_fresh = 1;
 	}
 	s->confirm.stop_ms = ns_to_ms(now_ns(s) - t0);
@@ -117,12 +118,12 @@ static void ctrl_fault_detail(struct re_super *s, struct re_fault *f)
 {
 	double fdet;
 
-	if (s->have_za && s->za.fcode != 0 &&
-	    re_io_read(&s->io, "fdet", &fdet, s->cfg.fault_cmd_timeout_ms) ==
-		GL_OK) {
-		re_ctrl_fault(&s->za, (long long)fdet, f);
-		re_seal_read_fault(s->cfg.seal, &s->io,
-				   s->cfg.fault_cmd_timeout_ms, f);
+	if (s->pub.have_za && s->pub.za.fcode != 0 &&
+	    re_io_read(&s->pub.io, "fdet", &fdet,
+		       s->pub.cfg.fault_cmd_timeout_ms) == GL_OK) {
+		re_ctrl_fault(&s->pub.za, (long long)fdet, f);
+		re_seal_read_fault(s->pub.cfg.seal, &s->pub.io,
+				   s->pub.cfg.fault_cmd_timeout_ms, f);
 	}
 }
 
@@ -130,7 +131,7 @@ static void ctrl_fault_detail(struct re_super *s, struct re_fault *f)
  * #JINV before #MAIN latched INPUT, thread 1 halted by #FAULT ...). */
 static int may_settle(const struct re_super *s, enum re_fault_id id)
 {
-	return s->cfg.settle_ms > 0 &&
+	return s->pub.cfg.settle_ms > 0 &&
 	       (id == RE_F_MOTOR_OFF || id == RE_F_THREAD || id == RE_F_STATE ||
 		id == RE_F_CTRL_STATE || id == RE_F_UNCMD);
 }
@@ -139,16 +140,18 @@ static int may_settle(const struct re_super *s, enum re_fault_id id)
 static int program_fault(struct re_super *s, struct re_za *za, double *det)
 {
 	double code = 0, axis = 0;
-	int rc =
-	    re_io_read(&s->io, "fcode", &code, s->cfg.fault_cmd_timeout_ms);
+	int rc = re_io_read(&s->pub.io, "fcode", &code,
+			    s->pub.cfg.fault_cmd_timeout_ms);
 
 	memset(za, 0, sizeof(*za));
 	*det = RE_VAL_UNKNOWN;
 	if (rc != GL_OK)
 		return rc;
 	if (code > 0 && code < 100) {
-		re_io_read(&s->io, "faxis", &axis, s->cfg.fault_cmd_timeout_ms);
-		re_io_read(&s->io, "fdet", det, s->cfg.fault_cmd_timeout_ms);
+		re_io_read(&s->pub.io, "faxis", &axis,
+			   s->pub.cfg.fault_cmd_timeout_ms);
+		re_io_read(&s->pub.io, "fdet", det,
+			   s->pub.cfg.fault_cmd_timeout_ms);
 		za->state = RE_DMC_FAULT;
 		za->fcode = (int)code;
 		za->faxis = axis >= 0 && axis <= 3 ? (int)axis : 0;
@@ -161,7 +164,7 @@ static int program_fault(struct re_super *s, struct re_za *za, double *det)
 static void program_verdict(struct re_super *s, struct re_fault *f)
 {
 	int64_t t0 = now_ns(s);
-	int64_t end = t0 + (int64_t)s->cfg.settle_ms * BASE_NS_PER_MS;
+	int64_t end = t0 + (int64_t)s->pub.cfg.settle_ms * BASE_NS_PER_MS;
 	struct re_za za;
 	double det;
 	int rc;
@@ -179,15 +182,15 @@ static void program_verdict(struct re_super *s, struct re_fault *f)
 				 "program fault %d after %.1f ms", za.fcode,
 				 ns_to_ms(now_ns(s) - t0));
 			re_ctrl_fault(&za, (long long)det, f);
-			re_seal_read_fault(s->cfg.seal, &s->io,
-					   s->cfg.fault_cmd_timeout_ms, f);
+			re_seal_read_fault(s->pub.cfg.seal, &s->pub.io,
+					   s->pub.cfg.fault_cmd_timeout_ms, f);
 			return;
 		}
-		s->io.ops->sleep_until(s->io.ud,
-				       now_ns(s) + 2 * BASE_NS_PER_MS);
+		s->pub.io.ops->sleep_until(s->pub.io.ud,
+					   now_ns(s) + 2 * BASE_NS_PER_MS);
 	} while (now_ns(s) < end);
 	snprintf(s->verdict, sizeof(s->verdict),
-		 "no program fault within %d ms", s->cfg.settle_ms);
+		 "no program fault within %d ms", s->pub.cfg.settle_ms);
 }
 
 /* Stop and switch off through the controller and tell the program
@@ -205,9 +208,9 @@ static int stop_controller(struct re_super *s, struct re_fault *f)
 	rc = send_stop(s, RE_STOP_ALL);
 	if (rc >= 0) {
 		program_verdict(s, f);
-		s->io.ops->command(s->io.ud, "pcflt=1", s->resp,
-				   sizeof(s->resp),
-				   s->cfg.fault_cmd_timeout_ms);
+		s->pub.io.ops->command(s->pub.io.ud, "pcflt=1", s->resp,
+				       sizeof(s->resp),
+				       s->pub.cfg.fault_cmd_timeout_ms);
 	}
 	return rc;
 }
@@ -219,8 +222,9 @@ static int motors_off(struct re_super *s)
 	double v;
 	int rc;
 
-	for (int i = 0; i < s->cfg.n_axes; i++) {
-		rc = re_io_read(&s->io, mo[i], &v, s->cfg.fault_cmd_timeout_ms);
+	for (int i = 0; i < s->pub.cfg.n_axes; i++) {
+		rc = re_io_read(&s->pub.io, mo[i], &v,
+				s->pub.cfg.fault_cmd_timeout_ms);
 		if (rc != GL_OK)
 			return rc;
 		if (v != 1)
@@ -244,7 +248,8 @@ static void relay_or_power(struct re_super *s, struct re_fault *f)
 	if (s->confirm.relay_rc != GL_OK)
 		snprintf(why, sizeof(why), "its off was not confirmed: %s",
 			 gl_strerror(s->confirm.relay_rc));
-	else if (s->io.ops->relay_check(s->io.ud, why, sizeof(why)) == GL_OK)
+	else if (s->pub.io.ops->relay_check(s->pub.io.ud, why, sizeof(why)) ==
+		 GL_OK)
 		return;
 	re_fault_set(f, RE_F_RELAY_POWER, -1);
 	snprintf(f->s, sizeof(f->s), "%s", why);
@@ -260,10 +265,10 @@ static void foreign_from_program(struct re_super *s)
 
 	if (s->confirm.stop_rc < 0)
 		return;
-	if (re_io_read(&s->io, "fhnew", &m, s->cfg.fault_cmd_timeout_ms) ==
-		GL_OK &&
+	if (re_io_read(&s->pub.io, "fhnew", &m,
+		       s->pub.cfg.fault_cmd_timeout_ms) == GL_OK &&
 	    m >= 1 && m <= 255)
-		s->foreign |= (unsigned)m;
+		s->pub.foreign |= (unsigned)m;
 }
 
 /* A program fault that our own stop caused: 12 (pcflt); a motor found
@@ -301,8 +306,8 @@ static void consequences(struct re_super *s, const struct re_fault *f)
 	    !za.fcode || own_doing(s, &za, det))
 		return;
 	re_ctrl_fault(&za, (long long)det, &c);
-	if (re_fault_what_units(&c, s->cfg.axis_names, &s->cfg.units, s->then,
-				sizeof(s->then)) == GL_ERR_ARG)
+	if (re_fault_what_units(&c, s->pub.cfg.axis_names, &s->pub.cfg.units,
+				s->then, sizeof(s->then)) == GL_ERR_ARG)
 		s->then[0] = '\0';
 }
 
@@ -350,16 +355,16 @@ static size_t foreign_text(unsigned mask, char *buf, size_t cap)
  * <confirm>. Recovery: ..." */
 static void compose_line(struct re_super *s)
 {
-	char *line = s->fault_line, *rec;
-	size_t cap = sizeof(s->fault_line), n;
+	char *line = s->pub.fault_line, *rec;
+	size_t cap = sizeof(s->pub.fault_line), n;
 	char tail[RE_SUPER_LINE];
 
-	if (re_fault_format_units(&s->fault, s->cfg.axis_names, &s->cfg.units,
-				  line, cap) == GL_ERR_ARG)
+	if (re_fault_format_units(&s->pub.fault, s->pub.cfg.axis_names,
+				  &s->pub.cfg.units, line, cap) == GL_ERR_ARG)
 		snprintf(line, cap,
 			 "FAULT PROGRAM: unknown fault %d. Recovery: quit, "
 			 "note the log and call service",
-			 (int)s->fault.id);
+			 (int)s->pub.fault.id);
 	rec = strstr(line, ". Recovery: ");
 	if (!rec)
 		return;
@@ -367,8 +372,8 @@ static void compose_line(struct re_super *s)
 	n = (size_t)(rec - line) + 1;
 	if (s->then[0] && n < cap)
 		n += (size_t)snprintf(line + n, cap - n, " Then: %s.", s->then);
-	if (s->foreign && n < cap)
-		n += foreign_text(s->foreign, line + n, cap - n);
+	if (s->pub.foreign && n < cap)
+		n += foreign_text(s->pub.foreign, line + n, cap - n);
 	if (n < cap)
 		n += confirm_text(s, line + n, cap - n);
 	if (n < cap)
@@ -380,24 +385,26 @@ static size_t snapshot(const struct re_super *s, char *buf, size_t cap)
 {
 	size_t n = 0;
 
-	for (int i = 0; s->have_record && i < s->cfg.n_axes && n < cap; i++) {
-		const struct gl_rec_axis *a = &s->rec.axis[i];
+	for (int i = 0; s->pub.have_record && i < s->pub.cfg.n_axes && n < cap;
+	     i++) {
+		const struct gl_rec_axis *a = &s->pub.rec.axis[i];
 
 		n += (size_t)snprintf(buf + n, cap - n,
 				      "; %s enc=%d ref=%d err=%d sc=%d mo=%d"
 				      " an=%.4fV",
-				      s->cfg.axis_names[i], (int)a->motor_pos,
-				      (int)a->ref_pos, (int)a->pos_err,
-				      a->stop_code,
+				      s->pub.cfg.axis_names[i],
+				      (int)a->motor_pos, (int)a->ref_pos,
+				      (int)a->pos_err, a->stop_code,
 				      a->status & GL_AXST_MOTOR_OFF ? 1 : 0,
 				      re_pot_volts(a->analog_in));
 	}
-	if (n < cap && s->have_za)
+	if (n < cap && s->pub.have_za)
 		n += (size_t)snprintf(buf + n, cap - n,
 				      "; dmc state=%d fcode=%d faxis=%d "
 				      "hbdmc=%d jraw=%d",
-				      s->za.state, s->za.fcode, s->za.faxis,
-				      (int)s->za.hbdmc, s->za.jraw);
+				      s->pub.za.state, s->pub.za.fcode,
+				      s->pub.za.faxis, (int)s->pub.za.hbdmc,
+				      s->pub.za.jraw);
 	return n < cap ? n : cap;
 }
 
@@ -416,16 +423,17 @@ static void log_fault(struct re_super *s)
 	    t, cap,
 	    "%s | relay off: %s | controller stop: %s%s (%.1f ms) | motors "
 	    "off: %s%s%s | cycle %llu, reply age %.1f ms",
-	    s->fault_line, c->relay_rc == GL_OK ? "confirmed" : "NOT confirmed",
+	    s->pub.fault_line,
+	    c->relay_rc == GL_OK ? "confirmed" : "NOT confirmed",
 	    rc_text(c->stop_rc, "delivered"),
 	    c->stop_fresh ? " over a new connection" : "", c->stop_ms,
 	    c->motors_rc == GL_OK ? "confirmed" : "NOT confirmed",
 	    s->verdict[0] ? " | " : "", s->verdict,
-	    (unsigned long long)s->cycles, ns_to_ms(s->age_last_ns));
+	    (unsigned long long)s->pub.cycles, ns_to_ms(s->pub.age_last_ns));
 	if (n < cap)
 		n += snapshot(s, t + n, cap - n);
 	if (n < cap && s->rec_fault) { /* flight recorder */
-		const char *note = s->rec_fault(s->rec_ud, s);
+		const char *note = s->rec_fault(s->rec_ud, &s->pub);
 
 		if (note)
 			snprintf(t + n, cap - n, " | %s", note);
@@ -437,16 +445,17 @@ static void log_fault(struct re_super *s)
 
 static int relay_start(struct re_super *s)
 {
-	if (s->io.ops->relay_off_start)
-		return s->io.ops->relay_off_start(s->io.ud);
-	return s->io.ops->relay_off(s->io.ud);
+	if (s->pub.io.ops->relay_off_start)
+		return s->pub.io.ops->relay_off_start(s->pub.io.ud);
+	return s->pub.io.ops->relay_off(s->pub.io.ud);
 }
 
 static int relay_finish(struct re_super *s, int start_rc)
 {
-	if (!s->io.ops->relay_off_start || !s->io.ops->relay_off_finish)
+	if (!s->pub.io.ops->relay_off_start || !s->pub.io.ops->relay_off_finish)
 		return start_rc;
-	return s->io.ops->relay_off_finish(s->io.ud, s->cfg.relay_off_ms);
+	return s->pub.io.ops->relay_off_finish(s->pub.io.ud,
+					       s->pub.cfg.relay_off_ms);
 }
 
 int re_super_fault(struct re_super *s, const struct re_fault *f)
@@ -454,10 +463,12 @@ int re_super_fault(struct re_super *s, const struct re_fault *f)
 	struct re_fault fault = *f;
 	int relay_rc;
 
-	if (s->latched) {
-		re_fault_format_units(f, s->cfg.axis_names, &s->cfg.units,
-				      s->msg, sizeof(s->msg));
-		re_io_logf(&s->io, RE_LOG_WARN, "while latched: %s", s->msg);
+	if (s->pub.latched) {
+		re_fault_format_units(f, s->pub.cfg.axis_names,
+				      &s->pub.cfg.units, s->msg,
+				      sizeof(s->msg));
+		re_io_logf(&s->pub.io, RE_LOG_WARN, "while latched: %s",
+			   s->msg);
 		re_super_note(s, RE_LOG_FAULT, RE_EV_LATER, s->msg);
 		return RE_OK;
 	}
@@ -473,9 +484,9 @@ int re_super_fault(struct re_super *s, const struct re_fault *f)
 	relay_or_power(s, &fault);
 	consequences(s, &fault);
 	foreign_from_program(s);
-	s->latched = 1;
-	s->armed = 0;
-	s->fault = fault;
+	s->pub.latched = 1;
+	s->pub.armed = 0;
+	s->pub.fault = fault;
 	compose_line(s);
 	/* 5. the log entry on disk before anyone reports the relay open */
 	log_fault(s);
@@ -484,7 +495,7 @@ int re_super_fault(struct re_super *s, const struct re_fault *f)
 
 const char *re_super_fault_line(const struct re_super *s)
 {
-	return s->latched ? s->fault_line : "";
+	return s->pub.latched ? s->pub.fault_line : "";
 }
 
 /* ---- shutdown ------------------------------------------------------------ */
@@ -495,17 +506,17 @@ int re_super_shutdown(struct re_super *s, char *what, size_t cap)
 
 	/* the program back to its safe state, so that the motors off is not
 	 * a fault to it; then the stop itself, whatever the program did */
-	off_rc =
-	    s->io.ops->command(s->io.ud, "offreq=1", s->resp, sizeof(s->resp),
-			       s->cfg.fault_cmd_timeout_ms);
+	off_rc = s->pub.io.ops->command(s->pub.io.ud, "offreq=1", s->resp,
+					sizeof(s->resp),
+					s->pub.cfg.fault_cmd_timeout_ms);
 	if (off_rc >= 0)
-		s->io.ops->sleep_until(s->io.ud,
-				       now_ns(s) + 25 * BASE_NS_PER_MS);
+		s->pub.io.ops->sleep_until(s->pub.io.ud,
+					   now_ns(s) + 25 * BASE_NS_PER_MS);
 	stop_rc = send_stop(s, RE_STOP_ALL);
 	mo_rc = stop_rc >= 0 ? motors_off(s) : stop_rc;
 	relay_rc = relay_finish(s, relay_start(s));
-	s->armed = 0;
-	s->expect = 0;
+	s->pub.armed = 0;
+	s->pub.expect = 0;
 	if (what)
 		snprintf(
 		    what, cap, "motors off: %s; motor power off (relay): %s",

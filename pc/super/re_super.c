@@ -3,7 +3,7 @@
  * checks, status. See re_super.h; the checks themselves are in re_check.c,
  * the fault reaction in re_react.c.
  */
-#include "re_super.h"
+#include "re_super_int.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -15,7 +15,7 @@
 
 static int64_t now_ns(const struct re_super *s)
 {
-	return s->io.ops->now_ns(s->io.ud);
+	return s->pub.io.ops->now_ns(s->pub.io.ud);
 }
 
 static double ns_to_ms(int64_t ns)
@@ -25,7 +25,7 @@ static double ns_to_ms(int64_t ns)
 
 static double pot_of(const struct re_super *s, int i)
 {
-	return re_pot_of(&s->rec, i, s->cfg.pot_input[i]);
+	return re_pot_of(&s->pub.rec, i, s->pub.cfg.pot_input[i]);
 }
 
 /* The read-back's chunks ("MG r1,...", each fitting the line after the
@@ -36,20 +36,35 @@ static int readback_init(struct re_super *s)
 	const size_t room = GL_LINE_MAX - sizeof("hbpc=999999999;;QR") + 1;
 	int n;
 
-	if (!s->cfg.seal || !s->io.ops->record_text)
+	if (!s->pub.cfg.seal || !s->pub.io.ops->record_text)
 		return GL_OK;
-	n = re_seal_chunks(s->cfg.seal, room < 63 ? room : 63, s->rb_first,
+	n = re_seal_chunks(s->pub.cfg.seal, room < 63 ? room : 63, s->rb_first,
 			   s->rb_count, RE_SEAL_MAX);
 	if (n < 0)
 		return n;
 	for (int k = 0; k < n; k++)
-		if (re_seal_chunk_text(s->cfg.seal, s->rb_first[k],
+		if (re_seal_chunk_text(s->pub.cfg.seal, s->rb_first[k],
 				       s->rb_count[k], s->rb_chunk[k],
 				       sizeof(s->rb_chunk[k])) < 0)
 			return GL_ERR_OVERFLOW;
-	s->rb_n = n;
-	re_seal_expect(s->cfg.seal, 0, NULL, NULL, s->seal_expect);
+	s->pub.rb_n = n;
+	re_seal_expect(s->pub.cfg.seal, 0, NULL, NULL, s->seal_expect);
 	return GL_OK;
+}
+
+struct re_super *re_super_new(void)
+{
+	return calloc(1, sizeof(struct re_super));
+}
+
+void re_super_free(struct re_super *s)
+{
+	free(s);
+}
+
+const struct re_super_view *re_super_view(const struct re_super *s)
+{
+	return &s->pub;
 }
 
 int re_super_init(struct re_super *s, const struct re_io *io,
@@ -60,18 +75,18 @@ int re_super_init(struct re_super *s, const struct re_io *io,
 	if (!io || !io->ops || !cfg || cfg->n_axes < 1 ||
 	    cfg->n_axes > RE_SUPER_AXES || cfg->period_ns <= 0)
 		return GL_ERR_ARG;
-	s->io = *io;
-	s->cfg = *cfg;
+	s->pub.io = *io;
+	s->pub.cfg = *cfg;
 	if (cfg->wdog.noncrit_ns <= 0 ||
 	    cfg->wdog.crit_ns < cfg->wdog.noncrit_ns)
 		return GL_ERR_ARG;
 	s->noncrit_ns = cfg->wdog.noncrit_ns;
-	s->crit_ns = cfg->wdog.crit_ns;
+	s->pub.crit_ns = cfg->wdog.crit_ns;
 	for (int i = 0; tables && i < cfg->n_axes; i++)
 		s->table[i] = tables[i];
-	s->expect = expect;
-	s->armed = expect == RE_DMC_ARMED;
-	s->period_ns = cfg->period_ns;
+	s->pub.expect = expect;
+	s->pub.armed = expect == RE_DMC_ARMED;
+	s->pub.period_ns = cfg->period_ns;
 	s->t0_ns = now_ns(s);
 	s->deadline_ns = s->t0_ns + cfg->period_ns; /* no previous cycle */
 	s->last_good_ns = s->t0_ns;
@@ -88,16 +103,16 @@ static void seal_expect(struct re_super *s,
 	double rev[RE_SUPER_AXES], fwd[RE_SUPER_AXES];
 	int have = tables && expect == RE_DMC_ARMED;
 
-	if (!s->rb_n)
+	if (!s->pub.rb_n)
 		return;
-	for (int i = 0; have && i < s->cfg.n_axes; i++) {
+	for (int i = 0; have && i < s->pub.cfg.n_axes; i++) {
 		have = tables[i] != NULL;
 		if (have) {
 			rev[i] = tables[i]->soft_rev;
 			fwd[i] = tables[i]->soft_fwd;
 		}
 	}
-	re_seal_expect(s->cfg.seal, expect, have ? rev : NULL,
+	re_seal_expect(s->pub.cfg.seal, expect, have ? rev : NULL,
 		       have ? fwd : NULL, s->seal_expect);
 	s->seal_state = expect;
 	s->state_cycles = 0;
@@ -107,34 +122,34 @@ static void seal_expect(struct re_super *s,
 void re_super_start(struct re_super *s, const struct re_caltable *const *tables,
 		    long hbpc, int expect)
 {
-	if (s->latched)
+	if (s->pub.latched)
 		return;
-	for (int i = 0; i < s->cfg.n_axes; i++) {
+	for (int i = 0; i < s->pub.cfg.n_axes; i++) {
 		s->table[i] = tables ? tables[i] : NULL;
 		s->encpot[i].violations = 0;
 		s->moving_ns[i] = 0;
 	}
-	s->expect = expect;
-	s->armed = expect == RE_DMC_ARMED;
+	s->pub.expect = expect;
+	s->pub.armed = expect == RE_DMC_ARMED;
 	s->own_mask = 0;
 	seal_expect(s, tables, expect);
 	re_xcheck_reset(&s->xc, now_ns(s));
 	/* the handles known stay from the first record on (just after the
 	 * take-over closed the others): a program that connects between two
 	 * phases, e.g. just before the first armed cycle, is still new */
-	s->hbpc = hbpc;
+	s->pub.hbpc = hbpc;
 	s->last_good_ns = now_ns(s);
 	/* the stall check counts from here: a stall before the first cycle
 	 * is one too */
 	s->last_end_ns = s->last_good_ns;
-	s->deadline_ns = s->last_good_ns + s->period_ns;
+	s->deadline_ns = s->last_good_ns + s->pub.period_ns;
 	re_alive_reset(&s->alive);
 }
 
 void re_super_tables(struct re_super *s,
 		     const struct re_caltable *const *tables)
 {
-	for (int i = 0; i < s->cfg.n_axes; i++) {
+	for (int i = 0; i < s->pub.cfg.n_axes; i++) {
 		s->table[i] = tables ? tables[i] : NULL;
 		s->encpot[i].violations = 0;
 	}
@@ -142,15 +157,15 @@ void re_super_tables(struct re_super *s,
 
 void re_super_set_period(struct re_super *s, int64_t period_ns)
 {
-	s->period_ns = period_ns > 0 ? period_ns : s->cfg.period_ns;
-	s->deadline_ns = now_ns(s) + s->period_ns;
+	s->pub.period_ns = period_ns > 0 ? period_ns : s->pub.cfg.period_ns;
+	s->deadline_ns = now_ns(s) + s->pub.period_ns;
 }
 
 void re_super_own(struct re_super *s, unsigned mask)
 {
 	int64_t now = now_ns(s);
 
-	for (int i = 0; i < s->cfg.n_axes; i++)
+	for (int i = 0; i < s->pub.cfg.n_axes; i++)
 		if ((s->own_mask | mask) >> i & 1)
 			s->cmd_ns[i] = now;
 	s->own_mask = mask;
@@ -163,21 +178,21 @@ int64_t re_super_wait(struct re_super *s)
 
 	if (now > s->deadline_ns) {
 		/* the last cycle ran into this one: no burst of late cycles */
-		s->overruns++;
+		s->pub.overruns++;
 		s->deadline_ns = now;
 	} else {
-		s->io.ops->sleep_until(s->io.ud, s->deadline_ns);
+		s->pub.io.ops->sleep_until(s->pub.io.ud, s->deadline_ns);
 		now = now_ns(s);
 	}
 	late = now - s->deadline_ns;
 	if (late < 0)
 		late = 0;
-	s->late_last_ns = late;
+	s->pub.late_last_ns = late;
 	if (late > s->late_worst_ns)
 		s->late_worst_ns = late;
 	bin = late / (RE_LATE_BIN_US * 1000);
 	s->late_hist[bin < RE_LATE_BINS - 1 ? bin : RE_LATE_BINS - 1]++;
-	s->deadline_ns += s->period_ns;
+	s->deadline_ns += s->pub.period_ns;
 	return late;
 }
 
@@ -185,7 +200,7 @@ int64_t re_super_wait(struct re_super *s)
 
 static int reply_timeout_ms(const struct re_super *s)
 {
-	int64_t left = s->last_good_ns + s->crit_ns - now_ns(s);
+	int64_t left = s->last_good_ns + s->pub.crit_ns - now_ns(s);
 
 	if (left < BASE_NS_PER_MS)
 		return 1;
@@ -211,11 +226,11 @@ static int check_stall(struct re_super *s, struct re_fault *f)
 	if (!s->last_end_ns)
 		return RE_OK;
 	gap = now_ns(s) - s->last_end_ns;
-	if (gap <= s->crit_ns)
+	if (gap <= s->pub.crit_ns)
 		return RE_OK;
 	re_fault_set(f, RE_F_STALL, -1);
 	f->i[0] = gap / BASE_NS_PER_MS;
-	f->i[1] = s->crit_ns / BASE_NS_PER_MS;
+	f->i[1] = s->pub.crit_ns / BASE_NS_PER_MS;
 	return RE_FAULT;
 }
 
@@ -268,11 +283,11 @@ static int record_readback(struct re_super *s, int tmo)
 	memcpy(s->rb_line, s->prefix, n);
 	s->rb_line[n] = ';';
 	memcpy(s->rb_line + n + 1, s->rb_chunk[s->rb_next], m + 1);
-	rc = s->io.ops->record_text(s->io.ud, s->rb_line, &s->rec, s->rb_reply,
-				    sizeof(s->rb_reply), tmo);
+	rc = s->pub.io.ops->record_text(s->pub.io.ud, s->rb_line, &s->pub.rec,
+					s->rb_reply, sizeof(s->rb_reply), tmo);
 	s->rb_have = rc == GL_OK;
 	s->rb_cur = s->rb_next;
-	s->rb_next = (s->rb_next + 1) % s->rb_n;
+	s->rb_next = (s->rb_next + 1) % s->pub.rb_n;
 	return rc;
 }
 
@@ -282,47 +297,48 @@ static int exchange(struct re_super *s, struct re_fault *f)
 	int64_t now, age = 0, t0 = now_ns(s), over;
 	int rc, v, tmo = reply_timeout_ms(s);
 
-	s->hbpc = (s->hbpc + 1) % RE_HBPC_WRAP;
-	hb_prefix_next(s, s->hbpc);
-	rc = s->rb_n ? record_readback(s, tmo)
-		     : s->io.ops->record(s->io.ud, s->prefix, &s->rec, tmo);
+	s->pub.hbpc = (s->pub.hbpc + 1) % RE_HBPC_WRAP;
+	hb_prefix_next(s, s->pub.hbpc);
+	rc = s->pub.rb_n ? record_readback(s, tmo)
+			 : s->pub.io.ops->record(s->pub.io.ud, s->prefix,
+						 &s->pub.rec, tmo);
 	now = now_ns(s);
-	s->link_ok = rc == GL_OK;
+	s->pub.link_ok = rc == GL_OK;
 	/* The round trip waits at most tmo: a return later than that by more
 	 * than the critical limit means this process did not run meanwhile
 	 * (stopped inside the wait), whatever the link did. */
 	over = now - t0 - (int64_t)tmo * BASE_NS_PER_MS;
-	if (over > s->crit_ns) {
+	if (over > s->pub.crit_ns) {
 		/* Reported from t0, the last moment it is known to have
 		 * run: 'over' alone would leave out the part of the stop
 		 * that fell inside the wait (a 2 s SIGSTOP read 1924 ms). */
 		re_fault_set(f, RE_F_STALL, -1);
 		f->i[0] = (now - t0) / BASE_NS_PER_MS;
-		f->i[1] = s->crit_ns / BASE_NS_PER_MS;
+		f->i[1] = s->pub.crit_ns / BASE_NS_PER_MS;
 		return RE_FAULT;
 	}
 	if (rc != GL_OK && rc != GL_ERR_TIMEOUT)
 		return comm_fault(rc, f);
-	v = re_check_reply_age(&s->cfg.wdog, s->last_good_ns, now, &age, f);
+	v = re_check_reply_age(&s->pub.cfg.wdog, s->last_good_ns, now, &age, f);
 	if (v < 0) {
 		re_fault_set(f, RE_F_WDOG_REPLY, -1);
 		f->i[0] = RE_VAL_UNKNOWN;
-		f->i[1] = s->crit_ns / BASE_NS_PER_MS;
+		f->i[1] = s->pub.crit_ns / BASE_NS_PER_MS;
 		v = RE_FAULT;
 	}
 	if (rc == GL_ERR_TIMEOUT && v != RE_FAULT) {
 		/* the deadline was the critical limit: rounding aside, late */
 		re_fault_set(f, RE_F_WDOG_REPLY, -1);
 		f->i[0] = age / BASE_NS_PER_MS;
-		f->i[1] = s->crit_ns / BASE_NS_PER_MS;
+		f->i[1] = s->pub.crit_ns / BASE_NS_PER_MS;
 		v = RE_FAULT;
 	}
 	if (rc == GL_OK) {
-		s->have_record = 1;
+		s->pub.have_record = 1;
 		s->last_good_ns = now;
-		s->age_last_ns = age;
-		if (age > s->age_worst_ns)
-			s->age_worst_ns = age;
+		s->pub.age_last_ns = age;
+		if (age > s->pub.age_worst_ns)
+			s->pub.age_worst_ns = age;
 	}
 	return v;
 }
@@ -333,9 +349,9 @@ static void warn_watchdog(struct re_super *s)
 	snprintf(s->text, sizeof(s->text),
 		 "watchdog: reply after %.1f ms "
 		 "(non-critical limit %.1f ms, critical %.1f ms)",
-		 ns_to_ms(s->age_last_ns), ns_to_ms(s->noncrit_ns),
-		 ns_to_ms(s->crit_ns));
-	re_io_logf(&s->io, RE_LOG_WARN, "%s", s->text);
+		 ns_to_ms(s->pub.age_last_ns), ns_to_ms(s->noncrit_ns),
+		 ns_to_ms(s->pub.crit_ns));
+	re_io_logf(&s->pub.io, RE_LOG_WARN, "%s", s->text);
 	re_super_note(s, RE_LOG_WARN, RE_EV_WATCHDOG, s->text);
 }
 
@@ -343,7 +359,7 @@ static int check_relay(struct re_super *s, struct re_fault *f)
 {
 	char why[sizeof(f->s)];
 
-	if (s->io.ops->relay_check(s->io.ud, why, sizeof(why)) == GL_OK)
+	if (s->pub.io.ops->relay_check(s->pub.io.ud, why, sizeof(why)) == GL_OK)
 		return RE_OK;
 	re_fault_set(f, RE_F_ESTOP_LOST, -1);
 	snprintf(f->s, sizeof(f->s), "%s", why);
@@ -362,20 +378,20 @@ static int check_error(struct re_fault *f, enum re_fault_id id, int axis,
 
 static int check_encpot(struct re_super *s, struct re_fault *f)
 {
-	for (int i = 0; i < s->cfg.n_axes; i++) {
-		const struct gl_rec_axis *a = &s->rec.axis[i];
+	for (int i = 0; i < s->pub.cfg.n_axes; i++) {
+		const struct gl_rec_axis *a = &s->pub.rec.axis[i];
 		int v;
 
-		s->have_encres[i] = 0;
+		s->pub.have_encres[i] = 0;
 		if (!s->table[i])
 			continue;
-		v = re_check_encpot(s->table[i], &s->cfg.encpot[i], i,
+		v = re_check_encpot(s->table[i], &s->pub.cfg.encpot[i], i,
 				    a->motor_pos, pot_of(s, i), &s->encpot[i],
-				    &s->encres[i], f);
+				    &s->pub.encres[i], f);
 		if (v < 0)
 			return check_error(f, RE_F_CONFIG, i,
 					   "encoder/potentiometer check", v);
-		s->have_encres[i] = 1;
+		s->pub.have_encres[i] = 1;
 		if (v == RE_FAULT)
 			return RE_FAULT;
 	}
@@ -397,13 +413,13 @@ static int check_uncmd(struct re_super *s, struct re_fault *f)
 {
 	int64_t now = now_ns(s);
 
-	if (!s->cfg.uncmd_grace_ns || !s->have_za)
+	if (!s->pub.cfg.uncmd_grace_ns || !s->pub.have_za)
 		return RE_OK;
-	for (int i = 0; i < s->cfg.n_axes; i++) {
-		int moving = !!(s->rec.axis[i].status & GL_AXST_MOVING);
+	for (int i = 0; i < s->pub.cfg.n_axes; i++) {
+		int moving = !!(s->pub.rec.axis[i].status & GL_AXST_MOVING);
 
-		if ((s->own_mask >> i & 1) || cmd_axis(s->za.mcmd) == i ||
-		    cmd_axis(s->za.jcmd) == i)
+		if ((s->own_mask >> i & 1) || cmd_axis(s->pub.za.mcmd) == i ||
+		    cmd_axis(s->pub.za.jcmd) == i)
 			s->cmd_ns[i] = now;
 		if (!moving) {
 			s->moving_ns[i] = 0;
@@ -411,8 +427,8 @@ static int check_uncmd(struct re_super *s, struct re_fault *f)
 		}
 		if (!s->moving_ns[i])
 			s->moving_ns[i] = now;
-		if (now - s->cmd_ns[i] <= s->cfg.uncmd_grace_ns ||
-		    now - s->moving_ns[i] <= s->cfg.uncmd_grace_ns)
+		if (now - s->cmd_ns[i] <= s->pub.cfg.uncmd_grace_ns ||
+		    now - s->moving_ns[i] <= s->pub.cfg.uncmd_grace_ns)
 			continue;
 		re_fault_set(f, RE_F_UNCMD, i);
 		snprintf(
@@ -434,7 +450,7 @@ static void watch_handles(struct re_super *s)
 	int n = 0;
 
 	for (int h = 0; h < 8; h++)
-		if (s->rec.handles[h])
+		if (s->pub.rec.handles[h])
 			mask |= 1u << h;
 	if (!s->have_handles) {
 		s->handles_known = mask;
@@ -445,25 +461,26 @@ static void watch_handles(struct re_super *s)
 	s->handles_known = mask;
 	if (!fresh)
 		return;
-	s->foreign |= fresh;
+	s->pub.foreign |= fresh;
 	for (int h = 0; h < 8; h++)
 		if (fresh >> h & 1)
 			hs[n++] = (char)('A' + h);
 	hs[n] = '\0';
 	snprintf(s->text, sizeof(s->text),
 		 "another program connected to the controller (handle %s)", hs);
-	re_io_logf(&s->io, RE_LOG_WARN, "%s", s->text);
+	re_io_logf(&s->pub.io, RE_LOG_WARN, "%s", s->text);
 	re_super_note(s, RE_LOG_WARN, RE_EV_FOREIGN, s->text);
 }
 
 static void drain_messages(struct re_super *s)
 {
 	for (int i = 0; i < RE_SUPER_MSGS; i++) {
-		int n = s->io.ops->message(s->io.ud, s->msg, sizeof(s->msg));
+		int n = s->pub.io.ops->message(s->pub.io.ud, s->msg,
+					       sizeof(s->msg));
 
 		if (n < 0)
 			break;
-		re_io_logf(&s->io, RE_LOG_INFO, "controller: %s", s->msg);
+		re_io_logf(&s->pub.io, RE_LOG_INFO, "controller: %s", s->msg);
 	}
 }
 
@@ -475,22 +492,22 @@ static int check_readback(struct re_super *s, struct re_fault *f)
 	int bad = 0, v;
 	double found = 0;
 
-	if (!s->rb_n || !s->rb_have || !s->have_za)
+	if (!s->pub.rb_n || !s->rb_have || !s->pub.have_za)
 		return RE_OK;
-	s->state_cycles = s->seal_state && s->za.state == s->seal_state
+	s->state_cycles = s->seal_state && s->pub.za.state == s->seal_state
 			      ? s->state_cycles + 1
 			      : 0;
-	v = re_seal_judge(s->cfg.seal, s->seal_expect, s->rb_first[s->rb_cur],
-			  s->rb_count[s->rb_cur], s->rb_reply,
-			  strlen(s->rb_reply), s->state_cycles >= 2,
-			  s->za.state, &bad, &found);
+	v = re_seal_judge(s->pub.cfg.seal, s->seal_expect,
+			  s->rb_first[s->rb_cur], s->rb_count[s->rb_cur],
+			  s->rb_reply, strlen(s->rb_reply),
+			  s->state_cycles >= 2, s->pub.za.state, &bad, &found);
 	if (v == GL_ERR_PROTO)
 		return check_error(f, RE_F_COMM, -1, "the seal's read-back", v);
 	if (v != RE_FAULT)
 		return RE_OK;
 	re_fault_set(f, RE_F_READBACK, -1);
 	f->i[0] = bad;
-	re_seal_fault(s->cfg.seal, found, s->seal_expect[bad - 1], f);
+	re_seal_fault(s->pub.cfg.seal, found, s->seal_expect[bad - 1], f);
 	f->id = RE_F_READBACK;
 	return RE_FAULT;
 }
@@ -500,14 +517,15 @@ static int check_record(struct re_super *s, struct re_fault *f)
 {
 	int v;
 
-	v = re_check_record(&s->rec, s->cfg.n_axes, s->expect, &s->za, f);
-	s->have_za = v == RE_OK || f->id != RE_F_RECORD;
+	v = re_check_record(&s->pub.rec, s->pub.cfg.n_axes, s->pub.expect,
+			    &s->pub.za, f);
+	s->pub.have_za = v == RE_OK || f->id != RE_F_RECORD;
 	if (v < 0)
 		return check_error(f, RE_F_COMM, -1, "the record check", v);
 	if (v != RE_OK)
 		return v;
-	v = re_check_alive(&s->cfg.alive, &s->alive, now_ns(s), s->za.hbdmc,
-			   s->rec.sample, f);
+	v = re_check_alive(&s->pub.cfg.alive, &s->alive, now_ns(s),
+			   s->pub.za.hbdmc, s->pub.rec.sample, f);
 	if (v < 0)
 		return check_error(f, RE_F_WDOG_HEARTBEAT, -1,
 				   "the liveness check", v);
@@ -517,32 +535,34 @@ static int check_record(struct re_super *s, struct re_fault *f)
 	if (v == RE_FAULT)
 		return v;
 	v = check_readback(s, f);
-	if (v == RE_FAULT || !s->expect)
+	if (v == RE_FAULT || !s->pub.expect)
 		return v;
 	v = check_uncmd(s, f);
-	if (v == RE_FAULT || !s->cfg.xcheck)
+	if (v == RE_FAULT || !s->pub.cfg.xcheck)
 		return v;
-	v = re_xcheck_step(&s->xc, s->cfg.xcheck, &s->rec, &s->za, now_ns(s),
-			   f);
+	v = re_xcheck_step(&s->xc, s->pub.cfg.xcheck, &s->pub.rec, &s->pub.za,
+			   now_ns(s), f);
 	return v < 0 ? check_error(f, RE_F_CONFIG, -1, "the joystick decode", v)
 		     : v;
 }
 
 static int latched_cycle(struct re_super *s)
 {
-	int rc = s->io.ops->record(s->io.ud, NULL, &s->rec,
-				   (int)(s->period_ns / BASE_NS_PER_MS) + 1);
+	int rc =
+	    s->pub.io.ops->record(s->pub.io.ud, NULL, &s->pub.rec,
+				  (int)(s->pub.period_ns / BASE_NS_PER_MS) + 1);
 	struct re_fault scratch;
 
 	memset(&scratch, 0, sizeof(scratch));
-	s->link_ok = rc == GL_OK;
+	s->pub.link_ok = rc == GL_OK;
 	if (rc == GL_OK) {
 		struct re_encpot_state st[RE_SUPER_AXES];
 
-		s->have_record = 1;
-		s->have_za = re_check_record(&s->rec, s->cfg.n_axes, 0, &s->za,
-					     &scratch) >= 0 &&
-			     scratch.id != RE_F_RECORD;
+		s->pub.have_record = 1;
+		s->pub.have_za =
+		    re_check_record(&s->pub.rec, s->pub.cfg.n_axes, 0,
+				    &s->pub.za, &scratch) >= 0 &&
+		    scratch.id != RE_F_RECORD;
 		memcpy(st, s->encpot, sizeof(st));
 		check_encpot(s, &scratch);
 		memcpy(s->encpot, st, sizeof(st));
@@ -551,9 +571,11 @@ static int latched_cycle(struct re_super *s)
 	 * is logged once, as the operator cannot be shown a second FAULT. */
 	if (!s->relay_lost_logged && check_relay(s, &scratch) == RE_FAULT) {
 		s->relay_lost_logged = 1;
-		re_fault_format_units(&scratch, s->cfg.axis_names,
-				      &s->cfg.units, s->text, sizeof(s->text));
-		re_io_logf(&s->io, RE_LOG_WARN, "while latched: %s", s->text);
+		re_fault_format_units(&scratch, s->pub.cfg.axis_names,
+				      &s->pub.cfg.units, s->text,
+				      sizeof(s->text));
+		re_io_logf(&s->pub.io, RE_LOG_WARN, "while latched: %s",
+			   s->text);
 		re_super_note(s, RE_LOG_FAULT, RE_EV_RELAY, s->text);
 	}
 	drain_messages(s);
@@ -569,8 +591,8 @@ static int cycle_checks(struct re_super *s)
 	if (check_stall(s, &f) == RE_FAULT)
 		return re_super_fault(s, &f);
 	v = exchange(s, &f);
-	warn = s->link_ok && s->age_last_ns > s->noncrit_ns;
-	if (s->link_ok)
+	warn = s->pub.link_ok && s->pub.age_last_ns > s->noncrit_ns;
+	if (s->pub.link_ok)
 		watch_handles(s);
 	rv = check_relay(s, &rf);
 	if (rv == RE_FAULT)
@@ -587,10 +609,9 @@ static int cycle_checks(struct re_super *s)
 }
 
 /* flight recorder: the hooks, and the one call per cycle */
-void re_super_recorder(struct re_super *s,
-		       void (*cycle)(void *ud, const struct re_super *s),
-		       const char *(*fault)(void *ud, const struct re_super *s),
-		       void *ud)
+void re_super_recorder(
+    struct re_super *s, void (*cycle)(void *ud, const struct re_super_view *v),
+    const char *(*fault)(void *ud, const struct re_super_view *v), void *ud)
 {
 	s->rec_cycle = cycle;
 	s->rec_fault = fault;
@@ -601,15 +622,15 @@ int re_super_cycle(struct re_super *s)
 {
 	int v;
 
-	s->cycles++;
-	if (s->latched) {
+	s->pub.cycles++;
+	if (s->pub.latched) {
 		v = latched_cycle(s);
 	} else {
 		v = cycle_checks(s);
-		s->last_end_ns = s->latched ? 0 : now_ns(s);
+		s->last_end_ns = s->pub.latched ? 0 : now_ns(s);
 	}
 	if (s->rec_cycle) /* flight recorder: a copy, no I/O */
-		s->rec_cycle(s->rec_ud, s);
+		s->rec_cycle(s->rec_ud, &s->pub);
 	return v;
 }
 
@@ -618,7 +639,7 @@ int re_super_cycle(struct re_super *s)
 static void axis_status(const struct re_super *s, int i,
 			struct re_axis_status *out)
 {
-	const struct gl_rec_axis *a = &s->rec.axis[i];
+	const struct gl_rec_axis *a = &s->pub.rec.axis[i];
 	const struct re_caltable *t = s->table[i];
 
 	out->enc_counts = a->motor_pos;
@@ -639,39 +660,39 @@ static void axis_status(const struct re_super *s, int i,
 		out->soft_fwd_counts = t->soft_fwd;
 		out->have_soft = 1;
 	}
-	out->have_expect = s->have_encres[i];
-	out->pot_expected_v = s->encres[i].exp.pot_v;
-	out->margin_v = s->encres[i].margin_v;
+	out->have_expect = s->pub.have_encres[i];
+	out->pot_expected_v = s->pub.encres[i].exp.pot_v;
+	out->margin_v = s->pub.encres[i].margin_v;
 }
 
 void re_super_status(const struct re_super *s, struct re_status *st)
 {
 	memset(st, 0, sizeof(*st));
-	st->n_axes = s->cfg.n_axes;
-	for (int i = 0; i < s->cfg.n_axes; i++) {
-		st->axis_names[i] = s->cfg.axis_names[i];
-		if (s->have_record)
+	st->n_axes = s->pub.cfg.n_axes;
+	for (int i = 0; i < s->pub.cfg.n_axes; i++) {
+		st->axis_names[i] = s->pub.cfg.axis_names[i];
+		if (s->pub.have_record)
 			axis_status(s, i, &st->axis[i]);
 	}
-	st->have_record = s->have_record;
-	st->relay = s->io.ops->relay_state(s->io.ud);
-	st->wd_last_ms = ns_to_ms(s->age_last_ns);
-	st->wd_worst_ms = ns_to_ms(s->age_worst_ns);
-	st->period_ms = ns_to_ms(s->period_ns);
-	st->late_last_ms = ns_to_ms(s->late_last_ns);
+	st->have_record = s->pub.have_record;
+	st->relay = s->pub.io.ops->relay_state(s->pub.io.ud);
+	st->wd_last_ms = ns_to_ms(s->pub.age_last_ns);
+	st->wd_worst_ms = ns_to_ms(s->pub.age_worst_ns);
+	st->period_ms = ns_to_ms(s->pub.period_ns);
+	st->late_last_ms = ns_to_ms(s->pub.late_last_ns);
 	st->late_worst_ms = ns_to_ms(s->late_worst_ns);
-	st->cycles = s->cycles;
-	st->overruns = s->overruns;
+	st->cycles = s->pub.cycles;
+	st->overruns = s->pub.overruns;
 	st->wd_warnings = s->wd_warnings;
-	st->armed = s->armed;
-	st->expect = s->expect;
-	st->log_failing = s->log_failing;
-	st->foreign = s->foreign;
-	st->link_ok = s->link_ok;
-	st->za = s->za;
-	st->have_za = s->have_za;
-	st->mode_name = s->cfg.mode_name ? s->cfg.mode_name : "";
-	st->latched = s->latched;
+	st->armed = s->pub.armed;
+	st->expect = s->pub.expect;
+	st->log_failing = s->pub.log_failing;
+	st->foreign = s->pub.foreign;
+	st->link_ok = s->pub.link_ok;
+	st->za = s->pub.za;
+	st->have_za = s->pub.have_za;
+	st->mode_name = s->pub.cfg.mode_name ? s->pub.cfg.mode_name : "";
+	st->latched = s->pub.latched;
 	st->fault_line = re_super_fault_line(s);
 	st->uptime_s = (double)(now_ns(s) - s->t0_ns) / 1e9;
 }

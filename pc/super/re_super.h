@@ -157,95 +157,53 @@ struct re_status {
 	double uptime_s;
 };
 
-#define RE_LATE_BIN_US 50   /* lateness histogram resolution, us */
-#define RE_LATE_BINS   2001 /* 0 .. 100 ms, then one overflow bin */
-
-struct re_super {
+/* What the supervisor publishes, read-only to the rest of roboelf (the
+ * console, the recorder, the start-up): re_super_view(). The core keeps
+ * these fields up to date itself; there is no copy to go stale. */
+struct re_super_view {
 	struct re_io io;
 	struct re_super_cfg cfg;
-	const struct re_caltable *table[RE_SUPER_AXES]; /* NULL: no check */
-	int expect; /* RE_DMC_ARMED, RE_DMC_SERVICE, or 0 (nothing on) */
-	int armed;  /* expect == RE_DMC_ARMED (kept for the status) */
-	/* schedule */
-	int64_t t0_ns;
-	int64_t deadline_ns; /* start of the next cycle */
-	int64_t period_ns;   /* the schedule's period (cfg or override) */
-	int64_t late_last_ns, late_worst_ns;
+	int expect;	   /* RE_DMC_ARMED, RE_DMC_SERVICE, or 0 (nothing on) */
+	int armed;	   /* expect == RE_DMC_ARMED (kept for the status) */
+	int64_t period_ns; /* the schedule's period (cfg or override) */
+	int64_t late_last_ns;
 	uint64_t cycles, overruns;
-	/* wake-up lateness histogram: RE_LATE_BIN_US bins, the last one
-	 * counts everything later (for the exit statistics; no allocation) */
-	uint32_t late_hist[RE_LATE_BINS];
-	/* the supervisor's own liveness: end of the last cycle (0: none) */
-	int64_t last_end_ns;
-	/* watchdog */
-	int64_t noncrit_ns, crit_ns;
-	int64_t last_good_ns;
+	int64_t crit_ns; /* the critical reply-age limit (the plan's) */
 	int64_t age_last_ns, age_worst_ns;
-	uint64_t wd_warnings;
 	long hbpc; /* heartbeat value last written */
-	struct re_alive_state alive;
 	/* the last record and its checks */
 	struct gl_record rec;
 	int have_record;
 	int link_ok;
 	struct re_za za;
 	int have_za;
-	struct re_encpot_state encpot[RE_SUPER_AXES];
 	struct re_encpot_result encres[RE_SUPER_AXES];
 	int have_encres[RE_SUPER_AXES];
-	/* motion cross-check: what the supervisor itself commands (service
-	 * moves), when each axis was last commanded, since when it moves */
-	unsigned own_mask;
-	int64_t cmd_ns[RE_SUPER_AXES];
-	int64_t moving_ns[RE_SUPER_AXES]; /* 0: at rest */
-	/* other programs at the controller: the handles open at the start
-	 * (and since), and those another program opened after it */
-	unsigned handles_known;
-	int have_handles;
-	unsigned foreign;
+	unsigned foreign; /* handles another program opened (1 = A) */
 	/* fault latch */
 	int latched;
 	struct re_fault fault;
-	struct re_confirm confirm;
 	char fault_line[RE_SUPER_LINE];
-	int relay_lost_logged; /* relay failure while latched, logged once */
-	/* later faults and warnings for the console: a fixed ring (no
-	 * allocation in the cycle), read with re_super_event() */
-	struct re_event events[RE_SUPER_EVENTS];
-	uint64_t event_seq; /* the newest event's seq, 0: none yet */
-	/* a log entry that could not be written, kept for re_super_retry() */
-	int log_failing;
-	enum re_log_level pending_lvl;
-	char pending[2048];
-	/* flight recorder (re_super_recorder()): @rec_cycle at the
-	 * end of every cycle, @rec_fault when a fault latches (its text is
-	 * added to the FAULT log entry); NULL: none */
-	void (*rec_cycle)(void *ud, const struct re_super *s);
-	const char *(*rec_fault)(void *ud, const struct re_super *s);
-	void *rec_ud;
-	/* the diverse checks: the supervisor's joystick decode, and the seal
-	 * read back a chunk per cycle ("hbpc=N;MG r1,...") against
-	 * seal_expect (made for the state @seal_state) */
-	struct re_xcheck xc;
-	double seal_expect[RE_SEAL_MAX];
-	int seal_state;		   /* RE_DMC_ARMED / _SERVICE / 0 */
-	int state_cycles;	   /* records in a row showing seal_state */
-	int rb_n, rb_next, rb_cur; /* chunks; next to send; in the reply */
-	int rb_have;		   /* rb_reply holds chunk rb_cur */
-	int rb_first[RE_SEAL_MAX], rb_count[RE_SEAL_MAX];
-	char rb_chunk[RE_SEAL_MAX][64];
-	char rb_line[96];
-	char rb_reply[512];
-	/* scratch, preallocated */
-	char prefix[32]; /* "hbpc=N" of the last request ... */
-	long prefix_hb;	 /* ... its N ... */
-	int prefix_len;	 /* ... and length (0: not built yet) */
-	char resp[128];
-	char verdict[96]; /* what the settle wait found, for the log */
-	char then[160];	  /* consequences seen after the first cause */
-	char msg[RE_SUPER_LINE];
-	char text[2048];
+	int log_failing; /* a log entry could not be written */
+	int rb_n;	 /* chunks of the seal's read-back */
 };
+
+/* The supervisor's state: private to pc/super (re_super_int.h). */
+struct re_super;
+
+/*
+ * re_super_new() - a zeroed supervisor, allocated once at start-up (never
+ * in the cycle); re_super_init() sets it up.
+ * re_super_free() - release it (NULL: nothing).
+ * Return (new): the supervisor, or NULL when out of memory.
+ */
+struct re_super *re_super_new(void);
+void re_super_free(struct re_super *s);
+
+/*
+ * re_super_view() - what @s publishes, valid as long as @s.
+ */
+const struct re_super_view *re_super_view(const struct re_super *s);
 
 /*
  * re_super_init() - set up the cycle state. Computes the watchdog limits.
@@ -314,10 +272,9 @@ int64_t re_super_wait(struct re_super *s);
  * name of the trace that will hold the fault. Both run inside the cycle:
  * they must not allocate, block or do I/O. NULL hooks: no recorder.
  */
-void re_super_recorder(struct re_super *s,
-		       void (*cycle)(void *ud, const struct re_super *s),
-		       const char *(*fault)(void *ud, const struct re_super *s),
-		       void *ud);
+void re_super_recorder(
+    struct re_super *s, void (*cycle)(void *ud, const struct re_super_view *v),
+    const char *(*fault)(void *ud, const struct re_super_view *v), void *ud);
 
 /*
  * re_super_cycle() - one cycle: round trip, checks, fault reaction.

@@ -991,7 +991,7 @@ static enum re_relay_state rb_relay(void *ud)
 
 static const struct re_io_ops rb_ops = {.now_ns = rb_now,
 					.relay_state = rb_relay};
-static struct re_super rb_sup;
+static struct re_super_view rb_sup;
 static struct re_rec rb_rec;
 
 /* A supervisor as after an armed cycle with tables, and a 30 s ring at
@@ -1004,7 +1004,7 @@ static int rec_setup(void)
 				.dir = "/tmp",
 				.n_axes = 3,
 				.axis_names = {"A", "B", "C"}};
-	struct re_super *s = &rb_sup;
+	struct re_super_view *s = &rb_sup;
 
 	memset(s, 0, sizeof(*s));
 	s->io.ops = &rb_ops;
@@ -1022,7 +1022,7 @@ static int rec_setup(void)
 	}
 	if (re_rec_init(&rb_rec, &rc) != 0)
 		return -1;
-	re_rec_attach(&rb_rec, s, "1");
+	re_rec_begin(&rb_rec, s, "1");
 	return 0;
 }
 

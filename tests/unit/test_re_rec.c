@@ -245,7 +245,7 @@ static int forbid_syscalls(void)
  * 0 is the proof that neither makes a system call. */
 static void test_rec_no_syscall(void **state)
 {
-	static struct re_super s;
+	static struct re_super_view s;
 	static struct re_rec r;
 	struct re_rec_cfg c = {.seconds = 30,
 			       .after_fault_s = 2,
@@ -265,7 +265,7 @@ static void test_rec_no_syscall(void **state)
 		s.have_encres[i] = 1;
 	snprintf(s.fault_line, sizeof(s.fault_line), "FAULT X: test");
 	assert_int_equal(re_rec_init(&r, &c), GL_OK);
-	re_rec_attach(&r, &s, "1");
+	re_rec_begin(&r, &s, "1");
 	pid = fork();
 	assert_true(pid >= 0);
 	if (pid == 0) {
@@ -301,7 +301,7 @@ static void test_rec_no_syscall(void **state)
  * record twice gives no figure (NAN). */
 static void test_rec_vcmd_controller_time(void **state)
 {
-	static struct re_super s;
+	static struct re_super_view s;
 	static struct re_rec r;
 	struct re_rec_cfg c = {.seconds = 2,
 			       .after_fault_s = 1,
@@ -318,7 +318,7 @@ static void test_rec_vcmd_controller_time(void **state)
 	s.have_record = s.have_za = s.link_ok = 1;
 	s.rec.sample = 65520; /* wraps after the second record */
 	assert_int_equal(re_rec_init(&r, &c), GL_OK);
-	re_rec_attach(&r, &s, "1");
+	re_rec_begin(&r, &s, "1");
 	re_rec_take(&r, &s);
 	assert_true(isnan(r.ring[0].axis[0].vcmd_cps)); /* no previous */
 	for (int k = 0; k < 5; k++) {

@@ -21,7 +21,7 @@
 #include "base_file.h"
 #include "gl_err.h"
 #include "re_rec.h"
-#include "re_super.h"
+#include "re_super_int.h"
 #include "re_trace.h"
 
 #define MS	  1000000LL
@@ -353,18 +353,18 @@ static void test_super_hbpc_text(void **state)
 	(void)state;
 	assert_int_equal(run(10), RE_OK);
 	assert_string_equal(fk.last_prefix, "hbpc=10");
-	sup.hbpc = 12344; /* not the last one + 1: written anew */
+	sup.pub.hbpc = 12344; /* not the last one + 1: written anew */
 	assert_int_equal(run(1), RE_OK);
 	assert_string_equal(fk.last_prefix, "hbpc=12345");
-	sup.hbpc = 1998;
+	sup.pub.hbpc = 1998;
 	assert_int_equal(run(2), RE_OK);
 	assert_string_equal(fk.last_prefix, "hbpc=2000");
-	sup.hbpc = 9998;
+	sup.pub.hbpc = 9998;
 	assert_int_equal(run(1), RE_OK);
 	assert_string_equal(fk.last_prefix, "hbpc=9999");
 	assert_int_equal(run(1), RE_OK); /* one digit more */
 	assert_string_equal(fk.last_prefix, "hbpc=10000");
-	sup.hbpc = RE_HBPC_WRAP - 2;
+	sup.pub.hbpc = RE_HBPC_WRAP - 2;
 	assert_int_equal(run(1), RE_OK);
 	assert_string_equal(fk.last_prefix, "hbpc=999999999");
 	assert_int_equal(run(2), RE_OK); /* the wrap */
@@ -471,8 +471,8 @@ static void test_super_stall_in_round_trip(void **state)
 		fk.record_rc = rcs[k];
 		assert_int_equal(step(), RE_FAULT);
 		assert_int_equal(fk.last_timeout_ms, 76);
-		assert_int_equal(sup.fault.id, RE_F_STALL);
-		assert_int_equal(sup.fault.i[0], k ? 2076 : 2000);
+		assert_int_equal(sup.pub.fault.id, RE_F_STALL);
+		assert_int_equal(sup.pub.fault.i[0], k ? 2076 : 2000);
 		assert_non_null(strstr(re_super_fault_line(&sup),
 				       "FAULT WATCHDOG: this supervisor did "
 				       "not run for "));
@@ -617,9 +617,9 @@ static void test_super_controller_fault(void **state)
 	assert_int_equal(step(), RE_FAULT);
 	assert_string_equal(fk.commands[0], "pcflt=1;AB 1;MO ABC");
 	assert_string_equal(fk.commands[1], "MG fdet");
-	assert_int_equal(sup.fault.id, RE_F_CTRL_POSERR);
-	assert_int_equal(sup.fault.axis, 1);
-	assert_int_equal(sup.fault.i[0], 5012);
+	assert_int_equal(sup.pub.fault.id, RE_F_CTRL_POSERR);
+	assert_int_equal(sup.pub.fault.axis, 1);
+	assert_int_equal(sup.pub.fault.i[0], 5012);
 	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT MOTION: ", 14));
 }
 
@@ -631,8 +631,8 @@ static void test_super_motor_off(void **state)
 	fk.rec.axis[2].status |= GL_AXST_MOTOR_OFF;
 	fk.rec.axis[2].stop_code = 12;
 	assert_int_equal(step(), RE_FAULT);
-	assert_int_equal(sup.fault.id, RE_F_MOTOR_OFF);
-	assert_int_equal(sup.fault.axis, 2);
+	assert_int_equal(sup.pub.fault.id, RE_F_MOTOR_OFF);
+	assert_int_equal(sup.pub.fault.axis, 2);
 	assert_non_null(strstr(re_super_fault_line(&sup), "encoder failure"));
 }
 
@@ -643,7 +643,7 @@ static void test_super_motor_off(void **state)
 static void test_super_settle_program_verdict(void **state)
 {
 	(void)state;
-	sup.cfg.settle_ms = 25;
+	sup.pub.cfg.settle_ms = 25;
 	assert_int_equal(run(2), RE_OK);
 	for (int i = 0; i < 3; i++) {
 		fk.rec.axis[i].status |= GL_AXST_MOTOR_OFF;
@@ -660,8 +660,8 @@ static void test_super_settle_program_verdict(void **state)
 				    "relay_off_finish,"
 				    "cmd:MG _MOA,cmd:MG _MOB,cmd:MG _MOC,"
 				    "cmd:MG fhnew,log:FAULT");
-	assert_int_equal(sup.fault.id, RE_F_CTRL_INPUT);
-	assert_int_equal(sup.fault.i[0], 1);
+	assert_int_equal(sup.pub.fault.id, RE_F_CTRL_INPUT);
+	assert_int_equal(sup.pub.fault.i[0], 1);
 	assert_true(!strncmp(re_super_fault_line(&sup), "FAULT INPUT: ", 13));
 	assert_non_null(strstr(fault_log(), " | program fault 3 after "));
 }
@@ -672,14 +672,14 @@ static void test_super_settle_timeout(void **state)
 	int64_t t;
 
 	(void)state;
-	sup.cfg.settle_ms = 25;
+	sup.pub.cfg.settle_ms = 25;
 	assert_int_equal(run(2), RE_OK);
 	fk.rec.axis[0].status |= GL_AXST_MOTOR_OFF;
 	fk.rec.axis[0].stop_code = 8;
 	fk.fcode_after = 1000;
 	t = fk.now;
 	assert_int_equal(step(), RE_FAULT);
-	assert_int_equal(sup.fault.id, RE_F_MOTOR_OFF);
+	assert_int_equal(sup.pub.fault.id, RE_F_MOTOR_OFF);
 	assert_true(fk.now - t >= 25 * MS && fk.now - t < 80 * MS);
 	assert_string_equal(fk.commands[fk.n_commands - 6], "pcflt=1");
 	assert_string_equal(fk.commands[fk.n_commands - 5], "MG _MOA");
@@ -695,8 +695,8 @@ static void test_super_thread_missing(void **state)
 	assert_int_equal(run(2), RE_OK);
 	fk.rec.threads = 0x01;
 	assert_int_equal(step(), RE_FAULT);
-	assert_int_equal(sup.fault.id, RE_F_THREAD);
-	assert_int_equal(sup.fault.i[0], 1);
+	assert_int_equal(sup.pub.fault.id, RE_F_THREAD);
+	assert_int_equal(sup.pub.fault.i[0], 1);
 }
 
 /* The program heartbeat stops: WATCHDOG after its limit, not before. */
@@ -707,7 +707,7 @@ static void test_super_heartbeat_frozen(void **state)
 	fk.freeze_hb = 1;
 	assert_int_equal(run(2), RE_OK);    /* 100 ms frozen < 125 ms */
 	assert_int_equal(step(), RE_FAULT); /* 150 ms */
-	assert_int_equal(sup.fault.id, RE_F_WDOG_HEARTBEAT);
+	assert_int_equal(sup.pub.fault.id, RE_F_WDOG_HEARTBEAT);
 	assert_true(
 	    !strncmp(re_super_fault_line(&sup), "FAULT WATCHDOG: ", 16));
 }
@@ -719,7 +719,7 @@ static void test_super_sample_frozen(void **state)
 	assert_int_equal(run(2), RE_OK);
 	fk.freeze_sample = 1;
 	assert_int_equal(run(10), RE_FAULT);
-	assert_int_equal(sup.fault.id, RE_F_WDOG_SAMPLE);
+	assert_int_equal(sup.pub.fault.id, RE_F_WDOG_SAMPLE);
 }
 
 /* Once latched: no more reactions, no heartbeat, status polling only; a
@@ -806,14 +806,14 @@ static void test_super_schedule_overrun(void **state)
 	(void)state;
 	assert_int_equal(run(4), RE_OK);
 	t = fk.now;
-	assert_int_equal(sup.overruns, 0);
+	assert_int_equal(sup.pub.overruns, 0);
 	fk.now += 120 * MS; /* the process was held up */
 	re_super_wait(&sup);
-	assert_int_equal(sup.overruns, 1);
+	assert_int_equal(sup.pub.overruns, 1);
 	t = fk.now;
 	re_super_wait(&sup); /* the next one is a full period on */
 	assert_int_equal(fk.now - t, PERIOD_MS * MS);
-	assert_int_equal(sup.overruns, 1);
+	assert_int_equal(sup.pub.overruns, 1);
 }
 
 /* The quit path: stop and motors off first, then the relay. */
@@ -963,7 +963,7 @@ static void test_super_recorder(void **state)
 	assert_string_equal(h.reason, "fault");
 	assert_int_equal(h.have_fault, 1);
 	assert_int_equal(strncmp(h.fault_text, "FAULT ", 6), 0);
-	assert_int_equal(r[49].cycle, (int32_t)sup.cycles);
+	assert_int_equal(r[49].cycle, (int32_t)sup.pub.cycles);
 	/* 20 latched cycles after the fault cycle, 29 before it */
 	assert_int_equal(r[29].phase, RE_TPH_FAULT);
 	assert_int_equal(r[28].phase, RE_TPH_ARMED);
