@@ -1,7 +1,7 @@
 # RoboELF control software - top-level Makefile (GNU make).
 #
 #   make deps     install the Debian packages the build and tests need
-#   make          build build/bin/{roboelf,galil-load,galil-sim}
+#   make          build build/bin/{roboelf,roboelf-tech,galil-load,galil-sim}
 #   make check    build and run every test (the one test command)
 #   make asan     the full check built with -fsanitize=address,undefined
 #   make demo     the whole system on the simulator
@@ -20,13 +20,15 @@
 #   pc/super/*.c         the safety core: the cycle, its checks, the fault
 #                        reaction, the relay, the log, the locks, real time
 #                                                         -> $(BUILD)/lib/libsuper.a
-#   pc/{config,calib,rec,console,start,comm}/*.c  the rest of the supervisor:
+#   pc/{config,calib,rec,console,start}/*.c  the rest of the supervisor:
 #                        configuration and plan, calibration, recorder and
-#                        traces, console, start-up, commissioning -> libre.a
+#                        traces, console, start-up -> libre.a
 #   pc/roboelf.c         supervisor main                 -> $(BUILD)/bin/roboelf
 #   tools/galil-sim/**.c simulator (main.c = main)       -> libsim.a + galil-sim
 #                        (ctrl/ the interpreter, plant/ the robot, net/ the ports)
 #   tools/galil-load/*.c loader (main.c = main)          -> libload.a + galil-load
+#   tools/roboelf-tech/*.c the technician's program: commissioning, viewers,
+#                        host check (main.c = main)      -> libtech.a + roboelf-tech
 #   tests/harness/*.c    test helpers                    -> libharness.a
 #   tests/stub/*.c       the misbehaving socket stub     -> $(BUILD)/bin/galil-stub
 #   tests/<dir>/test_*.c one cmocka binary each          -> $(BUILD)/tests/<dir>/test_*
@@ -34,7 +36,7 @@
 #     what is used is pulled in), plus extra linker flags from an optional
 #     tests/<dir>/test_*.ldflags file (e.g. -Wl,--wrap=sp_open).
 # Layering (checked by tests/checks/layers.sh): base <- galil, dmc <- super <- config
-# <- calib, rec <- console <- start, comm <- roboelf;
+# <- calib, rec <- console <- start <- roboelf, roboelf-tech;
 # base, galil, dmc <- galil-load and galil-sim; nothing includes upward.
 
 CC ?= cc
@@ -65,9 +67,9 @@ ALL_LDFLAGS = $(LDFLAGS) $(SAN)
 LIBS = $(PKG_LIBS) -lpthread -lm
 
 SIM_DIRS := tools/galil-sim $(wildcard tools/galil-sim/*/)
-RE_DIRS := pc/config pc/calib pc/rec pc/console pc/start pc/comm
+RE_DIRS := pc/config pc/calib pc/rec pc/console pc/start
 INC_DIRS := pc $(wildcard pc/base pc/galil pc/dmc) pc/super $(RE_DIRS) $(patsubst %/,%,$(SIM_DIRS)) \
-            tools/galil-load tests/harness tests/stub
+            tools/galil-load tools/roboelf-tech tests/harness tests/stub
 
 BASE_SRC := $(wildcard pc/base/*.c)
 GL_SRC := $(wildcard pc/gl_*.c pc/galil/*.c)
@@ -76,6 +78,7 @@ SUPER_SRC := $(wildcard pc/super/*.c)
 RE_SRC := $(wildcard $(addsuffix /*.c,$(RE_DIRS)))
 SIM_SRC := $(filter-out tools/galil-sim/main.c,$(wildcard $(addsuffix /*.c,$(patsubst %/,%,$(SIM_DIRS)))))
 LOAD_SRC := $(filter-out tools/galil-load/main.c,$(wildcard tools/galil-load/*.c))
+TECH_SRC := $(filter-out tools/roboelf-tech/main.c,$(wildcard tools/roboelf-tech/*.c))
 HARN_SRC := $(wildcard tests/harness/*.c)
 STUB_SRC := $(wildcard tests/stub/*.c)
 TEST_SRC := $(wildcard tests/*/test_*.c)
@@ -88,12 +91,14 @@ LIB_SUPER := $(BUILD)/lib/libsuper.a
 LIB_RE := $(BUILD)/lib/libre.a
 LIB_SIM := $(BUILD)/lib/libsim.a
 LIB_LOAD := $(BUILD)/lib/libload.a
+LIB_TECH := $(BUILD)/lib/libtech.a
 LIB_HARN := $(BUILD)/lib/libharness.a
-LINK_LIBS := $(LIB_HARN) $(LIB_LOAD) $(LIB_SIM) $(LIB_RE) $(LIB_SUPER) $(LIB_DMC) $(LIB_GL) \
+LINK_LIBS := $(LIB_HARN) $(LIB_TECH) $(LIB_LOAD) $(LIB_SIM) $(LIB_RE) $(LIB_SUPER) $(LIB_DMC) $(LIB_GL) \
              $(LIB_BASE)
 
 BINS := $(if $(wildcard pc/roboelf.c),$(BUILD)/bin/roboelf) \
         $(if $(wildcard tools/galil-load/main.c),$(BUILD)/bin/galil-load) \
+        $(if $(wildcard tools/roboelf-tech/main.c),$(BUILD)/bin/roboelf-tech) \
         $(if $(wildcard tools/galil-sim/main.c),$(BUILD)/bin/galil-sim) \
         $(if $(STUB_SRC),$(BUILD)/bin/galil-stub)
 TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
@@ -123,6 +128,7 @@ $(eval $(call mklib,$(LIB_SUPER),$(SUPER_SRC)))
 $(eval $(call mklib,$(LIB_RE),$(RE_SRC)))
 $(eval $(call mklib,$(LIB_SIM),$(SIM_SRC)))
 $(eval $(call mklib,$(LIB_LOAD),$(LOAD_SRC)))
+$(eval $(call mklib,$(LIB_TECH),$(TECH_SRC)))
 $(eval $(call mklib,$(LIB_HARN),$(HARN_SRC)))
 
 $(BUILD)/bin/roboelf: $(call obj,pc/roboelf.c) $(LIB_RE) $(LIB_SUPER) $(LIB_DMC) $(LIB_GL) $(LIB_BASE)
@@ -130,6 +136,10 @@ $(BUILD)/bin/roboelf: $(call obj,pc/roboelf.c) $(LIB_RE) $(LIB_SUPER) $(LIB_DMC)
 	$(CC) $(ALL_LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/bin/galil-load: $(call obj,tools/galil-load/main.c) $(LIB_LOAD) $(LIB_RE) $(LIB_SUPER) $(LIB_DMC) $(LIB_GL) \
 		$(LIB_BASE)
+	@mkdir -p $(@D)
+	$(CC) $(ALL_LDFLAGS) -o $@ $^ $(LIBS)
+$(BUILD)/bin/roboelf-tech: $(call obj,tools/roboelf-tech/main.c) $(LIB_TECH) $(LIB_RE) $(LIB_SUPER) $(LIB_DMC) \
+		$(LIB_GL) $(LIB_BASE)
 	@mkdir -p $(@D)
 	$(CC) $(ALL_LDFLAGS) -o $@ $^ $(LIBS)
 $(BUILD)/bin/galil-sim: $(call obj,tools/galil-sim/main.c) $(LIB_SIM) $(LIB_RE) $(LIB_SUPER) $(LIB_DMC) $(LIB_GL) \
@@ -306,7 +316,7 @@ install: all
 		$(INSTALL) -D -m 644 "$$f" "$(DESTDIR)$(DOCDIR)/$$f" || exit 1; done
 
 uninstall:
-	rm -f $(addprefix "$(DESTDIR)$(PREFIX)/bin/",roboelf galil-load galil-sim)
+	rm -f $(addprefix "$(DESTDIR)$(PREFIX)/bin/",roboelf roboelf-tech galil-load galil-sim)
 	rm -f $(addprefix "$(DESTDIR)$(PREFIX)/share/man/man1/",$(notdir $(MAN1)))
 	rm -f $(addprefix "$(DESTDIR)$(PREFIX)/share/man/man5/",$(notdir $(MAN5)))
 	rm -rf "$(DESTDIR)$(DATADIR)" "$(DESTDIR)$(DOCDIR)"

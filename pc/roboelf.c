@@ -6,7 +6,10 @@
  *   roboelf [-c FILE] [--galil HOST[:PORT]] [--relay PORT]
  *           [--calibration full|file] [--period MS] [--log FILE]
  *           [--counts]
- *   roboelf --show-calibration FILE
+ *
+ * roboelf supervises, and nothing else: the technician's commissioning
+ * run, the viewers of calibration files and traces and the host's
+ * self-test are roboelf-tech (tools/roboelf-tech).
  *
  * Exit codes: 0 normal quit; 2 configuration or usage error (also: a
  * calibration file that cannot be used, without a terminal to offer a full
@@ -44,11 +47,7 @@
 #include "gl_link.h"
 #include "re_calfile.h"
 #include "re_calib.h"
-#include "re_calshow.h"
 #include "re_check.h"
-#include "re_comm.h"
-#include "re_comm_report.h"
-#include "re_comm_start.h"
 #include "re_config.h"
 #include "re_console.h"
 #include "re_ctl.h"
@@ -59,77 +58,11 @@
 #include "re_rec.h"
 #include "re_relay.h"
 #include "re_rt.h"
+#include "re_app.h"
 #include "re_start.h"
-#include "re_traceshow.h"
 #include "re_super.h"
 
-static void on_signal(int sig)
-{
-	re_sig.quit = sig;
-}
-
-/* SIGUSR1: write a trace of the flight recorder now. */
-static volatile sig_atomic_t trace_asked;
-
-static void on_usr1(int sig)
-{
-	(void)sig;
-	trace_asked = 1;
-}
-
-/* A stop (SIGSTOP, a debugger) during start-up: the cycle measures its own
- * gaps, but start-up is a sequence of waits and commands. SIGCONT says
- * the process was stopped; the stop lasted from the last moment it is
- * known to have run (a link call's start or end) to the SIGCONT. */
-static void on_cont(int sig)
-{
-	int64_t now, from;
-
-	(void)sig;
-	now = base_now_ns();
-	from = re_sig.cont_real ? re_sig.cont_real->last_run_ns : now;
-	re_sig.cont_stop_ms = (now - from) / 1000000;
-	re_sig.continued = 1;
-}
-
-/* Every signal a terminal or a person can send ends in the orderly
- * shutdown (the safe state), never in a kill or a freeze with power on:
- * Ctrl-C, Ctrl-\, SIGTERM and a lost terminal (SIGHUP) quit; Ctrl-Z and
- * background terminal I/O are ignored; a closed pipe is an error return. */
-static void install_signals(void)
-{
-	static const int quit[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
-	static const int ignore[] = {SIGPIPE, SIGTSTP, SIGTTIN, SIGTTOU};
-	struct sigaction sa;
-
-	memset(&sa, 0, sizeof(sa));
-	sa.sa_handler = on_signal;
-	sigemptyset(&sa.sa_mask);
-	for (size_t i = 0; i < sizeof(quit) / sizeof(quit[0]); i++)
-		sigaction(quit[i], &sa, NULL);
-	sa.sa_handler = on_cont;
-	sa.sa_flags = SA_RESTART;
-	sigaction(SIGCONT, &sa, NULL);
-	sa.sa_handler = on_usr1;
-	sigaction(SIGUSR1, &sa, NULL);
-	sa.sa_flags = 0;
-	sa.sa_handler = SIG_IGN;
-	for (size_t i = 0; i < sizeof(ignore) / sizeof(ignore[0]); i++)
-		sigaction(ignore[i], &sa, NULL);
-}
-
 /* ---- options ----------------------------------------------------------- */
-
-/* The installed configuration: SYSCONFDIR/roboelf/roboelf.yaml, under
- * ROBOELF_ROOT when that is set (base_paths.h); "" when it does not fit. */
-static const char *system_config(void)
-{
-	static char path[RE_PATH_MAX];
-
-	if (!path[0])
-		base_paths_sysconf(SYSTEM_CONFIG, path, sizeof(path));
-	return path;
-}
 
 static void usage(FILE *f)
 {
@@ -139,11 +72,6 @@ static void usage(FILE *f)
 	    "               [--calibration full|file] [--period MS] "
 	    "[--log FILE]\n"
 	    "               [--counts]\n"
-	    "       roboelf --show-calibration FILE\n"
-	    "       roboelf --show-trace FILE [--window FROM:TO]\n"
-	    "       roboelf --commission DIR [-c FILE] [--galil ...] "
-	    "[--wait S]\n"
-	    "       roboelf --check-host[=SECONDS] [-c FILE]\n"
 	    "\n"
 	    "  -c, --config FILE        configuration (default %s, else "
 	    "%s)\n"
@@ -156,32 +84,19 @@ static void usage(FILE *f)
 	    "      --log FILE           failure log\n"
 	    "      --counts             the board in encoder counts, not "
 	    "deg/mm (key u toggles)\n"
-	    "      --show-calibration FILE  print a calibration file (and "
-	    "plot it)\n"
-	    "      --show-trace FILE    check a flight-recorder trace and "
-	    "plot it (PNG pages)\n"
-	    "      --window FROM:TO     --show-trace: only t_s FROM..TO "
-	    "seconds (either may be empty)\n"
-	    "      --commission DIR     the commissioning run; report "
-	    "in DIR\n"
-	    "      --wait S             commissioning: each wait for the "
-	    "technician (60 s)\n"
-	    "      --find-addr A, --find-port P  commissioning: where the "
-	    "discovery probe goes\n"
-	    "                           (255.255.255.255, 50000)\n"
-	    "      --check-host[=S]     measure this host's wake-up "
-	    "lateness for S s (10) and\n"
-	    "                           name the shortest safe period\n"
 	    "      --dmc DIR            the DMC programs --version names "
 	    "(default ./dmc, else the installed ones)\n"
 	    "  -h, --help               this text\n"
 	    "      --version            the release, the DMC interface it "
 	    "expects, the files it uses\n"
 	    "\n"
+	    "The commissioning run, the viewers of calibration files and "
+	    "traces and the\n"
+	    "host's self-test are roboelf-tech (roboelf-tech --help).\n"
+	    "\n"
 	    "exit: 0 quit, 2 usage/config, 3 no relay/controller, "
-	    "4 fault latched, 5 commissioning found a fault,\n"
-	    "      6 --check-host: the configured period is not safe here\n",
-	    DEFAULT_CONFIG, system_config());
+	    "4 fault latched\n",
+	    DEFAULT_CONFIG, re_app_system_config());
 }
 
 static int parse_period(const char *s, int *out)
@@ -208,45 +123,47 @@ static int parse_calib(const char *s, enum re_calib_choice *out)
 	return 0;
 }
 
+/* The command line. */
+struct opts {
+	struct re_app_args g; /* what roboelf-tech takes too */
+	int version;	      /* --version asked */
+	int counts;	      /* --counts: the board in encoder counts */
+	enum re_calib_choice calib;
+};
+
+/* An option that moved to the technician's program. */
+static const struct moved {
+	const char *opt, *now;
+} MOVED[] = {
+    {"commission", "roboelf-tech commission DIR"},
+    {"show-calibration", "roboelf-tech show-calibration FILE"},
+    {"show-trace", "roboelf-tech show-trace FILE"},
+    {"check-host", "roboelf-tech check-host"},
+    {"window", "roboelf-tech show-trace FILE --window FROM:TO"},
+    {"wait", "roboelf-tech commission DIR --wait S"},
+    {"find-addr", "roboelf-tech commission DIR --find-addr A"},
+    {"find-port", "roboelf-tech commission DIR --find-port P"},
+};
+#define N_MOVED ((int)(sizeof(MOVED) / sizeof(MOVED[0])))
+
 static int opt_value(struct opts *o, int c, const char *arg)
 {
+	if (c >= 1000 && c < 1000 + N_MOVED) {
+		fprintf(stderr,
+			"roboelf: error: --%s is not roboelf's: roboelf "
+			"supervises, and nothing else; run %s (the "
+			"technician's program)\n",
+			MOVED[c - 1000].opt, MOVED[c - 1000].now);
+		return -1;
+	}
 	switch (c) {
-	case 'c': o->config = arg; return 0;
-	case 'g': o->galil = arg; return 0;
-	case 'r': o->relay = arg; return 0;
-	case 'l': o->log = arg; return 0;
-	case 's': o->show_cal = arg; return 0;
-	case 'T': o->show_trace = arg; return 0;
-	case 'w': o->window = arg; return 0;
-	case 'M': o->commission = arg; return 0;
-	case 'F': o->find_addr = arg; return 0;
-	case 'D': o->dmc = arg; return 0;
-	case 'P':
-		o->find_port = atoi(arg);
-		if (o->find_port >= 1 && o->find_port <= 65535)
-			return 0;
-		fprintf(stderr, "roboelf: error: invalid port '%s'\n", arg);
-		return -1;
-	case 'W':
-		o->wait_s = atoi(arg);
-		if (o->wait_s >= 1 && o->wait_s <= 3600)
-			return 0;
-		fprintf(stderr,
-			"roboelf: error: invalid wait '%s': must be 1..3600 "
-			"s\n",
-			arg);
-		return -1;
-	case 'H':
-		o->check_host_s = arg ? atoi(arg) : 10;
-		if (o->check_host_s >= 1 && o->check_host_s <= 3600)
-			return 0;
-		fprintf(stderr,
-			"roboelf: error: invalid --check-host '%s': must be "
-			"1..3600 s\n",
-			arg);
-		return -1;
+	case 'c': o->g.config = arg; return 0;
+	case 'g': o->g.galil = arg; return 0;
+	case 'r': o->g.relay = arg; return 0;
+	case 'l': o->g.log = arg; return 0;
+	case 'D': o->g.dmc = arg; return 0;
 	case 'p':
-		if (parse_period(arg, &o->period_ms) == 0)
+		if (parse_period(arg, &o->g.period_ms) == 0)
 			return 0;
 		fprintf(stderr,
 			"roboelf: error: invalid period '%s': must be "
@@ -275,24 +192,23 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 	    {"calibration", required_argument, NULL, 'k'},
 	    {"period", required_argument, NULL, 'p'},
 	    {"log", required_argument, NULL, 'l'},
-	    {"show-calibration", required_argument, NULL, 's'},
-	    {"show-trace", required_argument, NULL, 'T'},
-	    {"window", required_argument, NULL, 'w'},
-	    {"commission", required_argument, NULL, 'M'},
-	    {"wait", required_argument, NULL, 'W'},
-	    {"find-addr", required_argument, NULL, 'F'},
-	    {"find-port", required_argument, NULL, 'P'},
-	    {"check-host", optional_argument, NULL, 'H'},
 	    {"dmc", required_argument, NULL, 'D'},
 	    {"help", no_argument, NULL, 'h'},
 	    {"version", no_argument, NULL, 'V'},
 	    {"counts", no_argument, NULL, 'U'},
+	    {"commission", optional_argument, NULL, 1000},
+	    {"show-calibration", optional_argument, NULL, 1001},
+	    {"show-trace", optional_argument, NULL, 1002},
+	    {"check-host", optional_argument, NULL, 1003},
+	    {"window", optional_argument, NULL, 1004},
+	    {"wait", optional_argument, NULL, 1005},
+	    {"find-addr", optional_argument, NULL, 1006},
+	    {"find-port", optional_argument, NULL, 1007},
 	    {NULL, 0, NULL, 0},
 	};
 	int c;
 
 	memset(o, 0, sizeof(*o));
-	o->config = NULL; /* searched for: find_config() */
 	while ((c = getopt_long(argc, argv, "c:h", lo, NULL)) != -1) {
 		if (c == 'h') {
 			usage(stdout);
@@ -318,138 +234,6 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 }
 
 /* ---- configuration and log ---------------------------------------------- */
-
-static void apply_overrides(struct app *a)
-{
-	struct re_config *c = &a->cfg;
-	char *port = c->mode == RE_MODE_CLINICAL ? c->relay.port_clinical
-						 : c->relay.port_development;
-
-	if (a->o.galil)
-		snprintf(c->controller.address, sizeof(c->controller.address),
-			 "%s", a->o.galil);
-	if (a->o.relay)
-		snprintf(port, RE_PATH_MAX, "%s", a->o.relay);
-	if (a->o.period_ms)
-		c->period_ms = a->o.period_ms;
-	if (a->o.log)
-		snprintf(c->log.path, sizeof(c->log.path), "%s", a->o.log);
-}
-
-static int check_analog(const struct re_config *c, char *err, size_t len)
-{
-	for (int i = 0; i < RE_AXES; i++) {
-		if (c->axes[i].analog.input > RE_AXES) {
-			snprintf(err, len,
-				 "axis '%s': analog input %d is not "
-				 "in the DMC-4030 data record (use 1..%d)",
-				 c->axes[i].name, c->axes[i].analog.input,
-				 RE_AXES);
-			return GL_ERR_CONFIG;
-		}
-	}
-	return GL_OK;
-}
-
-/* Without -c: ./config/roboelf.yaml (the source tree), then the
- * installed SYSCONFDIR/roboelf/roboelf.yaml; the first that exists. */
-static void find_config(struct opts *o)
-{
-	if (o->config)
-		return;
-	o->config_searched = 1;
-	o->config = access(DEFAULT_CONFIG, F_OK) == 0 ||
-			    access(system_config(), F_OK) != 0
-			? DEFAULT_CONFIG
-			: system_config();
-}
-
-/* --version: the release, the DMC interface, and the files this roboelf
- * would use from here: its configuration and the DMC programs that go
- * with it (--dmc, else ./dmc, else the installed ones). */
-static int print_version(struct opts *o)
-{
-	char dir[RE_PATH_MAX], manifest[RE_PATH_MAX + 16];
-
-	printf("roboelf %s (controller program interface %s, "
-	       "dmc/constants.dmc vers)\n",
-	       ROBOELF_VERSION, ROBOELF_DMC_VERSION);
-	find_config(o);
-	if (!o->config_searched)
-		printf("configuration: %s (-c)\n", o->config);
-	else if (access(o->config, F_OK) == 0)
-		printf("configuration: %s\n", o->config);
-	else
-		printf("configuration: none (neither %s here nor %s)\n",
-		       DEFAULT_CONFIG, system_config());
-	if (o->dmc) {
-		snprintf(manifest, sizeof(manifest), "%s/MANIFEST", o->dmc);
-		printf("DMC programs: %s (--dmc%s)\n", o->dmc,
-		       access(manifest, F_OK) == 0 ? ""
-						   : "; it has no MANIFEST");
-	} else if (base_paths_dmc_dir(dir, sizeof(dir)) == 0) {
-		printf("DMC programs: %s\n", dir);
-	} else {
-		printf("DMC programs: none (neither dmc/MANIFEST here nor "
-		       "%s/MANIFEST)\n",
-		       dir);
-	}
-	return 0;
-}
-
-static int load_config(struct app *a)
-{
-	find_config(&a->o);
-	if (re_config_load_file(a->o.config, &a->cfg, a->err, sizeof(a->err)) !=
-	    GL_OK) {
-		fprintf(stderr, "%s\n", a->err);
-		if (errno == ENOENT && a->o.config_searched)
-			fprintf(stderr,
-				"roboelf: no configuration: neither '%s' (in "
-				"this directory) nor '%s' exists; give one "
-				"with -c FILE\n",
-				DEFAULT_CONFIG, system_config());
-		return -1;
-	}
-	apply_overrides(a);
-	if (a->cfg.mode == RE_MODE_CLINICAL && base_paths_root()) {
-		fprintf(stderr,
-			"roboelf: error: %s is set: refused in clinical mode "
-			"(it is for testing a staged installation); unset it\n",
-			BASE_PATHS_ROOT_ENV);
-		return -1;
-	}
-	if (re_config_validate(&a->cfg, a->err, sizeof(a->err)) != GL_OK ||
-	    check_analog(&a->cfg, a->err, sizeof(a->err)) != GL_OK) {
-		fprintf(stderr, "roboelf: error: %s\n", a->err);
-		return -1;
-	}
-	for (int i = 0; i < RE_AXES; i++)
-		a->names[i] = a->cfg.axes[i].name;
-	return 0;
-}
-
-static int open_log(struct app *a)
-{
-	struct re_log_cfg lc = re_log_cfg_default();
-	char dump[1536];
-	int rc;
-
-	lc.max_bytes = (size_t)a->cfg.log.max_bytes;
-	lc.keep = a->cfg.log.keep; /* 1..9, checked by the config loader */
-	rc = re_log_open(&a->log, a->cfg.log.path, &lc);
-	if (rc != GL_OK) {
-		fprintf(stderr, "roboelf: error: cannot open log '%s': %s\n",
-			a->cfg.log.path,
-			rc == GL_ERR_SYS ? strerror(errno) : gl_strerror(rc));
-		return -1;
-	}
-	re_log_msg(&a->log, RE_LOG_INFO, "start: roboelf, config '%s'",
-		   a->o.config);
-	re_config_dump(&a->cfg, dump, sizeof(dump));
-	re_log_msg(&a->log, RE_LOG_INFO, "config: %s", dump);
-	return 0;
-}
 
 /* ---- run and cleanup ------------------------------------------------------
  */
@@ -580,9 +364,9 @@ static void trace_tick(struct app *a, int key)
 {
 	if (!a->rec)
 		return;
-	if ((trace_asked || key == 't' || key == 'T') &&
+	if ((re_sig.trace_asked || key == 't' || key == 'T') &&
 	    re_rec_request(a->rec) == GL_OK)
-		trace_asked = 0;
+		re_sig.trace_asked = 0;
 	re_rec_poll(a->rec, re_io_now_ns());
 	trace_report(a);
 }
@@ -663,44 +447,6 @@ static void run(struct app *a)
 	    (unsigned long long)a->con.dropped);
 }
 
-/* Power-off, the reverse of power-on: the program back to its safe
- * state, every motor off and read back, then the relay off and closed.
- * What was confirmed is said, on the screen and in the log. */
-static void power_off(struct app *a, int latched)
-{
-	char what[192] = "";
-	int rc = GL_OK;
-
-	if (a->sup)
-		rc = re_super_shutdown(a->sup, what, sizeof(what));
-	else if (a->real.link && a->ctl_ours)
-		rc = re_ctl_stop(&a->io, a->cfg.controller.timeout_ms);
-	/* refused (busy, not identified): somebody else's, left alone */
-	if (a->relay && re_relay_close(a->relay) != GL_OK)
-		rc = rc ? rc : GL_ERR_RELAY;
-	a->relay = a->real.relay = NULL;
-	gl_link_close(a->real.link);
-	a->real.link = NULL;
-	if (!a->powered) {
-		re_console_msg(&a->con,
-			       "roboelf: motor power was never "
-			       "switched on; %s",
-			       latched ? "a fault was latched" : "bye");
-		re_log_msg(&a->log, RE_LOG_INFO, "stop: motor power never on");
-		return;
-	}
-	if (!what[0])
-		snprintf(what, sizeof(what), "motors off: %s",
-			 rc == GL_OK ? "confirmed" : gl_strerror(rc));
-	re_console_msg(&a->con, "roboelf: %s%s; %s", what,
-		       rc == GL_OK ? ""
-				   : " - NOT ALL CONFIRMED: press the hardware "
-				     "E-stop",
-		       latched ? "a fault was latched" : "bye");
-	re_log_msg(&a->log, rc == GL_OK ? RE_LOG_INFO : RE_LOG_WARN,
-		   "stop: %s%s", what, latched ? " (fault latched)" : "");
-}
-
 /* ---- real time ------------------------------------------------ */
 
 /* SCHED_FIFO, locked memory and a CPU as configured, for this thread only
@@ -738,83 +484,20 @@ static int rt_setup(struct app *a)
 	return 0;
 }
 
-/* --check-host: this host's wake-up lateness under the configured real-
- * time set-up, and the verdict per period. Return: 0, EXIT_HOST when the
- * configured period is not safe, EXIT_USAGE when the probe failed. */
-static int check_host(struct app *a)
-{
-	static const int cand[] = {2, 3, 5, 10, 20, 50, 100};
-	const struct re_config_realtime *r = &a->cfg.realtime;
-	const struct re_config_watchdog *w = &a->cfg.watchdog;
-	struct re_rt_cfg rc = {r->priority, r->cpu, r->lock_memory};
-	struct re_rt_probe p;
-	struct re_rt_verdict v;
-	char d[RE_RT_DESCRIBE_MAX];
-	int best = 0, own_safe;
-
-	install_signals();
-	re_rt_setup(&rc, &a->rt);
-	printf("host check: %s\n", re_rt_describe(&a->rt, d, sizeof(d)));
-	printf("host check: sleeping to 1 ms deadlines for %d s ...\n",
-	       a->o.check_host_s);
-	fflush(stdout);
-	if (re_rt_probe_run(1000000, a->o.check_host_s * 1000000000LL,
-			    &re_sig.quit, &p) < 0 ||
-	    p.wakes == 0) {
-		fprintf(stderr, "roboelf: error: host check: %s\n",
-			strerror(errno));
-		return EXIT_USAGE;
-	}
-	printf("host check: %llu wake-ups, late p50 %.3f p99 %.3f p99.9 %.3f "
-	       "max %.3f ms; %llu later than 1 ms, %llu later than 5 ms\n",
-	       (unsigned long long)p.wakes, p.p50_ms, p.p99_ms, p.p999_ms,
-	       p.max_ms, (unsigned long long)p.over_1ms,
-	       (unsigned long long)p.over_5ms);
-	printf("period  lateness allowed  verdict (watchdog %.1f/%.1f x P)\n",
-	       w->noncritical_factor, w->critical_factor);
-	for (size_t i = 0; i < sizeof(cand) / sizeof(cand[0]); i++) {
-		re_rt_verdict(&p, cand[i], w->noncritical_factor,
-			      w->critical_factor, &v);
-		if (v.safe && cand[i] >= re_rt_min_period_ms(&a->rt) && !best)
-			best = cand[i];
-		printf("%4d ms  %8.1f ms        %s\n", cand[i], v.margin_ms,
-		       cand[i] < re_rt_min_period_ms(&a->rt)
-			   ? "refused without real-time scheduling"
-		       : !v.safe ? "NOT SAFE: would trip WATCHDOG"
-		       : v.quiet ? "safe"
-				 : "safe, with occasional watchdog warnings");
-	}
-	re_rt_verdict(&p, a->cfg.period_ms, w->noncritical_factor,
-		      w->critical_factor, &v);
-	own_safe = v.safe && a->cfg.period_ms >= re_rt_min_period_ms(&a->rt);
-	printf("host check: shortest safe period on this host: %s%d ms; the "
-	       "configured %d ms (%s) is %s\n",
-	       best ? "" : "none of these; more than ", best ? best : 100,
-	       a->cfg.period_ms, a->o.config, own_safe ? "safe" : "NOT SAFE");
-	return own_safe ? 0 : EXIT_HOST;
-}
-
 /* Return: 1 when a fault was latched. */
 static int cleanup(struct app *a)
 {
 	int latched = a->sup && re_super_view(a->sup)->latched;
 
 	re_io_flush_log(&a->real);
-	power_off(a, latched);
+	re_app_power_off(a, latched);
 	close_recorder(a);
-	re_lock_release(&a->lock_relay);
-	re_lock_release(&a->lock_ctl);
-	re_console_close(&a->con);
-	re_log_close(&a->log);
-	re_super_free(a->sup);
-	free(a->cal);
-	a->sup = NULL;
-	a->cal = NULL;
+	re_app_release(a);
 	return latched;
 }
 
 /* The console: the board in each axis's unit (or counts, --counts). */
-static void open_console(struct app *a)
+static void open_console(struct app *a, int counts)
 {
 	char abs[PATH_MAX];
 
@@ -824,15 +507,15 @@ static void open_console(struct app *a)
 	for (int i = 0; i < RE_AXES; i++)
 		re_console_units(&a->con, i, re_unit_name(a->cfg.axes[i].unit),
 				 a->cfg.axes[i].counts_per_unit);
-	re_console_counts(&a->con, a->o.counts);
+	re_console_counts(&a->con, counts);
 }
 
-static int supervise(struct app *a)
+static int supervise(struct app *a, int counts)
 {
 	int rc;
 
-	open_console(a);
-	if (a->o.calib == RE_CALIB_ASK && !a->con.tty_in) {
+	open_console(a, counts);
+	if (a->calib_opt == RE_CALIB_ASK && !a->con.tty_in) {
 		fprintf(stderr, "roboelf: error: no terminal to ask full or "
 				"file calibration: use --calibration full or "
 				"--calibration file\n");
@@ -844,7 +527,7 @@ static int supervise(struct app *a)
 	re_lock_init(&a->lock_ctl);
 	re_lock_init(&a->lock_relay);
 	re_io_bind(&a->io, &a->real);
-	install_signals();
+	re_app_signals();
 	if (open_recorder(a) < 0 || rt_setup(a) < 0) {
 		re_console_close(&a->con);
 		re_log_close(&a->log);
@@ -858,153 +541,27 @@ static int supervise(struct app *a)
 	return rc;
 }
 
-/* --show-calibration: the tables, and a plot per axis where gnuplot is
- * installed; the tolerance band from the configuration when it loads. */
-static int show_calibration(struct app *a)
-{
-	double allowed[RE_AXES];
-
-	find_config(&a->o);
-	if (re_config_load_file(a->o.config, &a->cfg, a->err, sizeof(a->err)) !=
-	    GL_OK)
-		re_config_defaults(&a->cfg);
-	for (int i = 0; i < RE_AXES; i++)
-		allowed[i] = a->cfg.axes[i].allowed_error;
-	return re_calshow_print(a->o.show_cal, allowed, RE_AXES, stdout,
-				stderr) == GL_OK
-		   ? 0
-		   : EXIT_USAGE;
-}
-
-/* --show-trace: the trace checked, summarised and drawn. */
-static int show_trace(struct app *a)
-{
-	struct re_traceshow_win w;
-
-	if (a->o.window && re_traceshow_window(a->o.window, &w) < 0) {
-		fprintf(stderr,
-			"roboelf: error: invalid window '%s': use FROM:TO in "
-			"seconds, FROM < TO, either may be empty\n",
-			a->o.window);
-		return EXIT_USAGE;
-	}
-	return re_traceshow_run(a->o.show_trace, a->o.window ? &w : NULL,
-				stdout, stderr);
-}
-
-/* ---- the commissioning run ------------------------------------------- */
-
-static void comm_say(void *ud, const char *line)
-{
-	struct app *a = ud;
-
-	re_console_msg(&a->con, "%s", line);
-	re_log_msg(&a->log, RE_LOG_INFO, "%s", line);
-}
-
-/* A yes/no question on the terminal (or a line on stdin): only "y" or
- * "yes" is a yes; end of input is a no. */
-static int comm_confirm(void *ud, const char *question)
-{
-	struct app *a = ud;
-	char line[32];
-	int yes;
-
-	re_console_msg(&a->con, "commission: %s [y/N]", question);
-	yes = fgets(line, sizeof(line), stdin) &&
-	      (!strcmp(line, "y\n") || !strcmp(line, "yes\n"));
-	re_log_msg(&a->log, RE_LOG_INFO, "commission: %s -> %s", question,
-		   yes ? "yes" : "no");
-	return yes;
-}
-
-static void comm_date(char *buf, size_t cap)
-{
-	time_t t = time(NULL);
-	struct tm tm;
-
-	gmtime_r(&t, &tm);
-	strftime(buf, cap, "%Y-%m-%d %H:%M:%S UTC", &tm);
-}
-
-/* After re_comm_start(): the steps, the report, the summary. */
-static int comm_steps(struct app *a)
-{
-	static struct re_comm c;
-	char date[32], line[1024], err[256];
-	struct re_comm_where w = {a->cfg.controller.address, a->o.config, date};
-	int rc, plots = 0;
-
-	re_comm_init(&c);
-	c.io = &a->io;
-	c.link = a->real.link;
-	c.relay = a->relay;
-	c.cfg = &a->cfg;
-	c.ui = (struct re_comm_ui){a, comm_say, comm_confirm};
-	c.quit = &re_sig.quit;
-	if (a->o.wait_s)
-		c.wait_ms = a->o.wait_s * 1000;
-	snprintf(c.model, sizeof(c.model), "%s", a->info.model);
-	c.serial = a->info.serial;
-	rc = re_comm_run(&c);
-	a->powered = c.power_on_seen;
-	comm_date(date, sizeof(date));
-	re_comm_summary(&c, line, sizeof(line));
-	re_console_msg(&a->con, "commission: %s", line);
-	re_log_msg(&a->log, rc ? RE_LOG_WARN : RE_LOG_INFO, "commission: %s",
-		   line);
-	if (re_comm_report(&c, &w, a->o.commission, &plots, err, sizeof(err)) !=
-	    GL_OK) {
-		re_console_msg(&a->con, "roboelf: error: %s", err);
-		return EXIT_CONNECT;
-	}
-	re_console_msg(&a->con, "commission: report %s/%s, %d plot(s)",
-		       a->o.commission, RE_COMM_REPORT_NAME, plots);
-	return rc == GL_OK ? 0 : EXIT_COMMISSION;
-}
-
-static int commission(struct app *a)
-{
-	int rc;
-
-	re_console_open(&a->con, stdout, STDIN_FILENO);
-	a->real.log = &a->log;
-	re_lock_init(&a->lock_ctl);
-	re_lock_init(&a->lock_relay);
-	re_io_bind(&a->io, &a->real);
-	install_signals();
-	rc = re_comm_start(a);
-	if (!rc)
-		rc = comm_steps(a);
-	cleanup(a);
-	return rc;
-}
-
 int main(int argc, char **argv)
 {
 	static struct app a;
-	int rc = parse_opts(argc, argv, &a.o);
+	static struct opts o;
+	int rc = parse_opts(argc, argv, &o);
 
 	if (rc)
 		return rc > 0 ? 0 : EXIT_USAGE;
+	a.prog = "roboelf";
 	if (base_paths_root())
 		fprintf(stderr,
 			"roboelf: %s=%s: the installed files are looked for "
 			"under it\n",
 			BASE_PATHS_ROOT_ENV, base_paths_root());
-	if (a.o.version)
-		return print_version(&a.o);
-	if (a.o.show_cal)
-		return show_calibration(&a);
-	if (a.o.show_trace)
-		return show_trace(&a);
-	if (load_config(&a) < 0)
+	if (o.version)
+		return re_app_print_version(a.prog, &o.g);
+	if (re_app_load_config(&a, &o.g) < 0)
 		return EXIT_USAGE;
-	if (a.o.check_host_s)
-		return check_host(&a);
-	if (open_log(&a) < 0)
+	a.config_path = o.g.config;
+	a.calib_opt = o.calib;
+	if (re_app_open_log(&a, &o.g) < 0)
 		return EXIT_USAGE;
-	if (a.o.commission)
-		return commission(&a);
-	return supervise(&a);
+	return supervise(&a, o.counts);
 }

@@ -40,12 +40,12 @@ fi
 	--alloc-lib "$TOP/$BUILD/bench/alloc_count.so" \
 	--faults-bin "$TOP/$BUILD/tests/system/test_sys_faults"
 
-# The host latency self-test (roboelf --check-host): this machine's wake-up
+# The host latency self-test (roboelf-tech check-host): this machine's wake-up
 # lateness under the configured real-time set-up and the shortest safe period.
 echo
-echo "bench: host self-test (roboelf --check-host=${ROBOELF_BENCH_HOST_S:-10})"
-"$BUILD/bin/roboelf" -c config/roboelf.yaml \
-	--check-host="${ROBOELF_BENCH_HOST_S:-10}" || true
+echo "bench: host self-test (roboelf-tech check-host ${ROBOELF_BENCH_HOST_S:-10})"
+"$BUILD/bin/roboelf-tech" check-host "${ROBOELF_BENCH_HOST_S:-10}" \
+	-c config/roboelf.yaml || true
 
 # The loops again with real-time scheduling (SCHED_FIFO 50, inherited by
 # galil-sim and roboelf), where this user may use it: the 2 ms period needs

@@ -8,7 +8,7 @@
 # invalid switch state that must not trip, and finally a potentiometer fault
 # that must trip the E-stop. It ends by naming the flight recorder's trace
 # of that fault (kept in $BUILD/demo/) and the PNG pages roboelf
-# --show-trace drew from it, and the directory $BUILD/demo/run-<time>
+# roboelf-tech show-trace drew from it, and the directory $BUILD/demo/run-<time>
 # where roboelf ran (its log, calibration file and output). roboelf's board
 # keeps to the bottom of the terminal; this narration scrolls above it.
 # roboelf is stopped by a SIGTERM to itself (an orderly quit), every other
@@ -241,8 +241,8 @@ trace=$(sed -n 's/.* trace: \(.*\) written (.*/\1/p' "$RUN/roboelf.log" | head -
 OUT="$TOP/$BUILD/demo"
 mkdir -p "$OUT" && cp "$trace" "$OUT/" || die "cannot keep the trace in $OUT"
 trace="$OUT/$(basename "$trace")"
-"$BIN/roboelf" --show-trace "$trace" >"$TMP/show.out" 2>"$TMP/show.err" ||
-	die "roboelf --show-trace failed: $(cat "$TMP/show.err")"
+"$BIN/roboelf-tech" show-trace "$trace" >"$TMP/show.out" 2>"$TMP/show.err" ||
+	die "roboelf-tech show-trace failed: $(cat "$TMP/show.err")"
 say "demo finished: stopping roboelf and galil-sim"
 stop_roboelf
 stop "$SIM_PID"; SIM_PID=""

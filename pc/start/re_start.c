@@ -28,7 +28,7 @@ void re_start_progress(struct app *a, const char *fmt, ...)
 	va_start(ap, fmt);
 	vsnprintf(text, sizeof(text), fmt, ap);
 	va_end(ap);
-	re_console_msg(&a->con, "roboelf: %s", text);
+	re_console_msg(&a->con, "%s: %s", a->prog, text);
 	re_log_msg(&a->log, RE_LOG_INFO, "%s", text);
 	a->real.last_run_ns = re_io_now_ns();
 }
@@ -40,14 +40,14 @@ int re_start_fail(struct app *a, const char *what)
 	int64_t ms = stalled_ms(a);
 
 	if (ms)
-		re_console_msg(
-		    &a->con,
-		    "roboelf: error: roboelf did not run for %lld ms "
-		    "(limit %lld ms: stopped, e.g. SIGSTOP or a "
-		    "debugger); then: %s",
-		    (long long)ms, (long long)re_start_stall_limit_ms(a), what);
+		re_console_msg(&a->con,
+			       "%s: error: %s did not run for %lld ms "
+			       "(limit %lld ms: stopped, e.g. SIGSTOP or a "
+			       "debugger); then: %s",
+			       a->prog, a->prog, (long long)ms,
+			       (long long)re_start_stall_limit_ms(a), what);
 	else
-		re_console_msg(&a->con, "roboelf: error: %s", what);
+		re_console_msg(&a->con, "%s: error: %s", a->prog, what);
 	re_log_msg(&a->log, RE_LOG_WARN, "start-up refused: %s%s", what,
 		   ms ? " (after a stop of roboelf itself)" : "");
 	return EXIT_CONNECT;
@@ -605,7 +605,7 @@ static int calib_load(struct app *a)
  * operator's (the prompt) or the command line's. Return: 0, EXIT_USAGE. */
 static int choose_calibration(struct app *a)
 {
-	int how = a->o.calib, rc;
+	int how = a->calib_opt, rc;
 
 	if (how == RE_CALIB_ASK)
 		how = re_console_ask_calibration(&a->con);

@@ -33,35 +33,16 @@
 #define EXIT_USAGE	2
 #define EXIT_CONNECT	3
 #define EXIT_FAULT	4
-#define EXIT_COMMISSION 5 /* the commissioning run found a fault */
-#define EXIT_HOST	6 /* --check-host: the configured period is not safe */
+#define EXIT_COMMISSION 5 /* roboelf-tech: commissioning found a fault */
+#define EXIT_HOST	6 /* roboelf-tech check-host: the period is not safe */
 #define DEFAULT_CONFIG	"config/roboelf.yaml"
 /* the installed one, under SYSCONFDIR (base_paths.h) */
 #define SYSTEM_CONFIG "roboelf/roboelf.yaml"
 
-struct opts {
-	const char *config; /* -c, or the one found (roboelf.1, FILES) */
-	const char *galil;
-	const char *relay;
-	const char *log;
-	const char *show_cal;
-	const char *show_trace; /* --show-trace FILE */
-	const char *window;	/* --window FROM:TO */
-	int config_searched;	/* no -c: find_config() chose it */
-	const char *dmc;	/* --dmc DIR: the DMC programs (--version) */
-	int version;		/* --version asked */
-	const char *commission; /* report directory */
-	int wait_s;	       /* commissioning: each wait for the technician */
-	const char *find_addr; /* commissioning: discovery probe address */
-	int find_port;	       /* and its port (0: the defaults) */
-	int period_ms;	       /* 0: from the configuration */
-	int counts;	       /* --counts: the board in encoder counts */
-	enum re_calib_choice calib;
-	int check_host_s; /* --check-host[=S]: seconds of the probe, 0: no */
-};
-
 struct app {
-	struct opts o;
+	const char *prog;	 /* "roboelf", "roboelf-tech": messages */
+	const char *config_path; /* the configuration file in use */
+	int calib_opt; /* --calibration: RE_CALIB_FULL, _FILE, or _ASK */
 	struct re_config cfg;
 	struct re_log log;
 	struct re_console con;
@@ -101,6 +82,7 @@ struct re_signals {
 	volatile sig_atomic_t continued;
 	volatile int64_t cont_stop_ms;
 	struct re_io_real *volatile cont_real;
+	volatile sig_atomic_t trace_asked; /* SIGUSR1: a trace now */
 };
 extern struct re_signals re_sig;
 

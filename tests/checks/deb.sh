@@ -26,8 +26,8 @@ make -s --no-print-directory BUILD="$BUILD" deb >"$tmp/make.log" 2>&1 ||
 
 dpkg -c "$deb" >"$tmp/list" || fail "dpkg -c"
 awk '{print $6}' "$tmp/list" >"$tmp/paths"
-for p in ./usr/bin/roboelf ./usr/bin/galil-load ./usr/bin/galil-sim \
-	./usr/share/man/man1/roboelf.1.gz ./usr/share/man/man1/galil-load.1.gz \
+for p in ./usr/bin/roboelf ./usr/bin/roboelf-tech ./usr/bin/galil-load ./usr/bin/galil-sim \
+	./usr/share/man/man1/roboelf.1.gz ./usr/share/man/man1/roboelf-tech.1.gz ./usr/share/man/man1/galil-load.1.gz \
 	./usr/share/man/man1/galil-sim.1.gz ./usr/share/man/man5/roboelf.yaml.5.gz \
 	./etc/roboelf/roboelf.yaml ./etc/security/limits.d/roboelf.conf \
 	./usr/share/roboelf/dmc/MANIFEST \

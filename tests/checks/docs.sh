@@ -382,6 +382,7 @@ report() {
 check_faults
 check_config
 check_options roboelf pc/roboelf.c
+check_options roboelf-tech tools/roboelf-tech/main.c
 check_options galil-load tools/galil-load/main.c
 check_options galil-sim tools/galil-sim/main.c
 

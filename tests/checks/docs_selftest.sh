@@ -45,7 +45,8 @@ drop() {
 
 # ---- 1. synthetic tree ---------------------------------------------------------
 S=$TMP/syn
-mkdir -p "$S/pc/super" "$S/pc/config" "$S/tools/galil-load" "$S/tools/galil-sim" "$S/docs"
+mkdir -p "$S/pc/super" "$S/pc/config" "$S/tools/galil-load" "$S/tools/galil-sim" \
+	"$S/tools/roboelf-tech" "$S/docs"
 cat >"$S/pc/super/re_fault.c" <<'EOF'
 /* "FAULT FAKE: in a comment. Recovery: never counted" */
 static const char *const re_fclass_names[RE_FC_COUNT] = {
@@ -104,6 +105,13 @@ int main(int argc, char **argv)
 			   ":a:", long_opts, NULL);
 }
 EOF
+cat >"$S/tools/roboelf-tech/main.c" <<'EOF'
+static const struct option lo[] = {
+    {"wait", required_argument, NULL, 'W'},
+    {NULL, 0, NULL, 0},
+};
+int main(int argc, char **argv) { return getopt_long(argc, argv, "", lo, NULL); }
+EOF
 cat >"$S/tools/galil-sim/main.c" <<'EOF'
 static const struct option longopts[] = {
     {"port", required_argument, NULL, 'p'},
@@ -128,6 +136,7 @@ cat >"$S/docs/config.md" <<'EOF'
 EOF
 printf '.TP\n.BR \\-c ", " \\-\\-config " \\fIFILE\\fR"\n.TP\n.B \\-h\n.BI \\-\\-show\\-calibration " FILE"\n' >"$S/docs/roboelf.1"
 printf '.BR \\-a ", " \\-\\-address\n' >"$S/docs/galil-load.1"
+printf '.BI \\-\\-wait " S"\n' >"$S/docs/roboelf-tech.1"
 printf '.BI \\-\\-port " N"\n.B \\-\\-no\\-relay\\-link\n' >"$S/docs/galil-sim.1"
 
 run_docs "$S"
@@ -145,6 +154,7 @@ if [ "$(grep -c '^fault	' "$TMP/list")" -eq 2 ] &&
    [ "$(grep -c '^config	' "$TMP/list")" -eq 4 ] &&
    grep -qxF 'option	roboelf	-h' "$TMP/list" &&
    grep -qxF 'option	galil-load	-a' "$TMP/list" &&
+   grep -qxF 'option	roboelf-tech	--wait' "$TMP/list" &&
    [ "$(grep -c '^option	galil-sim	' "$TMP/list")" -eq 2 ]; then
 	ok "synthetic tree: --list extracts exactly the items"
 else
@@ -183,8 +193,9 @@ expect_fail "synthetic: no config table found" "$TMP/g" \
 
 # ---- 2. the real tree ----------------------------------------------------------
 R=$TMP/real
-mkdir -p "$R/tools/galil-load" "$R/tools/galil-sim"
+mkdir -p "$R/tools/galil-load" "$R/tools/galil-sim" "$R/tools/roboelf-tech"
 cp -R "$TOP/pc" "$TOP/docs" "$R/" &&
+cp "$TOP/tools/roboelf-tech/main.c" "$R/tools/roboelf-tech/" &&
 cp "$TOP/tools/galil-load/main.c" "$R/tools/galil-load/" &&
 cp "$TOP/tools/galil-sim/main.c" "$R/tools/galil-sim/" || { bad "cannot copy the tree"; exit 1; }
 sh "$DOCS" --list "$R" >"$TMP/rlist"
@@ -231,9 +242,10 @@ expect_fail "real: config key added to re_config.c" "$TMP/r2" \
 
 # options: the last long option of each program removed from its man page,
 # and a new option added to roboelf
-for p in roboelf galil-load galil-sim; do
+for p in roboelf roboelf-tech galil-load galil-sim; do
 	case $p in
 	roboelf) src=pc/roboelf.c ;;
+	roboelf-tech) src=tools/roboelf-tech/main.c ;;
 	galil-load) src=tools/galil-load/main.c ;;
 	galil-sim) src=tools/galil-sim/main.c ;;
 	esac

@@ -17,11 +17,11 @@ mkdir "$tmp/elsewhere"
 
 make -s --no-print-directory BUILD="$BUILD" install DESTDIR="$root" PREFIX=/usr \
 	>"$tmp/make.log" 2>&1 || { cat "$tmp/make.log"; fail "make install"; }
-for f in usr/bin/roboelf usr/bin/galil-load usr/bin/galil-sim \
+for f in usr/bin/roboelf usr/bin/roboelf-tech usr/bin/galil-load usr/bin/galil-sim \
 	usr/share/roboelf/dmc/MANIFEST usr/share/roboelf/dmc/constants.dmc \
 	usr/share/roboelf/dmc/roboelf.dmc usr/share/roboelf/config/plant.yaml \
 	etc/roboelf/roboelf.yaml usr/share/man/man1/roboelf.1 \
-	usr/share/man/man1/galil-load.1 usr/share/man/man5/roboelf.yaml.5 \
+	usr/share/man/man1/galil-load.1 usr/share/man/man1/roboelf-tech.1 usr/share/man/man5/roboelf.yaml.5 \
 	usr/share/doc/roboelf/README.md usr/share/doc/roboelf/docs/technician.md \
 	usr/share/doc/roboelf/docs/trace-demo-pot-B.png; do
 	[ -f "$root/$f" ] || fail "not installed: /$f"

@@ -9,8 +9,8 @@
 #   0 base (pc/base)  1 galil (pc/galil), dmc (pc/dmc)
 #   2 super (pc/super): the safety core, over base, galil and dmc only
 #   3 config (pc/config)  4 calib (pc/calib), rec (pc/rec)
-#   5 console (pc/console)  6 start (pc/start)  7 comm (pc/comm)
-#   8 roboelf (pc/roboelf.c), galil-load, galil-sim (tools/)
+#   5 console (pc/console)  6 start (pc/start)
+#   7 roboelf (pc/roboelf.c), roboelf-tech, galil-load, galil-sim (tools/)
 #
 # Usage: layers.sh [--list]    (BUILD selects the build tree, default build)
 #   --list  also print every dependency.
@@ -49,9 +49,9 @@ function lib(m) {
 	if (m ~ /^pc\/rec\//) return "rec"
 	if (m ~ /^pc\/console\//) return "console"
 	if (m ~ /^pc\/start\//) return "start"
-	if (m ~ /^pc\/comm\//) return "comm"
 	if (m == "pc/roboelf") return "roboelf"
 	if (m ~ /^tools\/galil-load\//) return "galil-load"
+	if (m ~ /^tools\/roboelf-tech\//) return "roboelf-tech"
 	if (m ~ /^tools\/galil-sim\//) return "galil-sim"
 	return "other"
 }
@@ -63,8 +63,7 @@ function rank(l) {
 	if (l == "calib" || l == "rec") return 4
 	if (l == "console") return 5
 	if (l == "start") return 6
-	if (l == "comm") return 7
-	return 8
+	return 7
 }
 BEGIN { n = 0 }
 NR == FNR { def[$1] = mod($2); next }

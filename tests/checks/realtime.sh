@@ -1,6 +1,6 @@
 #!/bin/sh
 # realtime.sh - roboelf's real-time set-up seen from outside.
-#   1. As root (CI): `roboelf --check-host=1` reports SCHED_FIFO 50 in force
+#   1. As root (CI): `roboelf-tech check-host 1` reports SCHED_FIFO 50 in force
 #      (read back from the kernel), wake-up figures and a verdict, exit 0.
 #   2. Without the right (user 65534 via setpriv, RLIMIT_RTPRIO 0): a 5 ms
 #      period is refused with exit 2 and the message naming what to do,
@@ -20,11 +20,12 @@ T=$(mktemp -d "${TMPDIR:-/tmp}/rt-check.XXXXXX") || exit 1
 trap 'rm -rf "$T"' EXIT
 chmod 755 "$T"
 cp "$BIN/roboelf" "$T/roboelf"
+cp "$BIN/roboelf-tech" "$T/roboelf-tech"
 cp config/roboelf.yaml "$T/roboelf.yaml"
 mkdir "$T/w" && chmod 777 "$T/w"
 
 # 1. granted
-out=$("$T/roboelf" -c "$T/roboelf.yaml" --check-host=1 2>&1); rc=$?
+out=$("$T/roboelf-tech" check-host 1 -c "$T/roboelf.yaml" 2>&1); rc=$?
 first=$(echo "$out" | head -1)
 case "$first" in
 "host check: SCHED_FIFO 50, memory locked, not pinned" | \

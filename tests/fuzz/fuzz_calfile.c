@@ -5,7 +5,7 @@
  * Input: the file text. It is parsed as given, and again with its last
  * line's CRC recomputed (a last line "crc32 " + 8 hex digits gets the
  * right value) so that the fuzzer gets past the checksum into the tables.
- * Each text is read without expectations (roboelf --show-calibration) and
+ * Each text is read without expectations (roboelf-tech show-calibration) and
  * against a fixed expectation (controller "DMC4030-1234", axes A B C, the
  * config hash of docs/calibration-file.md). A file that parses without
  * expectations is formatted again: the text must parse back.

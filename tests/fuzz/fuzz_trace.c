@@ -1,6 +1,6 @@
 /*
  * fuzz_trace.c - libFuzzer target: the flight recorder's trace reader
- * (re_trace_parse(), the buffer entry point of roboelf --show-trace).
+ * (re_trace_parse(), the buffer entry point of roboelf-tech show-trace).
  *
  * Input: the trace text. It is parsed as given, and again with the CRC of
  * its end line recomputed (a line "# end N records crc32 " + 8 hex digits

@@ -419,7 +419,8 @@ static int start_roboelf(struct sys_case *c, const struct sys_opts *o)
 	char *argv[48];
 	int n = 0;
 
-	snprintf(bin, sizeof(bin), "%s/roboelf", e->bin);
+	snprintf(bin, sizeof(bin), "%s/%s", e->bin,
+		 o->tech ? "roboelf-tech" : "roboelf");
 	snprintf(addr, sizeof(addr), "%s:%d", c->sim_addr, c->sim.port);
 	for (int i = 0; o->re_wrap && o->re_wrap[i] && n < 12; i++)
 		argv[n++] = o->re_wrap[i];
@@ -430,11 +431,13 @@ static int start_roboelf(struct sys_case *c, const struct sys_opts *o)
 	argv[n++] = addr;
 	argv[n++] = (char *)"--relay";
 	argv[n++] = c->relay_link;
-	argv[n++] = (char *)"--calibration";
-	argv[n++] = (char *)(o->calibration ? o->calibration : "file");
+	if (!o->tech) {
+		argv[n++] = (char *)"--calibration";
+		argv[n++] = (char *)(o->calibration ? o->calibration : "file");
+	}
 	argv[n++] = (char *)"--log";
 	argv[n++] = c->log;
-	if (o->period_ms > 0) {
+	if (o->period_ms > 0 && !o->tech) {
 		snprintf(period, sizeof(period), "%d", o->period_ms);
 		argv[n++] = (char *)"--period";
 		argv[n++] = period;

@@ -100,11 +100,14 @@ struct sys_opts {
 	int period_ms;		       /* 0: the configuration's */
 	char *const *sim_args;	       /* extra galil-sim args, or NULL */
 	char *const *re_args;	       /* extra roboelf args, or NULL */
-	char *const *re_env;	       /* extra "NAME=value" for roboelf */
-	char *const *re_wrap;	       /* run roboelf through this command (e.g.
-					  valgrind and its options), or NULL */
-	int ready_timeout_ms;	       /* 0: 20 s ("file"), 150 s ("full") */
-	int no_ready;		       /* don't wait for Ready */
+	/* the technician's program instead (roboelf-tech): @re_args hold
+	 * its command and operands; no --calibration or --period */
+	int tech;
+	char *const *re_env;  /* extra "NAME=value" for roboelf */
+	char *const *re_wrap; /* run roboelf through this command (e.g.
+				 valgrind and its options), or NULL */
+	int ready_timeout_ms; /* 0: 20 s ("file"), 150 s ("full") */
+	int no_ready;	      /* don't wait for Ready */
 	/* galil-sim elsewhere (tests/net): run it through @sim_wrap (see
 	 * proc_sim_start_wrapped()) listening on every interface; roboelf and
 	 * galil-load use @sim_addr, the control port @ctl_addr. NULL: local */

@@ -1,14 +1,14 @@
 /*
- * test_sys_comm.c - the commissioning run (roboelf --commission DIR)
+ * test_sys_comm.c - the commissioning run (roboelf-tech commission DIR)
  * against galil-sim: a clean robot passes every step with its report and
  * plots; each miswiring galil-sim can model (--miswire) is found at the
  * right step with the right words; a controller that answers differently
  * from the reference (--deviate) is named in the report.
  *
- * The test plays the technician: it reads roboelf's prompts
+ * The test plays the technician: it reads roboelf-tech's prompts
  * ("commission: PRESS and hold the joystick B forward ...", "TRIP the
  * forward limit switch of axis A ...", "... [y/N]") and answers through
- * galil-sim's control port (joy, limit) and roboelf's stdin (y).
+ * galil-sim's control port (joy, limit) and roboelf-tech's stdin (y).
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -75,9 +75,9 @@ static int technician(struct sys_case *c, const char *line)
 	return 0;
 }
 
-/* Play the technician until roboelf prints a line starting with @stop
+/* Play the technician until roboelf-tech prints a line starting with @stop
  * (returns 0) or, with @stop NULL, until it exits (returns its exit code).
- * *@pos: how far roboelf's output was read. */
+ * *@pos: how far roboelf-tech's output was read. */
 static int drive(struct sys_case *c, const char *stop, size_t *pos)
 {
 	long long end = proc_now_ms() + RUN_TIMEOUT_MS;
@@ -103,12 +103,12 @@ static int drive(struct sys_case *c, const char *stop, size_t *pos)
 		if (!stop && proc_wait_exit(&c->re, 0, &status) == 0)
 			return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 	}
-	fail_msg("roboelf --commission: no %s within %d s",
+	fail_msg("roboelf-tech commission: no %s within %d s",
 		 stop ? stop : "exit", RUN_TIMEOUT_MS / 1000);
 	return -1;
 }
 
-/* Play the technician until roboelf exits; its exit code. */
+/* Play the technician until roboelf-tech exits; its exit code. */
 static int run_comm(struct sys_case *c)
 {
 	size_t pos = 0;
@@ -116,7 +116,7 @@ static int run_comm(struct sys_case *c)
 	return drive(c, NULL, &pos);
 }
 
-/* Start galil-sim (with @sim_args), galil-load and roboelf --commission. */
+/* Start galil-sim (with @sim_args), galil-load and roboelf-tech commission. */
 static int start(struct sys_case *c, char *const *sim_args, char *dir,
 		 size_t cap)
 {
@@ -125,13 +125,14 @@ static int start(struct sys_case *c, char *const *sim_args, char *dir,
 	char *re_args[5];
 
 	snprintf(dir, cap, "%s/comm-%d", env.dir, ++n);
-	re_args[0] = (char *)"--commission";
+	re_args[0] = (char *)"commission";
 	re_args[1] = dir;
 	re_args[2] = (char *)"--wait";
 	re_args[3] = (char *)"5";
 	re_args[4] = NULL;
 	o.sim_args = sim_args;
 	o.re_args = re_args;
+	o.tech = 1;
 	o.no_ready = 1;
 	if (sys_case_start(c, &env, &o) < 0)
 		fail_msg("case start: %s", c->err);
@@ -267,7 +268,7 @@ static void test_kill_during_move(void **state)
 	}
 }
 
-/* One galil-sim option, the line roboelf must end with, its exit code. */
+/* One galil-sim option, the line roboelf-tech must end with, its exit code. */
 struct wrong {
 	const char *opt, *arg;
 	int exit;
@@ -405,7 +406,7 @@ static void test_find_controller(void **state)
 	socklen_t len = sizeof(a);
 	struct lsn l = {0};
 	char dir[256], port[16], line[512];
-	char *re_args[] = {(char *)"--commission",
+	char *re_args[] = {(char *)"commission",
 			   dir,
 			   (char *)"--galil",
 			   (char *)"127.0.0.1:1",
@@ -429,6 +430,7 @@ static void test_find_controller(void **state)
 	assert_int_equal(pthread_create(&l.th, NULL, lsn_main, &l), 0);
 	snprintf(dir, sizeof(dir), "%s/comm-find", env.dir);
 	o.re_args = re_args;
+	o.tech = 1;
 	o.no_ready = 1;
 	if (sys_case_start(&c, &env, &o) < 0)
 		fail_msg("case start: %s", c.err);
@@ -441,7 +443,7 @@ static void test_find_controller(void **state)
 			   line, sizeof(line)) != 0)
 		fail_msg("no list in:\n%s", proc_output(&c.re, PROC_STDOUT));
 	assert_int_equal(proc_find_line(&c.re, PROC_STDOUT,
-					"roboelf: error: the configured "
+					"roboelf-tech: error: the configured "
 					"controller does not answer; the "
 					"controllers listed above do: run "
 					"again with --galil ADDRESS",

@@ -17,7 +17,7 @@
  *    directory): every trace under a final name still parses as complete,
  *    the traces written before are byte for byte intact, and a left
  *    NAME.tmp never parses as complete unless it is complete;
- *  - roboelf --show-trace: exit 0, one PNG per axis plus the timing page,
+ *  - roboelf-tech show-trace: exit 0, one PNG per axis plus the timing page,
  *    each a PNG (signature, IHDR 1200 x 1020); truncated, wrong-version,
  *    garbage and huge files and an empty window: exit 2 with the reason.
  *
@@ -52,7 +52,7 @@
 static struct sys_env env;
 static int env_ok;
 static struct sys_case cs;
-static char pot_trace[SYS_PATH_MAX]; /* for the --show-trace test */
+static char pot_trace[SYS_PATH_MAX]; /* for the show-trace test */
 
 static double P(void)
 {
@@ -421,23 +421,23 @@ static void test_trace_sigkill_while_writing(void **state)
 	sys_case_stop(&cs);
 }
 
-/* ---- --show-trace ------------------------------------------------------- */
+/* ---- roboelf-tech show-trace ------------------------------------------- */
 
 static int show(const char *path, const char *window, struct proc *p)
 {
 	char bin[SYS_PATH_MAX + 16];
-	char *argv[6] = {bin, (char *)"--show-trace", (char *)path, NULL, NULL,
+	char *argv[6] = {bin, (char *)"show-trace", (char *)path, NULL, NULL,
 			 NULL};
 	int st;
 
-	snprintf(bin, sizeof(bin), "%s/roboelf", env.bin);
+	snprintf(bin, sizeof(bin), "%s/roboelf-tech", env.bin);
 	if (window) {
 		argv[3] = (char *)"--window";
 		argv[4] = (char *)window;
 	}
 	memset(p, 0, sizeof(*p));
 	if (proc_spawn(p, argv, NULL) < 0 || proc_wait_exit(p, 60000, &st) < 0)
-		fail_msg("roboelf --show-trace did not finish");
+		fail_msg("roboelf-tech show-trace did not finish");
 	return proc_exit_code(p);
 }
 

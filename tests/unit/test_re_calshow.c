@@ -1,5 +1,5 @@
 /*
- * test_re_calshow.c - roboelf --show-calibration: the printed tables and the
+ * test_re_calshow.c - roboelf-tech show-calibration: the printed tables and the
  * gnuplot PNG per axis (gnuplot-nox is a declared dependency: `make deps`),
  * and a corrupt file refused with the loader's message.
  */

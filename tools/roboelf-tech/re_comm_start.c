@@ -9,6 +9,12 @@
 
 #include "re_comm_find.h"
 
+/* Where this run's discovery probe goes (re_comm_start()). */
+static struct {
+	const char *addr;
+	int port;
+} find_to;
+
 /* The configured address did not answer (@why): list the controllers
  * that answer the discovery probe and, on a terminal, let the technician
  * pick one (never chosen silently). Return 0 with a->cfg's address set to
@@ -16,8 +22,8 @@
 static int find(struct app *a, const char *why)
 {
 	static struct re_comm_found list[RE_COMM_FIND_MAX];
-	const char *bc = a->o.find_addr ? a->o.find_addr : RE_COMM_FIND_BCAST;
-	int port = a->o.find_port ? a->o.find_port : RE_COMM_FIND_PORT;
+	const char *bc = find_to.addr ? find_to.addr : RE_COMM_FIND_BCAST;
+	int port = find_to.port ? find_to.port : RE_COMM_FIND_PORT;
 	char line[32], *end;
 	long k;
 	int n;
@@ -57,10 +63,14 @@ static int find(struct app *a, const char *why)
 	return 0;
 }
 
-int re_comm_start(struct app *a)
+int re_comm_start(struct app *a, const char *find_addr, int find_port)
 {
 	static const struct re_bringup b = {find, 0, NULL};
-	int rc = re_start_bringup(a, &b);
+	int rc;
+
+	find_to.addr = find_addr;
+	find_to.port = find_port;
+	rc = re_start_bringup(a, &b);
 
 	if (rc || re_sig.quit)
 		return rc ? rc : EXIT_CONNECT;

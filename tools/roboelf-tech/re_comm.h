@@ -1,5 +1,5 @@
 /*
- * re_comm.h - the commissioning run (roboelf --commission DIR): the first
+ * re_comm.h - the commissioning run (roboelf-tech commission DIR): the first
  * contact with a controller and a robot, step by step, motor power off
  * until a step needs it (docs/technician.md, section 8).
  *

@@ -4,7 +4,7 @@
  * the discovery probe (pc/galil/gl_disc.h, the mechanism and its sources
  * in docs/galil-load.md) are listed for the technician to pick one.
  *
- * Only the commissioning run uses this (roboelf --commission, on the
+ * Only the commissioning run uses this (roboelf-tech commission, on the
  * technician's choice, never silently); roboelf's operation connects only
  * to its configured address (tests/checks/nodisc.sh). Nothing here prints.
  */
