@@ -238,7 +238,7 @@ check_faults() {
 # ---- (b) configuration keys --------------------------------------------------
 
 # config_keys: "TABLE<TAB>key" for every entry of every
-# `static const struct field NAME[] = { ... };` table of pc/config/re_config.c:
+# `static const struct field NAME[] = { ... };` table of pc/config/re_config*.c:
 # the first string literal of the entry ({ "key", ... } or IK("key", ...)),
 # else the second macro argument (I(struct s, key, ...): #m is the key).
 config_keys() {
@@ -292,7 +292,7 @@ check_config() {
 	need_file pc/config/re_config.c || return
 	config_keys >"$TMPD/keys"
 	if [ ! -s "$TMPD/keys" ]; then
-		fail "no configuration keys found in the 'struct field' tables of pc/config/re_config.c (the extraction no longer matches the code)"
+		fail "no configuration keys found in the 'struct field' tables of pc/config/re_config*.c (the extraction no longer matches the code)"
 		return
 	fi
 	if [ "$LIST" = 1 ]; then
@@ -302,7 +302,7 @@ check_config() {
 	need_file "$doc" || return
 	out=$(while IFS='	' read -r tab key; do
 		if ! grep -Eq "\`([A-Za-z0-9_]+\.)*$key\`" "$doc"; then
-			echo "docs.sh: config field '$key' ($tab) is in pc/config/re_config.c but not in $doc"
+			echo "docs.sh: config field '$key' ($tab) is in pc/config/re_config*.c but not in $doc"
 		fi
 	done <"$TMPD/keys")
 	report "$out"
