@@ -162,9 +162,12 @@ check test: deps
 	@$(MAKE) --no-print-directory tests
 	@BUILD=$(BUILD) tests/run-all.sh
 
+# The sanitizer run looks for memory and undefined-behaviour errors: every
+# test program again, the soak for 20 s instead of 60, and the checks that do
+# not run the sanitized programs only once, in make check (tests/run-all.sh).
 asan: deps
-	@$(MAKE) --no-print-directory BUILD=$(BUILD)/asan SANITIZE=address,undefined \
-		CFLAGS="-O1 -g" check
+	@ROBOELF_SAN=1 ROBOELF_SOAK_S=$${ROBOELF_SOAK_S:-20} $(MAKE) --no-print-directory \
+		BUILD=$(BUILD)/asan SANITIZE=address,undefined CFLAGS="-O1 -g" check
 
 # The scripts run with only the commands of docs/commands.md on their PATH
 # (tools/cmdtable.sh), as the tests do (tests/run-all.sh).
