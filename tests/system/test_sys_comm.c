@@ -9,6 +9,9 @@
  * ("commission: PRESS and hold the joystick B forward ...", "TRIP the
  * forward limit switch of axis A ...", "... [y/N]") and answers through
  * galil-sim's control port (joy, limit) and roboelf-tech's stdin (y).
+ *
+ * roboelf supervises, and nothing else: given one of the options that
+ * moved to roboelf-tech it exits 2 with one line naming the command.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -276,6 +279,13 @@ struct wrong {
 	const char *report; /* a line of the report (substring), or NULL */
 };
 
+#if defined(__SANITIZE_ADDRESS__)
+/* make asan looks for memory errors: every other case (make check: all) */
+static const size_t wrong_stride = 2;
+#else
+static const size_t wrong_stride = 1;
+#endif
+
 static const struct wrong wrongs[] = {
     {"--miswire", "joystick-swap:5,7", 5,
      "commission: FAILED at step joystick (B forward): swapped pair: input 5 "
@@ -341,7 +351,8 @@ static const struct wrong wrongs[] = {
 static void test_wrong_robot(void **state)
 {
 	(void)state;
-	for (size_t k = 0; k < sizeof(wrongs) / sizeof(wrongs[0]); k++) {
+	for (size_t k = 0; k < sizeof(wrongs) / sizeof(wrongs[0]);
+	     k += wrong_stride) {
 		const struct wrong *w = &wrongs[k];
 		char *args[] = {(char *)w->opt, (char *)w->arg, NULL};
 		char dir[256], path[320], line[1024];
@@ -456,9 +467,104 @@ static void test_find_controller(void **state)
 	close(l.fd);
 }
 
+/* Run @argv (its program in env.bin) to its end; its exit code, and its
+ * stderr in @err. */
+static int run_to_end(char **argv, char *err, size_t cap)
+{
+	char bin[SYS_PATH_MAX + 16];
+	struct proc p;
+	int status = -1, rc;
+
+	snprintf(bin, sizeof(bin), "%s/%s", env.bin, argv[0]);
+	argv[0] = bin;
+	if (proc_spawn(&p, argv, NULL) < 0)
+		fail_msg("cannot start %s", bin);
+	if (proc_wait_exit(&p, 10000, &status) < 0) {
+		proc_kill(&p);
+		fail_msg("%s did not end", bin);
+	}
+	rc = proc_exit_code(&p);
+	snprintf(err, cap, "%s", proc_output(&p, PROC_STDERR));
+	proc_kill(&p);
+	return rc;
+}
+
+/* roboelf given an option of roboelf-tech: exit 2, one line naming the
+ * command that does it now, nothing started. */
+static void test_moved_options(void **state)
+{
+	static const char *const moved[][2] = {
+	    {"--commission=x", "roboelf-tech commission DIR"},
+	    {"--show-calibration=x", "roboelf-tech show-calibration FILE"},
+	    {"--show-trace=x", "roboelf-tech show-trace FILE"},
+	    {"--check-host", "roboelf-tech check-host"},
+	    {"--check-host=5", "roboelf-tech check-host"},
+	    {"--window=1:2", "roboelf-tech show-trace FILE --window FROM:TO"},
+	    {"--wait=5", "roboelf-tech commission DIR --wait S"},
+	    {"--find-addr=x", "roboelf-tech commission DIR --find-addr A"},
+	    {"--find-port=1", "roboelf-tech commission DIR --find-port P"},
+	};
+	char err[1024], want[256], opt[64];
+
+	(void)state;
+	for (size_t i = 0; i < sizeof(moved) / sizeof(moved[0]); i++) {
+		char *argv[] = {(char *)"roboelf", (char *)moved[i][0], NULL};
+
+		snprintf(opt, sizeof(opt), "%.*s",
+			 (int)strcspn(moved[i][0], "="), moved[i][0]);
+		snprintf(want, sizeof(want),
+			 "roboelf: error: %s is not roboelf's: roboelf "
+			 "supervises, and nothing else; run %s (the "
+			 "technician's program)\n",
+			 opt, moved[i][1]);
+		assert_int_equal(run_to_end(argv, err, sizeof(err)), 2);
+		if (strcmp(err, want) != 0)
+			fail_msg("%s: stderr\n%s\nnot\n%s", moved[i][0], err,
+				 want);
+	}
+}
+
+/* roboelf-tech's command line: check-host=S and check-host S the same
+ * time rule, an unknown command or a missing operand refused (exit 2). */
+static void test_tech_usage(void **state)
+{
+	static const struct {
+		const char *a1, *a2, *err;
+	} bad[] = {
+	    {"check-host=0", NULL,
+	     "roboelf-tech: error: invalid check-host time '0': must be "
+	     "1..3600 s\n"},
+	    {"check-host", "3601",
+	     "roboelf-tech: error: invalid check-host time '3601': must be "
+	     "1..3600 s\n"},
+	    {"check-host=1", "2",
+	     "roboelf-tech: error: check-host takes at most a time in s\n"},
+	    {"show-trace", NULL,
+	     "roboelf-tech: error: show-trace takes one file (roboelf-tech "
+	     "--help)\n"},
+	    {"supervise", NULL,
+	     "roboelf-tech: error: unknown command 'supervise': commission, "
+	     "show-calibration, show-trace or check-host\n"},
+	};
+	char err[1024];
+
+	(void)state;
+	for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
+		char *argv[] = {(char *)"roboelf-tech", (char *)bad[i].a1,
+				(char *)bad[i].a2, NULL};
+
+		assert_int_equal(run_to_end(argv, err, sizeof(err)), 2);
+		if (strcmp(err, bad[i].err) != 0)
+			fail_msg("%s %s: stderr\n%s\nnot\n%s", bad[i].a1,
+				 bad[i].a2 ? bad[i].a2 : "", err, bad[i].err);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+	    cmocka_unit_test(test_moved_options),
+	    cmocka_unit_test(test_tech_usage),
 	    cmocka_unit_test(test_clean_robot),
 	    cmocka_unit_test(test_kill_during_move),
 	    cmocka_unit_test(test_wrong_robot),
