@@ -131,7 +131,7 @@ static int check_route(struct app *a)
 {
 	int fd = gl_link_fd(a->real.link), ms = 0, rc;
 	struct gl_route_info ri;
-	int crit = (int)(a->cfg.watchdog.critical_factor * a->cfg.period_ms);
+	int crit = (int)(a->plan.wdog.crit_ns / 1000000);
 	int limit = gl_route_rto_limit_ms(crit, a->cfg.period_ms);
 	char host[256], port[16], what[700];
 
@@ -219,7 +219,11 @@ static int start_link(struct app *a, const struct re_bringup *b)
 
 int re_start_bringup(struct app *a, const struct re_bringup *b)
 {
-	int rc = take_locks(a);
+	int rc;
+
+	/* the limits, derived once (the program's mainms is read later) */
+	re_plan_make(&a->cfg, 0, &a->plan);
+	rc = take_locks(a);
 
 	re_sig.cont_real = &a->real;
 	if (!rc && !re_sig.quit) {
@@ -317,9 +321,9 @@ static int init_super(struct app *a)
 /* The critical reply-age limit, ms: a stop longer than this is a stall. */
 int64_t re_start_stall_limit_ms(const struct app *a)
 {
-	return a->sup ? re_super_view(a->sup)->crit_ns / 1000000
-		      : (int64_t)(a->cfg.watchdog.critical_factor *
-				  a->cfg.period_ms);
+	return (a->sup ? re_super_view(a->sup)->crit_ns
+		       : a->plan.wdog.crit_ns) /
+	       1000000;
 }
 
 /* The stop of a SIGCONT since the last look, when it outlasted the
