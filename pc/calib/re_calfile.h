@@ -79,7 +79,7 @@ size_t re_calfile_format_size(const struct re_calset *set);
  * @buf, @len: the whole file content.
  * @filename: used in messages ("FILE:LINE: message").
  * @exp: [in] what the file must match; NULL parses without matching (for
- *       roboelf --show-calibration).
+ *       roboelf-tech show-calibration).
  * @out: [out] the calibration; on failure it is cleared (n_axes = 0), never
  *       left half-filled.
  * @err: [out] message on failure (may be NULL); @errlen its size.

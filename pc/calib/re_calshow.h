@@ -1,7 +1,7 @@
 /*
- * re_calshow.h - roboelf --show-calibration FILE: print a calibration file's
- * tables for a technician and, where gnuplot is installed, write one PNG per
- * axis (potentiometer against encoder with the run-time tolerance band:
+ * re_calshow.h - roboelf-tech show-calibration FILE: print a calibration
+ * file's tables for a technician and, where gnuplot is installed, write one
+ * PNG per axis (potentiometer against encoder with the run-time tolerance band:
  * a worn potentiometer shows as a kink or a flat stretch inside the band).
  *
  * Like re_console, this module prints (to the FILEs it is given).
