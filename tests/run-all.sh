@@ -8,8 +8,9 @@
 # number of CPUs): the unit, loader, simulator and DMC tests (in-process or
 # in virtual time) and the checks that judge files. The real-time ones run
 # alone, one after another, once the others are done: the system tests,
-# the network rig, and the checks that time a host or drive roboelf against
-# galil-sim in real time (realtime.sh, console_tmux.sh, install.sh). Each
+# the network rig, the unit and simulator tests that time real waits, and
+# the checks that time a host or drive roboelf against galil-sim in real
+# time (realtime.sh, console_tmux.sh, install.sh). Each
 # program's log is printed whole, in the order of the list, never
 # interleaved.
 #
@@ -52,6 +53,10 @@ deadline() {
 alone() {
 	case $1 in
 	system/* | net/* | checks/realtime.sh | checks/console_tmux.sh | checks/install.sh) return 0 ;;
+	# unit and simulator tests that time real waits (the relay's and the
+	# link's deadlines, the clock, the real-time set-up, the ports)
+	unit/test_re_relay* | unit/test_gl_link | unit/test_base_clock | unit/test_re_rt | \
+		unit/test_re_io | sim/test_sim_net | sim/test_sim_relay | sim/test_sim_speed) return 0 ;;
 	*) return 1 ;;
 	esac
 }
