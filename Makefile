@@ -283,9 +283,9 @@ netrig: deps
 
 # ---- install -----------------------------------------------------------------
 # The installed places: base_paths.c is built with DATADIR and
-# SYSCONFDIR (and rebuilt when they change); roboelf and galil-load look there
-# for what is not in the directory they are started in (docs/technician.md,
-# "Installation"). The docs tree is installed as it is, links intact.
+# SYSCONFDIR (and rebuilt when they change); roboelf, roboelf-tech and
+# galil-load look there for what is not in the directory they are started
+# in (docs/technician.md, "Installation"). The docs tree is installed as it is, links intact.
 DATADIR = $(PREFIX)/share/roboelf
 DOCDIR = $(PREFIX)/share/doc/roboelf
 MAN1 := $(wildcard docs/*.1)

@@ -29,36 +29,27 @@
  * re_super_fault(). Power-off is the reverse (re_super_shutdown()).
  */
 #include <errno.h>
-#include <limits.h>
 #include <getopt.h>
+#include <limits.h>
 #include <sched.h>
 #include <signal.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
-#include "base_clock.h"
 #include "base_paths.h"
-#include "base_version.h"
 #include "gl_err.h"
-#include "gl_link.h"
-#include "re_calfile.h"
+#include "re_app.h"
 #include "re_calib.h"
-#include "re_check.h"
 #include "re_config.h"
 #include "re_console.h"
-#include "re_ctl.h"
 #include "re_io.h"
 #include "re_lock.h"
 #include "re_log.h"
-#include "re_plan.h"
 #include "re_rec.h"
 #include "re_relay.h"
 #include "re_rt.h"
-#include "re_app.h"
 #include "re_start.h"
 #include "re_super.h"
 
@@ -233,10 +224,7 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 	return 0;
 }
 
-/* ---- configuration and log ---------------------------------------------- */
-
-/* ---- run and cleanup ------------------------------------------------------
- */
+/* ---- run and cleanup --------------------------------------------------- */
 
 static const char *quit_reason(int key)
 {
@@ -276,7 +264,7 @@ static void retry_log(struct app *a, int64_t *next_ns)
 			       a->cfg.log.path, strerror(errno));
 }
 
-/* ---- the flight recorder -------------------------------------- */
+/* ---- the flight recorder ----------------------------------------------- */
 
 /* The ring sized from the configuration; traces next to the log unless
  * recorder.dir says otherwise. */
@@ -382,6 +370,25 @@ static void close_recorder(struct app *a)
 	a->rec = NULL;
 }
 
+/* The run's end in the log: why it stopped (@key: the key that quit, -1:
+ * the terminal went away, 0: a signal) and the cycle's figures. */
+static void log_stop(struct app *a, int key)
+{
+	const struct re_super_view *v = re_super_view(a->sup);
+
+	re_log_msg(&a->log, RE_LOG_INFO, "stop: %s",
+		   key < 0 ? "the terminal went away" : quit_reason(key));
+	re_log_msg(&a->log, RE_LOG_INFO,
+		   "stats: cycles=%llu overruns=%llu period=%.1f ms "
+		   "late p50=%.3f p99=%.3f max=%.3f ms; reply age worst=%.1f "
+		   "ms; status frames dropped=%llu",
+		   (unsigned long long)v->cycles,
+		   (unsigned long long)v->overruns, ms_of_ns(v->period_ns),
+		   re_super_late_ms(a->sup, 50), re_super_late_ms(a->sup, 99),
+		   re_super_late_ms(a->sup, 100), ms_of_ns(v->age_worst_ns),
+		   (unsigned long long)a->con.dropped);
+}
+
 #define KEY_POLL_MS 100 /* the keyboard is read this often, ms */
 
 /* Every period until the operator quits; a latched fault keeps the status
@@ -431,23 +438,10 @@ static void run(struct app *a)
 			break;
 		key = 0;
 	}
-	re_log_msg(&a->log, RE_LOG_INFO, "stop: %s",
-		   key < 0 ? "the terminal went away" : quit_reason(key));
-	re_log_msg(
-	    &a->log, RE_LOG_INFO,
-	    "stats: cycles=%llu overruns=%llu period=%.1f ms "
-	    "late p50=%.3f p99=%.3f max=%.3f ms; reply age worst=%.1f ms; "
-	    "status frames dropped=%llu",
-	    (unsigned long long)re_super_view(a->sup)->cycles,
-	    (unsigned long long)re_super_view(a->sup)->overruns,
-	    ms_of_ns(re_super_view(a->sup)->period_ns),
-	    re_super_late_ms(a->sup, 50), re_super_late_ms(a->sup, 99),
-	    re_super_late_ms(a->sup, 100),
-	    ms_of_ns(re_super_view(a->sup)->age_worst_ns),
-	    (unsigned long long)a->con.dropped);
+	log_stop(a, key);
 }
 
-/* ---- real time ------------------------------------------------ */
+/* ---- real time --------------------------------------------------------- */
 
 /* SCHED_FIFO, locked memory and a CPU as configured, for this thread only
  * (the recorder's writer thread, started before, keeps the normal policy);

@@ -1,5 +1,5 @@
 /*
- * re_traceshow.h - roboelf --show-trace FILE [--window FROM:TO]: check a
+ * re_traceshow.h - roboelf-tech show-trace FILE [--window FROM:TO]: check a
  * trace strictly (re_trace_parse()), print its summary and write its PNG
  * pages with gnuplot, which reads the trace file itself (the format is
  * plain CSV to it): one page per axis (position, velocity, potentiometer

@@ -4,10 +4,13 @@
  * check of the calibration file, the move to the centre and arming, each
  * step supervised, and a stop of roboelf itself (SIGSTOP) during it named.
  * Also the application state the start-up, the run loop and the shutdown
- * share (struct app), and what the signal handlers tell them (re_sig).
+ * share (struct app), and what the signal handlers tell them (re_sig);
+ * the bring-up (re_start_bringup()) is shared with the technician's
+ * commissioning run (tools/roboelf-tech).
  *
- * Not the options, the signal handlers, the run loop or the shutdown
- * (pc/roboelf.c), nor the supervisor's cycle (re_super).
+ * Not the command lines (pc/roboelf.c, tools/roboelf-tech/main.c), the
+ * signal handlers and the power-off (re_app), the run loop, nor the
+ * supervisor's cycle (re_super).
  */
 #ifndef RE_START_H
 #define RE_START_H
@@ -29,13 +32,12 @@
 #include "re_rt.h"
 #include "re_super.h"
 
-/* roboelf's exit codes (roboelf.1). */
-#define EXIT_USAGE	2
-#define EXIT_CONNECT	3
-#define EXIT_FAULT	4
-#define EXIT_COMMISSION 5 /* roboelf-tech: commissioning found a fault */
-#define EXIT_HOST	6 /* roboelf-tech check-host: the period is not safe */
-#define DEFAULT_CONFIG	"config/roboelf.yaml"
+/* The start-up's exit codes (roboelf.1); roboelf-tech (roboelf-tech.1)
+ * exits 2 and 3 too, and has its own 5 and 6 (tools/roboelf-tech). */
+#define EXIT_USAGE     2
+#define EXIT_CONNECT   3
+#define EXIT_FAULT     4
+#define DEFAULT_CONFIG "config/roboelf.yaml"
 /* the installed one, under SYSCONFDIR (base_paths.h) */
 #define SYSTEM_CONFIG "roboelf/roboelf.yaml"
 
@@ -73,7 +75,7 @@ struct app {
 	char err[RE_CONFIG_ERR_MAX];
 };
 
-/* What the signal handlers (pc/roboelf.c) tell the start-up and the run
+/* What the signal handlers (re_app_signals()) tell the start-up and the run
  * loop: @quit the signal that asks to quit (0: none); @continued a SIGCONT
  * came, after a stop of @cont_stop_ms ms measured from
  * @cont_real->last_run_ns (the last moment roboelf is known to have run). */

@@ -8,7 +8,7 @@
  *                [--find-addr A] [--find-port P]
  *   roboelf-tech show-calibration FILE [-c FILE]
  *   roboelf-tech show-trace FILE [--window FROM:TO]
- *   roboelf-tech check-host [SECONDS] [-c FILE] [--period MS]
+ *   roboelf-tech check-host[=SECONDS] [-c FILE] [--period MS]
  *
  * Exit codes: 0 done; 2 usage, configuration or a file that cannot be
  * read; 3 no relay or controller, or the controller refused; 5 the
@@ -33,6 +33,11 @@
 #include "re_rt.h"
 #include "re_traceshow.h"
 
+/* roboelf-tech's own exit codes (roboelf-tech.1); 2 and 3 as roboelf's
+ * (re_start.h). */
+#define EXIT_COMMISSION 5 /* the commissioning run found a fault */
+#define EXIT_HOST	6 /* check-host: the configured period is not safe */
+
 /* The command line. */
 struct topts {
 	struct re_app_args g;
@@ -56,7 +61,7 @@ static void usage(FILE *f)
 		"[--find-port P]\n"
 		"       roboelf-tech show-calibration FILE [-c FILE]\n"
 		"       roboelf-tech show-trace FILE [--window FROM:TO]\n"
-		"       roboelf-tech check-host [SECONDS] [-c FILE] "
+		"       roboelf-tech check-host[=SECONDS] [-c FILE] "
 		"[--period MS]\n"
 		"\n"
 		"  commission DIR       the commissioning run; report in DIR\n"
@@ -64,9 +69,10 @@ static void usage(FILE *f)
 		"plot it)\n"
 		"  show-trace FILE      check a flight-recorder trace and plot "
 		"it (PNG pages)\n"
-		"  check-host [S]       measure this host's wake-up lateness "
+		"  check-host[=S]       measure this host's wake-up lateness "
 		"for S s (10) and\n"
-		"                       name the shortest safe period\n"
+		"                       name the shortest safe period "
+		"(check-host S: the same)\n"
 		"\n"
 		"  -c, --config FILE    configuration (default %s, else %s)\n"
 		"      --galil HOST[:PORT]  controller address (overrides the "
@@ -93,19 +99,43 @@ static void usage(FILE *f)
 		DEFAULT_CONFIG, re_app_system_config());
 }
 
+/* check-host's table: the verdict for each candidate period on probe @p.
+ * Return: the shortest safe one this host's scheduling allows, 0: none. */
+static int host_table(struct app *a, const struct re_rt_probe *p)
+{
+	static const int cand[] = {2, 3, 5, 10, 20, 50, 100};
+	const struct re_config_watchdog *w = &a->cfg.watchdog;
+	int min = re_rt_min_period_ms(&a->rt), best = 0;
+	struct re_rt_verdict v;
+
+	printf("period  lateness allowed  verdict (watchdog %.1f/%.1f x P)\n",
+	       w->noncritical_factor, w->critical_factor);
+	for (size_t i = 0; i < sizeof(cand) / sizeof(cand[0]); i++) {
+		re_rt_verdict(p, cand[i], w->noncritical_factor,
+			      w->critical_factor, &v);
+		if (v.safe && cand[i] >= min && !best)
+			best = cand[i];
+		printf("%4d ms  %8.1f ms        %s\n", cand[i], v.margin_ms,
+		       cand[i] < min ? "refused without real-time scheduling"
+		       : !v.safe     ? "NOT SAFE: would trip WATCHDOG"
+		       : v.quiet     ? "safe"
+				 : "safe, with occasional watchdog warnings");
+	}
+	return best;
+}
+
 /* check-host: this host's wake-up lateness under the configured real-
  * time set-up, and the verdict per period. Return: 0, EXIT_HOST when the
  * configured period is not safe, EXIT_USAGE when the probe failed. */
 static int check_host(struct app *a, int seconds)
 {
-	static const int cand[] = {2, 3, 5, 10, 20, 50, 100};
 	const struct re_config_realtime *r = &a->cfg.realtime;
 	const struct re_config_watchdog *w = &a->cfg.watchdog;
 	struct re_rt_cfg rc = {r->priority, r->cpu, r->lock_memory};
 	struct re_rt_probe p;
 	struct re_rt_verdict v;
 	char d[RE_RT_DESCRIBE_MAX];
-	int best = 0, own_safe;
+	int best, own_safe;
 
 	re_app_signals();
 	re_rt_setup(&rc, &a->rt);
@@ -125,20 +155,7 @@ static int check_host(struct app *a, int seconds)
 	       (unsigned long long)p.wakes, p.p50_ms, p.p99_ms, p.p999_ms,
 	       p.max_ms, (unsigned long long)p.over_1ms,
 	       (unsigned long long)p.over_5ms);
-	printf("period  lateness allowed  verdict (watchdog %.1f/%.1f x P)\n",
-	       w->noncritical_factor, w->critical_factor);
-	for (size_t i = 0; i < sizeof(cand) / sizeof(cand[0]); i++) {
-		re_rt_verdict(&p, cand[i], w->noncritical_factor,
-			      w->critical_factor, &v);
-		if (v.safe && cand[i] >= re_rt_min_period_ms(&a->rt) && !best)
-			best = cand[i];
-		printf("%4d ms  %8.1f ms        %s\n", cand[i], v.margin_ms,
-		       cand[i] < re_rt_min_period_ms(&a->rt)
-			   ? "refused without real-time scheduling"
-		       : !v.safe ? "NOT SAFE: would trip WATCHDOG"
-		       : v.quiet ? "safe"
-				 : "safe, with occasional watchdog warnings");
-	}
+	best = host_table(a, &p);
 	re_rt_verdict(&p, a->cfg.period_ms, w->noncritical_factor,
 		      w->critical_factor, &v);
 	own_safe = v.safe && a->cfg.period_ms >= re_rt_min_period_ms(&a->rt);
@@ -320,21 +337,34 @@ static int opt_value(struct topts *o, int c, const char *arg)
 	}
 }
 
+/* check-host's time in s: @eq from "check-host=S", else the one operand
+ * of "check-host S" (of @n), else 10 s. */
+static int host_seconds(struct topts *o, const char *eq, int n, char **arg)
+{
+	const char *s = eq ? eq : n == 1 ? arg[0] : NULL;
+
+	o->seconds = 10;
+	if (n > (eq ? 0 : 1)) {
+		fprintf(stderr, "roboelf-tech: error: check-host takes at most "
+				"a time in s\n");
+		return -1;
+	}
+	if (s && int_in(s, 1, 3600, &o->seconds))
+		return bad("check-host time", s, "must be 1..3600 s");
+	return 0;
+}
+
 /* The subcommand's operands: DIR, FILE or SECONDS. */
 static int operands(struct topts *o, int n, char **arg)
 {
-	if (!strcmp(o->sub, "check-host")) {
-		o->seconds = 10;
-		if (n > 1) {
-			fprintf(stderr, "roboelf-tech: error: check-host takes "
-					"at most a time in s\n");
-			return -1;
-		}
-		if (n == 1 && int_in(arg[0], 1, 3600, &o->seconds))
-			return bad("check-host time", arg[0],
-				   "must be 1..3600 s");
-		return 0;
+	if (!strncmp(o->sub, "check-host=", 11)) {
+		const char *eq = o->sub + 11;
+
+		o->sub = "check-host";
+		return host_seconds(o, eq, n, arg);
 	}
+	if (!strcmp(o->sub, "check-host"))
+		return host_seconds(o, NULL, n, arg);
 	if (n != 1) {
 		fprintf(stderr,
 			"roboelf-tech: error: %s takes one %s (roboelf-tech "
@@ -390,6 +420,8 @@ static int parse_opts(int argc, char **argv, struct topts *o)
 		return -1;
 	}
 	o->sub = argv[optind];
+	if (!strncmp(o->sub, "check-host=", 11)) /* the old --check-host=S */
+		return operands(o, argc - optind - 1, argv + optind + 1);
 	for (size_t i = 0; i < sizeof(subs) / sizeof(subs[0]); i++)
 		if (!strcmp(o->sub, subs[i]))
 			return operands(o, argc - optind - 1,
@@ -410,6 +442,11 @@ int main(int argc, char **argv)
 	if (rc)
 		return rc > 0 ? 0 : EXIT_USAGE;
 	a.prog = "roboelf-tech";
+	if (base_paths_root())
+		fprintf(stderr,
+			"roboelf-tech: %s=%s: the installed files are looked "
+			"for under it\n",
+			BASE_PATHS_ROOT_ENV, base_paths_root());
 	if (o.version)
 		return re_app_print_version(a.prog, &o.g);
 	if (!strcmp(o.sub, "show-calibration"))

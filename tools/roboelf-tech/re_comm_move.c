@@ -273,65 +273,60 @@ static int move_axis(struct re_comm *c, int ax, int counts, int trace,
 	return GL_OK;
 }
 
-/* Encoder against the motor, then the potentiometer against the encoder. */
-static void move_judge(struct re_comm *c, int ax, int counts,
-		       const struct move_res *m)
+/* The move ended early (@m: a fault latched or the deadline passed):
+ * the encoder counted against its motor, did not move, or stopped short. */
+static void judge_stopped(struct re_comm *c, int ax, int counts,
+			  const struct move_res *m)
 {
 	const struct re_config_axis *a = &c->cfg->axes[ax];
 	double moved = m->enc1 - m->enc0, er = a->position_error_limit_counts;
+	char why[96];
+
+	if (m->latched)
+		snprintf(why, sizeof(why),
+			 "the controller program latched fault %.0f "
+			 "(axis %.0f) and switched the motors off",
+			 m->fcode, m->faxis);
+	else
+		snprintf(why, sizeof(why), "the deadline of %d ms",
+			 RC_MOVE_MS + 500);
+	if (moved * counts < 0 && fabs(moved) > er / 4)
+		re_comm_add(c, "motion", a->name, RE_COMM_FAIL,
+			    "exchange the encoder's channels A and B "
+			    "(or reverse the motor leads) of this axis",
+			    "encoder reversed: asked for %+d counts, "
+			    "the encoder counted %+.0f (the servo ran "
+			    "away from the target) until %s: the "
+			    "encoder counts against its motor",
+			    counts, moved, why);
+	else if (fabs(moved) < er / 4)
+		re_comm_add(c, "motion", a->name, RE_COMM_FAIL,
+			    "check the amplifier, the motor cable, a "
+			    "brake or a jam on this axis",
+			    "did not move: asked for %+d counts, the "
+			    "encoder counted %+.0f before %s",
+			    counts, moved, why);
+	else
+		re_comm_add(c, "motion", a->name, RE_COMM_FAIL,
+			    "check the axis for a jam and the gains "
+			    "(kp, ki, kd) and torque_limit_v",
+			    "stopped short: %+.0f of %+d counts before "
+			    "%s",
+			    moved, counts, why);
+}
+
+/* The potentiometer against the encoder, which counted @moved of the
+ * @counts asked for: reversed, not following, or as the configuration
+ * expects for @counts. */
+static void judge_pot(struct re_comm *c, int ax, int counts, double moved,
+		      const struct move_res *m)
+{
+	const struct re_config_axis *a = &c->cfg->axes[ax];
 	double dv = m->pot1 - m->pot0,
 	       exp = (a->analog.forward_v - a->analog.reverse_v) * counts /
 		     a->travel_counts;
 	char fix[RE_COMM_FIX];
 
-	if (m->latched || m->timed_out) {
-		char why[96];
-
-		if (m->latched)
-			snprintf(why, sizeof(why),
-				 "the controller program latched fault %.0f "
-				 "(axis %.0f) and switched the motors off",
-				 m->fcode, m->faxis);
-		else
-			snprintf(why, sizeof(why), "the deadline of %d ms",
-				 RC_MOVE_MS + 500);
-		if (moved * counts < 0 && fabs(moved) > er / 4)
-			re_comm_add(c, "motion", a->name, RE_COMM_FAIL,
-				    "exchange the encoder's channels A and B "
-				    "(or reverse the motor leads) of this axis",
-				    "encoder reversed: asked for %+d counts, "
-				    "the encoder counted %+.0f (the servo ran "
-				    "away from the target) until %s: the "
-				    "encoder counts against its motor",
-				    counts, moved, why);
-		else if (fabs(moved) < er / 4)
-			re_comm_add(c, "motion", a->name, RE_COMM_FAIL,
-				    "check the amplifier, the motor cable, a "
-				    "brake or a jam on this axis",
-				    "did not move: asked for %+d counts, the "
-				    "encoder counted %+.0f before %s",
-				    counts, moved, why);
-		else
-			re_comm_add(c, "motion", a->name, RE_COMM_FAIL,
-				    "check the axis for a jam and the gains "
-				    "(kp, ki, kd) and torque_limit_v",
-				    "stopped short: %+.0f of %+d counts before "
-				    "%s",
-				    moved, counts, why);
-		return;
-	}
-	if (fabs(moved - counts) > er) {
-		re_comm_add(c, "motion", a->name, RE_COMM_FAIL,
-			    "check the encoder's resolution and wiring",
-			    "commanded %+d counts, the encoder counted %+.0f",
-			    counts, moved);
-		return;
-	}
-	re_comm_add(
-	    c, "motion", a->name, RE_COMM_PASS, NULL,
-	    "encoder: asked the program for %+d counts at %d counts/s, TL at "
-	    "most %.1f V: counted %+.0f with the motor",
-	    counts, RC_MOVE_CPS, RC_MOVE_TL_V, moved);
 	snprintf(fix, sizeof(fix),
 		 "exchange the potentiometer's two outer wires (supply and "
 		 "ground) on analog input %d, or mount it the other way",
@@ -356,6 +351,32 @@ static void move_judge(struct re_comm *c, int ax, int counts,
 			    "expected from reverse_v, forward_v and "
 			    "travel_counts)",
 			    dv, moved, exp);
+}
+
+/* Encoder against the motor, then the potentiometer against the encoder. */
+static void move_judge(struct re_comm *c, int ax, int counts,
+		       const struct move_res *m)
+{
+	const struct re_config_axis *a = &c->cfg->axes[ax];
+	double moved = m->enc1 - m->enc0;
+
+	if (m->latched || m->timed_out) {
+		judge_stopped(c, ax, counts, m);
+		return;
+	}
+	if (fabs(moved - counts) > a->position_error_limit_counts) {
+		re_comm_add(c, "motion", a->name, RE_COMM_FAIL,
+			    "check the encoder's resolution and wiring",
+			    "commanded %+d counts, the encoder counted %+.0f",
+			    counts, moved);
+		return;
+	}
+	re_comm_add(
+	    c, "motion", a->name, RE_COMM_PASS, NULL,
+	    "encoder: asked the program for %+d counts at %d counts/s, TL at "
+	    "most %.1f V: counted %+.0f with the motor",
+	    counts, RC_MOVE_CPS, RC_MOVE_TL_V, moved);
+	judge_pot(c, ax, counts, moved, m);
 }
 
 /* Wait until the profiler of @x stopped (_BGx 0), at most 2 s. */
