@@ -100,7 +100,7 @@ static int plot_axis(const char *path, const struct re_calset *s, int a,
 	snprintf(png, sizeof(png), "%s-%s.png", path, s->name[a]);
 	gp = popen("gnuplot", "w");
 	if (!gp) {
-		fprintf(err, "roboelf: warning: cannot run gnuplot\n");
+		fprintf(err, "roboelf-tech: warning: cannot run gnuplot\n");
 		return -1;
 	}
 	fprintf(gp,
@@ -116,7 +116,7 @@ static int plot_axis(const char *path, const struct re_calset *s, int a,
 	plot_data(gp, t, allowed, 1);
 	fprintf(gp, "unset multiplot\n");
 	if (pclose(gp) != 0) {
-		fprintf(err, "roboelf: warning: gnuplot failed for '%s'\n",
+		fprintf(err, "roboelf-tech: warning: gnuplot failed for '%s'\n",
 			png);
 		return -1;
 	}
@@ -133,7 +133,7 @@ int re_calshow_print(const char *path, const double *allowed_error, int n,
 	int plot;
 
 	if (rc != GL_OK) {
-		fprintf(err, "roboelf: error: %s\n", msg);
+		fprintf(err, "roboelf-tech: error: %s\n", msg);
 		return rc;
 	}
 	fprintf(out,

@@ -232,7 +232,7 @@ static int plot_pages(const char *path, const struct re_trace_hdr *h,
 	int np = re_traceshow_pages(h->n_axes);
 
 	if (!gp) {
-		fprintf(err, "roboelf: error: cannot run gnuplot: %s\n",
+		fprintf(err, "roboelf-tech: error: cannot run gnuplot: %s\n",
 			strerror(errno));
 		return EXIT_PLOT;
 	}
@@ -243,7 +243,8 @@ static int plot_pages(const char *path, const struct re_trace_hdr *h,
 	png_name(path, "timing", png[h->n_axes], sizeof(png[0]));
 	lanes_page(gp, path, png[h->n_axes], h, w);
 	if (pclose(gp) != 0) {
-		fprintf(err, "roboelf: error: gnuplot failed for '%s'\n", path);
+		fprintf(err, "roboelf-tech: error: gnuplot failed for '%s'\n",
+			path);
 		return EXIT_PLOT;
 	}
 	for (int p = 0; p < np; p++)
@@ -291,7 +292,8 @@ int re_traceshow_run(const char *path, const struct re_traceshow_win *w,
 	int rc = base_file_read(path, RE_TRACE_MAX_BYTES, &buf, &len);
 
 	if (rc < 0) {
-		fprintf(err, "roboelf: error: cannot read trace '%s': %s\n",
+		fprintf(err,
+			"roboelf-tech: error: cannot read trace '%s': %s\n",
 			path,
 			rc == -EFBIG ? "larger than the limit of 1 GiB"
 				     : strerror(-rc));
@@ -300,23 +302,25 @@ int re_traceshow_run(const char *path, const struct re_traceshow_win *w,
 	rc = re_trace_parse(buf, len, &h, &r, msg, sizeof(msg));
 	free(buf);
 	if (rc != GL_OK) {
-		fprintf(err, "roboelf: error: trace '%s' refused: %s\n", path,
-			msg);
+		fprintf(err, "roboelf-tech: error: trace '%s' refused: %s\n",
+			path, msg);
 		return EXIT_BAD;
 	}
 	summary(path, &h, r, out);
 	n = in_window(r, h.n_records, w);
 	free(r);
 	if (n == 0) {
-		fprintf(err,
-			"roboelf: error: trace '%s': no cycles in the %s\n",
-			path,
-			w && (w->have_from || w->have_to) ? "window" : "file");
+		fprintf(
+		    err,
+		    "roboelf-tech: error: trace '%s': no cycles in the %s\n",
+		    path,
+		    w && (w->have_from || w->have_to) ? "window" : "file");
 		return EXIT_BAD;
 	}
 	if (!have_gnuplot()) {
-		fprintf(err, "roboelf: error: gnuplot is not installed (make "
-			     "deps installs gnuplot-nox): no plots\n");
+		fprintf(err,
+			"roboelf-tech: error: gnuplot is not installed (make "
+			"deps installs gnuplot-nox): no plots\n");
 		return EXIT_BAD;
 	}
 	return plot_pages(path, &h, w, out, err);
