@@ -14,7 +14,7 @@
  * attributes changed) and that directory itself (deleted, moved); and the
  * final node (attributes changed, deleted, moved). Not watched: directories
  * further up (an ancestor renamed or mounted over), so callers still stat()
- * now and then (re_relay.c: at least once a second).
+ * now and then (re_relay_link.c: at least once a second).
  *
  * Nothing here prints or allocates; the descriptor is non-blocking and
  * close-on-exec.

@@ -5,7 +5,8 @@
  * write what the driver accepts now, tell how many bytes are still queued
  * for the wire, read what has arrived, discard the output queue, give a
  * descriptor for the link checks, close. Deadlines, protocols, state and the
- * checks live in re_relay.c. Messages are complete and name the port:
+ * checks live in re_relay.c and its parts (re_relay_int.h). Messages are
+ * complete and name the port:
  *   "relay '/dev/ttyUSB0': cannot open: Permission denied".
  *
  * Why nothing here may block (docs/config.md, "E-stop relay behaviour"):
@@ -49,8 +50,8 @@ struct re_relay_be_ops {
 	void (*discard)(struct re_relay_io *io);
 	/* The descriptor for poll/fstat, or -1. */
 	int (*fd)(const struct re_relay_io *io);
-	/* Close (no-op when closed). re_relay.c discards a non-empty output
-	 * queue first, so that close() has nothing to wait for. */
+	/* Close (no-op when closed). re_relay_port.c discards a non-empty
+	 * output queue first, so that close() has nothing to wait for. */
 	void (*close)(struct re_relay_io *io);
 };
 

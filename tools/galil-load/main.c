@@ -19,51 +19,20 @@
 
 #include "base_paths.h"
 #include "base_version.h"
-#include "dmc_cmd.h"
-#include "dmc_rule.h"
 #include "gl_disc.h"
 #include "gl_err.h"
 #include "gl_link.h"
-#include "gl_proto.h"
 #include "gload_check.h"
+#include "gload_cmd.h"
 #include "gload_dl.h"
+#include "gload_opts.h"
 #include "gload_prep.h"
 #include "gload_seal.h"
 #include "re_config.h"
 
-#define DEFAULT_TIMEOUT_MS 5000 /* gclib's default [galil-notes 1.6] */
-#define STOP_MS		   3000 /* default --stop-wait: axes stopped after ST */
-#define BUSY_WATCH_MS	   250	/* a supervisor's heartbeat changes within */
-#define MAX_COMMANDS	   64
-#define FIND_MS		   1000 /* discovery window (GAddresses: about 1 s) */
-#define FIND_MAX	   32
-
-struct opts {
-	const char *addr;
-	const struct dmc_model *model;
-	int check_only;
-	int burn;
-	int start;
-	int force;
-	int timeout_ms;
-	int stop_ms;
-	int timeout_set;
-	int find;
-	const char *find_addr;
-	int find_port;
-	char start_label[DMC_LABEL_MAX + 1];
-	const char *output;
-	const char *cmds[MAX_COMMANDS];
-	int ncmds;
-	char **paths;
-	int npaths;
-	const char *dmc;	    /* --dmc DIR */
-	const char *config;	    /* --config FILE: what the seal holds */
-	int version;		    /* --version */
-	int dmc_default;	    /* no files given: dmc_dir was chosen */
-	char *dmc_path[1];	    /* paths when --dmc or the default */
-	char dmc_dir[PATH_MAX + 1]; /* the default DMC directory */
-};
+#define BUSY_WATCH_MS 250  /* a supervisor's heartbeat changes within */
+#define FIND_MS	      1000 /* discovery window (GAddresses: about 1 s) */
+#define FIND_MAX      32
 
 static const char usage_text[] =
     "usage: galil-load [-a HOST[:PORT]] [options] FILE.dmc...|DIR\n"
@@ -125,277 +94,45 @@ static int usage_error(const char *fmt, ...)
 	return GLOAD_EXIT_USAGE;
 }
 
-static int parse_int(const char *s, int lo, int hi, int *out)
-{
-	char *end;
-	long v;
-
-	errno = 0;
-	v = strtol(s, &end, 10);
-	if (errno || end == s || *end || v < lo || v > hi)
-		return -1;
-	*out = (int)v;
-	return 0;
-}
-
-static int set_start_label(struct opts *o, const char *arg)
-{
-	size_t n;
-
-	o->start = 1;
-	if (!arg)
-		arg = "AUTO";
-	if (arg[0] == '#')
-		arg++;
-	n = strlen(arg);
-	if (n > DMC_LABEL_MAX || !dmc_label_ok(arg, n))
-		return -1;
-	memcpy(o->start_label, arg, n + 1);
-	return 0;
-}
-
-/* @c with control bytes shown in caret notation (0x12 -> "^R"). */
-static const char *shown(const char *c, char out[2 * GL_LINE_MAX + 8])
-{
-	size_t o = 0;
-
-	for (; *c && o < 2 * GL_LINE_MAX + 4; c++) {
-		unsigned char b = (unsigned char)*c;
-
-		if (b < 0x20 || b == 0x7f) {
-			out[o++] = '^';
-			out[o++] = (char)(b ^ 0x40);
-		} else {
-			out[o++] = (char)b;
-		}
-	}
-	out[o] = '\0';
-	return out;
-}
-
-/* A control-character request: ^R^V, or ^L^K ? (the lock state); the
- * others change the controller (command reference ^R^S, ^L^K). */
-static int check_ctrl_request(const char *cmd, enum gl_ctrl_kind k)
-{
-	char sh[2 * GL_LINE_MAX + 8];
-	const char *a = cmd + 2;
-
-	while (*a == ' ')
-		a++;
-	if (k == GL_CTRL_REVISION || (k == GL_CTRL_LOCK && !strcmp(a, "?")))
-		return 0;
-	if (k == GL_CTRL_RESET)
-		return usage_error("'^R^S' (master reset: erases the "
-				   "controller's EEPROM and its IP address) "
-				   "is not sent by galil-load");
-	if (k == GL_CTRL_LOCK)
-		return usage_error("'%s': only '^L^K ?' (is the program "
-				   "locked?) may be sent with -c",
-				   shown(cmd, sh));
-	return usage_error("'%s' holds a control character: only the "
-			   "requests ^R^V and '^L^K ?' may be sent with -c",
-			   shown(cmd, sh));
-}
-
-static int add_command(struct opts *o, const char *cmd)
-{
-	static const char *const refused[] = {"DL", "UL", "ED",
-					      "QD", "QU", "QR"};
-	enum gl_ctrl_kind k = gl_link_ctrl_kind(cmd);
-	size_t i;
-
-	if (o->ncmds == MAX_COMMANDS)
-		return usage_error("too many -c commands (at most %d)",
-				   MAX_COMMANDS);
-	if (k != GL_CTRL_NONE && check_ctrl_request(cmd, k))
-		return GLOAD_EXIT_USAGE;
-	if (k != GL_CTRL_NONE) {
-		o->cmds[o->ncmds++] = cmd;
-		return 0;
-	}
-	if (strlen(cmd) == 0 || strlen(cmd) > GL_LINE_MAX)
-		return usage_error("command '%s' is empty or longer than 80 "
-				   "characters",
-				   cmd);
-	if (strchr(cmd, '\r') || strchr(cmd, '\n'))
-		return usage_error("command '%s' holds a line end", cmd);
-	for (i = 0; i < sizeof(refused) / sizeof(refused[0]); i++)
-		if (!strncmp(cmd, refused[i], 2))
-			return usage_error("'%s' cannot be sent with -c "
-					   "(give program files to download)",
-					   cmd);
-	o->cmds[o->ncmds++] = cmd;
-	return 0;
-}
-
-enum {
-	OPT_CHECK = 256,
-	OPT_BURN,
-	OPT_START,
-	OPT_NO_START,
-	OPT_STOP_WAIT,
-	OPT_FIND,
-	OPT_FIND_ADDR,
-	OPT_FIND_PORT,
-	OPT_VERSION,
-	OPT_DMC,
-	OPT_CONFIG
-};
-
 static const struct option long_opts[] = {
     {"address", required_argument, NULL, 'a'},
-    {"check", no_argument, NULL, OPT_CHECK},
+    {"check", no_argument, NULL, GLOAD_OPT_CHECK},
     {"model", required_argument, NULL, 'm'},
     {"output", required_argument, NULL, 'o'},
     {"force", no_argument, NULL, 'f'},
-    {"burn", no_argument, NULL, OPT_BURN},
-    {"start", optional_argument, NULL, OPT_START},
-    {"no-start", no_argument, NULL, OPT_NO_START},
+    {"burn", no_argument, NULL, GLOAD_OPT_BURN},
+    {"start", optional_argument, NULL, GLOAD_OPT_START},
+    {"no-start", no_argument, NULL, GLOAD_OPT_NO_START},
     {"command", required_argument, NULL, 'c'},
     {"timeout", required_argument, NULL, 't'},
-    {"stop-wait", required_argument, NULL, OPT_STOP_WAIT},
-    {"find", no_argument, NULL, OPT_FIND},
-    {"find-addr", required_argument, NULL, OPT_FIND_ADDR},
-    {"find-port", required_argument, NULL, OPT_FIND_PORT},
+    {"stop-wait", required_argument, NULL, GLOAD_OPT_STOP_WAIT},
+    {"find", no_argument, NULL, GLOAD_OPT_FIND},
+    {"find-addr", required_argument, NULL, GLOAD_OPT_FIND_ADDR},
+    {"find-port", required_argument, NULL, GLOAD_OPT_FIND_PORT},
     {"help", no_argument, NULL, 'h'},
-    {"version", no_argument, NULL, OPT_VERSION},
-    {"dmc", required_argument, NULL, OPT_DMC},
-    {"config", required_argument, NULL, OPT_CONFIG},
+    {"version", no_argument, NULL, GLOAD_OPT_VERSION},
+    {"dmc", required_argument, NULL, GLOAD_OPT_DMC},
+    {"config", required_argument, NULL, GLOAD_OPT_CONFIG},
     {NULL, 0, NULL, 0},
 };
 
-/* One option; return 0, -1 for --help, or an exit code. */
-static int parse_opt(struct opts *o, int ch, const char *arg)
-{
-	switch (ch) {
-	case 'a': o->addr = arg; return 0;
-	case OPT_CHECK: o->check_only = 1; return 0;
-	case 'o': o->output = arg; return 0;
-	case 'f': o->force = 1; return 0;
-	case OPT_BURN: o->burn = 1; return 0;
-	case OPT_NO_START: o->start = 0; return 0;
-	case 'c': return add_command(o, arg);
-	case 'h': return -1;
-	case OPT_VERSION: o->version = 1; return 0;
-	case OPT_DMC: o->dmc = arg; return 0;
-	case OPT_CONFIG: o->config = arg; return 0;
-	case 'm':
-		o->model = dmc_model_find(arg);
-		return o->model ? 0
-				: usage_error("unknown model '%s' (40x0, "
-					      "41x3, 21x3, 30010)",
-					      arg);
-	case 't':
-		o->timeout_set = 1;
-		return parse_int(arg, 1, 600000, &o->timeout_ms)
-			   ? usage_error("invalid timeout '%s' (1..600000 "
-					 "ms)",
-					 arg)
-			   : 0;
-	case OPT_FIND: o->find = 1; return 0;
-	case OPT_FIND_ADDR: o->find_addr = arg; return 0;
-	case OPT_FIND_PORT:
-		return parse_int(arg, 1, 65535, &o->find_port)
-			   ? usage_error("invalid --find-port '%s'", arg)
-			   : 0;
-	case OPT_STOP_WAIT:
-		return parse_int(arg, 1, 60000, &o->stop_ms)
-			   ? usage_error("invalid --stop-wait '%s' (1..60000 "
-					 "ms)",
-					 arg)
-			   : 0;
-	case OPT_START:
-		return set_start_label(o, arg)
-			   ? usage_error("invalid label '%s' for --start", arg)
-			   : 0;
-	}
-	return usage_error("%s", "unknown option");
-}
-
-/* Combinations that make no sense or would be unsafe. */
-static int check_combination(const struct opts *o)
-{
-	if (o->check_only && (o->ncmds || o->burn || o->start))
-		return usage_error("%s",
-				   "--check does not talk to a "
-				   "controller; drop -c, --burn and --start");
-	if (o->check_only && o->npaths == 0)
-		return usage_error("%s", "--check needs program files");
-	if (o->npaths == 0 && (o->burn || o->start || o->output))
-		return usage_error("%s",
-				   "--burn, --start and -o need program "
-				   "files (only a checked program is burned or "
-				   "started)");
-	if (o->find && (o->npaths || o->ncmds || o->addr || o->check_only))
-		return usage_error("%s", "--find only lists controllers; give "
-					 "it no -a, -c, --check or files");
-	if (o->find)
-		return 0;
-	if (o->npaths == 0 && o->ncmds == 0)
-		return usage_error("%s", "no program files and no commands");
-	if (!o->check_only && !o->addr)
-		return usage_error("%s", "no controller address (-a HOST); use "
-					 "--check to check offline");
-	return 0;
-}
-
-/* --dmc DIR, or with neither files nor -c commands (nor --find) the
- * default DMC directory: ./dmc, else the installed one (base_paths.h). */
-static int choose_programs(struct opts *o)
-{
-	if (o->dmc && o->npaths)
-		return usage_error("%s", "--dmc DIR and program files: give "
-					 "one or the other");
-	if (o->dmc) {
-		o->dmc_path[0] = (char *)o->dmc;
-		o->paths = o->dmc_path;
-		o->npaths = 1;
-		return 0;
-	}
-	if (o->npaths || ((o->ncmds || o->find) && !o->version))
-		return 0;
-	if (base_paths_dmc_dir(o->dmc_dir, sizeof(o->dmc_dir)) < 0) {
-		if (o->version)
-			return 0;
-		return usage_error("no program files and no commands, and no "
-				   "DMC programs: neither dmc/MANIFEST here "
-				   "nor %s/MANIFEST",
-				   o->dmc_dir);
-	}
-	o->dmc_default = 1;
-	o->dmc_path[0] = o->dmc_dir;
-	o->paths = o->dmc_path;
-	o->npaths = 1;
-	return 0;
-}
-
 /* Return 0 to go on, -1 for --help, or an exit code. */
-static int parse_args(int argc, char **argv, struct opts *o)
+static int parse_args(int argc, char **argv, struct gload_opts *o)
 {
 	int ch, rc;
 
-	memset(o, 0, sizeof(*o));
-	o->model = dmc_model_default();
-	o->timeout_ms = DEFAULT_TIMEOUT_MS;
-	o->stop_ms = STOP_MS;
-	o->find_addr = GL_DISC_BCAST;
-	o->find_port = GL_DISC_PORT;
+	gload_opts_init(o);
 	opterr = 0;
 	while ((ch = getopt_long(argc, argv, ":a:m:o:fc:t:h", long_opts,
 				 NULL)) != -1) {
 		if (ch == '?' || ch == ':')
 			return usage_error("invalid or incomplete option '%s'",
 					   argv[optind - 1]);
-		rc = parse_opt(o, ch, optarg);
+		rc = gload_opts_set(o, ch, optarg, usage_error);
 		if (rc)
 			return rc;
 	}
-	o->paths = argv + optind;
-	o->npaths = argc - optind;
-	rc = choose_programs(o);
-	if (rc || o->version)
-		return rc;
-	return check_combination(o);
+	return gload_opts_finish(o, argv + optind, argc - optind, usage_error);
 }
 
 static void print_diags(struct gload_diags *d)
@@ -436,7 +173,8 @@ out_err:
 }
 
 static void print_sizes(const struct gload_prog *p,
-			const struct gload_stats *st, const struct opts *o)
+			const struct gload_stats *st,
+			const struct gload_opts *o)
 {
 	int files = p->nfiles - (p->seal ? 1 : 0); /* the seal is no file */
 
@@ -455,7 +193,7 @@ static void print_sizes(const struct gload_prog *p,
 
 /* The seal the manifest asks for, from --config or the configuration found
  * where roboelf looks for it. Return 0 or an exit code. */
-static int seal(const struct opts *o, struct gload_prog *p, int quiet)
+static int seal(const struct gload_opts *o, struct gload_prog *p, int quiet)
 {
 	static char found[PATH_MAX + 1];
 	char err[RE_CONFIG_ERR_MAX];
@@ -490,7 +228,7 @@ static int seal(const struct opts *o, struct gload_prog *p, int quiet)
 
 /* --version: the release, the interface, and the identity a download of
  * the programs (the files given, --dmc, or the default) is stamped with. */
-static int print_version(const struct opts *o)
+static int print_version(const struct gload_opts *o)
 {
 	struct gload_prog p = {0};
 	struct gload_diags d = {0};
@@ -527,7 +265,7 @@ static int print_version(const struct opts *o)
 }
 
 /* Read, preprocess, check and stamp. Return 0 or an exit code. */
-static int prepare(const struct opts *o, struct gload_prog *p)
+static int prepare(const struct gload_opts *o, struct gload_prog *p)
 {
 	struct gload_diags d = {0};
 	struct gload_stats st;
@@ -567,7 +305,7 @@ static int prepare(const struct opts *o, struct gload_prog *p)
 }
 
 /* The timeout of DL, UL and BP: at least GLOAD_SLOW_TIMEOUT_MS. */
-static int slow_ms(const struct opts *o)
+static int slow_ms(const struct gload_opts *o)
 {
 	return o->timeout_ms > GLOAD_SLOW_TIMEOUT_MS ? o->timeout_ms
 						     : GLOAD_SLOW_TIMEOUT_MS;
@@ -593,7 +331,7 @@ static int link_failed(gl_link *l, const char *what, int rc, int timeout_ms)
 	return gload_exit_for(rc);
 }
 
-static int open_link(const struct opts *o, gl_link **l)
+static int open_link(const struct gload_opts *o, gl_link **l)
 {
 	char err[GL_ERRTEXT_LEN] = "";
 	int rc = gl_link_open(l, o->addr, o->timeout_ms, err);
@@ -609,7 +347,7 @@ static int open_link(const struct opts *o, gl_link **l)
 
 /* Probe the network; print what answered to @f. Return the number found
  * (>= 0) or -1 (the message is printed). */
-static int find(const struct opts *o, struct gl_disc_ctrl *list, FILE *f)
+static int find(const struct gload_opts *o, struct gl_disc_ctrl *list, FILE *f)
 {
 	char err[GL_ERRTEXT_LEN] = "";
 	int i, ms = o->find && o->timeout_set ? o->timeout_ms : FIND_MS;
@@ -635,7 +373,7 @@ static int find(const struct opts *o, struct gl_disc_ctrl *list, FILE *f)
 /* -a did not answer: list the controllers that do and, on a terminal, let
  * the technician pick one (never chosen silently). Return 0 with *@l open,
  * or GLOAD_EXIT_CONN. */
-static int offer_found(struct opts *o, gl_link **l)
+static int offer_found(struct gload_opts *o, gl_link **l)
 {
 	static struct gl_disc_ctrl list[FIND_MAX];
 	static char chosen[sizeof(list[0].addr)];
@@ -649,7 +387,7 @@ static int offer_found(struct opts *o, gl_link **l)
 		return GLOAD_EXIT_CONN;
 	fprintf(stderr, "connect to which one (1-%d, Enter: none)? ", n);
 	if (!fgets(line, sizeof(line), stdin) ||
-	    parse_int(strtok(line, "\n") ? line : "", 1, n, &k))
+	    gload_opts_int(strtok(line, "\n") ? line : "", 1, n, &k))
 		return GLOAD_EXIT_CONN;
 	snprintf(chosen, sizeof(chosen), "%s", list[k - 1].addr);
 	o->addr = chosen;
@@ -658,7 +396,7 @@ static int offer_found(struct opts *o, gl_link **l)
 }
 
 /* gload_dl_halt() with the controller's own number of axes. */
-static int halt(gl_link *l, const struct opts *o, int *running,
+static int halt(gl_link *l, const struct gload_opts *o, int *running,
 		char failed[GLOAD_CMD_LEN])
 {
 	int axes = gl_link_axes(l);
@@ -670,7 +408,7 @@ static int halt(gl_link *l, const struct opts *o, int *running,
 }
 
 /* Leave the controller halted and empty after a failed download. */
-static void erase_after_failure(gl_link **l, const struct opts *o)
+static void erase_after_failure(gl_link **l, const struct gload_opts *o)
 {
 	int rc = *l ? gload_dl_erase(*l, o->timeout_ms) : GL_ERR_CLOSED;
 	char failed[GLOAD_CMD_LEN];
@@ -717,7 +455,7 @@ static void print_bad_line(const struct gload_prog *p, int bad)
 }
 
 /* Download and read back. Return 0 or an exit code (controller erased). */
-static int download(gl_link **l, const struct opts *o,
+static int download(gl_link **l, const struct gload_opts *o,
 		    const struct gload_prog *p, char *ul)
 {
 	int rc, bad = 0, line = 0;
@@ -754,7 +492,7 @@ static int download(gl_link **l, const struct opts *o,
 }
 
 /* 1 when the controller already holds exactly this program. */
-static int same_program(gl_link *l, const struct opts *o,
+static int same_program(gl_link *l, const struct gload_opts *o,
 			const struct gload_prog *p, char *ul, int *ex)
 {
 	int rc, line;
@@ -772,7 +510,7 @@ static int same_program(gl_link *l, const struct opts *o,
 }
 
 /* A supervisor driving the robot is not interrupted without --force. */
-static int busy(gl_link *l, const struct opts *o)
+static int busy(gl_link *l, const struct gload_opts *o)
 {
 	int state, rc = gload_dl_busy(l, BUSY_WATCH_MS, &state, o->timeout_ms);
 
@@ -798,7 +536,7 @@ static int busy(gl_link *l, const struct opts *o)
 	return 0;
 }
 
-static int identify_and_halt(gl_link *l, const struct opts *o)
+static int identify_and_halt(gl_link *l, const struct gload_opts *o)
 {
 	char model[128] = "", failed[GLOAD_CMD_LEN], what[GLOAD_CMD_LEN + 16];
 	long serial = 0;
@@ -850,7 +588,7 @@ static int identify_and_halt(gl_link *l, const struct opts *o)
 	return 0;
 }
 
-static int burn_and_start(gl_link *l, const struct opts *o)
+static int burn_and_start(gl_link *l, const struct gload_opts *o)
 {
 	double xq0 = -1;
 	char what[64];
@@ -880,7 +618,8 @@ static int burn_and_start(gl_link *l, const struct opts *o)
 	return 0;
 }
 
-static int load(gl_link **l, const struct opts *o, const struct gload_prog *p)
+static int load(gl_link **l, const struct gload_opts *o,
+		const struct gload_prog *p)
 {
 	char *ul = malloc(GLOAD_UPLOAD_CAP);
 	int ex, same;
@@ -919,32 +658,15 @@ static void print_reply(const char *s)
 	putchar('\n');
 }
 
-/* The RoboELF program's state: 1 armed or 3 service while it runs, else
- * -1 (no program, halted, or not ours: no "state" variable). */
-static int running_state(gl_link *l, const struct opts *o)
-{
-	char resp[64];
-	double v;
-	int rc =
-	    gl_link_command(l, "MG _XQ0", resp, sizeof(resp), o->timeout_ms);
-
-	if (rc < 0 || !gl_parse_double(resp, (size_t)rc, NULL, &v) || v < 0)
-		return -1;
-	rc = gl_link_command(l, "MG state", resp, sizeof(resp), o->timeout_ms);
-	if (rc < 0 || !gl_parse_double(resp, (size_t)rc, NULL, &v))
-		return -1;
-	return v == 1 || v == 3 ? (int)v : -1;
-}
-
 /* A command that writes, on a program in service or armed: refused
  * without --force (a write may change how the robot moves or is stopped;
  * docs/safety.md H12); reads (MG, TP, "KP ?,?", "name=") pass. */
-static int check_write(gl_link *l, const struct opts *o, const char *c)
+static int check_write(gl_link *l, const struct gload_opts *o, const char *c)
 {
-	char sh[2 * GL_LINE_MAX + 8];
-	int st;
+	char sh[GLOAD_SHOWN_LEN];
+	int st = gload_cmd_write_state(l, c, o->timeout_ms);
 
-	if (dmc_cmd_line_is_read(c) || (st = running_state(l, o)) < 0)
+	if (st < 0)
 		return 0;
 	if (!o->force) {
 		fprintf(stderr,
@@ -954,40 +676,32 @@ static int check_write(gl_link *l, const struct opts *o, const char *c)
 			"and 'KP ?,?' are allowed); quit roboelf first, or "
 			"give --force to send it anyway (the program latches "
 			"a fault if it changes a sealed value)\n",
-			shown(c, sh),
+			gload_cmd_shown(c, sh),
 			st == 1 ? "armed" : "in its service state");
 		return GLOAD_EXIT_BUSY;
 	}
 	printf("warning: --force: sending '%s' to a program that is %s: if "
 	       "it changes a sealed value, the program stops the robot and "
 	       "latches fault 17, and roboelf cuts motor power\n",
-	       shown(c, sh), st == 1 ? "armed" : "in its service state");
+	       gload_cmd_shown(c, sh),
+	       st == 1 ? "armed" : "in its service state");
 	return 0;
 }
 
-static int run_commands(gl_link *l, const struct opts *o)
+static int run_commands(gl_link *l, const struct gload_opts *o)
 {
 	static char resp[64 * 1024];
-	char what[2 * GL_LINE_MAX + 16], sh[2 * GL_LINE_MAX + 8];
+	char what[2 * GL_LINE_MAX + 16], sh[GLOAD_SHOWN_LEN];
 	int i, rc, tmo;
 
 	for (i = 0; i < o->ncmds; i++) {
 		const char *c = o->cmds[i];
 
-		/* burns and BZ pause the controller [galil-notes 1.6] */
-		tmo = (c[0] == 'B' && c[1] && strchr("PNVZ", c[1]))
-			  ? GLOAD_SLOW_TIMEOUT_MS
-			  : o->timeout_ms;
-		if (tmo < o->timeout_ms)
-			tmo = o->timeout_ms;
+		tmo = gload_cmd_timeout(c, o->timeout_ms);
 		if ((rc = check_write(l, o, c)) != 0)
 			return rc;
-		if (gl_link_ctrl_kind(c) > GL_CTRL_NONE)
-			rc =
-			    gl_link_ctrl_request(l, c, resp, sizeof(resp), tmo);
-		else
-			rc = gl_link_command(l, c, resp, sizeof(resp), tmo);
-		snprintf(what, sizeof(what), "'%s'", shown(c, sh));
+		rc = gload_cmd_send(l, c, resp, sizeof(resp), tmo);
+		snprintf(what, sizeof(what), "'%s'", gload_cmd_shown(c, sh));
 		if (rc < 0)
 			return link_failed(l, what, rc, tmo);
 		print_reply(resp);
@@ -998,7 +712,7 @@ static int run_commands(gl_link *l, const struct opts *o)
 int main(int argc, char **argv)
 {
 	struct gload_prog p = {0};
-	struct opts o;
+	struct gload_opts o;
 	gl_link *l = NULL;
 	int ex;
 
