@@ -135,7 +135,7 @@ static void test_show_corrupt(void **state)
 	slurp(out, text, sizeof(text));
 	assert_string_equal(text, "");
 	slurp(errf, text, sizeof(text));
-	assert_non_null(strstr(text, "roboelf: error: "));
+	assert_non_null(strstr(text, "roboelf-tech: error: "));
 	assert_non_null(strstr(text, "cal.txt"));
 	fclose(out);
 	fclose(errf);
