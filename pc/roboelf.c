@@ -38,7 +38,6 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "base_paths.h"
 #include "gl_err.h"
 #include "re_app.h"
 #include "re_calib.h"
@@ -544,11 +543,7 @@ int main(int argc, char **argv)
 	if (rc)
 		return rc > 0 ? 0 : EXIT_USAGE;
 	a.prog = "roboelf";
-	if (base_paths_root())
-		fprintf(stderr,
-			"roboelf: %s=%s: the installed files are looked for "
-			"under it\n",
-			BASE_PATHS_ROOT_ENV, base_paths_root());
+	re_app_root_note(a.prog);
 	if (o.version)
 		return re_app_print_version(a.prog, &o.g);
 	if (re_app_load_config(&a, &o.g) < 0)

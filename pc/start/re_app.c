@@ -263,3 +263,12 @@ void re_app_release(struct app *a)
 	a->sup = NULL;
 	a->cal = NULL;
 }
+
+void re_app_root_note(const char *prog)
+{
+	if (base_paths_root())
+		fprintf(stderr,
+			"%s: %s=%s: the installed files are looked for under "
+			"it\n",
+			prog, BASE_PATHS_ROOT_ENV, base_paths_root());
+}

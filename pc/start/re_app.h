@@ -33,6 +33,12 @@ struct re_app_args {
 void re_app_signals(void);
 
 /*
+ * re_app_root_note() - when ROBOELF_ROOT is set, say so on stderr:
+ * "PROG: ROBOELF_ROOT=DIR: the installed files are looked for under it".
+ */
+void re_app_root_note(const char *prog);
+
+/*
  * re_app_system_config() - the installed configuration,
  * SYSCONFDIR/roboelf/roboelf.yaml (under ROBOELF_ROOT when set); "" when
  * the path does not fit.
