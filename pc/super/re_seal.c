@@ -19,6 +19,8 @@
 #define T1_LABEL       "#MOTION" /* thread 1's code starts here */
 #define T1_END_LABEL   "#POSERR" /* and ends before this */
 #define ITEMS_PER_LINE 6	 /* checks joined on one line, at most */
+#define SLF_SELF       3	 /* #SLF's lines where thread 0 finds itself */
+#define SLF_WAIT_MS    10	 /* #SLW: a stray thread's look period, ms */
 
 static const char AXES[] = "ABC";
 
@@ -280,6 +282,10 @@ int re_seal_start(const char *body, size_t len, struct re_seal *out, char *err,
 	memset(out, 0, sizeof(*out));
 	out->t1_first = label_line(body, len, T1_LABEL);
 	out->t1_last = label_line(body, len, T1_END_LABEL) - 1;
+	for (size_t i = 0; i < len; i++)
+		out->body_lines += body[i] == '\n';
+	if (len && body[len - 1] != '\n')
+		out->body_lines++;
 	if (out->t1_first < 0 || out->t1_last < out->t1_first) {
 		seterr(err, errlen, "the program has no %s before %s", T1_LABEL,
 		       T1_END_LABEL);
@@ -321,6 +327,7 @@ struct emit {
 	char *out;
 	size_t cap, len;
 	int over;
+	int lines; /* whole lines emitted so far */
 };
 
 static void put(struct emit *e, const char *fmt, ...)
@@ -336,10 +343,13 @@ static void put(struct emit *e, const char *fmt, ...)
 	va_start(ap, fmt);
 	n = vsnprintf(e->out + e->len, e->cap - e->len, fmt, ap);
 	va_end(ap);
-	if (n < 0 || (size_t)n >= e->cap - e->len)
+	if (n < 0 || (size_t)n >= e->cap - e->len) {
 		e->over = 1;
-	else
-		e->len += (size_t)n;
+		return;
+	}
+	for (const char *c = e->out + e->len; *c; c++)
+		e->lines += *c == '\n';
+	e->len += (size_t)n;
 }
 
 /* A literal in an expression: a negative one as (0-N), since a unary minus
@@ -570,7 +580,15 @@ static void emit_find(struct emit *e, const struct re_seal *s)
 {
 	char c[LINE_MAX_CHARS + 1];
 
+	/* the line of #SLF: thread 0 running the test line finds itself
+	 * within its first SLF_SELF lines (_XQ0 the line it runs or the
+	 * next); any other thread finds thread 0 elsewhere and waits at
+	 * #SLW, where thread 0's next look finds it (halting itself here
+	 * would end it before thread 0 could name it) */
+	int slf = s->body_lines + e->lines;
+
 	put(e, "#SLF\nAB 1;MO ABC;OP 0\n");
+	put(e, "JP #SLW,(_XQ0<%d)|(_XQ0>%d)\n", slf, slf + SLF_SELF);
 	put(e,
 	    "sq1=_XQ1;sq2=_XQ2;sq3=_XQ3;sq4=_XQ4;sq5=_XQ5;sq6=_XQ6;sq7=_XQ7\n");
 	put(e, "HX1;HX2;HX3;HX4;HX5;HX6;HX7\n");
@@ -588,12 +606,15 @@ static void emit_find(struct emit *e, const struct re_seal *s)
 			    it->axis + 1, it->ref, c);
 	}
 	put(e, "sid=0;sax=0;sfv=0\n#SLX\nJS #FAULT(17,sax,sid)\nEN\n");
+	/* #SLW: a thread other than 0 keeps the motion stopped until thread
+	 * 0 halts it (SLF_WAIT_MS between looks) */
+	put(e, "#SLW\nAB 1;MO ABC;OP 0\nWT %d\nJP #SLW\n", SLF_WAIT_MS);
 }
 
 int re_seal_emit(const struct re_seal *s, char *out, size_t cap)
 {
 	static char lines[RE_SEAL_MAX][LINE_MAX_CHARS + 1];
-	struct emit e = {out, cap, 0, 0};
+	struct emit e = {out, cap, 0, 0, 0};
 	int n;
 
 	if (!cap)

@@ -80,6 +80,7 @@ struct re_seal {
 	int n;
 	struct re_seal_item item[RE_SEAL_MAX];
 	int t1_first, t1_last; /* program lines thread 1 may be on (armed) */
+	int body_lines;	       /* lines of the program before the seal part */
 };
 
 /*
@@ -114,7 +115,9 @@ int re_seal_const(const struct re_seal *s, const char *name, double *value);
 
 /*
  * re_seal_emit() - the program part that holds the seal: #SEALIN, #SEALS,
- * #SEAL, #SEALA and their slices, and #SLF (which item, then fault 17).
+ * #SEAL, #SEALA and their slices, #SLF (which item, then fault 17) and
+ * #SLW (where a thread other than 0 that reaches #SLF waits to be found).
+ * The line numbers in #SLF's own test follow @s->body_lines.
  * Lines of at most 80 characters, already in galil-load's preprocessed
  * form, each ending with LF; the first line is RE_SEAL_FIRST.
  * @out: [out] NUL-terminated.

@@ -22,6 +22,7 @@
 
 #include <cmocka.h>
 
+#include "ctrl.h"
 #include "dmc_h.h"
 
 /* ---- helpers ------------------------------------------------------------- */
@@ -275,6 +276,120 @@ static void test_hb_out_of_sequence(void **state)
 		assert_latched(&h, 14, 0, 1, 0);
 		dmc_h_close(&h);
 	}
+}
+
+/* Line budgets per sample tried: a host write lands at a sample boundary,
+ * and the budget moves the boundaries across the lines of #HBCHK. */
+#define STRAY_BUDGET_MIN  8
+#define STRAY_BUDGET_MAX  40
+#define STRAY_FIRST_AHEAD 1000 /* the stray value, past the heartbeat */
+#define STRAY_SAMPLES	  3000 /* how long one budget waits for its chance */
+#define STRAY_PASSES	  3    /* the next look, in mainms, at any budget */
+
+/* The 0-based number of the first line of @h's program at or after line
+ * @from that starts with @prefix, or -1. */
+static int prog_line(const struct dmc_h *h, const char *prefix, int from)
+{
+	const char *p = h->prog, *end = h->prog + h->prog_len;
+	size_t n = strlen(prefix);
+
+	for (int i = 0; p < end; i++) {
+		const char *nl = memchr(p, '\n', (size_t)(end - p));
+
+		if (i >= from && (size_t)(end - p) >= n && !memcmp(p, prefix, n))
+			return i;
+		p = nl ? nl + 1 : end;
+	}
+	return -1;
+}
+
+/* One budget: the supervisor writes once a pass until thread 0, in the
+ * pass after a write, is between #HBCHK's first statement and its copy
+ * into hbold (the look has begun with that write); then the stray write,
+ * and the supervisor is dead.
+ * Return: 1 and fault 14 detail 1 latched at the next look (within
+ * STRAY_PASSES * mainms of the stray write); 0 when no sample boundary fell in that window (nothing tested). */
+static int stray_run(int budget, int first, int copy)
+{
+	static struct dmc_h h;
+	double mainms, t0, t = -1;
+	int legit = 0, stray = 0;
+
+	if (dmc_h_setup(&h) < 0)
+		fail_msg("set-up: %s", h.err);
+	ctrl_set_line_budget(h.ctrl, budget);
+	mainms = dmc_h_var(&h, "mainms");
+	h.hb_on = 0;
+	for (int k = 0; k < STRAY_SAMPLES && !stray; k++) {
+		char r[32];
+		int xq;
+
+		DMC_H_CHECK(&h, ctrl_command(h.ctrl, "MG _XQ0", r, sizeof(r)));
+		xq = atoi(r);
+		/* no chance in this pass: the supervisor writes again */
+		if (legit && k - legit >= mainms)
+			legit = 0;
+		if (!legit && (xq < first - 1 || xq > copy)) {
+			DMC_H_CHECK(&h, dmc_h_set(&h, "hbpc", (double)++h.hb));
+			legit = k + 1;
+		} else if (legit && xq > first + 1 && xq <= copy) {
+			DMC_H_CHECK(&h, dmc_h_set(&h, "hbpc",
+						  h.hb + STRAY_FIRST_AHEAD));
+			stray = 1;
+			break;
+		}
+		dmc_h_advance(&h, 1);
+	}
+	if (!stray) {
+		dmc_h_close(&h);
+		return 0;
+	}
+	t0 = dmc_h_now(&h);
+	while (t < 0 && dmc_h_now(&h) - t0 < 10 * mainms) {
+		dmc_h_advance(&h, 1);
+		if (dmc_h_var(&h, "state") == 2)
+			t = dmc_h_now(&h) - t0;
+	}
+	/* a small budget stretches the pass: the next look, not mainms */
+	if (t < 0 || t > STRAY_PASSES * mainms ||
+	    dmc_h_var(&h, "fcode") != 14 || dmc_h_var(&h, "fdet") != 1)
+		fail_msg("%d lines per sample: the stray write inside #HBCHK "
+			 "was not judged (state %g, fault %g detail %g, %.0f "
+			 "ms after it)",
+			 budget, dmc_h_var(&h, "state"), dmc_h_var(&h, "fcode"),
+			 dmc_h_var(&h, "fdet"),
+			 t < 0 ? dmc_h_now(&h) - t0 : t);
+	assert_latched(&h, 14, 0, 1, 0);
+	dmc_h_close(&h);
+	return 1;
+}
+
+/*
+ * A stray writer (it starts from its own value) whose write lands inside
+ * #HBCHK, after the look began with the supervisor's last write: it is
+ * judged, fault 14, axis 0, detail 1 at the next look, never taken for the heartbeat (its later values would then be in
+ * sequence and hold the watchdog off). Tried with every line budget from
+ * STRAY_BUDGET_MIN to STRAY_BUDGET_MAX; at least one must land there.
+ */
+static void test_hb_stray_inside_look(void **state)
+{
+	static struct dmc_h h;
+	int first, copy, landed = 0;
+
+	(void)state;
+	DMC_H_CHECK(&h, dmc_h_open(&h));
+	first = prog_line(&h, "#HBCHK", 0);
+	copy = prog_line(&h, "hbold=", first);
+	dmc_h_close(&h);
+	assert_true(first > 0 && copy > first && copy - first < 10);
+	for (int b = STRAY_BUDGET_MIN; b <= STRAY_BUDGET_MAX; b++)
+		landed += stray_run(b, first, copy);
+	print_message("measured: a stray hbpc write inside #HBCHK (lines "
+		      "%d..%d) at %d of %d line budgets -> fault 14 at the next "
+		      "look each\n",
+		      first + 2, copy, landed,
+		      STRAY_BUDGET_MAX - STRAY_BUDGET_MIN + 1);
+	assert_true(landed > 0);
 }
 
 /*
@@ -730,6 +845,7 @@ int main(void)
 	    cmocka_unit_test_setup_teardown(test_host_sp_persistent,
 					    dmc_h_fx_armed, dmc_h_fx_free),
 	    cmocka_unit_test(test_hb_out_of_sequence),
+	    cmocka_unit_test(test_hb_stray_inside_look),
 	    cmocka_unit_test_setup_teardown(test_hb_wrap, dmc_h_fx_new,
 					    dmc_h_fx_free),
 	    cmocka_unit_test(test_new_handle),

@@ -21,6 +21,7 @@
 
 #include <cmocka.h>
 
+#include "ctrl.h"
 #include "dmc_h.h"
 
 /* A value the controller computes, read with a host MG (NAN on error). */
@@ -259,6 +260,34 @@ static void test_thread1_elsewhere(void **state)
 			 dmc_h_var(h, "fdet"), k + 1);
 }
 
+/* Thread 1 started in the finder itself while armed (a client's "HX1;XQ
+ * #SLF,1"): it stops the motion and waits at #SLW instead of ending
+ * itself, so thread 0 finds it there: fault 17 on _XQ1, and thread 1
+ * halted. */
+static void test_thread1_in_finder(void **state)
+{
+	struct dmc_h *h = *state;
+	double mainms;
+	int k;
+
+	setup(h, 0);
+	mainms = dmc_h_var(h, "mainms");
+	for (k = 0; k < h->seal.n && strcmp(h->seal.item[k].ref, "_XQ1"); k++)
+		;
+	assert_true(k < h->seal.n);
+	DMC_H_CHECK(h, dmc_h_cmd(h, "HX1;XQ #SLF,1", NULL, 0));
+	assert_true(dmc_h_wait_var(h, "state", 2,
+				   (RE_SEAL_SLICES + 1) * mainms + 2) >= 0);
+	dmc_h_advance(h, 2 * mainms);
+	if (dmc_h_var(h, "fcode") != 17 || dmc_h_var(h, "fdet") != k + 1)
+		fail_msg("fault %g axis %g detail %g, want 17 detail %d (_XQ1)",
+			 dmc_h_var(h, "fcode"), dmc_h_var(h, "faxis"),
+			 dmc_h_var(h, "fdet"), k + 1);
+	assert_int_equal(ctrl_threads(h->ctrl) & 2u, 0);
+	for (int i = 0; i < DMC_H_AXES; i++)
+		assert_int_equal(dmc_h_axis(h, i).motor_off, 1);
+}
+
 /* A sealed value changed in the safe state is caught at the request,
  * before any motor goes on: the arm and the service request refused. */
 static void test_refused_at_request(void **state)
@@ -336,6 +365,8 @@ int main(void)
 	    cmocka_unit_test(test_every_item_armed),
 	    cmocka_unit_test(test_every_item_service),
 	    cmocka_unit_test_setup_teardown(test_thread1_elsewhere,
+					    dmc_h_fx_new, dmc_h_fx_free),
+	    cmocka_unit_test_setup_teardown(test_thread1_in_finder,
 					    dmc_h_fx_new, dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_refused_at_request,
 					    dmc_h_fx_new, dmc_h_fx_free),
