@@ -153,7 +153,7 @@ static void check_label_def(struct lint *c, int line, const char *s, size_t n)
 {
 	size_t wl = word_len(s + 1, n - 1);
 
-	if (wl != n - 1 || !dmc_label_ok(s + 1, wl))
+	if (wl != n - 1 || !dmc_label_ok_model(c->m, s + 1, wl))
 		report(c, line, 0, DMC_R_LABEL_SYNTAX,
 		       "invalid label '%.*s' (a letter, then letters or "
 		       "digits)",
@@ -473,7 +473,12 @@ static int is_comment(const char *s, size_t n)
 	       (n == 2 || !dmc_is_name_char(s[2]));
 }
 
-/* A NO comment with text, then ';' and more: the rest runs. */
+/*
+ * A NO comment with text, then ';' and more: the rest runs (the command
+ * reference's NO and ';' pages; docs/galil-sim.md). When the rest starts
+ * with a comment of its own ("NO a; NO b"), nothing runs yet: that
+ * comment is judged as the next statement.
+ */
 static void check_no_rest(struct lint *c, int line, const char *st,
 			  const char *s, const char *end)
 {
@@ -483,7 +488,8 @@ static void check_no_rest(struct lint *c, int line, const char *st,
 		t++;
 	while (r < end && *r == ' ')
 		r++;
-	if (st[0] == 'N' && t < s && r < end)
+	if (st[0] == 'N' && t < s && r < end &&
+	    !is_comment(r, (size_t)(end - r)))
 		report(c, line, 0, DMC_R_NO_SEMICOLON,
 		       "';' ends the NO comment: '%.*s' runs as commands",
 		       (int)(end - r), r);
@@ -516,10 +522,27 @@ static void check_statements(struct lint *c, int line, const char *s, size_t n)
 	}
 }
 
+/*
+ * A tab inside a "string": no reference says the firmware keeps it, and
+ * Galil's own downloader replaces every tab before it sends a program, so
+ * it is refused like any control character, with the documented way to
+ * print one (MG's {^n}: docs/galil-sim.md).
+ */
+static void report_char(struct lint *c, int line, unsigned char ch, int in_str)
+{
+	if (ch == '\t' && in_str)
+		report(c, line, 0, DMC_R_CHAR,
+		       "tab inside a string is not known to reach the "
+		       "firmware (print one with {^9})");
+	else
+		report(c, line, 0, DMC_R_CHAR,
+		       "character 0x%02X is not printable ASCII", ch);
+}
+
 static void check_chars(struct lint *c, int line, const char *s, size_t n)
 {
 	size_t i;
-	int bad = 0, bslash = 0;
+	int bad = 0, bslash = 0, in_str = 0;
 
 	if (n > (size_t)c->m->line_chars)
 		report(c, line, 0, DMC_R_LINE_LENGTH,
@@ -528,12 +551,12 @@ static void check_chars(struct lint *c, int line, const char *s, size_t n)
 	for (i = 0; i < n; i++) {
 		unsigned char ch = (unsigned char)s[i];
 
+		in_str ^= ch == '"';
 		if (ch == '\\' && !bslash++)
 			report(c, line, 0, DMC_R_BACKSLASH,
 			       "'\\' ends the download early");
 		else if ((ch < 0x20 || ch > 0x7e) && !bad++)
-			report(c, line, 0, DMC_R_CHAR,
-			       "character 0x%02X is not printable ASCII", ch);
+			report_char(c, line, ch, in_str);
 	}
 }
 

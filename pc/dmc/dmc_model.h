@@ -28,10 +28,13 @@ struct dmc_model {
 	int line_chars;	   /* characters per program line */
 	int max_lines;	   /* program lines */
 	int max_labels;
-	int max_vars;  /* scalar variables */
-	int threads;   /* program threads 0..threads-1 */
-	int confirmed; /* 0: limits not confirmed from a primary
-			* source; conservative values */
+	int max_vars;	      /* scalar variables */
+	int threads;	      /* program threads 0..threads-1 */
+	int confirmed;	      /* 0: limits not confirmed from a primary
+			       * source; conservative values */
+	int label_underscore; /* 1: '_' accepted in a label after its
+			       * first character (docs/galil-sim.md,
+			       * "Labels with '_'") */
 };
 
 /*

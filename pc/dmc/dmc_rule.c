@@ -4,6 +4,7 @@
  */
 #include <ctype.h>
 
+#include "dmc_model.h"
 #include "dmc_rule.h"
 
 static const struct dmc_rule rules[DMC_R_COUNT] = {
@@ -19,7 +20,7 @@ static const struct dmc_rule rules[DMC_R_COUNT] = {
 			   0},
     [DMC_R_LABEL_SYNTAX] = {"label-syntax",
 			    "CR, # (label): a letter, then letters and "
-			    "digits; no '_'",
+			    "digits; '_' too on the DMC-40x0",
 			    DMC_RULE_SIM},
     [DMC_R_LABEL_LENGTH] = {"label-length",
 			    "CR, #: at most 7 characters after '#'",
@@ -80,14 +81,26 @@ const struct dmc_rule *dmc_rule(enum dmc_rule_id id)
 	return (unsigned)id < DMC_R_COUNT ? &rules[id] : NULL;
 }
 
-int dmc_label_ok(const char *s, size_t n)
+/* A letter, then letters or digits, and '_' when @underscore is set. */
+static int label_chars_ok(const char *s, size_t n, int underscore)
 {
 	if (n == 0 || !isalpha((unsigned char)s[0]))
 		return 0;
 	for (size_t i = 1; i < n; i++)
-		if (!isalnum((unsigned char)s[i]))
+		if (!isalnum((unsigned char)s[i]) &&
+		    !(underscore && s[i] == '_'))
 			return 0;
 	return 1;
+}
+
+int dmc_label_ok(const char *s, size_t n)
+{
+	return label_chars_ok(s, n, 1);
+}
+
+int dmc_label_ok_model(const struct dmc_model *m, const char *s, size_t n)
+{
+	return label_chars_ok(s, n, m->label_underscore);
 }
 
 int dmc_var_ok(const char *s, size_t n)

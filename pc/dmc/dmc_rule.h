@@ -58,13 +58,24 @@ struct dmc_rule {
  */
 const struct dmc_rule *dmc_rule(enum dmc_rule_id id);
 
+struct dmc_model;
+
 /*
- * dmc_label_ok() - 1 when the @n bytes at @s are a valid label name
- * (without the '#') by its characters: a letter, then letters or
- * digits - no '_' (command reference, #). 0 otherwise. The length
- * (DMC_LABEL_MAX, dmc_model.h) is judged apart, by its own rule.
+ * dmc_label_ok() - 1 when the @n bytes at @s are a label name (without
+ * the '#') that some model accepts by its characters: a letter, then
+ * letters, digits or '_'. 0 otherwise. For a command-line label, before
+ * the model is known; a program's labels are judged per model by
+ * dmc_label_ok_model(). The length (DMC_LABEL_MAX, dmc_model.h) is
+ * judged apart, by its own rule.
  */
 int dmc_label_ok(const char *s, size_t n);
+
+/*
+ * dmc_label_ok_model() - dmc_label_ok() for the model @m (not NULL): a
+ * letter, then letters or digits (command reference, #), and '_' too when
+ * @m->label_underscore is set. Return 1 when valid, else 0.
+ */
+int dmc_label_ok_model(const struct dmc_model *m, const char *s, size_t n);
 
 /*
  * dmc_var_ok() - 1 when the @n bytes at @s are a valid variable name by

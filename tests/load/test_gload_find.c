@@ -3,9 +3,11 @@
  * against a listener of this test on 127.0.0.1 that answers the probe like
  * a controller ("DMC4030 Rev 1.2h" CR LF ':'): --find lists it exactly;
  * when -a does not answer, galil-load lists it on stderr and, stdin not
- * being a terminal, exits 3 without connecting anywhere else.
+ * being a terminal, exits 3 without connecting anywhere else. And against
+ * galil-sim --disc-port 0, the simulator a technician practises on: --find
+ * lists it with the model text it answers to ^R^V.
  *
- * Needs $ROBOELF_BIN/galil-load.
+ * Needs $ROBOELF_BIN/galil-load and $ROBOELF_BIN/galil-sim.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -29,6 +31,8 @@
 
 #define RUN_DEADLINE_MS 10000
 #define LISTEN_MS	8000 /* the listener gives up after this */
+
+#define SIM_START_MS 5000 /* galil-sim's ready line */
 
 static char load_bin[512];
 
@@ -134,6 +138,39 @@ static void test_find(void **state)
 	proc_kill(&p);
 }
 
+/* galil-sim answers the probe: listed with its ^R^V text, exactly. */
+static void test_find_sim(void **state)
+{
+	char *const extra[] = {(char *)"--disc-port", (char *)"0", NULL};
+	char port[16], line[512];
+	const char *args[] = {"--find",	     "--find-addr", "127.0.0.1",
+			      "--find-port", port,	    "-t",
+			      "500",	     NULL};
+	struct proc_sim sim;
+	struct proc p;
+	const char *d;
+	int disc = 0;
+
+	(void)state;
+	assert_int_equal(proc_sim_start(&sim, getenv("ROBOELF_BIN"), NULL,
+					extra, SIM_START_MS),
+			 0);
+	assert_int_equal(proc_find_line(&sim.p, PROC_STDOUT,
+					"galil-sim: listening on ", line,
+					sizeof(line)),
+			 0);
+	d = strstr(line, " disc ");
+	assert_non_null(d);
+	assert_int_equal(sscanf(d, " disc %d", &disc), 1);
+	snprintf(port, sizeof(port), "%d", disc);
+	assert_int_equal(run(&p, NULL, args), 0);
+	assert_string_equal(proc_output(&p, PROC_STDOUT),
+			    "  1  127.0.0.1        DMC4030 Rev 1.2h-sim\n");
+	assert_string_equal(proc_output(&p, PROC_STDERR), "");
+	proc_kill(&p);
+	proc_kill(&sim.p);
+}
+
 /* Nothing answers at another port: exit 3 and says so. */
 static void test_find_none(void **state)
 {
@@ -189,6 +226,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test_setup_teardown(test_find, lsn_start, lsn_stop),
+	    cmocka_unit_test(test_find_sim),
 	    cmocka_unit_test_setup_teardown(test_find_none, lsn_start,
 					    lsn_stop),
 	    cmocka_unit_test_setup_teardown(test_unreachable_lists, lsn_start,

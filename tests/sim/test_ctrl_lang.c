@@ -1,9 +1,10 @@
 /*
  * test_ctrl_lang.c - the DMC language of the simulated controller:
  * expressions (left to right), numbers and formats, variables and arrays,
- * IF nesting, JS parameters, WT/AT timing, threads and _XQn, #CMDERR with
- * _TC/_ED, and the TC codes of bad commands. Expected values come from the
- * DMC-40x0 command reference examples (galil-notes.md 4.2, MG, @functions).
+ * IF nesting, JS parameters, labels with '_', WT/AT timing, threads and _XQn,
+ * #CMDERR with _TC/_ED, and the TC codes of bad commands. Expected values come
+ * from the DMC-40x0 command reference examples (galil-notes.md 4.2, MG,
+ * @functions).
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -324,6 +325,30 @@ static void test_js_params(void **state)
 	assert_true(tp_mg(p, "q") == 9);
 }
 
+/* Labels with '_' download and run on the DMC-40x0 (docs/galil-sim.md,
+ * "Labels with '_'"): a subroutine and a jump target, called and taken. */
+static void test_underscore_labels(void **state)
+{
+	struct tplant *p = *state;
+	const char *prog = "#run_it\r"
+			   "ecode=2\r"
+			   "JS #error_h(ecode)\r"
+			   "ret=_JS\r"
+			   "JP #done_x,(code=20)\r"
+			   "code=-1\r"
+			   "#done_x\r"
+			   "EN\r"
+			   "#error_h\r"
+			   "code=^a*10\r"
+			   "EN ,,code+1\r";
+
+	load_run(p, prog, "XQ #run_it", 10);
+	assert_int_equal(ctrl_threads(p->c), 0);
+	assert_int_equal(tp_tc(p), 0);
+	assert_true(tp_mg(p, "code") == 20);
+	assert_true(tp_mg(p, "ret") == 21);
+}
+
 /* JS deeper than 16 levels is TC 12. */
 static void test_js_depth(void **state)
 {
@@ -631,6 +656,8 @@ int main(void)
 	    cmocka_unit_test_setup_teardown(test_if_without_endif, setup,
 					    teardown),
 	    cmocka_unit_test_setup_teardown(test_js_params, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_underscore_labels, setup,
+					    teardown),
 	    cmocka_unit_test_setup_teardown(test_js_depth, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_wt_timing, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_at_timing, setup, teardown),

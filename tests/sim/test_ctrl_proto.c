@@ -208,7 +208,7 @@ static void test_dl_bad(void **state)
 	exchange(p, 0, "TC\r", " 61\r\n:");
 	exchange(p, 0, "DL\r#9A\r\\", ":?");
 	exchange(p, 0, "DL\r#TOOLONGX\r\\", ":?");
-	exchange(p, 0, "DL\r#ok_no\r\\", ":?");
+	exchange(p, 0, "DL\r#_ok\r\\", ":?");
 	exchange(p, 0, "TC\r", " 61\r\n:");
 	/* 4000 lines fit, line 4001 does not */
 	exchange(p, 0, "DL\r", "");

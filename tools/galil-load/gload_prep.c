@@ -53,7 +53,9 @@ static size_t strip_line(const char *s, size_t n, char *out)
 		if (at_start)
 			in_no = is_no_stmt(s + i, n - i);
 		at_start = 0;
-		if (c == '\'')
+		/* a ' inside a NO comment is comment text, not a ' comment:
+		 * what follows the NO's ';' still runs and is sent */
+		if (c == '\'' && !in_no)
 			break;
 		if (c == ';') {
 			o = trim_end(out, o);

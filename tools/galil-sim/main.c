@@ -32,6 +32,7 @@
 
 struct opts {
 	int port, control_port;
+	int disc_port;		 /* --disc-port N, -1: no discovery answer */
 	const char *listen_addr; /* --listen, NULL: 127.0.0.1 */
 	const char *plant, *relay_link, *protocol;
 	unsigned long seed;
@@ -58,7 +59,7 @@ static void usage(FILE *f)
 	fprintf(
 	    f,
 	    "usage: galil-sim [--port N] [--control-port M] [--listen ADDR]\n"
-	    "                 [--plant FILE]\n"
+	    "                 [--disc-port N] [--plant FILE]\n"
 	    "                 [--relay-link PATH | --no-relay-link]\n"
 	    "                 [--relay-protocol NAME] [--seed N] [--verbose]\n"
 	    "                 [--no-amp-undervoltage] [--power-output N]\n"
@@ -71,6 +72,10 @@ static void usage(FILE *f)
 	    "  --control-port M    control port (default %d, 0 = any)\n"
 	    "  --listen ADDR       IPv4 address of both ports (default "
 	    "127.0.0.1)\n"
+	    "  --disc-port N       answer the controller discovery probe on "
+	    "UDP port N\n"
+	    "                      of ADDR (Galil's is 50000; 0 = any; "
+	    "default: off)\n"
 	    "  --plant FILE        robot model (default: built in, see "
 	    "config/plant.yaml)\n"
 	    "  --relay-link PATH   symbolic link to the relay pty (default "
@@ -154,11 +159,14 @@ static int parse_opt(int c, const char *arg, struct opts *o)
 	switch (c) {
 	case 'p':
 	case 'c':
+	case 'D':
 		if (parse_ulong(arg, 65535, &v) < 0) {
 			fprintf(stderr, "galil-sim: bad port '%s'\n", arg);
 			return -1;
 		}
-		*(c == 'p' ? &o->port : &o->control_port) = (int)v;
+		*(c == 'p'   ? &o->port
+		  : c == 'c' ? &o->control_port
+			     : &o->disc_port) = (int)v;
 		return 0;
 	case 'P': o->plant = arg; return 0;
 	case 'L': o->listen_addr = arg; return 0;
@@ -215,6 +223,7 @@ static int parse_args(int argc, char **argv, struct opts *o)
 	    {"port", required_argument, NULL, 'p'},
 	    {"control-port", required_argument, NULL, 'c'},
 	    {"listen", required_argument, NULL, 'L'},
+	    {"disc-port", required_argument, NULL, 'D'},
 	    {"plant", required_argument, NULL, 'P'},
 	    {"relay-link", required_argument, NULL, 'l'},
 	    {"no-relay-link", no_argument, NULL, 'n'},
@@ -300,6 +309,41 @@ static int run_bench(double seconds)
 	return 0;
 }
 
+/* The command and control ports, and the discovery port when asked for.
+ * Return: 0, or 1 (the message is printed). */
+static int open_ports(struct sim *s, const struct opts *o, struct sim_net **net)
+{
+	char err[ERR_LEN];
+
+	if (sim_net_open(net, s, o->listen_addr, o->port, o->control_port, err,
+			 sizeof(err)) < 0) {
+		fprintf(stderr, "galil-sim: %s\n", err);
+		return 1;
+	}
+	if (o->disc_port >= 0 &&
+	    sim_net_open_disc(*net, o->listen_addr, o->disc_port, err,
+			      sizeof(err)) < 0) {
+		fprintf(stderr, "galil-sim: %s\n", err);
+		sim_net_free(*net);
+		return 1;
+	}
+	return 0;
+}
+
+/* The ready line; " disc <port>" only when discovery is on, so that the
+ * line stays what it was for everything that does not ask for it. */
+static void print_ready(struct sim *s, const struct opts *o,
+			const struct sim_net *net)
+{
+	printf("galil-sim: listening on %s:%d control %d relay %s",
+	       o->listen_addr ? o->listen_addr : "127.0.0.1", sim_net_port(net),
+	       sim_net_control_port(net), sim_relay_tty(sim_get_relay(s)));
+	if (sim_net_disc_port(net) > 0)
+		printf(" disc %d", sim_net_disc_port(net));
+	printf("\n");
+	fflush(stdout);
+}
+
 static int serve(struct sim *s, const struct opts *o)
 {
 	struct sim_net *net;
@@ -307,15 +351,9 @@ static int serve(struct sim *s, const struct opts *o)
 	char err[ERR_LEN];
 	int rc;
 
-	if (sim_net_open(&net, s, o->listen_addr, o->port, o->control_port, err,
-			 sizeof(err)) < 0) {
-		fprintf(stderr, "galil-sim: %s\n", err);
+	if (open_ports(s, o, &net))
 		return 1;
-	}
-	printf("galil-sim: listening on %s:%d control %d relay %s\n",
-	       o->listen_addr ? o->listen_addr : "127.0.0.1", sim_net_port(net),
-	       sim_net_control_port(net), sim_relay_tty(sim_get_relay(s)));
-	fflush(stdout);
+	print_ready(s, o, net);
 	rc = sim_net_run(net, &stop, err, sizeof(err));
 	if (rc < 0)
 		fprintf(stderr, "galil-sim: %s\n", err);
@@ -336,6 +374,7 @@ int main(int argc, char **argv)
 	struct opts o = {
 	    .port = DEFAULT_PORT,
 	    .control_port = DEFAULT_CONTROL_PORT,
+	    .disc_port = -1,
 	    .relay_link = DEFAULT_RELAY_LINK,
 	    .protocol = DEFAULT_PROTOCOL,
 	    .power_output = -1,

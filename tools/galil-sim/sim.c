@@ -152,6 +152,12 @@ void sim_free(struct sim *s)
 	free(s);
 }
 
+const char *sim_model(const struct sim *s)
+{
+	(void)s; /* every simulator is the same model (make_parts()) */
+	return SIM_MODEL;
+}
+
 struct ctrl *sim_ctrl(struct sim *s)
 {
 	return s->ctrl;

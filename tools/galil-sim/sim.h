@@ -98,6 +98,12 @@ int sim_new_serial(struct sim **out, const char *plant_file, long serial,
 		   char *err, size_t errlen);
 void sim_free(struct sim *s);
 
+/*
+ * sim_model() - the controller's model and firmware text, the answer to
+ * ^R^V without CR LF ':' ("DMC4030 Rev 1.2h-sim"); a static string.
+ */
+const char *sim_model(const struct sim *s);
+
 /* sim_ctrl() - the controller inside, for ctrl_* calls (owned by @s). */
 struct ctrl *sim_ctrl(struct sim *s);
 

@@ -2,8 +2,9 @@
  * ctrl_prog.c - program memory. A download is checked whole and either
  * replaces the program or is refused (the old program is then erased too,
  * see docs/galil-sim-controller.md): lines of at most 80 characters, at
- * most 4000 lines (TC 60), labels '#' + 1..7 letters/digits starting with a
- * letter, unique, at most 510 (TC 61, 62).
+ * most 4000 lines (TC 60), labels '#' + 1..7 letters, digits or '_'
+ * starting with a letter (the DMC-40x0's rule, dmc_model.h), unique, at
+ * most 510 (TC 61, 62).
  *
  * Each line is split into statements at ';' outside "strings"; REM makes
  * the rest of the line a comment, ' and NO only up to the next ';'.
@@ -16,6 +17,8 @@
 
 #include "ctrl_prog.h"
 #include "ctrl_var.h"
+#include "dmc_model.h"
+#include "dmc_rule.h"
 #include "dmc_text.h"
 
 struct split {
@@ -49,10 +52,11 @@ static int line_label(const char *s, size_t n, uint64_t *key)
 
 	if (n == 0 || s[0] != '#')
 		return 0;
-	for (k = 1; k < n && isalnum((unsigned char)s[k]); k++)
+	for (k = 1; k < n && dmc_is_name_char(s[k]); k++)
 		;
+	/* the characters by the DMC-40x0's rule, '_' included (dmc_model) */
 	if (k - 1 < 1 || k - 1 > CTRL_LABEL_MAX ||
-	    !isalpha((unsigned char)s[1]))
+	    !dmc_label_ok_model(dmc_model_default(), s + 1, k - 1))
 		return 61;
 	if (k < n && s[k] != ';' && s[k] != ' ' && s[k] != '\'')
 		return 61;

@@ -21,11 +21,12 @@
 #include "sim.h"
 #include "sim_cmdport.h"
 #include "sim_ctlport.h"
+#include "sim_disc.h"
 #include "sim_net.h"
 #include "sim_relay.h"
 
 #define NET_CATCHUP_SAMPLES 100 /* samples stepped per pass when late */
-#define NET_POLL_MAX	    (4 + CTRL_HANDLES + SIM_CTLPORT_CLIENTS)
+#define NET_POLL_MAX	    (5 + CTRL_HANDLES + SIM_CTLPORT_CLIENTS)
 
 struct sim_net {
 	struct sim *sim;
@@ -34,6 +35,7 @@ struct sim_net {
 	uint64_t debt;	   /* samples due but not stepped yet */
 	struct sim_cmdport cmd;
 	struct sim_ctlport ctl;
+	struct sim_disc disc; /* off unless sim_net_open_disc() */
 	struct sim_net_stats stats;
 };
 
@@ -53,6 +55,7 @@ int sim_net_open(struct sim_net **out, struct sim *s, const char *addr,
 	n->tfd = -1;
 	sim_cmdport_init(&n->cmd, s);
 	sim_ctlport_init(&n->ctl, s);
+	sim_disc_init(&n->disc);
 	if (sim_cmdport_listen(&n->cmd, addr, port, err, errlen) < 0 ||
 	    sim_ctlport_listen(&n->ctl, addr, control_port, err, errlen) < 0) {
 		sim_net_free(n);
@@ -70,6 +73,7 @@ void sim_net_free(struct sim_net *n)
 	sim_set_disconnect(n->sim, NULL, NULL);
 	sim_cmdport_shutdown(&n->cmd);
 	sim_ctlport_shutdown(&n->ctl);
+	sim_disc_close(&n->disc);
 	if (n->tfd >= 0)
 		close(n->tfd);
 	free(n);
@@ -83,6 +87,22 @@ int sim_net_port(const struct sim_net *n)
 int sim_net_control_port(const struct sim_net *n)
 {
 	return n->ctl.port;
+}
+
+int sim_net_open_disc(struct sim_net *n, const char *addr, int port, char *err,
+		      size_t errlen)
+{
+	if (n->disc.fd >= 0) {
+		snprintf(err, errlen, "the discovery port is open already");
+		return GL_ERR_ARG;
+	}
+	return sim_disc_open(&n->disc, addr, port, sim_model(n->sim), err,
+			     errlen);
+}
+
+int sim_net_disc_port(const struct sim_net *n)
+{
+	return n->disc.port;
 }
 
 void sim_net_stats(const struct sim_net *n, struct sim_net_stats *out)
@@ -141,7 +161,8 @@ static void step_due(struct sim_net *n)
 }
 
 /* Fill @fds; @slot[i] says what fds[i] is: -1 timer, -2 command listener,
- * -3 control listener, -4 relay, 0..7 command conn, 100+i control client. */
+ * -3 control listener, -4 relay, -5 discovery, 0..7 command conn, 100+i
+ * control client. */
 static int build_poll(struct sim_net *n, struct pollfd *fds, int *slot)
 {
 	int k = 0, fd, rfd = sim_relay_fd(sim_get_relay(n->sim));
@@ -166,6 +187,10 @@ static int build_poll(struct sim_net *n, struct pollfd *fds, int *slot)
 		fds[k] = (struct pollfd){rfd, POLLIN, 0};
 		slot[k++] = -4;
 	}
+	if (n->disc.fd >= 0) {
+		fds[k] = (struct pollfd){n->disc.fd, POLLIN, 0};
+		slot[k++] = -5;
+	}
 	for (int i = 0; i < SIM_CTLPORT_CLIENTS; i++) {
 		if ((fd = sim_ctlport_fd(&n->ctl, i)) >= 0) {
 			fds[k] = (struct pollfd){fd, POLLIN, 0};
@@ -188,6 +213,30 @@ static void relay_service(struct sim_net *n)
 	sim_relay_set_fault(r, SIM_RELAY_UNPLUG, err, sizeof(err));
 }
 
+/* Answer the discovery probes waiting; each datagram is an event, so that
+ * a test (and --verbose) sees an ignored one as well as an answered one. */
+static void disc_service(struct sim_net *n)
+{
+	struct sim_disc_seen seen[SIM_DISC_BURST];
+	int k = sim_disc_service(&n->disc, seen);
+
+	for (int i = 0; i < k; i++) {
+		const struct sim_disc_seen *d = &seen[i];
+
+		if (d->outcome == SIM_DISC_ANSWERED)
+			sim_event(n->sim, "discovery: answered %s", d->from);
+		else if (d->outcome == SIM_DISC_UNSENT)
+			sim_event(n->sim,
+				  "discovery: reply to %s not sent (%s)",
+				  d->from, strerror(d->err));
+		else
+			sim_event(n->sim,
+				  "discovery: ignored %zu bytes from %s (not "
+				  "^R^V CR)",
+				  d->len, d->from);
+	}
+}
+
 static void dispatch(struct sim_net *n, int slot)
 {
 	switch (slot) {
@@ -195,6 +244,7 @@ static void dispatch(struct sim_net *n, int slot)
 	case -2: sim_cmdport_accept(&n->cmd); break;
 	case -3: sim_ctlport_accept(&n->ctl); break;
 	case -4: relay_service(n); break;
+	case -5: disc_service(n); break;
 	default:
 		if (slot >= 0 && slot < CTRL_HANDLES)
 			sim_cmdport_read(&n->cmd, slot);

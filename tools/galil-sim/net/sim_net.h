@@ -11,7 +11,8 @@
  * most NET_CATCHUP_SAMPLES per pass so that I/O is still served), then
  * moves bytes. Commands are executed as they arrive, between samples, as
  * the controller's command interpreter does. Both ports bind 127.0.0.1
- * only. Nothing here prints.
+ * unless told otherwise; the UDP discovery responder (sim_disc.h) is off
+ * unless sim_net_open_disc() is called. Nothing here prints.
  *
  * This is the loop and the server's life cycle only: the command port's
  * connections and link faults are sim_cmdport.h, the control port's line
@@ -64,6 +65,23 @@ void sim_net_free(struct sim_net *n);
  */
 int sim_net_port(const struct sim_net *n);
 int sim_net_control_port(const struct sim_net *n);
+
+/*
+ * sim_net_open_disc() - also answer the controller discovery probe on UDP
+ * @addr:@port (sim_disc.h) with the model text of @n's simulator (its
+ * ^R^V answer, sim_model()). Each datagram becomes an event:
+ * "discovery: answered 127.0.0.1:40000", "discovery: ignored 2 bytes from
+ * 127.0.0.1:40000 (not ^R^V CR)".
+ * @addr: dotted IPv4 address, NULL for 127.0.0.1.
+ * @port: 0 = any free port (sim_net_disc_port() tells which).
+ * @err: [out] the reason on failure; @errlen its size.
+ * Return: 0, GL_ERR_ARG (bad address, or already open), GL_ERR_SYS.
+ */
+int sim_net_open_disc(struct sim_net *n, const char *addr, int port, char *err,
+		      size_t errlen);
+
+/* sim_net_disc_port() - the bound discovery port, 0 when it is off. */
+int sim_net_disc_port(const struct sim_net *n);
 
 /*
  * sim_net_run() - serve in real time until the "quit" request or until
