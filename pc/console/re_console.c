@@ -58,11 +58,39 @@ int re_console_open(struct re_console *c, FILE *out, int in_fd)
 	return 0;
 }
 
+/* The terminal's own settings, kept once before the first change, so
+ * that every later change starts from them and the restore gives them
+ * back. Return: 0, or -1 when they cannot be read. */
+static int term_save(struct re_console *c)
+{
+	if (c->raw || c->quiet)
+		return 0;
+	return tcgetattr(c->in_fd, &c->saved) < 0 ? -1 : 0;
+}
+
+/* The terminal's own settings without the echo (of the newline too):
+ * the line discipline, Ctrl-C and the rest stay as they were. */
+static int set_quiet(const struct re_console *c)
+{
+	struct termios t = c->saved;
+
+	t.c_lflag &= ~(tcflag_t)(ECHO | ECHONL);
+	return tcsetattr(c->in_fd, TCSANOW, &t);
+}
+
+void re_console_quiet(struct re_console *c)
+{
+	if (!c->tty_in || c->raw || c->quiet || term_save(c) < 0)
+		return;
+	if (set_quiet(c) == 0)
+		c->quiet = 1;
+}
+
 void re_console_raw(struct re_console *c)
 {
 	struct termios t;
 
-	if (!c->tty_in || c->raw || tcgetattr(c->in_fd, &c->saved) < 0)
+	if (!c->tty_in || c->raw || term_save(c) < 0)
 		return;
 	t = c->saved;
 	t.c_lflag &= ~(tcflag_t)(ICANON | ECHO);
@@ -83,9 +111,10 @@ void re_console_flush_keys(struct re_console *c)
 
 void re_console_restore(struct re_console *c)
 {
-	if (c->raw) {
+	if (c->raw || c->quiet) {
 		tcsetattr(c->in_fd, TCSANOW, &c->saved);
 		c->raw = 0;
+		c->quiet = 0;
 	}
 }
 
@@ -254,7 +283,9 @@ static void fault_keep(struct re_console *c, const char *line)
 		return;
 	}
 	memset(&ev, 0, sizeof(ev));
-	ev.t_s = c->last_t_s;
+	/* its time is not given; the last board's is earlier than the fault,
+	 * so it would be a wrong stamp: said as not known */
+	ev.t_s = -1;
 	ev.level = RE_LOG_FAULT;
 	ev.kind = RE_EV_OTHER;
 	snprintf(ev.text, sizeof(ev.text), "%s", line);
@@ -607,6 +638,18 @@ static int board_faults(struct re_console *c, int width)
 	return k;
 }
 
+/* When @h happened, on the clock of the header's "up" (seconds since the
+ * supervisor started), to the millisecond: a stamp, never an interval,
+ * so that "[up 12.100 s] later FAULT" cannot be read as "12.1 s after
+ * the first fault". "?" when not known. */
+static void hist_stamp(const struct re_console_event *h, char *buf, size_t cap)
+{
+	if (h->t_s < 0)
+		snprintf(buf, cap, "[up %8s s]", "?");
+	else
+		snprintf(buf, cap, "[up %8.3f s]", h->t_s);
+}
+
 /* The later faults and warnings, newest first, at most @room lines
  * (the last of them the log's path). */
 static void board_history(struct re_console *c, int width, int room)
@@ -617,7 +660,7 @@ static void board_history(struct re_console *c, int width, int room)
 		return;
 	for (int i = 0; i < n; i++) {
 		const struct re_console_event *h = &c->hist[i];
-		char times[16] = "";
+		char times[16] = "", at[32];
 
 		if (h->count > 1)
 			snprintf(times, sizeof(times), " (x%u)", h->count);
@@ -626,8 +669,9 @@ static void board_history(struct re_console *c, int width, int room)
 		/* "FAULT COMM: ..." is shown as "later FAULT COMM: ..." */
 		if (h->level == RE_LOG_FAULT && !strncmp(text, "FAULT ", 6))
 			text += 6;
+		hist_stamp(h, at, sizeof(at));
 		board_printf(
-		    c, width, "%7.1f s %s%s%s%s%s %s", h->t_s,
+		    c, width, "%s %s%s%s%s%s %s", at,
 		    col(c, h->level == RE_LOG_FAULT ? ANSI_RED : ANSI_YELLOW),
 		    h->level == RE_LOG_FAULT ? "later FAULT" : "WARN",
 		    col(c, ANSI_OFF), times, text == h->text ? ":" : "", text);
@@ -696,7 +740,6 @@ static void board_build(struct re_console *c, const struct re_status *st,
 	char ctl[64];
 	int lines;
 
-	c->last_t_s = st->uptime_s;
 	ctrl_text(st, ctl, sizeof(ctl));
 	board_printf(
 	    c, width, "RoboELF  mode %s  up %.0f s  relay %s%s%s  link %s",
@@ -916,13 +959,23 @@ static int read_answer(struct re_console *c, char *buf, size_t cap)
 	return (int)n;
 }
 
-enum re_calib_choice re_console_ask_calibration(struct re_console *c)
+/* An answer is seen as it is typed, also while the console is quiet:
+ * the terminal's own settings for the question (@on), quiet again after
+ * it. */
+static void question_echo(struct re_console *c, int on)
+{
+	if (!c->quiet || c->raw)
+		return;
+	if (on)
+		tcsetattr(c->in_fd, TCSANOW, &c->saved);
+	else
+		set_quiet(c);
+}
+
+static enum re_calib_choice ask_calibration(struct re_console *c)
 {
 	char a[32];
 
-	if (!c->tty_in)
-		return RE_CALIB_ASK;
-	re_console_flush_keys(c);
 	for (;;) {
 		re_console_msg(c, "Calibration: [f]ull (move every axis "
 				  "end to end) or [l]oad from file?");
@@ -936,13 +989,23 @@ enum re_calib_choice re_console_ask_calibration(struct re_console *c)
 	}
 }
 
-int re_console_ask_yes(struct re_console *c, const char *question)
+enum re_calib_choice re_console_ask_calibration(struct re_console *c)
+{
+	enum re_calib_choice k;
+
+	if (!c->tty_in)
+		return RE_CALIB_ASK;
+	re_console_flush_keys(c);
+	question_echo(c, 1);
+	k = ask_calibration(c);
+	question_echo(c, 0);
+	return k;
+}
+
+static int ask_yes(struct re_console *c, const char *question)
 {
 	char a[32];
 
-	if (!c->tty_in)
-		return 0;
-	re_console_flush_keys(c);
 	for (;;) {
 		re_console_msg(c, "%s [y/n]", question);
 		if (read_answer(c, a, sizeof(a)) < 0)
@@ -953,4 +1016,17 @@ int re_console_ask_yes(struct re_console *c, const char *question)
 			return 0;
 		re_console_msg(c, "invalid answer '%s': type y or n", a);
 	}
+}
+
+int re_console_ask_yes(struct re_console *c, const char *question)
+{
+	int yes;
+
+	if (!c->tty_in)
+		return 0;
+	re_console_flush_keys(c);
+	question_echo(c, 1);
+	yes = ask_yes(c, question);
+	question_echo(c, 0);
+	return yes;
 }

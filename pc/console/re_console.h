@@ -21,14 +21,18 @@
  * FAULT line is also kept on the board, in a panel under the header, until the
  * program ends, so it cannot scroll away; below it the history of later
  * faults and warnings (re_console_event()), newest first, as many as fit
- * (repeats of one kind folded into one line with a count), and the log
- * file's path (re_console_log_path()). Every board line is cut to the
+ * (repeats of one kind folded into one line with a count), each stamped
+ * with when it happened on the header's "up" clock ("[up 12.100 s]": a
+ * time since the start, never an interval since the first fault), and
+ * the log file's path (re_console_log_path()). Every board line is cut to the
  * terminal's width (never wraps); a terminal narrower than RE_CONSOLE_MIN_COLS
  * or lower than RE_CONSOLE_MIN_ROWS gets the status lines instead, said once; a
  * resize redraws the board from the top of the screen. Colour only on a
  * terminal and only when NO_COLOR is unset (no-color.org) and TERM is not
- * "dumb". The keyboard is in raw mode (no echo, no line buffering) between
- * re_console_open() and re_console_close().
+ * "dumb". The keyboard is in raw mode (no echo, no line buffering) from
+ * re_console_raw() to re_console_close(), and does not echo from
+ * re_console_quiet() on (the start-up and the calibration) but for the
+ * answer to a question.
  *
  * Not on a terminal: one "status ..." line per second, no escape codes.
  *
@@ -78,7 +82,8 @@ struct re_console {
 	int tty_out; /* @out is a terminal: status board */
 	int tty_in;  /* @in_fd is a terminal: raw keys, questions */
 	int color;
-	int raw;	 /* termios changed; restore on close */
+	int raw;	 /* raw mode (termios changed; restore on close) */
+	int quiet;	 /* no echo (termios changed; restore on close) */
 	int board_lines; /* lines of the board now on screen (at the bottom,
 			  * under the scroll region); 0: none */
 	int half;	 /* the last frame was cut short: its saved cursor
@@ -95,7 +100,7 @@ struct re_console {
 	int small_said;		      /* "terminal too small" was said */
 	char fault[RE_CONSOLE_FAULT]; /* the first FAULT, kept on the board */
 	struct re_console_event {
-		double t_s;
+		double t_s; /* since the supervisor started, s; < 0 unknown */
 		enum re_log_level level;
 		enum re_event_kind kind;
 		unsigned count; /* folded repeats of this kind */
@@ -103,7 +108,6 @@ struct re_console {
 	} hist[RE_CONSOLE_HIST]; /* newest first */
 	int nhist;
 	char log_path[256]; /* shown under the history; "" none */
-	double last_t_s;    /* uptime of the last board */
 	uint64_t nfaults;   /* FAULT lines shown in all */
 	struct re_console_axis ax[RE_SUPER_AXES];
 	int counts;		      /* show encoder counts instead of units */
@@ -122,6 +126,18 @@ enum re_calib_choice {
  * Return: 0 (never fails; without a terminal it degrades to plain lines).
  */
 int re_console_open(struct re_console *c, FILE *out, int in_fd);
+
+/*
+ * re_console_quiet() - from now on the terminal does not echo what is
+ * typed (line editing, Ctrl-C and the rest unchanged), so that a key typed
+ * during the start-up or the calibration cannot land inside the lines
+ * roboelf prints; the keys stay unread and re_console_raw() drops them. A
+ * question (re_console_ask_calibration(), re_console_ask_yes()) echoes its
+ * answer while it waits for it. Restored by re_console_close() and
+ * re_console_restore(); re_console_raw() takes over from it. No-op without
+ * a terminal or when the terminal's settings cannot be read.
+ */
+void re_console_quiet(struct re_console *c);
 
 /*
  * re_console_raw() - put the keyboard in raw mode (no echo, one key at a

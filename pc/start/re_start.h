@@ -93,6 +93,8 @@ extern struct re_signals re_sig;
  * loaded and open): locks, relay, controller, calibration, arming. Every
  * step is refused (exit 3, message on the console and in the log) or
  * latches a fault (exit 4) when it fails; a quit signal ends it early.
+ * The terminal does not echo from here on (re_console_quiet()) but for the
+ * answers to its questions; re_app_release() gives it back.
  * Return: 0 when armed (re_start_show_ready() then says "RoboELF Ready
  * for Use") or on a quit signal; EXIT_CONNECT, EXIT_USAGE or EXIT_FAULT
  * otherwise.

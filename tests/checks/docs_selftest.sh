@@ -57,7 +57,7 @@ static const char *const re_fclass_names[RE_FC_COUNT] = {
 static const struct re_fault_msg re_fault_table[] = {
 	{RE_F_ONE, RE_FC_MOTION,
 	 "axis {a}: it moved {i0} counts (\"quoted\")",
-	 "keep the E-stop pressed, then restart roboelf"},
+	 "press the E-stop and keep it pressed, then restart roboelf"},
 	{RE_F_TWO, RE_FC_ESTOP,
 	 "the relay is gone ({s}); "
 	 "split over two literals",
@@ -123,7 +123,7 @@ EOF
 cat >"$S/docs/operator.md" <<'EOF'
 # faults
 ```
-FAULT MOTION: axis {a}: it moved {i0} counts ("quoted"). Recovery: keep the E-stop pressed, then restart roboelf
+FAULT MOTION: axis {a}: it moved {i0} counts ("quoted"). Recovery: press the E-stop and keep it pressed, then restart roboelf
 ```
     FAULT ESTOP: the relay is gone ({s}); split over two literals. Recovery: press the hardware E-stop now
 An internal error: `FAULT PROGRAM: unknown fault N. Recovery: quit, note the log`.
@@ -165,10 +165,10 @@ fi
 gap() { rm -rf "$TMP/g"; cp -R "$S" "$TMP/g"; }
 gap; drop "$TMP/g/docs/operator.md" 'FAULT MOTION: axis'
 expect_fail "synthetic: FAULT line removed" "$TMP/g" \
-	'docs.sh: FAULT message RE_F_ONE ("FAULT MOTION: axis {a}: it moved {i0} counts ("quoted"). Recovery: keep the E-stop pressed, then restart roboelf") is in pc/super/re_fault.c but not in docs/operator.md'
+	'docs.sh: FAULT message RE_F_ONE ("FAULT MOTION: axis {a}: it moved {i0} counts ("quoted"). Recovery: press the E-stop and keep it pressed, then restart roboelf") is in pc/super/re_fault.c but not in docs/operator.md'
 gap; sed 's/then restart roboelf/then restart/' "$S/docs/operator.md" >"$TMP/g/docs/operator.md"
 expect_fail "synthetic: recovery text changed in the doc" "$TMP/g" \
-	'docs.sh: FAULT message RE_F_ONE ("FAULT MOTION: axis {a}: it moved {i0} counts ("quoted"). Recovery: keep the E-stop pressed, then restart roboelf") is in pc/super/re_fault.c but not in docs/operator.md'
+	'docs.sh: FAULT message RE_F_ONE ("FAULT MOTION: axis {a}: it moved {i0} counts ("quoted"). Recovery: press the E-stop and keep it pressed, then restart roboelf") is in pc/super/re_fault.c but not in docs/operator.md'
 gap; drop "$TMP/g/docs/operator.md" 'unknown fault'
 expect_fail "synthetic: printf FAULT line removed" "$TMP/g" \
 	'docs.sh: FAULT message "FAULT PROGRAM: unknown fault %d. Recovery: quit, note the log" is in pc/super/re_super.c but not in docs/operator.md'

@@ -421,8 +421,9 @@ int sx_tpl_encpot(const struct sys_env *env, char *tpl, size_t cap, int axis)
 		 "FAULT ENCODER: axis %c: potentiometer reads {n} V "
 		 "but {n} V is expected at encoder position %s; "
 		 "they differ by {n} V, more than the {n} V allowed, "
-		 "for {n} cycles." SX_SAFE_OK " Recovery: keep the E-stop "
-		 "pressed, check the encoder and potentiometer cables "
+		 "for {n} cycles." SX_SAFE_OK " Recovery: press the E-stop "
+		 "and keep it pressed, check the encoder and potentiometer "
+		 "cables "
 		 "of axis %c, restart roboelf and recalibrate",
 		 'A' + axis, pos, 'A' + axis);
 	return k;

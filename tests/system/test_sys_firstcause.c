@@ -219,7 +219,7 @@ static void sigstop(const char *name, int phase_ms, int delay_ms)
 		 "stopped in a debugger), not the link. Then: the controller "
 		 "stopped the robot: no heartbeat from this PC for {n} "
 		 "ms." SX_SAFE_OK
-		 " Recovery: keep the E-stop pressed, find what "
+		 " Recovery: press the E-stop and keep it pressed, find what "
 		 "stopped roboelf (Ctrl-Z, a debugger, CPU or disk load), then "
 		 "restart it",
 		 env.crit_factor * sx_p(&env));

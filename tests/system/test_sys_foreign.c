@@ -45,9 +45,9 @@
 /* Recovery text of the MOTION fault of another program's move, as
  * roboelf prints it (pc/super/re_fault.c; docs/operator.md section 7). */
 #define REC_UNCMD                                                              \
-	" Recovery: keep the E-stop pressed, find which other program or "     \
-	"person sent commands to the controller (another roboelf, "            \
-	"galil-load, a terminal) and stop it, then restart roboelf"
+	" Recovery: press the E-stop and keep it pressed, find which other "   \
+	"program or person sent commands to the controller (another "          \
+	"roboelf, galil-load, a terminal) and stop it, then restart roboelf"
 
 static struct sys_env env;
 static struct sx_fixture fx;

@@ -159,9 +159,9 @@ static void tpl_poserr(char *tpl, size_t cap, int axis)
 		 "FAULT MOTION: axis %c: position error of at least %s, "
 		 "above its limit (blocked, jammed, or its encoder "
 		 "stuck?)." SX_SAFE_OK
-		 " Recovery: keep the E-stop pressed, check that axis %c moves "
-		 "freely and nothing blocks it, then its encoder cable, then "
-		 "restart roboelf",
+		 " Recovery: press the E-stop and keep it pressed, check "
+		 "that axis %c moves freely and nothing blocks it, then its "
+		 "encoder cable, then restart roboelf",
 		 'A' + axis, er, 'A' + axis);
 }
 
@@ -180,14 +180,15 @@ static void jam(int axis, int calibrating)
 	if (calibrating)
 		tpl_poserr(tpl, sizeof(tpl), axis);
 	else
-		snprintf(tpl, sizeof(tpl),
-			 "FAULT ENCODER: axis %c: the controller detected an "
-			 "encoder failure or a blocked axis (stop code "
-			 "12)." SX_SAFE_OK
-			 " Recovery: keep the E-stop pressed, check "
-			 "that axis %c moves freely, then its encoder cable "
-			 "and its motor, restart roboelf and recalibrate",
-			 'A' + axis, 'A' + axis);
+		snprintf(
+		    tpl, sizeof(tpl),
+		    "FAULT ENCODER: axis %c: the controller detected an "
+		    "encoder failure or a blocked axis (stop code "
+		    "12)." SX_SAFE_OK
+		    " Recovery: press the E-stop and keep it pressed, check "
+		    "that axis %c moves freely, then its encoder cable "
+		    "and its motor, restart roboelf and recalibrate",
+		    'A' + axis, 'A' + axis);
 	expect_cause(r, t, tpl, d_jam() + sx_d_ctrl_to_relay(&env), d_jam(),
 		     NULL, 0);
 	sx_row_pass(r, "axis %c named (%s)", 'A' + axis,

@@ -58,8 +58,8 @@
 /* Recovery text of the PROGRAM fault, as roboelf prints it
  * (pc/super/re_fault.c; docs/operator.md section 7). */
 #define REC_THREAD                                                             \
-	" Recovery: keep the E-stop pressed, restart roboelf; if it happens "  \
-	"again, reload the program with galil-load"
+	" Recovery: press the E-stop and keep it pressed, restart roboelf; "   \
+	"if it happens again, reload the program with galil-load"
 
 static struct sys_env env;
 static struct sx_fixture fx;

@@ -329,9 +329,9 @@ static void test_wdog_fault_text(void **state)
 	assert_true(re_fault_format(&f, NULL, line, sizeof(line)) > 0);
 	assert_string_equal(
 	    line,
-	    "FAULT WATCHDOG: no reply from the controller for 126 ms "
-	    "(limit 125 ms). Recovery: keep the E-stop pressed, check the "
-	    "controller's Ethernet cable and power, then restart roboelf");
+	    "FAULT WATCHDOG: no reply from the controller for 126 ms (limit "
+	    "125 ms). Recovery: press the E-stop and keep it pressed, check "
+	    "the controller's Ethernet cable and power, then restart roboelf");
 }
 
 static void test_wdog_other_periods_and_args(void **state)
@@ -415,8 +415,8 @@ static void test_alive_sample(void **state)
 	assert_string_equal(
 	    line,
 	    "FAULT WATCHDOG: the controller's sample counter froze at 65535 "
-	    "for 126 ms (limit 125 ms). Recovery: keep the E-stop pressed, "
-	    "switch the controller off and on, then restart roboelf");
+	    "for 126 ms (limit 125 ms). Recovery: press the E-stop and keep it "
+	    "pressed, switch the controller off and on, then restart roboelf");
 	assert_int_equal(re_check_alive(&c, &st, 100 * MS, 4, 0, &f),
 			 GL_ERR_ARG); /* time went back */
 }
@@ -544,19 +544,19 @@ static void test_ctrl_fault_texts(void **state)
 	    line,
 	    "FAULT MOTION: axis B: position error of at least 5012 counts, "
 	    "above its limit (blocked, jammed, or its encoder stuck?). "
-	    "Recovery: keep "
-	    "the E-stop pressed, check that axis B moves freely and nothing "
-	    "blocks it, then its encoder cable, then restart roboelf");
+	    "Recovery: press the E-stop and keep it pressed, check that axis "
+	    "B moves freely and nothing blocks it, then its encoder cable, "
+	    "then restart roboelf");
 	z.fcode = 3;
 	z.faxis = 0;
 	re_ctrl_fault(&z, 0x30c, &f);
 	re_fault_format(&f, NULL, line, sizeof(line));
 	assert_string_equal(
 	    line,
-	    "FAULT INPUT: invalid joystick switch state 0x30c held longer "
-	    "than the invalid-input timeout. Recovery: release the "
-	    "joysticks, keep the E-stop pressed, check the joystick cables "
-	    "and switches, then restart roboelf");
+	    "FAULT INPUT: invalid joystick switch state 0x30c held longer than "
+	    "the invalid-input timeout. Recovery: release the joysticks, press "
+	    "the E-stop and keep it pressed, check the joystick cables and "
+	    "switches, then restart roboelf");
 	re_ctrl_fault(&z, RE_VAL_UNKNOWN, &f);
 	re_fault_format(&f, NULL, line, sizeof(line));
 	assert_non_null(strstr(line, "FAULT INPUT: invalid joystick switch "
@@ -569,9 +569,9 @@ static void test_ctrl_fault_texts(void **state)
 	assert_string_equal(
 	    line,
 	    "FAULT LIMIT: axis C: the reverse hardware limit switch was "
-	    "reached. Recovery: keep the E-stop pressed, make sure axis C "
-	    "is clear of the patient, check its limit switch, then restart "
-	    "roboelf and recalibrate");
+	    "reached. Recovery: press the E-stop and keep it pressed, make "
+	    "sure axis C is clear of the patient, check its limit switch, then "
+	    "restart roboelf and recalibrate");
 	z.fcode = 10;
 	z.faxis = 1;
 	re_ctrl_fault(&z, 8, &f);
@@ -692,9 +692,10 @@ static void test_check_motors(void **state)
 	assert_string_equal(
 	    line,
 	    "FAULT MOTION: axis C: the controller switched the motor off: "
-	    "encoder failure (stop code 12). Recovery: keep the E-stop "
-	    "pressed, check that axis C moves freely and nothing blocks it, "
-	    "check its motor and encoder cables, then restart roboelf");
+	    "encoder failure (stop code 12). Recovery: press the E-stop and "
+	    "keep it pressed, check that axis C moves freely and nothing "
+	    "blocks it, check its motor and encoder cables, then restart "
+	    "roboelf");
 	rec.axis[1].status = GL_AXST_MOTOR_OFF | GL_AXST_MOVING;
 	rec.axis[1].stop_code = 15;
 	assert_int_equal(re_check_motors(&rec, 3, 1, &f), RE_FAULT);
@@ -807,10 +808,10 @@ static void test_cal_point(void **state)
 	assert_string_equal(
 	    line,
 	    "FAULT CALIBRATION: axis C: encoder advanced 0 counts at "
-	    "calibration point 7, expected 100 +- 5 counts. Recovery: keep "
-	    "the E-stop pressed, check that axis C moves freely (jammed?) "
-	    "and its encoder cable, then restart roboelf and calibrate "
-	    "again");
+	    "calibration point 7, expected 100 +- 5 counts. Recovery: press "
+	    "the E-stop and keep it pressed, check that axis C moves freely "
+	    "(jammed?) and its encoder cable, then restart roboelf and "
+	    "calibrate again");
 	/* Potentiometer must rise by more than the margin. */
 	assert_int_equal(
 	    re_cal_check_point(&ccfg, 2, 7, 100, 1000, 1100, 1.0, 1.125, &f),
@@ -820,9 +821,9 @@ static void test_cal_point(void **state)
 	assert_string_equal(
 	    line,
 	    "FAULT CALIBRATION: axis C: potentiometer not rising at "
-	    "calibration point 7: 1.125 V after 1 V (it must rise by more "
-	    "than 0.125 V). Recovery: keep the E-stop pressed, check the "
-	    "potentiometer of axis C and its cable (worn or loose), then "
+	    "calibration point 7: 1.125 V after 1 V (it must rise by more than "
+	    "0.125 V). Recovery: press the E-stop and keep it pressed, check "
+	    "the potentiometer of axis C and its cable (worn or loose), then "
 	    "restart roboelf and calibrate again");
 	assert_int_equal(re_cal_check_point(&ccfg, 2, 7, 100, 1000, 1100, 1.0,
 					    1.125 + 1e-9, &f),
@@ -967,8 +968,8 @@ static void test_format_names_and_overflow(void **state)
 	assert_string_equal(
 	    line,
 	    "FAULT CALIBRATION: axis insert: calibration aborted: forward "
-	    "limit switch never came. Recovery: keep the E-stop pressed, "
-	    "check axis insert, its limit switches and cables, then "
+	    "limit switch never came. Recovery: press the E-stop and keep it "
+	    "pressed, check axis insert, its limit switches and cables, then "
 	    "restart roboelf and calibrate again");
 	assert_int_equal(re_fault_format(&f, names, small, sizeof(small)),
 			 GL_ERR_OVERFLOW);

@@ -2,10 +2,14 @@
  * test_re_console.c - the periodic status output never blocks the
  * supervisor's loop: with its reader stalled (a full pipe) every status
  * frame returns at once and is counted as dropped; once the reader drains,
- * frames arrive whole again. Also the one-line format without a terminal.
+ * frames arrive whole again. Also the one-line format without a terminal,
+ * the board's texts (snapshots in tests/data/console/), the history's time
+ * stamps, and the terminal's echo on a pseudo-terminal.
  */
 #include <errno.h>
 #include <fcntl.h>
+#include <poll.h>
+#include <pty.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -13,6 +17,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
+#include <termios.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -362,10 +368,10 @@ static void test_history(void **state)
 			    "FAULT COMM: the link is gone. Recovery: restart "
 			    "roboelf");
 	line_of(buf, 2, l, sizeof(l));
-	assert_string_equal(l, "    4.2 s later FAULT ESTOP: relay lost");
+	assert_string_equal(l, "[up    4.250 s] later FAULT ESTOP: relay lost");
 	line_of(buf, 3, l, sizeof(l));
-	assert_string_equal(l, "    1.6 s WARN (x2): watchdog: reply after 90 "
-			       "ms");
+	assert_string_equal(l, "[up    1.600 s] WARN (x2): watchdog: reply "
+			       "after 90 ms");
 	line_of(buf, 4, l, sizeof(l));
 	assert_string_equal(l, "every fault and warning is in the log "
 			       "/var/log/roboelf.log");
@@ -377,12 +383,58 @@ static void test_history(void **state)
 	n = re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
 	assert_int_equal(n, 19);
 	line_of(buf, 2, l, sizeof(l));
-	assert_string_equal(l, "   14.0 s WARN: x");
+	assert_string_equal(l, "[up   14.000 s] WARN: x");
 	line_of(buf, 10, l, sizeof(l));
-	assert_string_equal(l, "    6.0 s WARN: x");
+	assert_string_equal(l, "[up    6.000 s] WARN: x");
 	line_of(buf, 11, l, sizeof(l));
 	assert_string_equal(l, "3 older not shown; all in the log "
 			       "/var/log/roboelf.log");
+}
+
+/* A later fault 46 ms after the first, 12.1 s after the start: its line
+ * says when it happened on the header's "up" clock, to the millisecond,
+ * and nothing reads as "12.1 s after the first fault"; two entries 46 ms
+ * apart are told apart. A FAULT line given without its time says so. */
+static void test_history_times(void **state)
+{
+	static struct re_console c;
+	static char buf[RE_CONSOLE_FRAME];
+	struct re_status st;
+	char l[256];
+	FILE *devnull = fopen("/dev/null", "w");
+
+	(void)state;
+	assert_non_null(devnull);
+	re_console_open(&c, devnull, -1);
+	c.tty_out = 1;
+	calibrated(&c, &st);
+	st.uptime_s = 12.2;
+	re_console_fault(&c, "FAULT ENCODER: axis A: it slipped. Recovery: "
+			     "restart roboelf");
+	event(&c, 12.054, RE_LOG_WARN, RE_EV_WATCHDOG,
+	      "watchdog: reply after 80.2 ms");
+	event(&c, 12.1, RE_LOG_FAULT, RE_EV_LATER,
+	      "FAULT ESTOP: the E-stop relay stopped answering");
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 0, l, sizeof(l));
+	assert_string_equal(l, "RoboELF  mode development  up 12 s  relay ON  "
+			       "link ok");
+	line_of(buf, 2, l, sizeof(l));
+	assert_string_equal(l, "[up   12.100 s] later FAULT ESTOP: the E-stop "
+			       "relay stopped answering");
+	line_of(buf, 3, l, sizeof(l));
+	assert_string_equal(l, "[up   12.054 s] WARN: watchdog: reply after "
+			       "80.2 ms");
+	re_console_fault(&c, "FAULT COMM: the link is gone. Recovery: restart "
+			     "roboelf");
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 2, l, sizeof(l));
+	assert_string_equal(l, "[up        ? s] later FAULT COMM: the link is "
+			       "gone. Recovery: restart roboelf");
+	line_of(buf, 3, l, sizeof(l));
+	assert_string_equal(l, "[up   12.100 s] later FAULT ESTOP: the E-stop "
+			       "relay stopped answering");
+	fclose(devnull);
 }
 
 /* Without a terminal, each later fault or warning is one line. */
@@ -408,6 +460,114 @@ static void test_event_lines(void **state)
 				 "to the controller (handle C)\n"
 				 "roboelf: later FAULT ESTOP: relay lost\n");
 	assert_int_equal(c.nhist, 2);
+}
+
+/* ---- the terminal's echo, on a pseudo-terminal -------------------------
+ *
+ * The test holds the master side (what a terminal emulator would show:
+ * everything roboelf writes, and the terminal's echo of the keys typed)
+ * and types there; the console has the slave as its keyboard and output.
+ */
+
+/* What the terminal shows within @ms of quiet, NUL-terminated. */
+static size_t pty_shown(int m, char *buf, size_t cap, int ms)
+{
+	struct pollfd p = {.fd = m, .events = POLLIN};
+	size_t n = 0;
+	ssize_t r;
+
+	while (n + 1 < cap && poll(&p, 1, ms) > 0) {
+		r = read(m, buf + n, cap - 1 - n);
+		if (r <= 0)
+			break;
+		n += (size_t)r;
+	}
+	buf[n] = '\0';
+	return n;
+}
+
+/* The typist: waits until the question is on the screen, answers "y",
+ * and checks that the answer is echoed. Exit 0 when it saw exactly that. */
+static void typist(int m)
+{
+	char buf[256] = "";
+	size_t n = 0;
+
+	while (!strstr(buf, "[y/n]\r\n") &&
+	       pty_shown(m, buf + n, sizeof(buf) - n, 5000) > 0)
+		n = strlen(buf);
+	if (strcmp(buf, "Go on? [y/n]\r\n") || write(m, "y\n", 2) != 2)
+		_exit(1);
+	pty_shown(m, buf, sizeof(buf), 500);
+	_exit(strcmp(buf, "y\r\n") ? 2 : 0);
+}
+
+/* The settings that count (a struct termios has padding). */
+static void assert_same_termios(const struct termios *a,
+				const struct termios *b)
+{
+	assert_int_equal(a->c_iflag, b->c_iflag);
+	assert_int_equal(a->c_oflag, b->c_oflag);
+	assert_int_equal(a->c_cflag, b->c_cflag);
+	assert_int_equal(a->c_lflag, b->c_lflag);
+	assert_memory_equal(a->c_cc, b->c_cc, sizeof(a->c_cc));
+	assert_int_equal(cfgetispeed(a), cfgetispeed(b));
+	assert_int_equal(cfgetospeed(a), cfgetospeed(b));
+}
+
+/* Quiet: a key typed during the start-up or the calibration is not
+ * echoed (nothing else of the terminal changes); a question's answer is
+ * echoed while it is asked, and quiet again after it; raw mode takes over
+ * from quiet; the close gives the terminal back exactly as it was. */
+static void test_quiet_no_echo(void **state)
+{
+	static struct re_console c;
+	struct termios before, t;
+	char buf[256];
+	int m, s, st = -1;
+	pid_t pid;
+	FILE *out;
+
+	(void)state;
+	assert_int_equal(openpty(&m, &s, NULL, NULL, NULL), 0);
+	assert_int_equal(tcgetattr(s, &before), 0);
+	assert_true(before.c_lflag & ECHO);
+	out = fdopen(dup(s), "w");
+	assert_non_null(out);
+	re_console_open(&c, out, s);
+	assert_int_equal(c.tty_in, 1);
+	re_console_quiet(&c);
+	assert_int_equal(tcgetattr(s, &t), 0);
+	assert_int_equal(t.c_lflag & (ECHO | ECHONL), 0);
+	t.c_lflag |= before.c_lflag & (ECHO | ECHONL);
+	assert_same_termios(&t, &before);      /* only the echo */
+	assert_int_equal(write(m, "a", 1), 1); /* during calibration */
+	assert_int_equal(pty_shown(m, buf, sizeof(buf), 200), 0);
+
+	alarm(20); /* a lost answer must fail the test, not hang it */
+	pid = fork();
+	assert_true(pid >= 0);
+	if (pid == 0)
+		typist(m);
+	assert_int_equal(re_console_ask_yes(&c, "Go on?"), 1);
+	assert_int_equal(waitpid(pid, &st, 0), pid);
+	alarm(0);
+	assert_true(WIFEXITED(st));
+	assert_int_equal(WEXITSTATUS(st), 0);
+	assert_int_equal(tcgetattr(s, &t), 0);
+	assert_int_equal(t.c_lflag & ECHO, 0); /* quiet again */
+	assert_int_equal(write(m, "b", 1), 1);
+	assert_int_equal(pty_shown(m, buf, sizeof(buf), 200), 0);
+
+	re_console_raw(&c); /* the board: from the terminal's own settings */
+	assert_int_equal(tcgetattr(s, &t), 0);
+	assert_int_equal(t.c_lflag & (ECHO | ICANON), 0);
+	re_console_close(&c);
+	assert_int_equal(tcgetattr(s, &t), 0);
+	assert_same_termios(&t, &before);
+	fclose(out);
+	close(s);
+	close(m);
 }
 
 /* ---- snapshots: the whole board at 80x24, exactly --------------------
@@ -687,7 +847,9 @@ int main(void)
 	    cmocka_unit_test(test_status_words),
 	    cmocka_unit_test(test_units_and_bar),
 	    cmocka_unit_test(test_history),
+	    cmocka_unit_test(test_history_times),
 	    cmocka_unit_test(test_event_lines),
+	    cmocka_unit_test(test_quiet_no_echo),
 	    cmocka_unit_test(test_snapshot_faults),
 	    cmocka_unit_test(test_snapshot_phases),
 	    cmocka_unit_test(test_stalled_reader_never_blocks),
