@@ -309,11 +309,12 @@ install: all
 	$(if $(MAN5),$(INSTALL) -m 644 $(MAN5) "$(DESTDIR)$(PREFIX)/share/man/man5/")
 	$(INSTALL) -m 644 $(wildcard dmc/*.dmc dmc/MANIFEST) "$(DESTDIR)$(DATADIR)/dmc/"
 	$(INSTALL) -m 644 $(wildcard config/*.yaml) "$(DESTDIR)$(DATADIR)/config/"
-	@# the operator's configuration roboelf finds without -c; an existing
-	@# (edited) one is kept
+	@# the operator's configuration roboelf finds without -c: the site
+	@# template, refused until the technician fills it in (the development
+	@# configuration stays in the source tree); an existing (edited) one is kept
 	$(INSTALL) -d "$(DESTDIR)$(SYSCONFDIR)/roboelf"
 	[ -e "$(DESTDIR)$(SYSCONFDIR)/roboelf/roboelf.yaml" ] || \
-		$(INSTALL) -m 644 config/roboelf.yaml "$(DESTDIR)$(SYSCONFDIR)/roboelf/roboelf.yaml"
+		$(INSTALL) -m 644 config/roboelf-site.yaml "$(DESTDIR)$(SYSCONFDIR)/roboelf/roboelf.yaml"
 	$(INSTALL) -m 644 README.md "$(DESTDIR)$(DOCDIR)/"
 	@for f in $(DOC_FILES); do \
 		$(INSTALL) -D -m 644 "$$f" "$(DESTDIR)$(DOCDIR)/$$f" || exit 1; done

@@ -162,7 +162,12 @@ static int parse_document(struct pctx *c, yaml_document_t *doc)
 				   "expected a mapping of settings at the top "
 				   "level, got %s",
 				   cfg_node_kind(root));
-	rc = cfg_parse_map(c, root, cfg_root_fields, c->cfg, "configuration");
+	/* All of them at once: a site configuration left half done should
+	 * not be finished one refusal at a time. */
+	rc = cfg_fill_check(c, root);
+	if (!rc)
+		rc = cfg_parse_map(c, root, cfg_root_fields, c->cfg,
+				   "configuration");
 	/* The ranges first: the defaults derived from a field (4 x period_ms)
 	 * may only be computed from a value in its range (a period_ms of
 	 * 1326439257 overflowed int here before it was refused). */
@@ -234,6 +239,9 @@ int re_config_load_file(const char *path, struct re_config *out, char *err,
 	}
 	rc = re_config_parse(buf, len, path, out, err, errlen);
 	free(buf);
+	/* a caller telling "no such file" from a bad one by errno (ENOENT,
+	 * e.g. left over from looking for the file) must not see a stale one */
+	errno = 0;
 	return rc;
 }
 

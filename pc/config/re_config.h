@@ -21,13 +21,18 @@
 #include "re_dmcif.h"
 #include "re_relay.h"
 
-#define RE_NAME_MAX	  16  /* axis name, bytes including the NUL */
-#define RE_ADDR_MAX	  128 /* controller address, bytes incl. NUL */
-#define RE_MODEL_MAX	  32  /* controller model, bytes incl. NUL */
-#define RE_PATH_MAX	  256 /* file paths, bytes incl. NUL */
-#define RE_CONFIG_ERR_MAX 512 /* a good size for the @err buffers */
+#define RE_NAME_MAX	  16   /* axis name, bytes including the NUL */
+#define RE_ADDR_MAX	  128  /* controller address, bytes incl. NUL */
+#define RE_MODEL_MAX	  32   /* controller model, bytes incl. NUL */
+#define RE_PATH_MAX	  256  /* file paths, bytes incl. NUL */
+#define RE_CONFIG_ERR_MAX 8192 /* a good size for the @err buffers */
 /* most table points per axis: travel_counts / step_counts at most this */
 #define RE_CONFIG_POINTS_MAX 10000
+/* The value a site configuration (config/roboelf-site.yaml) leaves in every
+ * field the technician must set. It is never a valid value: the loader
+ * refuses a file holding it, listing every place it is left, one line of
+ * about 100 bytes each (34 in that file: RE_CONFIG_ERR_MAX holds them). */
+#define RE_CONFIG_FILL_IN "FILL-IN"
 
 enum re_mode {
 	RE_MODE_CLINICAL = 0, /* default: real relay through libserialport,
@@ -200,8 +205,14 @@ void re_config_defaults(struct re_config *out);
  * Fields absent from the file keep their defaults; the result is validated
  * as re_config_validate() does, each cross-field error reported at the
  * position of the later of the fields involved.
+ * A file with RE_CONFIG_FILL_IN values (a site configuration not finished)
+ * is refused before anything else is checked, with every place listed, one
+ * line each, in the order of the file:
+ *   "FILE: this site's configuration is not finished: N values are still
+ *   FILL-IN\nFILE:LINE:COLUMN: 'controller.address' is still FILL-IN\n..."
+ * (a list longer than @errlen ends "... and N more").
  * Return: GL_OK; GL_ERR_CONFIG (syntax, unknown or duplicate key, wrong
- *         type, out of range, inconsistent); GL_ERR_NOMEM.
+ *         type, out of range, inconsistent, not filled in); GL_ERR_NOMEM.
  */
 int re_config_parse(const char *buf, size_t len, const char *filename,
 		    struct re_config *out, char *err, size_t errlen);
@@ -211,7 +222,7 @@ int re_config_parse(const char *buf, size_t len, const char *filename,
  * Messages use @path as FILE. A file that cannot be read gives
  * "cannot read 'PATH': <strerror>" (no position).
  * Return: as re_config_parse(), plus GL_ERR_SYS (errno kept) when the file
- *         cannot be read.
+ *         cannot be read; errno is 0 after any other return.
  */
 int re_config_load_file(const char *path, struct re_config *out, char *err,
 			size_t errlen);

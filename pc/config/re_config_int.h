@@ -108,6 +108,15 @@ const yaml_mark_t *cfg_seen_mark(const struct pctx *c, const void *field);
 int cfg_type_error(struct pctx *c, const yaml_node_t *v, const char *what,
 		   const char *key);
 /*
+ * cfg_fill_check() - every RE_CONFIG_FILL_IN scalar under @root (of
+ * @c->doc), quoted or not, wherever the schema could take a value
+ * (re_config_read.c); one met again through an alias counts once.
+ * Return: GL_OK when there is none; GL_ERR_CONFIG with the header line and
+ * one line per value, in file order, in @c->err (re_config_parse());
+ * GL_ERR_NOMEM.
+ */
+int cfg_fill_check(struct pctx *c, yaml_node_t *root);
+/*
  * The schema (re_config_schema.c): cfg_root_fields, the whole file's
  * table, cfg_axis_fields, one axis's (the defaults are there too:
  * re_config_defaults()).

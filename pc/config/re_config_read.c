@@ -401,3 +401,124 @@ int cfg_parse_map(struct pctx *c, yaml_node_t *map, const struct field *tab,
 	}
 	return GL_OK;
 }
+
+/* ---- values not filled in ---- */
+
+/* Deeper than any key of the schema (axes[i].analog.input is four levels
+ * down): a placeholder below sits where the schema refuses anything, and
+ * the walk's recursion stays shallow whatever the nesting. */
+#define FILL_DEPTH_MAX 8
+#define FILL_PATH_MAX  128 /* bytes of a key path, e.g. axes[2].analog.input */
+/* Room kept for the last line "... and N more" */
+#define FILL_TAIL 32
+
+/* One walk over the document: counting, or writing the lines into @out. */
+struct fill {
+	struct pctx *c;
+	unsigned char *seen; /* per node of the document: walked already (an
+			      * alias is the same node again: each is walked
+			      * and reported once, the walk stays linear) */
+	char *out;	     /* NULL: count only */
+	size_t cap;	     /* size of @out */
+	size_t used;	     /* strlen(@out) */
+	bool full;	     /* a line did not fit: no more are written */
+	int count;	     /* placeholders found */
+	int shown;	     /* of them, written */
+};
+
+static bool is_fill_in(const yaml_node_t *v)
+{
+	return v->type == YAML_SCALAR_NODE &&
+	       v->data.scalar.length == sizeof(RE_CONFIG_FILL_IN) - 1 &&
+	       !memcmp(v->data.scalar.value, RE_CONFIG_FILL_IN,
+		       sizeof(RE_CONFIG_FILL_IN) - 1);
+}
+
+/* The line of the placeholder at @v, key path @path, when it fits whole. */
+static void fill_add(struct fill *f, const yaml_node_t *v, const char *path)
+{
+	char line[FILL_PATH_MAX + RE_PATH_MAX + 64];
+	int n;
+
+	f->count++;
+	if (!f->out || f->full)
+		return;
+	n = snprintf(line, sizeof(line), "\n%s:%zu:%zu: '%s' is still %s",
+		     f->c->file, v->start_mark.line + 1,
+		     v->start_mark.column + 1, path, RE_CONFIG_FILL_IN);
+	if (n < 0 || f->used + (size_t)n + FILL_TAIL >= f->cap) {
+		f->full = true;
+		return;
+	}
+	memcpy(f->out + f->used, line, (size_t)n + 1);
+	f->used += (size_t)n;
+	f->shown++;
+}
+
+/* Walk @v, whose key path is @path (@plen bytes used of FILL_PATH_MAX). */
+static void fill_walk(struct fill *f, yaml_node_t *v, char *path, size_t plen,
+		      int depth)
+{
+	yaml_node_pair_t *p;
+	yaml_node_item_t *it;
+	const char *k;
+
+	if (!v || depth > FILL_DEPTH_MAX || f->seen[v - f->c->doc->nodes.start])
+		return;
+	f->seen[v - f->c->doc->nodes.start] = 1;
+	if (is_fill_in(v)) {
+		fill_add(f, v, path);
+	} else if (v->type == YAML_MAPPING_NODE) {
+		for (p = v->data.mapping.pairs.start;
+		     p < v->data.mapping.pairs.top; p++) {
+			k = base_yaml_scalar(cfg_node_at(f->c, p->key));
+			snprintf(path + plen, FILL_PATH_MAX - plen, "%s%.*s",
+				 plen ? "." : "", TEXT_SHOWN, k ? k : "?");
+			fill_walk(f, cfg_node_at(f->c, p->value), path,
+				  strlen(path), depth + 1);
+		}
+	} else if (v->type == YAML_SEQUENCE_NODE) {
+		for (it = v->data.sequence.items.start;
+		     it < v->data.sequence.items.top; it++) {
+			snprintf(path + plen, FILL_PATH_MAX - plen, "[%d]",
+				 (int)(it - v->data.sequence.items.start));
+			fill_walk(f, cfg_node_at(f->c, *it), path, strlen(path),
+				  depth + 1);
+		}
+	}
+	path[plen] = '\0';
+}
+
+int cfg_fill_check(struct pctx *c, yaml_node_t *root)
+{
+	size_t nodes = (size_t)(c->doc->nodes.top - c->doc->nodes.start);
+	struct fill f = {.c = c, .seen = calloc(nodes ? nodes : 1, 1)};
+	char path[FILL_PATH_MAX] = "";
+	int n;
+
+	if (!f.seen) {
+		cfg_fail_at(c, NULL, "out of memory");
+		return GL_ERR_NOMEM;
+	}
+	/* a first walk counts, so that the header can say how many */
+	fill_walk(&f, root, path, 0, 0);
+	n = f.count;
+	if (n)
+		cfg_fail_at(c, NULL,
+			    "this site's configuration is not finished: %d "
+			    "value%s still %s",
+			    n, n == 1 ? " is" : "s are", RE_CONFIG_FILL_IN);
+	if (n && c->err && c->errlen) {
+		memset(f.seen, 0, nodes);
+		f.out = c->err;
+		f.cap = c->errlen;
+		f.used = strlen(c->err);
+		f.count = 0;
+		fill_walk(&f, root, path, 0, 0);
+		if (f.shown < f.count)
+			snprintf(c->err + f.used, c->errlen - f.used,
+				 "\n... and %d more", f.count - f.shown);
+	}
+	free(f.seen);
+	return n ? GL_ERR_CONFIG : GL_OK;
+}

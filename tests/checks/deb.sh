@@ -1,9 +1,10 @@
 #!/bin/sh
 # deb.sh - the Debian package: `make deb` builds
 # $BUILD/roboelf_<version>_<arch>.deb; `dpkg -c` lists the programs, the man
-# pages, the conffiles /etc/roboelf/roboelf.yaml and the group's real-time
-# limits, the DMC programs, the docs tree and the relay's udev rule, all
-# owned by root; the packaged galil-load
+# pages, the conffiles /etc/roboelf/roboelf.yaml (the site template
+# config/roboelf-site.yaml, which the packaged roboelf refuses until it is
+# filled in) and the group's real-time limits, the DMC programs, the docs
+# tree and the relay's udev rule, all owned by root; the packaged galil-load
 # finds the packaged DMC programs; the postinst creates the group roboelf
 # once (run twice against stand-in commands, never on this machine's
 # groups); lintian reports no error. lintian comes from `make deps`: a
@@ -32,7 +33,8 @@ for p in ./usr/bin/roboelf ./usr/bin/roboelf-tech ./usr/bin/galil-load ./usr/bin
 	./etc/roboelf/roboelf.yaml ./etc/security/limits.d/roboelf.conf \
 	./usr/share/roboelf/dmc/MANIFEST \
 	./usr/share/roboelf/dmc/constants.dmc ./usr/share/roboelf/dmc/roboelf.dmc \
-	./usr/share/roboelf/config/plant.yaml ./lib/udev/rules.d/60-roboelf-relay.rules \
+	./usr/share/roboelf/config/plant.yaml ./usr/share/roboelf/config/roboelf.yaml \
+	./usr/share/roboelf/config/roboelf-site.yaml ./lib/udev/rules.d/60-roboelf-relay.rules \
 	./usr/share/doc/roboelf/copyright ./usr/share/doc/roboelf/changelog.gz \
 	./usr/share/doc/roboelf/README.md ./usr/share/doc/roboelf/docs/technician.md; do
 	grep -qxF "$p" "$tmp/paths" || fail "dpkg -c: no $p"
@@ -53,9 +55,24 @@ grep -v '^#' "$tmp/x/lib/udev/rules.d/60-roboelf-relay.rules" | grep -qxF "$want
 	fail "udev rule: $(grep -v '^#' "$tmp/x/lib/udev/rules.d/60-roboelf-relay.rules")"
 [ "$(grep -v '^#' "$tmp/x/etc/security/limits.d/roboelf.conf")" = "$(printf '@roboelf\t-\trtprio\t60\n@roboelf\t-\tmemlock\tunlimited')" ] ||
 	fail "limits: $(cat "$tmp/x/etc/security/limits.d/roboelf.conf")"
-cmp -s "$tmp/x/etc/roboelf/roboelf.yaml" config/roboelf.yaml || fail "the conffile is not config/roboelf.yaml"
+cmp -s "$tmp/x/etc/roboelf/roboelf.yaml" config/roboelf-site.yaml ||
+	fail "the conffile is not the site template config/roboelf-site.yaml"
+cmp -s "$tmp/x/usr/share/roboelf/config/roboelf.yaml" config/roboelf.yaml ||
+	fail "/usr/share/roboelf/config/roboelf.yaml is not the development configuration"
+# the packaged roboelf refuses the conffile as installed (every FILL-IN
+# listed: install.sh, test_re_config)
+cfg=$tmp/x/etc/roboelf/roboelf.yaml
+n=$(grep -c '^ *[a-z_]*: FILL-IN$' "$cfg")
+out=$(cd "$tmp" && ROBOELF_ROOT=$tmp/x "$tmp/x/usr/bin/roboelf" --calibration file 2>&1 </dev/null)
+rc=$?
+[ $rc -eq 2 ] || fail "packaged roboelf with the conffile: exit $rc: $out"
+[ "$(printf '%s\n' "$out" | sed -n 2p)" = "$cfg: this site's configuration is not finished: $n values are still FILL-IN" ] ||
+	fail "packaged roboelf with the conffile: $out"
 # built for /usr: the packaged galil-load finds the packaged DMC programs
-out=$(cd "$tmp" && ROBOELF_ROOT=$tmp/x "$tmp/x/usr/bin/galil-load" --version 2>/dev/null | sed -n 2p)
+# (sealed with the packaged development configuration: the conffile is
+# refused until filled in, and the identity includes the seal)
+out=$(cd "$tmp" && ROBOELF_ROOT=$tmp/x "$tmp/x/usr/bin/galil-load" --version \
+	--config "$tmp/x/usr/share/roboelf/config/roboelf.yaml" 2>/dev/null | sed -n 2p)
 case $out in "DMC programs: $tmp/x/usr/share/roboelf/dmc, identity 'NO ID "*"'") ;;
 *) fail "packaged galil-load --version: '$out'" ;; esac
 

@@ -3,8 +3,10 @@
 # `make install DESTDIR=$tmp/root PREFIX=/usr`, then the installed roboelf
 # and galil-load, started in an empty directory with ROBOELF_ROOT=$tmp/root
 # (the staged installation's root, base_paths.h), find the installed DMC
-# programs and configuration; --dmc and -c still win; the edited
-# configuration survives a second install; the docs tree keeps its links.
+# programs and configuration; the installed configuration is the site
+# template config/roboelf-site.yaml, refused with every FILL-IN listed until
+# it is filled in; --dmc and -c still win; the edited configuration
+# survives a second install; the docs tree keeps its links.
 set -u
 cd "$(dirname "$0")/../.." || exit 1
 TOP=$PWD
@@ -20,6 +22,7 @@ make -s --no-print-directory BUILD="$BUILD" install DESTDIR="$root" PREFIX=/usr 
 for f in usr/bin/roboelf usr/bin/roboelf-tech usr/bin/galil-load usr/bin/galil-sim \
 	usr/share/roboelf/dmc/MANIFEST usr/share/roboelf/dmc/constants.dmc \
 	usr/share/roboelf/dmc/roboelf.dmc usr/share/roboelf/config/plant.yaml \
+	usr/share/roboelf/config/roboelf.yaml usr/share/roboelf/config/roboelf-site.yaml \
 	etc/roboelf/roboelf.yaml usr/share/man/man1/roboelf.1 \
 	usr/share/man/man1/galil-load.1 usr/share/man/man1/roboelf-tech.1 usr/share/man/man5/roboelf.yaml.5 \
 	usr/share/doc/roboelf/README.md usr/share/doc/roboelf/docs/technician.md \
@@ -36,6 +39,42 @@ for md in "$doc"/README.md "$doc"/docs/*.md; do
 	done
 done
 
+re() { (cd "$tmp/elsewhere" && ROBOELF_ROOT=$root "$root/usr/bin/roboelf" "$@" </dev/null); }
+# the installed configuration is the site template, refused until filled
+# in, with every value to fill in listed (the exact list: test_re_config)
+cfg=$root/etc/roboelf/roboelf.yaml
+cmp -s "$cfg" config/roboelf-site.yaml || fail "the installed configuration is not config/roboelf-site.yaml"
+out=$(re --calibration file 2>&1)
+rc=$?
+n=$(grep -c '^ *[a-z_]*: FILL-IN$' "$cfg")
+line=$(grep -n '^  address: FILL-IN$' "$cfg" | cut -d: -f1)
+[ "$n" -gt 30 ] && [ -n "$line" ] || fail "the template's FILL-INs: $n, address at '$line'"
+want="roboelf: ROBOELF_ROOT=$root: the installed files are looked for under it
+$cfg: this site's configuration is not finished: $n values are still FILL-IN
+$cfg:$line:12: 'controller.address' is still FILL-IN"
+[ $rc -eq 2 ] || fail "the template: exit $rc: $out"
+[ "$(printf '%s\n' "$out" | head -3)" = "$want" ] || fail "the template: '$out'"
+[ "$(printf '%s\n' "$out" | grep -c "^$cfg:[0-9]*:[0-9]*: '[][a-z_.0-9]*' is still FILL-IN$")" = "$n" ] &&
+	[ "$(printf '%s\n' "$out" | wc -l)" = $((n + 2)) ] || fail "the template: not every FILL-IN listed: $out"
+# galil-load seals the program with it: refused as well
+out=$(cd "$tmp/elsewhere" && ROBOELF_ROOT=$root "$root/usr/bin/galil-load" --check 2>&1)
+rc=$?
+[ $rc -eq 2 ] || fail "galil-load --check with the template: exit $rc: $out"
+printf '%s\n' "$out" | grep -qxF "galil-load: cannot seal the program with '$cfg': $cfg: this site's configuration is not finished: $n values are still FILL-IN" ||
+	fail "galil-load --check with the template: $out"
+# filled in with the values of the source tree's configuration
+sed -i -e 's|^\(  address:\) FILL-IN$|\1 "192.0.2.1"|' -e 's|^\(  power_output:\) FILL-IN$|\1 0|' \
+	-e 's|^\(  port_clinical:\) FILL-IN$|\1 /dev/roboelf-relay|' -e 's|^\(  protocol:\) FILL-IN$|\1 devantech|' \
+	-e 's|^\(  channel:\) FILL-IN$|\1 1|' -e 's|^\(  inputs:\) FILL-IN$|\1 [1, 2, 3, 4, 5, 6, 7, 8, 17, 18, 19, 20]|' \
+	-e 's|^\(  active_low:\) FILL-IN$|\1 false|' -e 's|^\( *vmax:\) FILL-IN$|\1 8000|' \
+	-e 's|^\( *travel_counts:\) FILL-IN$|\1 100000|' -e 's|^\( *kp:\) FILL-IN$|\1 6|' -e 's|^\( *ki:\) FILL-IN$|\1 1|' \
+	-e 's|^\( *kd:\) FILL-IN$|\1 64|' -e 's|^\( *torque_limit_v:\) FILL-IN$|\1 5.0|' \
+	-e 's|^\( *expected_range_v:\) FILL-IN$|\1 4.0|' -e 's|^\( *reverse_v:\) FILL-IN$|\1 0.5|' \
+	-e 's|^\( *forward_v:\) FILL-IN$|\1 4.5|' "$cfg"
+# C's travel as in the source tree's configuration: the same seal, so the
+# same identity as its dmc/ (below)
+sed -i '/^  - name: C$/,/travel_counts/ s/^\(    travel_counts:\) 100000$/\1 80000/' "$cfg"
+grep -v '^ *#' "$cfg" | grep -q FILL-IN && fail "a FILL-IN left: $(grep -n FILL-IN "$cfg")"
 # galil-load: no files -> the installed DMC; the identity is the source tree's
 want_id=$("$BUILD/bin/galil-load" --check dmc | sed -n "s/.*identity line '\(.*\)'/\1/p")
 [ -n "$want_id" ] || fail "no identity from galil-load --check dmc"
@@ -63,14 +102,19 @@ want="galil-load: no program files and no commands, and no DMC programs: neither
 [ "$(printf '%s\n' "$out" | head -1)" = "$want" ] || fail "no DMC: '$out'"
 
 # roboelf: --version names the installed configuration and DMC programs
-re() { (cd "$tmp/elsewhere" && ROBOELF_ROOT=$root "$root/usr/bin/roboelf" "$@" </dev/null); }
 want="roboelf $version (controller program interface $iface, dmc/constants.dmc vers)
 configuration: $root/etc/roboelf/roboelf.yaml
 DMC programs: $root/usr/share/roboelf/dmc"
 out=$(re --version 2>/dev/null) || fail "roboelf --version: exit $?"
 [ "$out" = "$want" ] || fail "roboelf --version: '$out'"
+# the filled-in configuration loads: clinical, so ROBOELF_ROOT is refused,
+# before anything is opened
+out=$(re --calibration file 2>&1)
+rc=$?
+want="roboelf: ROBOELF_ROOT=$root: the installed files are looked for under it
+roboelf: error: ROBOELF_ROOT is set: refused in clinical mode (it is for testing a staged installation); unset it"
+[ $rc -eq 2 ] && [ "$out" = "$want" ] || fail "clinical with ROBOELF_ROOT: exit $rc: '$out'"
 # the installed configuration is the one read: an edit shows in the error
-cfg=$root/etc/roboelf/roboelf.yaml
 sed -i 's/^period_ms: .*/period_ms: 1/' "$cfg"
 line=$(grep -n '^period_ms: 1$' "$cfg" | cut -d: -f1)
 [ -n "$line" ] || fail "no period_ms line in the installed configuration"
@@ -78,17 +122,6 @@ out=$(re --calibration file 2>&1)
 rc=$?
 [ $rc -eq 2 ] || fail "edited configuration: exit $rc: $out"
 printf '%s\n' "$out" | grep -q "^$cfg:$line:" || fail "edited configuration not read: $out"
-# ROBOELF_ROOT is refused in clinical mode, before anything is opened
-cp "$cfg" "$tmp/edited.yaml"
-sed -i -e 's/^period_ms: 1$/period_ms: 50/' -e 's/^mode: development$/mode: clinical/' \
-	-e 's|^  port_clinical: ""$|  port_clinical: /dev/roboelf-relay|' \
-	-e 's|^  address: "127.0.0.1:23023"$|  address: "192.0.2.1"|' "$cfg"
-out=$(re --calibration file 2>&1)
-rc=$?
-want="roboelf: ROBOELF_ROOT=$root: the installed files are looked for under it
-roboelf: error: ROBOELF_ROOT is set: refused in clinical mode (it is for testing a staged installation); unset it"
-[ $rc -eq 2 ] && [ "$out" = "$want" ] || fail "clinical with ROBOELF_ROOT: exit $rc: '$out'"
-cp "$tmp/edited.yaml" "$cfg"
 # -c wins
 printf 'period_ms: 0\n' >"$tmp/mine.yaml"
 out=$(re -c "$tmp/mine.yaml" --calibration file 2>&1)

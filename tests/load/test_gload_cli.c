@@ -135,6 +135,25 @@ static const struct usage_case usages[] = {
     {{"-a", "127.0.0.1", "-t", "0", "-c", "TP", NULL},
      "galil-load: invalid timeout '0' (1..600000 ms)\n"},
     {{"--bogus", NULL}, "galil-load: invalid or incomplete option '--bogus'\n"},
+    /* --verify never writes: nothing that would may come with it */
+    {{"-a", "127.0.0.1", "--verify", "-f", GOOD "clean.dmc", NULL},
+     "galil-load: --verify only reads the controller's program; drop "
+     "--check, -f, --burn, --start, -c and --find\n"},
+    {{"-a", "127.0.0.1", "--verify", "--burn", GOOD "clean.dmc", NULL},
+     "galil-load: --verify only reads the controller's program; drop "
+     "--check, -f, --burn, --start, -c and --find\n"},
+    {{"-a", "127.0.0.1", "--verify", "--start", GOOD "clean.dmc", NULL},
+     "galil-load: --verify only reads the controller's program; drop "
+     "--check, -f, --burn, --start, -c and --find\n"},
+    {{"-a", "127.0.0.1", "--verify", "-c", "MG 1", GOOD "clean.dmc", NULL},
+     "galil-load: --verify only reads the controller's program; drop "
+     "--check, -f, --burn, --start, -c and --find\n"},
+    {{"--verify", "--check", GOOD "clean.dmc", NULL},
+     "galil-load: --verify only reads the controller's program; drop "
+     "--check, -f, --burn, --start, -c and --find\n"},
+    {{"--verify", GOOD "clean.dmc", NULL},
+     "galil-load: no controller address (-a HOST); use --check to check "
+     "offline\n"},
 };
 
 /* Usage errors: exit 2, the reason first, then the usage text. */

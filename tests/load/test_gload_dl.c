@@ -417,8 +417,13 @@ static void dl_lines(char *out, size_t cap, const char *prog)
 	"MG _XQ0\nMG _XQ1\nMG _XQ2\nMG _XQ3\nMG _XQ4\nMG _XQ5\nMG _XQ6\n"      \
 	"MG _XQ7\n"
 
-/* Identify, the busy check (no program running: one question). */
-static const char halt_log[] = "^R^V\nMG _BN\nMG _XQ0\n" HALT_CMDS;
+/* Identify, then the controller's program read (UL) before anything is
+ * halted: a program it already holds is left running. */
+#define IDENT_UL "^R^V\nMG _BN\nUL\n"
+
+/* Identify, UL, the busy check (no program running: one question), the
+ * halt. */
+static const char halt_log[] = IDENT_UL "MG _XQ0\n" HALT_CMDS;
 
 static void assert_log(const char *want)
 {
@@ -433,7 +438,7 @@ static int has(const struct proc *p, enum proc_stream s, const char *text)
 	return strstr(proc_output(p, s), text) != NULL;
 }
 
-/* A clean program: halt, upload, download, read back; exact sequence. */
+/* A clean program: upload, halt, download, read back; exact sequence. */
 static void test_load_clean(void **state)
 {
 	static const char *const args[] = {GOOD "clean.dmc", NULL};
@@ -443,7 +448,7 @@ static void test_load_clean(void **state)
 
 	(void)state;
 	assert_int_equal(run(&p, args), 0);
-	n = snprintf(want, sizeof(want), "%sUL\nDL\n", halt_log);
+	n = snprintf(want, sizeof(want), "%sDL\n", halt_log);
 	dl_lines(want + n, sizeof(want) - (size_t)n, prog);
 	strcat(want, "UL\n");
 	assert_log(want);
@@ -460,31 +465,92 @@ static void test_load_clean(void **state)
 	free(prog);
 }
 
-/* The same program again: no download; --force downloads anyway. */
+/* The same program again: read, nothing halted or written (the running
+ * thread keeps running); --force halts and downloads anyway. */
 static void test_unchanged(void **state)
 {
 	static const char *const args[] = {GOOD "clean.dmc", NULL};
 	static const char *const force[] = {"-f", GOOD "clean.dmc", NULL};
-	char *prog = clean_program(), want[LOG_CAP];
+	char *prog = clean_program();
 	struct proc p;
 
 	(void)state;
 	strcpy(fk.prog, prog);
 	fk.prog_len = strlen(prog);
+	fk.running[0] = 1;
+	fk.motors_on = 1;
 	assert_int_equal(run(&p, args), 0);
-	snprintf(want, sizeof(want), "%sUL\n", halt_log);
-	assert_log(want);
+	assert_log(IDENT_UL);
 	assert_true(has(&p, PROC_STDOUT,
 			"unchanged: the controller already "
 			"holds this program (identity " CLEAN_ID "); not "
-			"downloaded\n"));
+			"downloaded\n"
+			"left running: nothing halted, nothing written\n"));
+	assert_string_equal(proc_output(&p, PROC_STDERR), "");
 	assert_int_equal(fk.downloads, 0);
+	assert_int_equal(fk.running[0], 1);
+	assert_int_equal(fk.motors_on, 1);
 	proc_kill(&p);
 	assert_int_equal(run(&p, force), 0);
 	assert_int_equal(fk.downloads, 1);
+	assert_int_equal(fk.running[0], 0);
 	assert_string_equal(fk.prog, prog);
 	proc_kill(&p);
 	free(prog);
+}
+
+/* --verify, the same program: UL only (the protocol log holds nothing
+ * else), exit 0, the running thread and the motors untouched. */
+static void test_verify_equal(void **state)
+{
+	static const char *const args[] = {"--verify", GOOD "clean.dmc", NULL};
+	char *prog = clean_program();
+	struct proc p;
+
+	(void)state;
+	strcpy(fk.prog, prog);
+	fk.prog_len = strlen(prog);
+	fk.running[0] = 1;
+	fk.motors_on = 1;
+	assert_int_equal(run(&p, args), 0);
+	assert_log(IDENT_UL);
+	assert_true(has(&p, PROC_STDOUT,
+			"controller: DMC4030 Rev 1.2h-fake, serial 4242\n"
+			"verified: the controller holds this program, "
+			"identity " CLEAN_ID "\n"));
+	assert_string_equal(proc_output(&p, PROC_STDERR), "");
+	assert_int_equal(fk.downloads, 0);
+	assert_int_equal(fk.running[0], 1);
+	assert_int_equal(fk.motors_on, 1);
+	assert_string_equal(fk.prog, prog);
+	proc_kill(&p);
+	free(prog);
+}
+
+/* --verify, no program on the controller: exit 6, what differs and what
+ * to do; UL only, nothing halted or written. */
+static void test_verify_empty(void **state)
+{
+	static const char *const args[] = {"--verify", GOOD "clean.dmc", NULL};
+	struct proc p;
+
+	(void)state;
+	fk.running[0] = 1;
+	fk.motors_on = 1;
+	assert_int_equal(run(&p, args), 6);
+	assert_log(IDENT_UL);
+	assert_string_equal(
+	    proc_output(&p, PROC_STDERR),
+	    "galil-load: verify: the controller's program differs from "
+	    "these files (identity " CLEAN_ID ")\n"
+	    "galil-load: the controller holds no program\n"
+	    "galil-load: nothing was halted or written; to load these files "
+	    "run galil-load without --verify (that halts the program)\n");
+	assert_false(has(&p, PROC_STDOUT, "verified"));
+	assert_int_equal(fk.downloads, 0);
+	assert_int_equal(fk.running[0], 1);
+	assert_int_equal(fk.motors_on, 1);
+	proc_kill(&p);
 }
 
 /*
@@ -499,9 +565,10 @@ static void assert_rejected_line(const struct proc *p, int bad)
 	int line = 0;
 
 	if (!s) {
-		assert_non_null(strstr(err,
-				       "galil-load: the controller did not "
-				       "say which line it rejected\n"));
+		if (!strstr(err, "galil-load: the controller did not say "
+				 "which line it rejected\n"))
+			fail_msg("no rejected line named; galil-load said:\n%s",
+				 err);
 		return;
 	}
 	assert_int_equal(
@@ -627,6 +694,38 @@ static void test_burn_and_start(void **state)
 	free(prog);
 }
 
+/* The same program with --burn --start: BP is refused while a program
+ * runs, so the running thread is halted (after the busy check), then the
+ * program burned and started; nothing is downloaded. */
+static void test_unchanged_burn_start(void **state)
+{
+	static const char *const args[] = {"--burn", "--start",
+					   GOOD "clean.dmc", NULL};
+	char *prog = clean_program();
+	struct proc p;
+
+	(void)state;
+	strcpy(fk.prog, prog);
+	fk.prog_len = strlen(prog);
+	fk.running[0] = 1;
+	assert_int_equal(run(&p, args), 0);
+	/* thread 0 runs: the busy check asks the state (no RoboELF
+	 * program here: refused, TC1 read) */
+	assert_log(IDENT_UL "MG _XQ0\nMG state\nTC1\n" HALT_CMDS
+			    "BP\nXQ #AUTO,0\nMG _XQ0\n");
+	assert_true(has(&p, PROC_STDOUT,
+			"unchanged: the controller already holds this program "
+			"(identity " CLEAN_ID "); not downloaded\n"
+			"halted: threads stopped, axes stopped, motors off\n"
+			"burned: #AUTO runs at power-up\n"
+			"started: #AUTO in thread 0 (at line 5)\n"));
+	assert_int_equal(fk.downloads, 0);
+	assert_string_equal(fk.burned, prog);
+	assert_int_equal(fk.running[0], 1);
+	proc_kill(&p);
+	free(prog);
+}
+
 /* --start=LABEL that does not run; BP refused. Both exit 4. */
 static void test_start_and_burn_fail(void **state)
 {
@@ -738,7 +837,7 @@ static void test_busy_refused(void **state)
 	fk.supervised = 1;
 	fk.motors_on = 1;
 	assert_int_equal(run(&p, args), 5);
-	assert_log("^R^V\nMG _BN\nMG _XQ0\nMG state\nMG hbpc\nMG hbpc\n");
+	assert_log(IDENT_UL "MG _XQ0\nMG state\nMG hbpc\nMG hbpc\n");
 	assert_true(has(&p, PROC_STDERR,
 			"galil-load: the controller's program is armed and "
 			"its supervisor's heartbeat is advancing: roboelf is "
@@ -809,7 +908,9 @@ static void test_axis_not_stopping(void **state)
 	assert_non_null(strstr(fk.log, "MG _BGC\nAB 1\nMG _BGA\nMG _BGB\n"
 				       "MG _BGC\nMO\nMG _MOA\n"));
 	assert_null(strstr(fk.log, "DL\n"));
-	assert_null(strstr(fk.log, "UL\n"));
+	/* the one UL is the comparison, before the halt */
+	assert_int_equal(strncmp(fk.log, IDENT_UL, strlen(IDENT_UL)), 0);
+	assert_null(strstr(fk.log + strlen(IDENT_UL), "UL\n"));
 	pthread_mutex_unlock(&fk.mu);
 	assert_int_equal(fk.motors_on, 0);
 	assert_int_equal(fk.downloads, 0);
@@ -821,6 +922,10 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test_setup_teardown(test_load_clean, fk_start, fk_stop),
 	    cmocka_unit_test_setup_teardown(test_unchanged, fk_start, fk_stop),
+	    cmocka_unit_test_setup_teardown(test_verify_equal, fk_start,
+					    fk_stop),
+	    cmocka_unit_test_setup_teardown(test_verify_empty, fk_start,
+					    fk_stop),
 	    cmocka_unit_test_setup_teardown(test_reject_line, fk_start,
 					    fk_stop),
 	    cmocka_unit_test_setup_teardown(test_drop_mid_download, fk_start,
@@ -830,6 +935,8 @@ int main(void)
 	    cmocka_unit_test_setup_teardown(test_thread_stuck, fk_start,
 					    fk_stop),
 	    cmocka_unit_test_setup_teardown(test_burn_and_start, fk_start,
+					    fk_stop),
+	    cmocka_unit_test_setup_teardown(test_unchanged_burn_start, fk_start,
 					    fk_stop),
 	    cmocka_unit_test_setup_teardown(test_start_and_burn_fail, fk_start,
 					    fk_stop),

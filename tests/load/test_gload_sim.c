@@ -2,10 +2,12 @@
  * test_gload_sim.c - galil-load (child process) against galil-sim, which
  * really runs the DMC: a clean program loaded, verified, started and
  * running (the variable its #AUTO sets); the identity stamp read back and
- * verified as roboelf does at start-up; a second load found unchanged; a
- * running program halted before a forced reload; --burn then a power cycle
- * runs #AUTO (and without --burn the power cycle leaves nothing); -c round
- * trips and a rejected command; ^R^V through -c; a load while an axis jogs.
+ * verified as roboelf does at start-up; a second load found unchanged and
+ * the program left running; a running program halted before a forced
+ * reload; --verify equal and different, halting and writing nothing; --burn
+ * then a power cycle runs #AUTO (and without --burn the power cycle leaves
+ * nothing); -c round trips and a rejected command; ^R^V through -c; a load
+ * while an axis jogs.
  *
  * Needs $ROBOELF_BIN/galil-sim and galil-load. One simulator per test,
  * started with --port 0 --control-port 0, killed by pid.
@@ -95,6 +97,19 @@ static int run(struct proc *p, const struct simctx *c, const char *const *args)
 	return rc;
 }
 
+/* run() that must exit 0; otherwise the failure shows galil-load's
+ * own words. */
+static void run_ok(struct proc *p, const struct simctx *c,
+		   const char *const *args)
+{
+	int rc = run(p, c, args);
+
+	if (rc != 0)
+		fail_msg("galil-load exited %d: %s%s", rc,
+			 proc_output(p, PROC_STDOUT),
+			 proc_output(p, PROC_STDERR));
+}
+
 static gl_link *sim_link(const struct simctx *c)
 {
 	char err[GL_ERRTEXT_LEN];
@@ -152,7 +167,7 @@ static void test_clean_start(void **state)
 
 	(void)state;
 	sim_start(&c);
-	assert_int_equal(run(&p, &c, args), 0);
+	run_ok(&p, &c, args);
 	assert_true(has(&p, PROC_STDOUT,
 			"verified: the read-back matches, "
 			"identity 32DC74A870EEBF04\n"));
@@ -173,8 +188,43 @@ static void test_clean_start(void **state)
 	sim_stop(&c);
 }
 
-/* A second load of the same program downloads nothing; a forced load
- * halts the running program first (DL is refused while it runs). */
+/* Switch motor A on (SH A): a halt would switch it off (MO), so a motor
+ * still on afterwards shows that nothing was halted. */
+static void motor_on(const struct simctx *c)
+{
+	gl_link *l = sim_link(c);
+	char resp[64];
+
+	assert_true(gl_link_command(l, "SH A", resp, sizeof(resp), 2000) >= 0);
+	gl_link_close(l);
+}
+
+/* The running program untouched: thread 0 still runs, motor A still on,
+ * and the controller still holds the program stamped @id. */
+static void assert_untouched(const struct simctx *c, uint64_t id)
+{
+	char prog[8192];
+	uint64_t held = 0;
+	gl_link *l;
+	double v;
+	int n;
+
+	assert_int_equal(sim_query(c, "MG _XQ0", &v), GL_OK);
+	assert_true(v >= 0);
+	assert_int_equal(sim_query(c, "MG _MOA", &v), GL_OK);
+	assert_true(v == 0);
+	l = sim_link(c);
+	n = gl_link_upload(l, prog, sizeof(prog), 5000);
+	gl_link_close(l);
+	assert_true(n > 0);
+	assert_int_equal(gl_ident_verify(prog, (size_t)n, &held), GL_OK);
+	assert_true(held == id);
+}
+
+/* A second load of the same program is compared before anything is
+ * halted: the running program keeps running and nothing is downloaded;
+ * --start finds thread 0 running and leaves it; a forced load halts the
+ * running program first (DL is refused while it runs). */
 static void test_unchanged_and_forced(void **state)
 {
 	static const char *const start[] = {"--start", GOOD "clean.dmc", NULL};
@@ -186,25 +236,127 @@ static void test_unchanged_and_forced(void **state)
 
 	(void)state;
 	sim_start(&c);
-	assert_int_equal(run(&p, &c, start), 0);
+	run_ok(&p, &c, start);
 	proc_kill(&p);
 	assert_int_equal(wait_value(&c, "MG booted", 1, 2000), 0);
-	assert_int_equal(run(&p, &c, again), 0);
+	motor_on(&c);
+	run_ok(&p, &c, again);
 	assert_true(has(&p, PROC_STDOUT,
-			"unchanged: the controller already "
-			"holds this program"));
+			"unchanged: the controller already holds this program "
+			"(identity 32DC74A870EEBF04); not downloaded\n"
+			"left running: nothing halted, nothing written\n"));
+	assert_false(has(&p, PROC_STDOUT, "halted:"));
+	assert_false(has(&p, PROC_STDOUT, "downloading"));
+	assert_string_equal(proc_output(&p, PROC_STDERR), "");
 	proc_kill(&p);
-	assert_int_equal(sim_query(&c, "MG _XQ0", &v), GL_OK);
-	assert_true(v == -1); /* halted, not restarted */
-	assert_int_equal(run(&p, &c, start), 0);
+	assert_untouched(&c, CLEAN_ID);
+	run_ok(&p, &c, start);
+	assert_true(has(&p, PROC_STDOUT,
+			"running: thread 0 already runs it "
+			"(at line "));
+	assert_true(has(&p, PROC_STDOUT,
+			"); not restarted (--force halts, reloads and "
+			"restarts it)\n"
+			"left running: nothing halted, nothing written\n"));
 	proc_kill(&p);
-	assert_int_equal(run(&p, &c, force), 0);
+	assert_untouched(&c, CLEAN_ID);
+	run_ok(&p, &c, force);
 	assert_true(has(&p, PROC_STDOUT, "halted: threads stopped"));
 	assert_true(has(&p, PROC_STDOUT, "verified: the read-back matches"));
 	proc_kill(&p);
 	assert_int_equal(sim_query(&c, "MG _XQ0", &v), GL_OK);
 	assert_true(v == -1);
+	assert_int_equal(sim_query(&c, "MG _MOA", &v), GL_OK);
+	assert_true(v == 1);
 	sim_stop(&c);
+}
+
+/* clean.dmc with its 'WT 10' (program line 13, file line 19) made 'WT 20',
+ * written to @path (PATH_MAX) in a new temporary directory. */
+static void write_variant(char *path, size_t cap)
+{
+	static const char from[] = "\tWT 10";
+	char src[4096], dir[] = "/tmp/gload_verify.XXXXXX";
+	FILE *f = fopen(GOOD "clean.dmc", "rb");
+	char *at;
+	size_t n;
+
+	assert_non_null(f);
+	n = fread(src, 1, sizeof(src) - 1, f);
+	fclose(f);
+	src[n] = 0;
+	at = strstr(src, from);
+	assert_non_null(at);
+	at[5] = '2';
+	assert_non_null(mkdtemp(dir));
+	snprintf(path, cap, "%s/variant.dmc", dir);
+	f = fopen(path, "wb");
+	assert_non_null(f);
+	assert_int_equal(fwrite(src, 1, n, f), n);
+	assert_int_equal(fclose(f), 0);
+}
+
+static void remove_variant(const char *path)
+{
+	char dir[512];
+
+	snprintf(dir, sizeof(dir), "%s", path);
+	unlink(path);
+	*strrchr(dir, '/') = 0;
+	rmdir(dir);
+}
+
+/* --verify against the program that runs: equal (exit 0) and different
+ * (exit 6, the first differing line); neither halts nor writes. */
+static void test_verify(void **state)
+{
+	char var[512], want[1024];
+	const char *const same[] = {"--verify", var, NULL};
+	const char *const other[] = {"--verify", GOOD "clean.dmc", NULL};
+	const char *const start[] = {"--start", var, NULL};
+	unsigned long long id = 0;
+	struct simctx c;
+	struct proc p;
+	const char *s;
+
+	(void)state;
+	write_variant(var, sizeof(var));
+	sim_start(&c);
+	run_ok(&p, &c, start);
+	s = strstr(proc_output(&p, PROC_STDOUT),
+		   "read-back matches, identity ");
+	assert_non_null(s);
+	assert_int_equal(sscanf(s, "read-back matches, identity %llX", &id), 1);
+	proc_kill(&p);
+	assert_int_equal(wait_value(&c, "MG booted", 1, 2000), 0);
+	motor_on(&c);
+	assert_int_equal(run(&p, &c, other), 6);
+	snprintf(want, sizeof(want),
+		 "galil-load: verify: the controller's program differs from "
+		 "these files (identity 32DC74A870EEBF04)\n"
+		 "galil-load: the controller holds identity %016llX\n"
+		 "tests/data/dmc_good/clean.dmc:19: first difference: program "
+		 "line 13 'WT 10'\n"
+		 "galil-load: nothing was halted or written; to load these "
+		 "files run galil-load without --verify (that halts the "
+		 "program)\n",
+		 id);
+	assert_string_equal(proc_output(&p, PROC_STDERR), want);
+	assert_false(has(&p, PROC_STDOUT, "verified"));
+	proc_kill(&p);
+	assert_untouched(&c, id);
+	run_ok(&p, &c, same);
+	snprintf(want, sizeof(want),
+		 "verified: the controller holds this program, identity "
+		 "%016llX\n",
+		 id);
+	assert_true(has(&p, PROC_STDOUT, want));
+	assert_false(has(&p, PROC_STDOUT, "halted:"));
+	assert_string_equal(proc_output(&p, PROC_STDERR), "");
+	proc_kill(&p);
+	assert_untouched(&c, id);
+	sim_stop(&c);
+	remove_variant(var);
 }
 
 static void power_cycle(struct simctx *c)
@@ -230,7 +382,7 @@ static void test_burn_power_cycle(void **state)
 
 	(void)state;
 	sim_start(&c);
-	assert_int_equal(run(&p, &c, plain), 0);
+	run_ok(&p, &c, plain);
 	proc_kill(&p);
 	power_cycle(&c);
 	l = sim_link(&c);
@@ -238,7 +390,7 @@ static void test_burn_power_cycle(void **state)
 	gl_link_close(l);
 	assert_int_equal(sim_query(&c, "MG _XQ0", &v), GL_OK);
 	assert_true(v == -1);
-	assert_int_equal(run(&p, &c, burn), 0);
+	run_ok(&p, &c, burn);
 	assert_true(has(&p, PROC_STDOUT, "burned: #AUTO runs at power-up\n"));
 	proc_kill(&p);
 	assert_int_equal(sim_query(&c, "MG _XQ0", &v), GL_OK);
@@ -262,7 +414,7 @@ static void test_commands(void **state)
 
 	(void)state;
 	sim_start(&c);
-	assert_int_equal(run(&p, &c, ok), 0);
+	run_ok(&p, &c, ok);
 	assert_int_equal(
 	    sscanf(proc_output(&p, PROC_STDOUT), "%lf\n%lf", &a, &b), 2);
 	assert_true(a == 9);
@@ -289,7 +441,7 @@ static void test_ctrl_requests(void **state)
 
 	(void)state;
 	sim_start(&c);
-	assert_int_equal(run(&p, &c, rv), 0);
+	run_ok(&p, &c, rv);
 	assert_string_equal(proc_output(&p, PROC_STDOUT),
 			    "DMC4030 Rev 1.2h-sim\n");
 	assert_string_equal(proc_output(&p, PROC_STDERR), "");
@@ -338,7 +490,7 @@ static void test_load_while_jogging(void **state)
 	gl_link_close(l);
 	assert_int_equal(sim_query(&c, "MG _BGA", &v), GL_OK);
 	assert_true(v == 1);
-	assert_int_equal(run(&p, &c, args), 0);
+	run_ok(&p, &c, args);
 	assert_true(has(&p, PROC_STDOUT,
 			"halted: threads stopped, axes stopped, motors off\n"
 			"downloading 19 lines to "));
@@ -377,7 +529,7 @@ static void test_stalled(void **state)
 	assert_true(
 	    proc_ctl_request(c.ctl, "link ok", resp, sizeof(resp), 2000) >= 0);
 	assert_string_equal(resp, "ok");
-	assert_int_equal(run(&p, &c, args), 0);
+	run_ok(&p, &c, args);
 	proc_kill(&p);
 	sim_stop(&c);
 }
@@ -387,6 +539,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_clean_start),
 	    cmocka_unit_test(test_unchanged_and_forced),
+	    cmocka_unit_test(test_verify),
 	    cmocka_unit_test(test_burn_power_cycle),
 	    cmocka_unit_test(test_commands),
 	    cmocka_unit_test(test_stalled),

@@ -4,7 +4,9 @@
  * Every malformed file in tests/data/config/bad_*.yaml is listed below with
  * the exact message and position it must produce; the default file must load
  * and equal the documented defaults; every field must survive a round trip
- * through YAML text; nothing is applied on error.
+ * through YAML text; nothing is applied on error. The site template
+ * config/roboelf-site.yaml is refused with every FILL-IN listed, and loads
+ * once they are filled in.
  */
 #include <errno.h>
 #include <setjmp.h>
@@ -859,6 +861,278 @@ static void test_dump(void **state)
 	assert_int_equal(re_config_dump(&c, NULL, 0), n);
 }
 
+/* ---- the site template, config/roboelf-site.yaml ---- */
+
+#define SITE_FILE "config/roboelf-site.yaml"
+#define ETC_NAME  "/etc/roboelf/roboelf.yaml" /* as installed */
+
+/* Where the template leaves a value to fill in, in file order. */
+struct fill_at {
+	int line, column;
+	const char *path;
+};
+
+static const struct fill_at site_fill[] = {
+    {34, 12, "controller.address"},
+    {44, 17, "controller.power_output"},
+    {50, 18, "relay.port_clinical"},
+    {58, 13, "relay.protocol"},
+    {60, 12, "relay.channel"},
+    {89, 11, "joystick.inputs"},
+    {91, 15, "joystick.active_low"},
+    {112, 11, "axes[0].vmax"},
+    {115, 20, "axes[0].travel_counts"},
+    {117, 9, "axes[0].kp"},
+    {118, 9, "axes[0].ki"},
+    {119, 9, "axes[0].kd"},
+    {120, 21, "axes[0].torque_limit_v"},
+    {129, 25, "axes[0].analog.expected_range_v"},
+    {131, 18, "axes[0].analog.reverse_v"},
+    {132, 18, "axes[0].analog.forward_v"},
+    {143, 11, "axes[1].vmax"},
+    {146, 20, "axes[1].travel_counts"},
+    {148, 9, "axes[1].kp"},
+    {149, 9, "axes[1].ki"},
+    {150, 9, "axes[1].kd"},
+    {151, 21, "axes[1].torque_limit_v"},
+    {157, 25, "axes[1].analog.expected_range_v"},
+    {159, 18, "axes[1].analog.reverse_v"},
+    {160, 18, "axes[1].analog.forward_v"},
+    {168, 11, "axes[2].vmax"},
+    {171, 20, "axes[2].travel_counts"},
+    {173, 9, "axes[2].kp"},
+    {174, 9, "axes[2].ki"},
+    {175, 9, "axes[2].kd"},
+    {176, 21, "axes[2].torque_limit_v"},
+    {182, 25, "axes[2].analog.expected_range_v"},
+    {184, 18, "axes[2].analog.reverse_v"},
+    {185, 18, "axes[2].analog.forward_v"},
+};
+
+#define N_SITE_FILL (sizeof(site_fill) / sizeof(site_fill[0]))
+
+/* A site's values for site_fill[], in the same order: none is a default,
+ * so the test sees each one read. */
+static const char *const site_values[N_SITE_FILL] = {
+    "192.0.2.10",
+    "4",
+    "/dev/roboelf-relay",
+    "lcus",
+    "2",
+    "[2, 1, 3, 4, 5, 6, 7, 8, 17, 18, 19, 21]",
+    "true",
+    /* A */ "6000",
+    "90000",
+    "7",
+    "2",
+    "70",
+    "4.5",
+    "3.8",
+    "0.6",
+    "4.4",
+    /* B */ "7000",
+    "100000",
+    "6",
+    "1",
+    "64",
+    "5.0",
+    "4.0",
+    "0.5",
+    "4.5",
+    /* C */ "5000",
+    "60000",
+    "5.5",
+    "0.5",
+    "50",
+    "3.0",
+    "3.0",
+    "1.0",
+    "4.0",
+};
+
+/* The whole of @path, NUL-terminated; the test fails if it cannot be read. */
+static char *slurp(const char *path, size_t *len)
+{
+	FILE *f = fopen(path, "rb");
+	char *buf = malloc(65536);
+	size_t n;
+
+	assert_non_null(f);
+	assert_non_null(buf);
+	n = fread(buf, 1, 65535, f);
+	assert_true(feof(f));
+	fclose(f);
+	buf[n] = '\0';
+	*len = n;
+	return buf;
+}
+
+/* The template as shipped is refused with every value to fill in, each at
+ * its line and column, in file order, and nothing is applied. */
+static void test_site_template_refused(void **state)
+{
+	static char want[RE_CONFIG_ERR_MAX], err[RE_CONFIG_ERR_MAX];
+	struct re_config cfg, pattern;
+	size_t len, n, i;
+	char *buf = slurp(SITE_FILE, &len);
+
+	(void)state;
+	n = (size_t)snprintf(want, sizeof(want),
+			     ETC_NAME ": this site's configuration is not "
+				      "finished: 34 values are still FILL-IN");
+	for (i = 0; i < N_SITE_FILL; i++)
+		n += (size_t)snprintf(want + n, sizeof(want) - n,
+				      "\n" ETC_NAME ":%d:%d: '%s' is still "
+				      "FILL-IN",
+				      site_fill[i].line, site_fill[i].column,
+				      site_fill[i].path);
+	assert_true(n < sizeof(want));
+	memset(&cfg, 0xA5, sizeof(cfg));
+	memset(&pattern, 0xA5, sizeof(pattern));
+	assert_int_equal(
+	    re_config_parse(buf, len, ETC_NAME, &cfg, err, sizeof(err)),
+	    GL_ERR_CONFIG);
+	assert_string_equal(err, want);
+	assert_memory_equal(&cfg, &pattern, sizeof(cfg));
+	free(buf);
+}
+
+/* @text with its value placeholders (": FILL-IN") replaced by
+ * site_values[] in order; comments that name FILL-IN stay. */
+static char *fill_in(const char *text)
+{
+	static const char mark[] = ": FILL-IN";
+	char *out = malloc(strlen(text) + 65536), *o = out;
+	const char *p = text, *q;
+	size_t k = 0;
+
+	assert_non_null(out);
+	while ((q = strstr(p, mark)) != NULL) {
+		assert_true(k < N_SITE_FILL);
+		memcpy(o, p, (size_t)(q - p));
+		o += q - p;
+		o += sprintf(o, ": %s", site_values[k++]);
+		p = q + sizeof(mark) - 1;
+	}
+	strcpy(o, p);
+	assert_int_equal(k, N_SITE_FILL);
+	return out;
+}
+
+/* Filled in, the template loads: clinical, and every value is the site's. */
+static void test_site_template_filled(void **state)
+{
+	static const int joy[RE_JOY_INPUTS] = {2, 1, 3,	 4,  5,	 6,
+					       7, 8, 17, 18, 19, 21};
+	struct re_config c;
+	char err[RE_CONFIG_ERR_MAX];
+	size_t len;
+	char *tmpl = slurp(SITE_FILE, &len), *text = fill_in(tmpl);
+	const struct re_config_axis *a = c.axes, *cc = &c.axes[2];
+
+	(void)state;
+	assert_int_equal(parse_text(text, &c, err, sizeof(err)), GL_OK);
+	assert_string_equal(err, "");
+	assert_int_equal(c.mode, RE_MODE_CLINICAL);
+	assert_string_equal(c.controller.address, "192.0.2.10");
+	assert_int_equal(c.controller.power_output, 4);
+	assert_string_equal(c.relay.port_clinical, "/dev/roboelf-relay");
+	assert_int_equal(c.relay.protocol, RE_RELAY_LCUS);
+	assert_false(c.relay.readback); /* its default for lcus */
+	assert_int_equal(c.relay.channel, 2);
+	assert_memory_equal(c.joystick.inputs, joy, sizeof(joy));
+	assert_true(c.joystick.active_low);
+	assert_int_equal(a->vmax_cps, 6000);
+	assert_int_equal(a->vmin_cps, 1500); /* vmax / 4 */
+	assert_int_equal(a->travel_counts, 90000);
+	assert_true(a->kp == 7 && a->ki == 2 && a->kd == 70);
+	assert_true(a->torque_limit_v == 4.5);
+	assert_true(a->analog.expected_range_v == 3.8);
+	assert_true(a->analog.reverse_v == 0.6 && a->analog.forward_v == 4.4);
+	assert_int_equal(c.axes[1].vmax_cps, 7000);
+	assert_int_equal(cc->vmax_cps, 5000);
+	assert_int_equal(cc->travel_counts, 60000);
+	assert_true(cc->kp == 5.5 && cc->ki == 0.5 && cc->kd == 50);
+	assert_true(cc->torque_limit_v == 3.0);
+	assert_true(cc->analog.reverse_v == 1.0 && cc->analog.forward_v == 4.0);
+	assert_int_equal(cc->unit, RE_UNIT_MM);
+	free(text);
+	free(tmpl);
+}
+
+/* The placeholder is found wherever it is: quoted, in a list, in a flow
+ * mapping, under an unknown key (before that key is refused); one value
+ * reads "1 value is". */
+static void test_fill_in_anywhere(void **state)
+{
+	struct re_config c;
+	char err[RE_CONFIG_ERR_MAX];
+
+	(void)state;
+	assert_int_equal(parse_text("relay: {port_clinical: \"FILL-IN\"}\n"
+				    "joystick:\n"
+				    "  inputs: [1, 2, FILL-IN]\n"
+				    "axes:\n"
+				    "  - {analog: {reverse_v: FILL-IN}}\n"
+				    "colour: 'FILL-IN'\n",
+				    &c, err, sizeof(err)),
+			 GL_ERR_CONFIG);
+	assert_string_equal(
+	    err, "t.yaml: this site's configuration is not finished: 4 "
+		 "values are still FILL-IN\n"
+		 "t.yaml:1:24: 'relay.port_clinical' is still FILL-IN\n"
+		 "t.yaml:3:18: 'joystick.inputs[2]' is still FILL-IN\n"
+		 "t.yaml:5:26: 'axes[0].analog.reverse_v' is still FILL-IN\n"
+		 "t.yaml:6:9: 'colour' is still FILL-IN");
+	assert_int_equal(
+	    parse_text("period_ms: 20\nmode: FILL-IN\n", &c, err, sizeof(err)),
+	    GL_ERR_CONFIG);
+	assert_string_equal(err, "t.yaml: this site's configuration is not "
+				 "finished: 1 value is still FILL-IN\n"
+				 "t.yaml:2:7: 'mode' is still FILL-IN");
+	/* met again through an alias, it is still the one place */
+	assert_int_equal(parse_text("a: &x [1, FILL-IN]\nb: [*x, *x]\n"
+				    "c: *x\nd: FILL-IN\n",
+				    &c, err, sizeof(err)),
+			 GL_ERR_CONFIG);
+	assert_string_equal(err, "t.yaml: this site's configuration is not "
+				 "finished: 2 values are still FILL-IN\n"
+				 "t.yaml:1:11: 'a[1]' is still FILL-IN\n"
+				 "t.yaml:4:4: 'd' is still FILL-IN");
+	/* a value that merely contains the word is a value */
+	assert_int_equal(parse_text("mode: development\n"
+				    "log: {path: FILL-IN.log}\n",
+				    &c, err, sizeof(err)),
+			 GL_OK);
+	assert_string_equal(c.log.path, "FILL-IN.log");
+}
+
+/* A list longer than the buffer ends with whole lines and the count of
+ * those left out. */
+static void test_fill_in_list_cut(void **state)
+{
+	static const char head[] = "t.yaml: this site's configuration is not "
+				   "finished: 3 values are still FILL-IN";
+	static const char first[] =
+	    "\nt.yaml:2:12: 'controller.address' is still FILL-IN";
+	char err[RE_CONFIG_ERR_MAX];
+	struct re_config c;
+
+	(void)state;
+	/* room for the first line and 40 bytes more: not for the second */
+	assert_int_equal(parse_text("controller:\n"
+				    "  address: FILL-IN\n"
+				    "  model: FILL-IN\n"
+				    "relay: {port_clinical: FILL-IN}\n",
+				    &c, err, strlen(head) + strlen(first) + 40),
+			 GL_ERR_CONFIG);
+	assert_string_equal(err, "t.yaml: this site's configuration is not "
+				 "finished: 3 values are still FILL-IN\n"
+				 "t.yaml:2:12: 'controller.address' is still "
+				 "FILL-IN\n"
+				 "... and 2 more");
+}
+
 int main(void)
 {
 	static const struct CMUnitTest fixed[] = {
@@ -878,6 +1152,10 @@ int main(void)
 	    cmocka_unit_test(test_short_error_buffer),
 	    cmocka_unit_test(test_hash),
 	    cmocka_unit_test(test_dump),
+	    cmocka_unit_test(test_site_template_refused),
+	    cmocka_unit_test(test_site_template_filled),
+	    cmocka_unit_test(test_fill_in_anywhere),
+	    cmocka_unit_test(test_fill_in_list_cut),
 	};
 	enum { N_FIXED = sizeof(fixed) / sizeof(fixed[0]) };
 	static struct CMUnitTest tests[N_FIXED + N_BAD];

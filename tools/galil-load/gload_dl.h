@@ -25,6 +25,8 @@ enum gload_exit {
 	GLOAD_EXIT_CTRL = 4,  /* the controller rejected something, or the
 			       * read-back / start confirmation failed */
 	GLOAD_EXIT_BUSY = 5,  /* a supervisor drives the robot (no --force) */
+	GLOAD_EXIT_DIFFERS = 6, /* --verify: the controller holds another
+				 * program (nothing was written) */
 };
 
 #define GLOAD_SLOW_TIMEOUT_MS 10000	    /* DL, UL, BP [galil-notes 1.6] */

@@ -82,6 +82,7 @@ int gload_opts_set(struct gload_opts *o, int ch, const char *arg,
 	case GLOAD_OPT_VERSION: o->version = 1; return 0;
 	case GLOAD_OPT_DMC: o->dmc = arg; return 0;
 	case GLOAD_OPT_CONFIG: o->config = arg; return 0;
+	case GLOAD_OPT_VERIFY: o->verify = 1; return 0;
 	case 'm':
 		o->model = dmc_model_find(arg);
 		return o->model ? 0
@@ -118,6 +119,11 @@ int gload_opts_set(struct gload_opts *o, int ch, const char *arg,
 /* Combinations that make no sense or would be unsafe. */
 static int check_combination(const struct gload_opts *o, gload_usage_fn *usage)
 {
+	if (o->verify && (o->check_only || o->force || o->burn || o->start ||
+			  o->ncmds || o->find))
+		return usage("%s", "--verify only reads the controller's "
+				   "program; drop --check, -f, --burn, "
+				   "--start, -c and --find");
 	if (o->check_only && (o->ncmds || o->burn || o->start))
 		return usage("%s", "--check does not talk to a "
 				   "controller; drop -c, --burn and --start");

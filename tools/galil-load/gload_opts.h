@@ -31,7 +31,8 @@ enum gload_opt {
 	GLOAD_OPT_FIND_PORT,
 	GLOAD_OPT_VERSION,
 	GLOAD_OPT_DMC,
-	GLOAD_OPT_CONFIG
+	GLOAD_OPT_CONFIG,
+	GLOAD_OPT_VERIFY
 };
 
 /* What the command line asks for (the defaults: gload_opts_init()). */
@@ -57,6 +58,7 @@ struct gload_opts {
 	const char *dmc;	    /* --dmc DIR */
 	const char *config;	    /* --config FILE: what the seal holds */
 	int version;		    /* --version */
+	int verify;		    /* --verify: compare, never write */
 	int dmc_default;	    /* no files given: dmc_dir was chosen */
 	char *dmc_path[1];	    /* paths when --dmc or the default */
 	char dmc_dir[PATH_MAX + 1]; /* the default DMC directory */

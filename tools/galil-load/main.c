@@ -6,12 +6,15 @@
  *
  * See docs/galil-load.1 and docs/galil-load.md. Every step that touches the
  * controller comes after the offline check has passed; a failed download or
- * read-back leaves the controller halted and empty.
+ * read-back leaves the controller halted and empty. The controller's
+ * program is read (UL) and compared before anything is halted, so that a
+ * load of the program it already holds, and --verify, stop nothing.
  */
 #include <errno.h>
 #include <getopt.h>
 #include <limits.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,6 +24,7 @@
 #include "base_version.h"
 #include "gl_disc.h"
 #include "gl_err.h"
+#include "gl_ident.h"
 #include "gl_link.h"
 #include "gload_check.h"
 #include "gload_cmd.h"
@@ -41,10 +45,14 @@ static const char usage_text[] =
     "\n"
     "  -a, --address HOST[:PORT]  controller (default port 23)\n"
     "      --check                check and preprocess only; no controller\n"
+    "      --verify               compare the controller's program (UL)\n"
+    "                             with these files; halts nothing, writes\n"
+    "                             nothing (exit 6: it differs)\n"
     "  -m, --model MODEL          limits of 40x0 (default), 41x3, 21x3, 30010\n"
     "  -o, --output FILE          also write the stamped program to FILE\n"
     "  -f, --force                download even if the controller already\n"
-    "                             holds the same program, and even while\n"
+    "                             holds the same program (without -f that\n"
+    "                             program is left running), and even while\n"
     "                             roboelf drives the robot (halts it: axes\n"
     "                             stop, motors off, roboelf latches a fault)\n"
     "      --burn                 burn the program to flash (BP) after the\n"
@@ -77,7 +85,8 @@ static const char usage_text[] =
     "\n"
     "A DIR is loaded through DIR/MANIFEST (one file name per line, '#'\n"
     "comments). Exit: 0 ok, 1 check failed, 2 usage, 3 connection,\n"
-    "4 controller rejected or verify failed.\n";
+    "4 controller rejected or verify failed, 5 roboelf drives the robot\n"
+    "(no --force), 6 --verify: the controller holds another program.\n";
 
 static int usage_error(const char *fmt, ...)
     __attribute__((format(printf, 1, 2)));
@@ -113,6 +122,7 @@ static const struct option long_opts[] = {
     {"version", no_argument, NULL, GLOAD_OPT_VERSION},
     {"dmc", required_argument, NULL, GLOAD_OPT_DMC},
     {"config", required_argument, NULL, GLOAD_OPT_CONFIG},
+    {"verify", no_argument, NULL, GLOAD_OPT_VERIFY},
     {NULL, 0, NULL, 0},
 };
 
@@ -491,22 +501,35 @@ static int download(gl_link **l, const struct gload_opts *o,
 	return 0;
 }
 
-/* 1 when the controller already holds exactly this program. */
-static int same_program(gl_link *l, const struct gload_opts *o,
-			const struct gload_prog *p, char *ul, int *ex)
+/*
+ * Read the controller's program (UL, which only reads: nothing is halted
+ * first) into @ul and compare it with @p. *@line: the first differing
+ * line, 0 when they are equal or the UL was refused. Return 1 the same,
+ * 0 different (a refused or too long UL is never taken as the same), or
+ * an exit code > 1 with the message printed (the link failed). The
+ * refused UL comes back in *@refused so that --verify can say so.
+ */
+static int held_program(gl_link *l, const struct gload_opts *o,
+			const struct gload_prog *p, char *ul, int *line,
+			int *refused)
 {
-	int rc, line;
+	int rc;
 
-	*ex = 0;
+	*line = 0;
+	*refused = 0;
 	rc = gload_dl_upload(l, ul, GLOAD_UPLOAD_CAP, o->timeout_ms);
-	if (rc == GL_ERR_CTRL || rc == GL_ERR_OVERFLOW)
-		return 0;
-	if (rc < 0) {
-		*ex = link_failed(l, "the upload (UL)", rc, slow_ms(o));
+	if (rc == GL_ERR_CTRL || rc == GL_ERR_OVERFLOW) {
+		*refused = rc;
 		return 0;
 	}
-	return gload_dl_compare(p->text, p->text_len, ul, (size_t)rc, &line) ==
-	       GL_OK;
+	if (rc < 0)
+		return link_failed(l, "the upload (UL)", rc, slow_ms(o));
+	rc = gload_dl_compare(p->text, p->text_len, ul, (size_t)rc, line);
+	if (rc == GL_ERR_NOMEM) {
+		fprintf(stderr, "galil-load: out of memory\n");
+		return GLOAD_EXIT_CONN;
+	}
+	return rc == GL_OK;
 }
 
 /* A supervisor driving the robot is not interrupted without --force. */
@@ -536,18 +559,29 @@ static int busy(gl_link *l, const struct gload_opts *o)
 	return 0;
 }
 
-static int identify_and_halt(gl_link *l, const struct gload_opts *o)
+/* Print the controller's model and serial; a controller that refuses the
+ * question (GL_ERR_CTRL) is not identified but still served. Return 0 or
+ * an exit code. */
+static int identify(gl_link *l, const struct gload_opts *o)
 {
-	char model[128] = "", failed[GLOAD_CMD_LEN], what[GLOAD_CMD_LEN + 16];
+	char model[128] = "";
 	long serial = 0;
-	int rc, running = -1;
+	int rc = gl_link_identify(l, model, sizeof(model), &serial);
 
-	rc = gl_link_identify(l, model, sizeof(model), &serial);
 	if (rc == GL_OK)
 		printf("controller: %s, serial %ld\n", model, serial);
 	else if (rc != GL_ERR_CTRL)
 		return link_failed(l, "identification (^R^V, MG _BN)", rc,
 				   o->timeout_ms);
+	return 0;
+}
+
+/* The busy check, then the halt: everything a write needs first. */
+static int check_and_halt(gl_link *l, const struct gload_opts *o)
+{
+	char failed[GLOAD_CMD_LEN], what[GLOAD_CMD_LEN + 16];
+	int rc, running = -1;
+
 	rc = busy(l, o);
 	if (rc)
 		return rc;
@@ -618,31 +652,156 @@ static int burn_and_start(gl_link *l, const struct gload_opts *o)
 	return 0;
 }
 
+/*
+ * The controller already holds @p: may it be left as it is? Yes without
+ * --burn and --start, and with --start alone when thread 0 already runs
+ * (the program the technician asked for is running). --burn needs a
+ * halted program (BP is refused while one runs, TC 17), and starting a
+ * thread that does not run means halting the others first, as a load
+ * does. Return 1 (left as it is, said so), 0 (halt), or an exit code > 1.
+ */
+static int leave_running(gl_link *l, const struct gload_opts *o,
+			 const struct gload_prog *p)
+{
+	double xq0 = -1;
+	int rc;
+
+	printf("unchanged: the controller already holds this program "
+	       "(identity %016llX); not downloaded\n",
+	       (unsigned long long)p->id);
+	if (o->burn)
+		return 0;
+	if (o->start) {
+		rc = gload_query_number(l, "MG _XQ0", &xq0, o->timeout_ms);
+		if (rc != GL_OK)
+			return link_failed(l, "'MG _XQ0'", rc, o->timeout_ms);
+		if (xq0 < 0)
+			return 0;
+		printf("running: thread 0 already runs it (at line %.0f); "
+		       "not restarted (--force halts, reloads and "
+		       "restarts it)\n",
+		       xq0);
+	}
+	printf("left running: nothing halted, nothing written\n");
+	return 1;
+}
+
+/* Compare first (UL only reads); halt and download only when the program
+ * differs or with --force, so that loading the program the controller
+ * already runs stops nothing. */
 static int load(gl_link **l, const struct gload_opts *o,
 		const struct gload_prog *p)
 {
 	char *ul = malloc(GLOAD_UPLOAD_CAP);
-	int ex, same;
+	int ex, same = 0, line, refused;
 
 	if (!ul) {
 		fprintf(stderr, "galil-load: out of memory\n");
 		return GLOAD_EXIT_CONN;
 	}
-	ex = identify_and_halt(*l, o);
-	if (ex)
-		goto out_free;
-	same = !o->force && same_program(*l, o, p, ul, &ex);
-	if (ex)
-		goto out_free;
-	if (same)
-		printf("unchanged: the controller already holds this program "
-		       "(identity %016llX); not downloaded\n",
-		       (unsigned long long)p->id);
-	else
+	ex = identify(*l, o);
+	if (!ex && !o->force) {
+		same = held_program(*l, o, p, ul, &line, &refused);
+		ex = same > 1 ? same : 0;
+	}
+	if (!ex && same) {
+		ex = leave_running(*l, o, p);
+		if (ex == 1) {
+			ex = 0;
+			goto out_free;
+		}
+	}
+	if (!ex)
+		ex = check_and_halt(*l, o);
+	if (!ex && !same)
 		ex = download(l, o, p, ul);
 	if (!ex)
 		ex = burn_and_start(*l, o);
 out_free:
+	free(ul);
+	return ex;
+}
+
+/* --verify found a difference at @line (0: not known): say where, with the
+ * file line when it is one of ours, and what the controller holds. */
+static void print_difference(const struct gload_prog *p, const char *ul,
+			     size_t ul_len, int line)
+{
+	uint64_t held = 0;
+	int rc = gl_ident_verify(ul, ul_len, &held);
+
+	if (ul_len == 0)
+		fprintf(stderr, "galil-load: the controller holds no "
+				"program\n");
+	else if (rc == GL_OK)
+		fprintf(stderr,
+			"galil-load: the controller holds identity %016llX\n",
+			(unsigned long long)held);
+	else
+		fprintf(stderr, "galil-load: the controller's program has no "
+				"valid galil-load stamp\n");
+	if (ul_len == 0)
+		return;
+	if (line >= 1 && line <= p->nlines)
+		fprintf(stderr,
+			"%s:%d: first difference: program line %d "
+			"'%s'\n",
+			p->files[p->lines[line - 1].file],
+			p->lines[line - 1].src_line, line,
+			p->lines[line - 1].text);
+	else if (line == p->nlines + 1)
+		fprintf(stderr,
+			"galil-load: first difference: the identity "
+			"line %d '%s'\n",
+			line, p->stamp);
+	else
+		fprintf(stderr,
+			"galil-load: first difference: line %d, after "
+			"the end of these files\n",
+			line);
+}
+
+/* --verify: UL and compare, nothing halted, nothing written. Return 0 (the
+ * same), GLOAD_EXIT_DIFFERS, or another exit code. */
+static int verify(gl_link *l, const struct gload_opts *o,
+		  const struct gload_prog *p)
+{
+	char *ul = malloc(GLOAD_UPLOAD_CAP);
+	int ex, line = 0, refused = 0;
+
+	if (!ul) {
+		fprintf(stderr, "galil-load: out of memory\n");
+		return GLOAD_EXIT_CONN;
+	}
+	ex = identify(l, o);
+	if (!ex)
+		ex = held_program(l, o, p, ul, &line, &refused);
+	if (ex == 1) {
+		printf("verified: the controller holds this program, "
+		       "identity %016llX\n",
+		       (unsigned long long)p->id);
+		ex = 0;
+	} else if (ex == 0 && refused == GL_ERR_OVERFLOW) {
+		fprintf(stderr,
+			"galil-load: verify: the controller's program differs "
+			"from these files: it is longer than any program "
+			"galil-load loads; nothing was halted or written\n");
+		ex = GLOAD_EXIT_DIFFERS;
+	} else if (ex == 0 && refused) {
+		ex = link_failed(l, "the upload (UL)", refused, slow_ms(o));
+		fprintf(stderr, "galil-load: not verified: the program could "
+				"not be read; nothing was halted or written\n");
+	} else if (ex == 0) {
+		fprintf(stderr,
+			"galil-load: verify: the controller's program differs "
+			"from these files (identity %016llX)\n",
+			(unsigned long long)p->id);
+		print_difference(p, ul, strlen(ul), line);
+		fprintf(stderr, "galil-load: nothing was halted or written; to "
+				"load these files run galil-load without "
+				"--verify (that halts the program)\n");
+		ex = GLOAD_EXIT_DIFFERS;
+	}
 	free(ul);
 	return ex;
 }
@@ -747,7 +906,9 @@ int main(int argc, char **argv)
 	ex = open_link(&o, &l);
 	if (ex)
 		ex = offer_found(&o, &l);
-	if (!ex && o.npaths > 0)
+	if (!ex && o.verify)
+		ex = verify(l, &o, &p);
+	else if (!ex && o.npaths > 0)
 		ex = load(&l, &o, &p);
 	if (!ex && l)
 		ex = run_commands(l, &o);
