@@ -417,13 +417,18 @@ static void dl_lines(char *out, size_t cap, const char *prog)
 	"MG _XQ0\nMG _XQ1\nMG _XQ2\nMG _XQ3\nMG _XQ4\nMG _XQ5\nMG _XQ6\n"      \
 	"MG _XQ7\n"
 
-/* Identify, then the controller's program read (UL) before anything is
- * halted: a program it already holds is left running. */
-#define IDENT_UL "^R^V\nMG _BN\nUL\n"
+/* Identify; the busy check before anything else (no program running:
+ * one question; a program but no RoboELF state: refused, TC1 read); then
+ * the controller's program read (UL) before anything is halted: a program
+ * it already holds is left running. */
+#define IDENT	       "^R^V\nMG _BN\n"
+#define BUSY_IDLE      "MG _XQ0\n"
+#define BUSY_NOSTATE   "MG _XQ0\nMG state\nTC1\n"
+#define IDENT_UL       IDENT BUSY_IDLE "UL\n"
+#define IDENT_RUN_UL   IDENT BUSY_NOSTATE "UL\n"
 
-/* Identify, UL, the busy check (no program running: one question), the
- * halt. */
-static const char halt_log[] = IDENT_UL "MG _XQ0\n" HALT_CMDS;
+/* Identify, the busy check, UL, the halt. */
+static const char halt_log[] = IDENT_UL HALT_CMDS;
 
 static void assert_log(const char *want)
 {
@@ -480,7 +485,7 @@ static void test_unchanged(void **state)
 	fk.running[0] = 1;
 	fk.motors_on = 1;
 	assert_int_equal(run(&p, args), 0);
-	assert_log(IDENT_UL);
+	assert_log(IDENT_RUN_UL);
 	assert_true(has(&p, PROC_STDOUT,
 			"unchanged: the controller already "
 			"holds this program (identity " CLEAN_ID "); not "
@@ -513,7 +518,7 @@ static void test_verify_equal(void **state)
 	fk.running[0] = 1;
 	fk.motors_on = 1;
 	assert_int_equal(run(&p, args), 0);
-	assert_log(IDENT_UL);
+	assert_log(IDENT_RUN_UL);
 	assert_true(has(&p, PROC_STDOUT,
 			"controller: DMC4030 Rev 1.2h-fake, serial 4242\n"
 			"verified: the controller holds this program, "
@@ -538,7 +543,7 @@ static void test_verify_empty(void **state)
 	fk.running[0] = 1;
 	fk.motors_on = 1;
 	assert_int_equal(run(&p, args), 6);
-	assert_log(IDENT_UL);
+	assert_log(IDENT_RUN_UL);
 	assert_string_equal(
 	    proc_output(&p, PROC_STDERR),
 	    "galil-load: verify: the controller's program differs from "
@@ -711,7 +716,7 @@ static void test_unchanged_burn_start(void **state)
 	assert_int_equal(run(&p, args), 0);
 	/* thread 0 runs: the busy check asks the state (no RoboELF
 	 * program here: refused, TC1 read) */
-	assert_log(IDENT_UL "MG _XQ0\nMG state\nTC1\n" HALT_CMDS
+	assert_log(IDENT_RUN_UL HALT_CMDS
 			    "BP\nXQ #AUTO,0\nMG _XQ0\n");
 	assert_true(has(&p, PROC_STDOUT,
 			"unchanged: the controller already holds this program "
@@ -837,7 +842,8 @@ static void test_busy_refused(void **state)
 	fk.supervised = 1;
 	fk.motors_on = 1;
 	assert_int_equal(run(&p, args), 5);
-	assert_log(IDENT_UL "MG _XQ0\nMG state\nMG hbpc\nMG hbpc\n");
+	/* refused before the program is read */
+	assert_log(IDENT "MG _XQ0\nMG state\nMG hbpc\nMG hbpc\n");
 	assert_true(has(&p, PROC_STDERR,
 			"galil-load: the controller's program is armed and "
 			"its supervisor's heartbeat is advancing: roboelf is "
@@ -856,6 +862,30 @@ static void test_busy_refused(void **state)
 	assert_int_equal(fk.running[0], 0);
 	assert_int_equal(fk.motors_on, 0);
 	assert_int_equal(fk.downloads, 1);
+	proc_kill(&p);
+}
+
+/* --verify while roboelf drives the robot: refused with exit 5 before the
+ * program is read (the upload would delay its cycle); nothing else sent. */
+static void test_verify_busy(void **state)
+{
+	static const char *const args[] = {"--verify", GOOD "clean.dmc", NULL};
+	struct proc p;
+
+	(void)state;
+	fk.running[0] = fk.running[1] = 1;
+	fk.supervised = 1;
+	fk.motors_on = 1;
+	assert_int_equal(run(&p, args), 5);
+	assert_log(IDENT "MG _XQ0\nMG state\nMG hbpc\nMG hbpc\n");
+	assert_string_equal(proc_output(&p, PROC_STDERR),
+			    "galil-load: the controller's program is armed and "
+			    "its supervisor's heartbeat is advancing: roboelf "
+			    "is driving the robot. --verify reads the whole "
+			    "program (UL), which would delay roboelf's cycle; "
+			    "nothing was read. Verify when roboelf has quit\n");
+	assert_int_equal(fk.running[0], 1);
+	assert_int_equal(fk.motors_on, 1);
 	proc_kill(&p);
 }
 
@@ -944,6 +974,8 @@ int main(void)
 	    cmocka_unit_test_setup_teardown(test_commands_armed, fk_start,
 					    fk_stop),
 	    cmocka_unit_test_setup_teardown(test_busy_refused, fk_start,
+					    fk_stop),
+	    cmocka_unit_test_setup_teardown(test_verify_busy, fk_start,
 					    fk_stop),
 	    cmocka_unit_test_setup_teardown(test_load_while_jogging, fk_start,
 					    fk_stop),

@@ -576,15 +576,13 @@ static int identify(gl_link *l, const struct gload_opts *o)
 	return 0;
 }
 
-/* The busy check, then the halt: everything a write needs first. */
+/* The halt: everything a write needs first (the busy check came before
+ * the program was read). */
 static int check_and_halt(gl_link *l, const struct gload_opts *o)
 {
 	char failed[GLOAD_CMD_LEN], what[GLOAD_CMD_LEN + 16];
 	int rc, running = -1;
 
-	rc = busy(l, o);
-	if (rc)
-		return rc;
 	rc = halt(l, o, &running, failed);
 	if (rc == GL_ERR_MISMATCH && running == GLOAD_HALT_LATE) {
 		fprintf(stderr,
@@ -686,7 +684,10 @@ static int leave_running(gl_link *l, const struct gload_opts *o,
 	return 1;
 }
 
-/* Compare first (UL only reads); halt and download only when the program
+/* The busy check first: a supervisor driving the robot is not disturbed
+ * without --force, not even by the upload (a whole program read through
+ * the controller's command interpreter would delay its cycle). Then
+ * compare (UL only reads); halt and download only when the program
  * differs or with --force, so that loading the program the controller
  * already runs stops nothing. */
 static int load(gl_link **l, const struct gload_opts *o,
@@ -700,6 +701,8 @@ static int load(gl_link **l, const struct gload_opts *o,
 		return GLOAD_EXIT_CONN;
 	}
 	ex = identify(*l, o);
+	if (!ex)
+		ex = busy(*l, o);
 	if (!ex && !o->force) {
 		same = held_program(*l, o, p, ul, &line, &refused);
 		ex = same > 1 ? same : 0;
@@ -761,6 +764,26 @@ static void print_difference(const struct gload_prog *p, const char *ul,
 			line);
 }
 
+/* --verify on a robot that roboelf drives: refused, since the upload would
+ * delay its cycle. Return 0, GLOAD_EXIT_BUSY or another exit code. */
+static int verify_idle(gl_link *l, const struct gload_opts *o)
+{
+	int state, rc = gload_dl_busy(l, BUSY_WATCH_MS, &state, o->timeout_ms);
+
+	if (rc < 0)
+		return link_failed(l, "the busy check", rc, o->timeout_ms);
+	if (rc == 0)
+		return 0;
+	fprintf(stderr,
+		"galil-load: the controller's program is %s and its "
+		"supervisor's heartbeat is advancing: roboelf is driving the "
+		"robot. --verify reads the whole program (UL), which would "
+		"delay roboelf's cycle; nothing was read. Verify when roboelf "
+		"has quit\n",
+		state == 1 ? "armed" : "in its service state");
+	return GLOAD_EXIT_BUSY;
+}
+
 /* --verify: UL and compare, nothing halted, nothing written. Return 0 (the
  * same), GLOAD_EXIT_DIFFERS, or another exit code. */
 static int verify(gl_link *l, const struct gload_opts *o,
@@ -774,6 +797,8 @@ static int verify(gl_link *l, const struct gload_opts *o,
 		return GLOAD_EXIT_CONN;
 	}
 	ex = identify(l, o);
+	if (!ex)
+		ex = verify_idle(l, o);
 	if (!ex)
 		ex = held_program(l, o, p, ul, &line, &refused);
 	if (ex == 1) {
