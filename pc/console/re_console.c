@@ -58,66 +58,6 @@ int re_console_open(struct re_console *c, FILE *out, int in_fd)
 	return 0;
 }
 
-/* The terminal's own settings, kept once before the first change, so
- * that every later change starts from them and the restore gives them
- * back. Return: 0, or -1 when they cannot be read. */
-static int term_save(struct re_console *c)
-{
-	if (c->raw || c->quiet)
-		return 0;
-	return tcgetattr(c->in_fd, &c->saved) < 0 ? -1 : 0;
-}
-
-/* The terminal's own settings without the echo (of the newline too):
- * the line discipline, Ctrl-C and the rest stay as they were. */
-static int set_quiet(const struct re_console *c)
-{
-	struct termios t = c->saved;
-
-	t.c_lflag &= ~(tcflag_t)(ECHO | ECHONL);
-	return tcsetattr(c->in_fd, TCSANOW, &t);
-}
-
-void re_console_quiet(struct re_console *c)
-{
-	if (!c->tty_in || c->raw || c->quiet || term_save(c) < 0)
-		return;
-	if (set_quiet(c) == 0)
-		c->quiet = 1;
-}
-
-void re_console_raw(struct re_console *c)
-{
-	struct termios t;
-
-	if (!c->tty_in || c->raw || term_save(c) < 0)
-		return;
-	t = c->saved;
-	t.c_lflag &= ~(tcflag_t)(ICANON | ECHO);
-	t.c_iflag &= ~(tcflag_t)IXON; /* Ctrl-S must not freeze the board */
-	t.c_cc[VMIN] = 0;
-	t.c_cc[VTIME] = 0;
-	/* TCSAFLUSH: what was typed before (during the calibration) is
-	 * dropped, never read as a key of the run */
-	if (tcsetattr(c->in_fd, TCSAFLUSH, &t) == 0)
-		c->raw = 1;
-}
-
-void re_console_flush_keys(struct re_console *c)
-{
-	if (c->tty_in)
-		tcflush(c->in_fd, TCIFLUSH);
-}
-
-void re_console_restore(struct re_console *c)
-{
-	if (c->raw || c->quiet) {
-		tcsetattr(c->in_fd, TCSANOW, &c->saved);
-		c->raw = 0;
-		c->quiet = 0;
-	}
-}
-
 static void board_remove(struct re_console *c, FILE *out);
 
 void re_console_close(struct re_console *c)
@@ -318,22 +258,6 @@ void re_console_fault(struct re_console *c, const char *line)
 	board_erase(c);
 	put_wrapped(c, line, c->color ? ANSI_RED : NULL);
 	fflush(c->out);
-}
-
-int re_console_key(struct re_console *c)
-{
-	struct pollfd p = {.fd = c->in_fd, .events = POLLIN};
-	unsigned char ch;
-	ssize_t n;
-
-	if (c->in_fd < 0 || !c->tty_in)
-		return 0;
-	if (poll(&p, 1, 0) <= 0)
-		return 0;
-	n = read(c->in_fd, &ch, 1);
-	if (n == 0)
-		return -1;
-	return n == 1 ? ch : 0;
 }
 
 /* ---- texts ------------------------------------------------------------- */
@@ -959,19 +883,6 @@ static int read_answer(struct re_console *c, char *buf, size_t cap)
 	return (int)n;
 }
 
-/* An answer is seen as it is typed, also while the console is quiet:
- * the terminal's own settings for the question (@on), quiet again after
- * it. */
-static void question_echo(struct re_console *c, int on)
-{
-	if (!c->quiet || c->raw)
-		return;
-	if (on)
-		tcsetattr(c->in_fd, TCSANOW, &c->saved);
-	else
-		set_quiet(c);
-}
-
 static enum re_calib_choice ask_calibration(struct re_console *c)
 {
 	char a[32];
@@ -996,9 +907,9 @@ enum re_calib_choice re_console_ask_calibration(struct re_console *c)
 	if (!c->tty_in)
 		return RE_CALIB_ASK;
 	re_console_flush_keys(c);
-	question_echo(c, 1);
+	re_console_echo(c, 1);
 	k = ask_calibration(c);
-	question_echo(c, 0);
+	re_console_echo(c, 0);
 	return k;
 }
 
@@ -1025,8 +936,8 @@ int re_console_ask_yes(struct re_console *c, const char *question)
 	if (!c->tty_in)
 		return 0;
 	re_console_flush_keys(c);
-	question_echo(c, 1);
+	re_console_echo(c, 1);
 	yes = ask_yes(c, question);
-	question_echo(c, 0);
+	re_console_echo(c, 0);
 	return yes;
 }

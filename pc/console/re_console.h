@@ -147,6 +147,13 @@ void re_console_quiet(struct re_console *c);
 void re_console_raw(struct re_console *c);
 
 /*
+ * re_console_echo() - the echo of an answer while a question waits for it
+ * (@on 1: the terminal's own settings), quiet again after it (@on 0). Only
+ * while quiet (re_console_quiet()) and not raw; a no-op otherwise.
+ */
+void re_console_echo(struct re_console *c, int on);
+
+/*
  * re_console_flush_keys() - drop every key typed but not read yet, so that
  * nothing typed in one phase acts in the next (keys typed during the
  * calibration, before a question, before a fault). No-op without a
