@@ -532,15 +532,27 @@ static int held_program(gl_link *l, const struct gload_opts *o,
 	return rc == GL_OK;
 }
 
+/* Whether a supervisor drives the robot: 1 (*state: 1 armed, 2 service),
+ * 0, or -1 with *ex the exit code of a failed check (already printed). */
+static int driven(gl_link *l, const struct gload_opts *o, int *state,
+		  int *ex)
+{
+	int rc = gload_dl_busy(l, BUSY_WATCH_MS, state, o->timeout_ms);
+
+	if (rc < 0) {
+		*ex = link_failed(l, "the busy check", rc, o->timeout_ms);
+		return -1;
+	}
+	return rc != 0;
+}
+
 /* A supervisor driving the robot is not interrupted without --force. */
 static int busy(gl_link *l, const struct gload_opts *o)
 {
-	int state, rc = gload_dl_busy(l, BUSY_WATCH_MS, &state, o->timeout_ms);
+	int state, ex, d = driven(l, o, &state, &ex);
 
-	if (rc < 0)
-		return link_failed(l, "the busy check", rc, o->timeout_ms);
-	if (rc == 0)
-		return 0;
+	if (d <= 0)
+		return d < 0 ? ex : 0;
 	if (!o->force) {
 		fprintf(stderr,
 			"galil-load: the controller's program is %s and its "
@@ -768,12 +780,10 @@ static void print_difference(const struct gload_prog *p, const char *ul,
  * delay its cycle. Return 0, GLOAD_EXIT_BUSY or another exit code. */
 static int verify_idle(gl_link *l, const struct gload_opts *o)
 {
-	int state, rc = gload_dl_busy(l, BUSY_WATCH_MS, &state, o->timeout_ms);
+	int state, ex, d = driven(l, o, &state, &ex);
 
-	if (rc < 0)
-		return link_failed(l, "the busy check", rc, o->timeout_ms);
-	if (rc == 0)
-		return 0;
+	if (d <= 0)
+		return d < 0 ? ex : 0;
 	fprintf(stderr,
 		"galil-load: the controller's program is %s and its "
 		"supervisor's heartbeat is advancing: roboelf is driving the "
