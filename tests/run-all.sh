@@ -7,10 +7,11 @@
 # Independent programs run side by side (ROBOELF_JOBS at once, default the
 # number of CPUs): the unit, loader, simulator and DMC tests (in-process or
 # in virtual time) and the checks that judge files. The real-time ones run
-# alone, one after another, once the others are done: the system tests,
-# the network rig, the unit and simulator tests that time real waits, and
-# the checks that time a host or drive roboelf against galil-sim in real
-# time (realtime.sh, console_tmux.sh, install.sh). Each
+# once the others are done: the system tests and the console in tmux
+# ROBOELF_RT_JOBS at once (default 2, the longest of the last run first),
+# then alone, one after another, the network rig, the unit and simulator
+# tests that time real waits, and the checks that time a host or install
+# and drive roboelf in real time (realtime.sh, install.sh). Each
 # program's log is printed whole, in the order of the list, never
 # interleaved.
 #
@@ -49,10 +50,20 @@ deadline() {
 	*) echo "${ROBOELF_TEST_TIMEOUT:-180}" ;;
 	esac
 }
-# The real-time programs: alone, after the others.
+# The real-time programs: after the others. The system tests and the
+# console in tmux run a few at a time (ROBOELF_RT_JOBS, default 2): each is
+# one roboelf and one galil-sim mostly waiting on real time (about 6 % of one
+# core, measured), so two of them on 2 cores do not delay each other's
+# cycle; the rest (the network rig, the host's timing) run alone.
+few() {
+	case $1 in
+	system/* | checks/console_tmux.sh) return 0 ;;
+	*) return 1 ;;
+	esac
+}
 alone() {
 	case $1 in
-	system/* | net/* | checks/realtime.sh | checks/console_tmux.sh | checks/install.sh) return 0 ;;
+	net/* | checks/realtime.sh | checks/install.sh) return 0 ;;
 	# unit and simulator tests that time real waits (the relay's and the
 	# link's deadlines, the clock, the real-time set-up, the ports)
 	unit/test_re_relay* | unit/test_gl_link | unit/test_base_clock | unit/test_re_rt | \
@@ -145,16 +156,37 @@ if [ $# -eq 0 ]; then
 	done
 fi
 jobs=${ROBOELF_JOBS:-$(nproc)}
-pool=""; rt=""
+rtjobs=${ROBOELF_RT_JOBS:-2}
+# secsof NAME: its time in the last run (for the order), 9999 if unknown
+secsof() {
+	f="$(logof "$1").res"
+	if [ -f "$f" ]; then sed -n 3p "$f"; else echo 9999; fi
+}
+pool=""; rt=""; rtfew=""
 for n in $list; do
+	if few "$n"; then rtfew="$rtfew $(secsof "$n"):$n"
+	elif alone "$n"; then rt="$rt $n"; else pool="$pool $(secsof "$n"):$n"; fi
 	rm -f "$(logof "$n").res"
-	if alone "$n"; then rt="$rt $n"; else pool="$pool $n"; fi
 done
+# longest_first SECS:NAME...: the names, the longest of the last run first
+# (unknown ones first, by name), so that the last to finish is a short one
+longest_first() {
+	printf '%s\n' "$@" | sort -t: -k1,1nr -k2,2 | cut -d: -f2-
+}
+# shellcheck disable=SC2086 # one entry per word
+rtfew=$(longest_first $rtfew)
+# shellcheck disable=SC2086 # one entry per word
+pool=$(longest_first $pool)
 t0=$(date +%s)
 # shellcheck disable=SC2086 # one name per word
 [ -n "$pool" ] && printf '%s\n' $pool | xargs -P "$jobs" -n 1 sh "$ROBOELF_TOP/tests/run-all.sh" --one
 for n in $pool; do report "$n"; done
 echo "=== side by side ($jobs at once): $(echo $pool | wc -w) programs in $(( $(date +%s) - t0 )) s"
+t0=$(date +%s)
+# shellcheck disable=SC2086 # one name per word
+[ -n "$rtfew" ] && printf '%s\n' $rtfew | xargs -P "$rtjobs" -n 1 sh "$ROBOELF_TOP/tests/run-all.sh" --one
+for n in $rtfew; do report "$n"; done
+[ -n "$rtfew" ] && echo "=== real time, $rtjobs at once: $(echo $rtfew | wc -w) programs in $(( $(date +%s) - t0 )) s"
 for n in $rt; do
 	echo "=== $n (alone)"
 	exec1 "$n"
