@@ -41,6 +41,13 @@ if [ "${1:-}" != --one ]; then # a child (--one) has all this from its parent
 fi
 LOGDIR=$BUILD/test-logs
 mkdir -p "$LOGDIR"
+# The system tests of one run share one full calibration per configuration
+# (tests/harness/sys_h.h, sys_env_calibrate()): a fresh directory each run.
+if [ "${1:-}" != --one ] && [ -z "${ROBOELF_SYS_CAL_SHARE:-}" ]; then
+	ROBOELF_SYS_CAL_SHARE=$ROBOELF_TOP/$LOGDIR/calibration-share
+	rm -rf "$ROBOELF_SYS_CAL_SHARE" && mkdir "$ROBOELF_SYS_CAL_SHARE" || exit 1
+	export ROBOELF_SYS_CAL_SHARE
+fi
 # Per-program deadline (s): a hung test fails with exit 124 instead of hanging
 # the run; system tests get more, and so does the fuzz check, which builds
 # its targets first (ROBOELF_TEST_TIMEOUT overrides both).

@@ -235,6 +235,8 @@ static void calibrate_env(struct sx_fixture *fx)
 
 int sx_group_setup(struct sx_fixture *fx, struct sys_env *env)
 {
+	char text[SYS_PATH_MAX + 320];
+
 	memset(fx, 0, sizeof(*fx));
 	fx->env = env;
 	fx->re_env[0] = fx->lock_env;
@@ -253,10 +255,14 @@ int sx_group_setup(struct sx_fixture *fx, struct sys_env *env)
 		    setenv("ROBOELF_LOCK_DIR", fx->lock_dir, 1) == 0)
 			calibrate_env(fx);
 	}
-	print_message("[   INFO   ] full calibration %s in %.1f s (P %d ms, "
-		      "%s)\n",
-		      fx->ok ? "done" : "FAILED", env->calib_s, env->period_ms,
-		      env->dir);
+	if (fx->ok)
+		print_message("[   INFO   ] %s (P %d ms, %s)\n",
+			      sys_env_cal_text(env, text, sizeof(text)),
+			      env->period_ms, env->dir);
+	else
+		print_message("[   INFO   ] full calibration FAILED (P %d ms, "
+			      "%s): %s\n",
+			      env->period_ms, env->dir, env->err);
 	return 0;
 }
 

@@ -6,6 +6,7 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
@@ -15,6 +16,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <time.h>
@@ -308,17 +310,15 @@ static int reuse_calibration(struct sys_env *e, const char *from)
 	return ok ? 0 : -1;
 }
 
-int sys_env_calibrate(struct sys_env *e, int timeout_ms)
+/* One full calibration with `--calibration full`. */
+static int calibrate_full(struct sys_env *e, int timeout_ms)
 {
 	struct sys_opts o = {.calibration = "full",
 			     .ready_timeout_ms = timeout_ms};
-	const char *reuse = getenv("ROBOELF_SYS_CAL");
 	struct sys_case c;
 	struct stat st;
 	int rc = -1, status;
 
-	if (reuse && *reuse)
-		return reuse_calibration(e, reuse);
 	if (sys_case_start(&c, e, &o) < 0) {
 		snprintf(e->err, sizeof(e->err), "%s", c.err);
 		return -1;
@@ -340,6 +340,123 @@ int sys_env_calibrate(struct sys_env *e, int timeout_ms)
 		rc = 0;
 	sys_case_stop(&c);
 	return rc;
+}
+
+/* The key of @e's configuration: FNV-1a of its text with the temporary
+ * directory taken out (the only thing that differs between programs that
+ * use the same configuration). 0 if it cannot be read. */
+static uint64_t config_key(const struct sys_env *e)
+{
+	uint64_t h = 14695981039346656037ULL;
+	size_t len, dlen = strlen(e->dir);
+	char *buf;
+
+	if (read_file(e->cfg, &buf, &len) < 0)
+		return 0;
+	for (size_t i = 0; i < len; i++) {
+		if (dlen && !strncmp(buf + i, e->dir, dlen)) {
+			i += dlen - 1;
+			continue;
+		}
+		h = (h ^ (unsigned char)buf[i]) * 1099511628211ULL;
+	}
+	free(buf);
+	return h;
+}
+
+/* Copy @from to @to whole or not at all (a temporary file renamed). */
+static int copy_whole(const char *from, const char *to)
+{
+	char tmp[SYS_PATH_MAX + 80], *buf;
+	size_t len;
+	FILE *f;
+	int ok;
+
+	if (read_file(from, &buf, &len) < 0)
+		return -1;
+	snprintf(tmp, sizeof(tmp), "%s.%ld.tmp", to, (long)getpid());
+	f = fopen(tmp, "w");
+	ok = f && fwrite(buf, 1, len, f) == len;
+	if (f && fclose(f) != 0)
+		ok = 0;
+	free(buf);
+	if (ok && rename(tmp, to) == 0)
+		return 0;
+	unlink(tmp);
+	return -1;
+}
+
+/* Take the lock @fd within @timeout_ms (polled: flock has no deadline). */
+static int lock_within(int fd, int timeout_ms)
+{
+	long long end = proc_now_ms() + timeout_ms;
+
+	while (flock(fd, LOCK_EX | LOCK_NB) < 0) {
+		if (errno != EWOULDBLOCK || proc_now_ms() > end)
+			return -1;
+		poll(NULL, 0, 50);
+	}
+	return 0;
+}
+
+/* ROBOELF_SYS_CAL_SHARE=DIR: the first program of the run with this
+ * configuration calibrates and keeps a copy in DIR; the others wait for
+ * it (a lock) and copy it into their own directory. */
+static int shared_calibration(struct sys_env *e, const char *share,
+			      int timeout_ms)
+{
+	char copy[SYS_PATH_MAX + 64], lock[SYS_PATH_MAX + 80];
+	uint64_t key = config_key(e);
+	int fd, rc;
+
+	if (!key)
+		return calibrate_full(e, timeout_ms);
+	snprintf(copy, sizeof(copy), "%s/calibration-%016llx.cal", share,
+		 (unsigned long long)key);
+	snprintf(lock, sizeof(lock), "%s.lock", copy);
+	fd = open(lock, O_CREAT | O_RDWR | O_CLOEXEC, 0600);
+	if (fd < 0 || lock_within(fd, timeout_ms + 30000) < 0) {
+		seterr(e->err, "cannot lock '%s' within %d ms: %s", lock,
+		       timeout_ms + 30000, strerror(errno));
+		if (fd >= 0)
+			close(fd);
+		return -1;
+	}
+	if (access(copy, R_OK) == 0) {
+		rc = reuse_calibration(e, copy);
+		if (!rc)
+			snprintf(e->cal_from, sizeof(e->cal_from), "%s", copy);
+	} else {
+		rc = calibrate_full(e, timeout_ms);
+		if (!rc && copy_whole(e->cal, copy) < 0)
+			seterr(e->err, "cannot keep a copy in '%s'", copy);
+	}
+	close(fd); /* the lock goes with it */
+	return rc;
+}
+
+int sys_env_calibrate(struct sys_env *e, int timeout_ms)
+{
+	const char *reuse = getenv("ROBOELF_SYS_CAL");
+	const char *share = getenv("ROBOELF_SYS_CAL_SHARE");
+
+	if (reuse && *reuse)
+		return reuse_calibration(e, reuse);
+	if (share && *share)
+		return shared_calibration(e, share, timeout_ms);
+	return calibrate_full(e, timeout_ms);
+}
+
+const char *sys_env_cal_text(const struct sys_env *e, char *buf, size_t cap)
+{
+	if (e->cal_from[0])
+		snprintf(buf, cap, "full calibration shared: copied from %s "
+			 "(made once in this run by the first program with "
+			 "this configuration)", e->cal_from);
+	else
+		snprintf(buf, cap, "full calibration done in %.1f s",
+			 e->calib_s);
+	return buf;
 }
 
 void sys_env_cleanup(struct sys_env *e)
@@ -366,10 +483,15 @@ void sys_env_cleanup(struct sys_env *e)
 int sys_env_ready(struct sys_env *e)
 {
 	int ok = sys_env_init(e) == 0 && sys_env_calibrate(e, 150000) == 0;
+	char text[SYS_PATH_MAX + 320];
 
-	printf("[   INFO   ] full calibration %s in %.1f s (P %d ms, %s)%s%s\n",
-	       ok ? "done" : "FAILED", e->calib_s, e->period_ms, e->dir,
-	       ok ? "" : ": ", ok ? "" : e->err);
+	if (ok)
+		printf("[   INFO   ] %s (P %d ms, %s)\n",
+		       sys_env_cal_text(e, text, sizeof(text)), e->period_ms,
+		       e->dir);
+	else
+		printf("[   INFO   ] full calibration FAILED (P %d ms, %s): %s\n",
+		       e->period_ms, e->dir, e->err);
 	fflush(stdout);
 	return ok;
 }

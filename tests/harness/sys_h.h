@@ -53,6 +53,7 @@ struct sys_env {
 	char cal[SYS_PATH_MAX]; /* the calibration file */
 	int ncase;		/* cases started (unique names) */
 	double calib_s;		/* full calibration, wall s */
+	char cal_from[SYS_PATH_MAX + 64]; /* the shared copy it came from */
 	/* figures read from the configuration (defaults if absent) */
 	int period_ms; /* P */
 	double noncrit_factor, crit_factor;
@@ -158,10 +159,18 @@ int sys_env_init(struct sys_env *e);
  * (at most @timeout_ms), quit it with SIGTERM (exit 0 expected) and check
  * that the calibration file exists. e->calib_s gets the time from roboelf's
  * start to Ready. With ROBOELF_SYS_CAL=FILE set, FILE is copied instead
- * (development shortcut; calib_s stays 0).
+ * (development shortcut; calib_s stays 0). With ROBOELF_SYS_CAL_SHARE=DIR
+ * (tests/run-all.sh sets it for one run), the programs of the run share one
+ * calibration per configuration: the first makes it and keeps a copy in DIR,
+ * the others wait for it (a lock) and copy it (e->cal_from names the copy).
  * Return: 0, or -1 with e->err set.
  */
 int sys_env_calibrate(struct sys_env *e, int timeout_ms);
+
+/* sys_env_cal_text() - what the calibration of @e was, for the INFO line:
+ * "full calibration done in N s" or "... shared: copied from FILE ...".
+ * Return: @buf. */
+const char *sys_env_cal_text(const struct sys_env *e, char *buf, size_t cap);
 
 /* sys_env_cleanup() - remove the temporary directory (unless ROBOELF_KEEP). */
 void sys_env_cleanup(struct sys_env *e);
