@@ -335,18 +335,13 @@ PKG_CONFIG ?= pkg-config
 CLANG_FORMAT ?= clang-format
 CPPCHECK ?= cppcheck
 DEB_PKGS += dpkg-dev lintian
-RELAY_USB_VENDOR ?= 0403
-RELAY_USB_PRODUCT ?= 6001
-RELAY_USB_SERIAL ?=
 .PHONY: have-deps have-lint-deps deb
 have-deps:
 	@CC="$(CC)" PKG_CONFIG="$(PKG_CONFIG)" sh tools/have-deps.sh build
 have-lint-deps:
 	@CLANG_FORMAT="$(CLANG_FORMAT)" CPPCHECK="$(CPPCHECK)" sh tools/have-deps.sh lint
 deb: have-deps
-	@BUILD="$(BUILD)" MAKE="$(MAKE)" RELAY_USB_VENDOR="$(RELAY_USB_VENDOR)" \
-		RELAY_USB_PRODUCT="$(RELAY_USB_PRODUCT)" RELAY_USB_SERIAL="$(RELAY_USB_SERIAL)" \
-		sh tools/mkdeb.sh
+	@BUILD="$(BUILD)" MAKE="$(MAKE)" sh tools/mkdeb.sh
 
 clean:
 	rm -rf $(BUILD)

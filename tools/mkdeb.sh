@@ -7,17 +7,14 @@
 # The programs are built again with the Debian build flags (hardening, and
 # --as-needed so only the libraries used are depended on) in $BUILD/deb/build,
 # installed with PREFIX=/usr into $BUILD/deb/root, stripped; the man pages
-# and the changelog compressed; the copyright, the udev rule of the relay
-# (RELAY_USB_VENDOR, RELAY_USB_PRODUCT, optional RELAY_USB_SERIAL), the
+# and the changelog compressed; the copyright, the relay's udev rules file
+# (which names no board: roboelf-tech bind-relay binds one), the
 # group's real-time limits, the conffile list and the postinst added; then dpkg-deb builds the package
 # (root-owned files, no fakeroot needed).
 set -eu
 cd "$(dirname "$0")/.."
 BUILD=${BUILD:-build}
 MAKE=${MAKE:-make}
-VENDOR=${RELAY_USB_VENDOR:-0403}
-PRODUCT=${RELAY_USB_PRODUCT:-6001}
-SERIAL=${RELAY_USB_SERIAL:-}
 MAINTAINER=${DEB_MAINTAINER:-RoboELF maintainers <roboelf@example.org>}
 PKG=packaging/deb
 DEB=$BUILD/deb
@@ -26,7 +23,6 @@ version=$(sed -n 's/^#define ROBOELF_VERSION[ \t]*"\(.*\)"/\1/p' pc/base/base_ve
 arch=$(dpkg --print-architecture)
 out=$BUILD/roboelf_${version}_${arch}.deb
 [ -n "$version" ] || { echo "mkdeb: no ROBOELF_VERSION in pc/base/base_version.h" >&2; exit 1; }
-case $VENDOR$PRODUCT in *[!0-9a-f]*) echo "mkdeb: RELAY_USB_VENDOR/PRODUCT: 4 lower-case hex digits each" >&2; exit 1 ;; esac
 
 rm -rf "$root" "$out"
 mkdir -p "$root" "$DEB/shlibs/debian"
@@ -55,18 +51,10 @@ date=$(git log -1 --format=%cD 2>/dev/null || date -R)
 printf 'roboelf (%s) unstable; urgency=medium\n\n  * Release %s (README.md, docs/).\n\n -- %s  %s\n' \
 	"$version" "$version" "$MAINTAINER" "$date" | gzip -9n >"$doc/changelog.gz"
 
-# the relay's udev rule
-if [ -n "$SERIAL" ]; then
-	serial_match=", ATTRS{serial}==\"$SERIAL\""
-	serial_note=", serial $SERIAL"
-else
-	serial_match=""
-	serial_note=" (any serial number)"
-fi
-mkdir -p "$root/lib/udev/rules.d"
-sed -e "s/@VENDOR@/$VENDOR/g" -e "s/@PRODUCT@/$PRODUCT/g" \
-	-e "s/@SERIAL_MATCH@/$serial_match/" -e "s/@SERIAL_NOTE@/$serial_note/" \
-	"$PKG/60-roboelf-relay.rules.in" >"$root/lib/udev/rules.d/60-roboelf-relay.rules"
+# the relay's udev rules file: no rule until the technician binds the
+# board by its serial number (roboelf-tech bind-relay writes the one in
+# /etc/udev/rules.d, which masks this one)
+install -D -m 644 "$PKG/60-roboelf-relay.rules.in" "$root/lib/udev/rules.d/60-roboelf-relay.rules"
 
 # the operators' real-time limits (pam_limits)
 install -D -m 644 "$PKG/limits.conf" "$root/etc/security/limits.d/roboelf.conf"

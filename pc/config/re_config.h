@@ -18,6 +18,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "re_bind.h"
 #include "re_dmcif.h"
 #include "re_relay.h"
 
@@ -52,6 +53,9 @@ struct re_config_controller {
 struct re_config_relay {
 	char port_clinical[RE_PATH_MAX];    /* used in clinical mode */
 	char port_development[RE_PATH_MAX]; /* used in development mode */
+	char serial[RE_BIND_SERIAL_MAX];    /* the relay board's USB serial
+					     * number (re_bind.h); clinical:
+					     * required */
 	enum re_relay_proto protocol;
 	int channel; /* 1..8 */
 	enum re_relay_backend backend;

@@ -19,6 +19,7 @@
 #include "gl_err.h"
 #include "gl_hash.h"
 #include "gl_link.h"
+#include "re_bind.h"
 #include "re_rt.h"
 
 /* ---- validation ---- */
@@ -247,6 +248,18 @@ static bool baud_ok(int baud)
 	return false;
 }
 
+/* A serial number set is one a udev rule can hold (re_bind.h): the one
+ * 'roboelf-tech bind-relay' can bind. */
+static int check_serial(struct pctx *c, const struct re_config_relay *r)
+{
+	char why[RE_BIND_ERR_MAX];
+
+	if (!r->serial[0] || !re_bind_serial_check(r->serial, why, sizeof(why)))
+		return GL_OK;
+	return cfg_fail_at(c, cfg_later_mark(c, r->serial, NULL),
+			   "'serial': %s", why);
+}
+
 static int check_relay(struct pctx *c, const struct re_config *cfg)
 {
 	const struct re_config_relay *r = &cfg->relay;
@@ -277,7 +290,7 @@ static int check_relay(struct pctx *c, const struct re_config *cfg)
 		    c, cfg_later_mark(c, r->port_development, &cfg->mode),
 		    "'port_development' must be set in "
 		    "development mode");
-	return GL_OK;
+	return check_serial(c, r);
 }
 
 static bool is_loopback(const char *addr)
@@ -320,6 +333,12 @@ static int check_clinical(struct pctx *c, const struct re_config *cfg)
 		    "'address' %.*s is a loopback address; clinical "
 		    "mode needs the real controller",
 		    TEXT_SHOWN, cfg->controller.address);
+	if (!r->serial[0])
+		return cfg_fail_at(
+		    c, cfg_later_mark(c, r->serial, &cfg->mode),
+		    "'serial' must be set in clinical mode: the relay "
+		    "board's USB serial number, which 'roboelf-tech "
+		    "bind-relay' prints");
 	return GL_OK;
 }
 

@@ -215,6 +215,7 @@ static const struct field controller_fields[] = {
 static const struct field relay_fields[] = {
 	S(struct re_config_relay, port_clinical, 0),
 	S(struct re_config_relay, port_development, 0),
+	S(struct re_config_relay, serial, 0),
 	{ "protocol", FT_CUSTOM, 0, 0, 0, 0, NULL, parse_protocol },
 	I(struct re_config_relay, channel, 1, 8),
 	E(struct re_config_relay, backend, cfg_backend_names, 2),

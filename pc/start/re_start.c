@@ -15,6 +15,7 @@
 #include "gl_err.h"
 #include "gl_link.h"
 #include "gl_route.h"
+#include "re_bind.h"
 
 struct re_signals re_sig;
 
@@ -83,12 +84,36 @@ static int take_locks(struct app *a)
 	return 0;
 }
 
+/*
+ * Clinical: the relay at @port is the board bound to this robot, its USB
+ * serial number relay.serial (docs/safety.md, "The relay bound to this
+ * robot"). Read without opening the port, before the relay is opened: a
+ * board that is not ours never receives a byte, not even "off".
+ */
+static int check_bound(struct app *a, const char *port)
+{
+	char serial[RE_BIND_SERIAL_MAX];
+
+	if (re_relay_usb_serial(port, serial, sizeof(serial), a->err,
+				sizeof(a->err)) != GL_OK ||
+	    re_bind_verify(port, serial, a->cfg.relay.serial, a->err,
+			   sizeof(a->err)) != GL_OK)
+		return re_start_fail(a, a->err);
+	re_start_progress(a,
+			  "the E-stop relay '%s' is the board bound to this "
+			  "robot (USB serial number '%s', relay.serial)",
+			  port, serial);
+	return 0;
+}
+
 /* The relay opened (which switches it off) and kept off. */
 static int start_relay(struct app *a)
 {
 	struct re_relay_cfg rc;
 
 	re_config_relay_cfg(&a->cfg, &rc);
+	if (a->cfg.mode == RE_MODE_CLINICAL && check_bound(a, rc.port))
+		return EXIT_CONNECT;
 	re_start_progress(
 	    a, "opening the E-stop relay '%s' (motor power stays off)",
 	    rc.port);

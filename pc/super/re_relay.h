@@ -279,4 +279,21 @@ int re_relay_message(const struct re_relay_cfg *cfg, bool on, uint8_t *buf);
 /* re_relay_proto_name() - "devantech", ..., "explicit"; never NULL. */
 const char *re_relay_proto_name(enum re_relay_proto proto);
 
+/*
+ * re_relay_usb_serial() - the USB serial number of the serial port @path
+ * (a link such as /dev/roboelf-relay is followed to its node), as
+ * libserialport reads it from sysfs; the port is not opened and nothing is
+ * written to it, so that a board that is not the relay never receives a
+ * byte (clinical start-up, re_bind_verify()).
+ * @buf: [out] the serial number, NUL-terminated; "" when the port is not a
+ *       USB device or has no serial number. @cap: its size.
+ * @err: [out] optional, e.g. "relay '/dev/roboelf-relay': cannot read its
+ *       USB serial number: not a serial port known to libserialport".
+ * Allocates (libserialport), for start-up only.
+ * Return: GL_OK; GL_ERR_RELAY (not a port libserialport knows, or a serial
+ *         number that does not fit @cap); GL_ERR_ARG (NULL, @cap 0).
+ */
+int re_relay_usb_serial(const char *path, char *buf, size_t cap, char *err,
+			size_t errlen);
+
 #endif /* RE_RELAY_H */

@@ -11,13 +11,20 @@
  * output queue is sp_output_waiting (TIOCOUTQ) and sp_flush; never
  * sp_drain or sp_blocking_*, whose waits have no deadline or hold the
  * caller for the whole timeout.
+ *
+ * Also the USB serial number of a port (re_relay_usb_serial()), read the
+ * way libserialport reads every port's details, for the clinical
+ * start-up's check that the relay is the board bound to this robot.
  */
 #include <errno.h>
 #include <libserialport.h>
+#include <limits.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "gl_err.h"
+#include "re_relay.h"
 #include "re_relay_be.h"
 
 static const char *sp_reason(enum sp_return rc)
@@ -59,13 +66,27 @@ static enum sp_return sp_configure(struct sp_port *port, int baud)
 	return rc;
 }
 
+/*
+ * The port by the name of its device node: libserialport finds a port's
+ * details under /sys/class/tty/<name after /dev/>, so a link such as
+ * /dev/roboelf-relay (udev's SYMLINK) or /dev/serial/by-id/usb-... is
+ * refused as "not a serial port" unless resolved first. A path that does
+ * not resolve is passed as given (libserialport then says why).
+ */
+static enum sp_return port_by_path(const char *path, struct sp_port **port)
+{
+	char real[PATH_MAX];
+
+	return sp_get_port_by_name(realpath(path, real) ? real : path, port);
+}
+
 static int spb_open(struct re_relay_io *io, int baud, char *err, size_t errlen)
 {
 	struct sp_port *port = NULL;
 	enum sp_return rc;
 	int ret;
 
-	rc = sp_get_port_by_name(io->path, &port);
+	rc = port_by_path(io->path, &port);
 	if (rc != SP_OK)
 		return sp_fail(io, "cannot open", rc, err, errlen);
 	rc = sp_open(port, SP_MODE_READ_WRITE);
@@ -174,3 +195,39 @@ const struct re_relay_be_ops re_relay_be_serialport = {
     .fd = spb_fd,
     .close = spb_close,
 };
+
+int re_relay_usb_serial(const char *path, char *buf, size_t cap, char *err,
+			size_t errlen)
+{
+	struct re_relay_io io = {.path = path, .fd = -1, .port = NULL};
+	struct sp_port *port = NULL;
+	enum sp_return rc;
+	const char *s = NULL;
+	size_t len = 0;
+
+	if (!path || !buf || !cap)
+		return GL_ERR_ARG;
+	buf[0] = '\0';
+	rc = port_by_path(path, &port);
+	if (rc != SP_OK) {
+		sp_fail(&io, "cannot read its USB serial number", rc, err,
+			errlen);
+		return GL_ERR_RELAY;
+	}
+	if (sp_get_port_transport(port) == SP_TRANSPORT_USB)
+		s = sp_get_port_usb_serial(port);
+	if (s)
+		len = strlen(s);
+	if (len < cap)
+		memcpy(buf, s ? s : "", len + 1);
+	sp_free_port(port);
+	if (len >= cap) {
+		if (err && errlen)
+			snprintf(err, errlen,
+				 "relay '%s': its USB serial number is longer "
+				 "than %zu bytes",
+				 path, cap - 1);
+		return GL_ERR_RELAY;
+	}
+	return GL_OK;
+}

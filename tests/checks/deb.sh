@@ -4,7 +4,8 @@
 # pages, the conffiles /etc/roboelf/roboelf.yaml (the site template
 # config/roboelf-site.yaml, which the packaged roboelf refuses until it is
 # filled in) and the group's real-time limits, the DMC programs, the docs
-# tree and the relay's udev rule, all owned by root; the packaged galil-load
+# tree and the relay's udev rules file (no rule: it names no board until
+# roboelf-tech bind-relay binds one), all owned by root; the packaged galil-load
 # finds the packaged DMC programs; the postinst creates the group roboelf
 # once (run twice against stand-in commands, never on this machine's
 # groups); lintian reports no error. lintian comes from `make deps`: a
@@ -50,9 +51,12 @@ dpkg-deb -e "$deb" "$tmp/ctl" || fail "dpkg-deb -e"
 /etc/security/limits.d/roboelf.conf" ] || fail "conffiles: $(cat "$tmp/ctl/conffiles")"
 
 dpkg-deb -x "$deb" "$tmp/x" || fail "dpkg-deb -x"
-want='SUBSYSTEM=="tty", ATTRS{idVendor}=="0403", ATTRS{idProduct}=="6001", SYMLINK+="roboelf-relay", GROUP="roboelf", MODE="0660"'
-grep -v '^#' "$tmp/x/lib/udev/rules.d/60-roboelf-relay.rules" | grep -qxF "$want" ||
-	fail "udev rule: $(grep -v '^#' "$tmp/x/lib/udev/rules.d/60-roboelf-relay.rules")"
+# the packaged udev rules file names no board (no rule at all: every line a
+# comment) until the technician binds one (roboelf-tech bind-relay), and
+# says so
+rules=$tmp/x/lib/udev/rules.d/60-roboelf-relay.rules
+grep -v '^#' "$rules" | grep -q . && fail "the packaged udev rules file has a rule: $(grep -v '^#' "$rules")"
+grep -qF '#     roboelf-tech bind-relay' "$rules" || fail "the packaged udev rules file does not say how to bind the relay"
 [ "$(grep -v '^#' "$tmp/x/etc/security/limits.d/roboelf.conf")" = "$(printf '@roboelf\t-\trtprio\t60\n@roboelf\t-\tmemlock\tunlimited')" ] ||
 	fail "limits: $(cat "$tmp/x/etc/security/limits.d/roboelf.conf")"
 cmp -s "$tmp/x/etc/roboelf/roboelf.yaml" config/roboelf-site.yaml ||

@@ -64,7 +64,8 @@ printf '%s\n' "$out" | grep -qxF "galil-load: cannot seal the program with '$cfg
 	fail "galil-load --check with the template: $out"
 # filled in with the values of the source tree's configuration
 sed -i -e 's|^\(  address:\) FILL-IN$|\1 "192.0.2.1"|' -e 's|^\(  power_output:\) FILL-IN$|\1 0|' \
-	-e 's|^\(  port_clinical:\) FILL-IN$|\1 /dev/roboelf-relay|' -e 's|^\(  protocol:\) FILL-IN$|\1 devantech|' \
+	-e 's|^\(  port_clinical:\) FILL-IN$|\1 /dev/roboelf-relay|' -e 's|^\(  serial:\) FILL-IN$|\1 A10KXYZ9|' \
+	-e 's|^\(  protocol:\) FILL-IN$|\1 devantech|' \
 	-e 's|^\(  channel:\) FILL-IN$|\1 1|' -e 's|^\(  inputs:\) FILL-IN$|\1 [1, 2, 3, 4, 5, 6, 7, 8, 17, 18, 19, 20]|' \
 	-e 's|^\(  active_low:\) FILL-IN$|\1 false|' -e 's|^\( *vmax:\) FILL-IN$|\1 8000|' \
 	-e 's|^\( *travel_counts:\) FILL-IN$|\1 100000|' -e 's|^\( *kp:\) FILL-IN$|\1 6|' -e 's|^\( *ki:\) FILL-IN$|\1 1|' \

@@ -6,6 +6,9 @@
 #     any relay is opened;
 #   - no relay: the reason, a hint naming the next step, and no claim of
 #     switching off what was never on (exit 3);
+#   - clinical: a relay whose USB serial number cannot be read is refused
+#     before it is opened (exit 3); no relay.serial is refused by the
+#     configuration check (exit 2);
 #   - a directory given to -c (exit 2);
 #   - an unclosed quote reported at its own line (exit 2);
 #   - --version names the release and the DMC interface (exit 0).
@@ -53,6 +56,21 @@ expect no-relay 3 "roboelf: error: cannot open the E-stop relay '$tmp/no-relay':
 roboelf: motor power was never switched on; bye" \
 	-- -c "$tmp/ok.yaml" --calibration file
 [ -e "$tmp/no-relay" ] && fail "no-relay: the relay path was created"
+
+# clinical: a relay that is not a USB serial port is refused by the
+# binding check (its USB serial number against relay.serial) before it is
+# opened, so it never receives a byte (/dev/null: no device is touched)
+sed -e 's#^mode: .*#mode: clinical#' -e 's#^  port_clinical: .*#  port_clinical: /dev/null#' \
+    -e 's#^  serial: .*#  serial: A10KXYZ9#' -e 's#address: "127.0.0.1:23023"#address: "192.0.2.1"#' \
+    "$tmp/ok.yaml" >"$tmp/clinical.yaml"
+expect unbound 3 "roboelf: error: relay '/dev/null': cannot read its USB serial number: not a serial port known to libserialport
+roboelf: motor power was never switched on; bye" \
+	-- -c "$tmp/clinical.yaml" --calibration file
+# without relay.serial: refused by the configuration check (exit 2)
+sed 's#^  serial: .*#  serial: ""#' "$tmp/clinical.yaml" >"$tmp/noserial.yaml"
+sline=$(grep -n '^  serial: ""$' "$tmp/noserial.yaml" | cut -d: -f1)
+expect no-serial 2 "$tmp/noserial.yaml:$sline:11: 'serial' must be set in clinical mode: the relay board's USB serial number, which 'roboelf-tech bind-relay' prints" \
+	-- -c "$tmp/noserial.yaml" --calibration file
 
 expect directory 2 "cannot read '$tmp': it is a directory; give the configuration file (e.g. $tmp/roboelf.yaml)" \
 	-- -c "$tmp"

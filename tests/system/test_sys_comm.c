@@ -12,6 +12,8 @@
  *
  * roboelf supervises, and nothing else: given one of the options that
  * moved to roboelf-tech it exits 2 with one line naming the command.
+ * roboelf-tech's command line, and bind-relay refusing a serial number
+ * before anything is written (the rest of bind-relay: test_re_bind).
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -544,7 +546,13 @@ static void test_tech_usage(void **state)
 	     "--help)\n"},
 	    {"supervise", NULL,
 	     "roboelf-tech: error: unknown command 'supervise': commission, "
-	     "show-calibration, show-trace or check-host\n"},
+	     "show-calibration, show-trace, check-host or bind-relay\n"},
+	    {"bind-relay", "x",
+	     "roboelf-tech: error: bind-relay takes no operand (roboelf-tech "
+	     "--help)\n"},
+	    {"--bind-relay", "x",
+	     "roboelf-tech: error: bind-relay takes no operand (roboelf-tech "
+	     "--help)\n"},
 	};
 	char err[1024];
 
@@ -560,11 +568,38 @@ static void test_tech_usage(void **state)
 	}
 }
 
+/* roboelf-tech bind-relay with a serial number a udev rule cannot hold:
+ * refused (exit 3) whatever ports this machine has (libserialport's
+ * listing reads sysfs and opens none), and no rules file written. */
+static void test_bind_relay_refused(void **state)
+{
+	char dir[] = "/tmp/test_sys_comm.XXXXXX", rules[64], err[1024];
+	char *argv[] = {(char *)"roboelf-tech",
+			(char *)"bind-relay",
+			(char *)"--serial",
+			(char *)"A\"1",
+			(char *)"--rules-file",
+			rules,
+			NULL};
+
+	(void)state;
+	assert_non_null(mkdtemp(dir));
+	snprintf(rules, sizeof(rules), "%s/60-roboelf-relay.rules", dir);
+	assert_int_equal(run_to_end(argv, err, sizeof(err)), 3);
+	assert_string_equal(err, "roboelf-tech: error: serial number 'A\"1' "
+				 "has a character not allowed in a udev rule "
+				 "('\"' at position 2): only letters, digits, "
+				 "'.', '_', '-' and ':'\n");
+	assert_int_equal(access(rules, F_OK), -1);
+	assert_int_equal(rmdir(dir), 0);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_moved_options),
 	    cmocka_unit_test(test_tech_usage),
+	    cmocka_unit_test(test_bind_relay_refused),
 	    cmocka_unit_test(test_clean_robot),
 	    cmocka_unit_test(test_kill_during_move),
 	    cmocka_unit_test(test_wrong_robot),

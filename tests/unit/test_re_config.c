@@ -445,6 +445,7 @@ static void emit(struct sbuf *b, const struct re_config *c)
 	    c->controller.timeout_ms, c->controller.connect_timeout_ms);
 	put(b, "relay:\n  port_clinical: \"%s\"\n  port_development: \"%s\"\n",
 	    c->relay.port_clinical, c->relay.port_development);
+	put(b, "  serial: \"%s\"\n", c->relay.serial);
 	if (c->relay.protocol == RE_RELAY_EXPLICIT) {
 		put(b, "  protocol:\n");
 		put_bytes(b, "on", c->relay.on, c->relay.on_len);
@@ -504,6 +505,7 @@ static void changed(struct re_config *c)
 	c->controller.connect_timeout_ms = 1500;
 	strcpy(c->relay.port_clinical, "/dev/serial/by-id/usb-relay");
 	strcpy(c->relay.port_development, "/tmp/other-relay");
+	strcpy(c->relay.serial, "FT4-ab.c_1:2");
 	c->relay.protocol = RE_RELAY_EXPLICIT;
 	memcpy(c->relay.on, on, sizeof(on));
 	c->relay.on_len = sizeof(on);
@@ -676,9 +678,11 @@ static void test_clinical_accepted(void **state)
 		"mode: clinical\ncontroller:\n"
 		"  address: 10.0.0.2\nrelay:\n"
 		"  port_clinical: /dev/serial/by-id/usb-TEST_relay-if00\n"
+		"  serial: A10KXYZ9\n"
 		"  channel: 2\n",
 		&c, err, sizeof(err)),
 	    GL_OK);
+	assert_string_equal(c.relay.serial, "A10KXYZ9");
 	assert_string_equal(re_config_relay_port(&c),
 			    "/dev/serial/by-id/usb-TEST_relay-if00");
 	re_config_relay_cfg(&c, &r);
@@ -694,6 +698,40 @@ static void test_clinical_accepted(void **state)
 	re_config_relay_cfg(&c, &r);
 	assert_string_equal(r.port, "/tmp/roboelf-relay");
 	assert_false(r.clinical);
+}
+
+/* relay.serial: required in clinical mode (after the other clinical
+ * rules), and whatever the mode only a value a udev rule can hold, each
+ * refusal at the value's (or mode's) position. */
+static void test_relay_serial(void **state)
+{
+	struct re_config c;
+	char err[RE_CONFIG_ERR_MAX];
+
+	(void)state;
+	assert_int_equal(parse_text("mode: clinical\ncontroller:\n"
+				    "  address: 10.0.0.2\nrelay:\n"
+				    "  port_clinical: /dev/roboelf-relay\n",
+				    &c, err, sizeof(err)),
+			 GL_ERR_CONFIG);
+	assert_string_equal(err, "t.yaml:1:7: 'serial' must be set in clinical "
+				 "mode: the relay board's USB serial number, "
+				 "which 'roboelf-tech bind-relay' prints");
+	assert_int_equal(parse_text("relay:\n  serial: \"A1*\"\n"
+				    "mode: development\n",
+				    &c, err, sizeof(err)),
+			 GL_ERR_CONFIG);
+	assert_string_equal(err, "t.yaml:2:11: 'serial': serial number 'A1*' "
+				 "has a character not allowed in a udev rule "
+				 "('*' at position 3): only letters, digits, "
+				 "'.', '_', '-' and ':'");
+	assert_int_equal(parse_text("mode: development\nrelay:\n"
+				    "  serial: A10KXYZ9\n",
+				    &c, err, sizeof(err)),
+			 GL_OK);
+	assert_string_equal(c.relay.serial, "A10KXYZ9");
+	re_config_defaults(&c);
+	assert_string_equal(c.relay.serial, "");
 }
 
 /* Command-line overrides are validated without a position. */
@@ -876,37 +914,38 @@ static const struct fill_at site_fill[] = {
     {34, 12, "controller.address"},
     {44, 17, "controller.power_output"},
     {50, 18, "relay.port_clinical"},
-    {58, 13, "relay.protocol"},
-    {60, 12, "relay.channel"},
-    {89, 11, "joystick.inputs"},
-    {91, 15, "joystick.active_low"},
-    {112, 11, "axes[0].vmax"},
-    {115, 20, "axes[0].travel_counts"},
-    {117, 9, "axes[0].kp"},
-    {118, 9, "axes[0].ki"},
-    {119, 9, "axes[0].kd"},
-    {120, 21, "axes[0].torque_limit_v"},
-    {129, 25, "axes[0].analog.expected_range_v"},
-    {131, 18, "axes[0].analog.reverse_v"},
-    {132, 18, "axes[0].analog.forward_v"},
-    {143, 11, "axes[1].vmax"},
-    {146, 20, "axes[1].travel_counts"},
-    {148, 9, "axes[1].kp"},
-    {149, 9, "axes[1].ki"},
-    {150, 9, "axes[1].kd"},
-    {151, 21, "axes[1].torque_limit_v"},
-    {157, 25, "axes[1].analog.expected_range_v"},
-    {159, 18, "axes[1].analog.reverse_v"},
-    {160, 18, "axes[1].analog.forward_v"},
-    {168, 11, "axes[2].vmax"},
-    {171, 20, "axes[2].travel_counts"},
-    {173, 9, "axes[2].kp"},
-    {174, 9, "axes[2].ki"},
-    {175, 9, "axes[2].kd"},
-    {176, 21, "axes[2].torque_limit_v"},
-    {182, 25, "axes[2].analog.expected_range_v"},
-    {184, 18, "axes[2].analog.reverse_v"},
-    {185, 18, "axes[2].analog.forward_v"},
+    {56, 11, "relay.serial"},
+    {64, 13, "relay.protocol"},
+    {66, 12, "relay.channel"},
+    {95, 11, "joystick.inputs"},
+    {97, 15, "joystick.active_low"},
+    {118, 11, "axes[0].vmax"},
+    {121, 20, "axes[0].travel_counts"},
+    {123, 9, "axes[0].kp"},
+    {124, 9, "axes[0].ki"},
+    {125, 9, "axes[0].kd"},
+    {126, 21, "axes[0].torque_limit_v"},
+    {135, 25, "axes[0].analog.expected_range_v"},
+    {137, 18, "axes[0].analog.reverse_v"},
+    {138, 18, "axes[0].analog.forward_v"},
+    {149, 11, "axes[1].vmax"},
+    {152, 20, "axes[1].travel_counts"},
+    {154, 9, "axes[1].kp"},
+    {155, 9, "axes[1].ki"},
+    {156, 9, "axes[1].kd"},
+    {157, 21, "axes[1].torque_limit_v"},
+    {163, 25, "axes[1].analog.expected_range_v"},
+    {165, 18, "axes[1].analog.reverse_v"},
+    {166, 18, "axes[1].analog.forward_v"},
+    {174, 11, "axes[2].vmax"},
+    {177, 20, "axes[2].travel_counts"},
+    {179, 9, "axes[2].kp"},
+    {180, 9, "axes[2].ki"},
+    {181, 9, "axes[2].kd"},
+    {182, 21, "axes[2].torque_limit_v"},
+    {188, 25, "axes[2].analog.expected_range_v"},
+    {190, 18, "axes[2].analog.reverse_v"},
+    {191, 18, "axes[2].analog.forward_v"},
 };
 
 #define N_SITE_FILL (sizeof(site_fill) / sizeof(site_fill[0]))
@@ -917,6 +956,7 @@ static const char *const site_values[N_SITE_FILL] = {
     "192.0.2.10",
     "4",
     "/dev/roboelf-relay",
+    "A10KXYZ9",
     "lcus",
     "2",
     "[2, 1, 3, 4, 5, 6, 7, 8, 17, 18, 19, 21]",
@@ -979,7 +1019,7 @@ static void test_site_template_refused(void **state)
 	(void)state;
 	n = (size_t)snprintf(want, sizeof(want),
 			     ETC_NAME ": this site's configuration is not "
-				      "finished: 34 values are still FILL-IN");
+				      "finished: 35 values are still FILL-IN");
 	for (i = 0; i < N_SITE_FILL; i++)
 		n += (size_t)snprintf(want + n, sizeof(want) - n,
 				      "\n" ETC_NAME ":%d:%d: '%s' is still "
@@ -1037,6 +1077,7 @@ static void test_site_template_filled(void **state)
 	assert_string_equal(c.controller.address, "192.0.2.10");
 	assert_int_equal(c.controller.power_output, 4);
 	assert_string_equal(c.relay.port_clinical, "/dev/roboelf-relay");
+	assert_string_equal(c.relay.serial, "A10KXYZ9");
 	assert_int_equal(c.relay.protocol, RE_RELAY_LCUS);
 	assert_false(c.relay.readback); /* its default for lcus */
 	assert_int_equal(c.relay.channel, 2);
@@ -1145,6 +1186,7 @@ int main(void)
 	    cmocka_unit_test(test_controller_timeout_auto),
 	    cmocka_unit_test(test_readback_default),
 	    cmocka_unit_test(test_clinical_accepted),
+	    cmocka_unit_test(test_relay_serial),
 	    cmocka_unit_test(test_validate_overrides),
 	    cmocka_unit_test(test_quoted_strings),
 	    cmocka_unit_test(test_buffer_not_terminated),

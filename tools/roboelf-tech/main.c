@@ -9,11 +9,13 @@
  *   roboelf-tech show-calibration FILE [-c FILE]
  *   roboelf-tech show-trace FILE [--window FROM:TO]
  *   roboelf-tech check-host[=SECONDS] [-c FILE] [--period MS]
+ *   roboelf-tech bind-relay [--serial S] [--rules-file PATH]
  *
  * Exit codes: 0 done; 2 usage, configuration or a file that cannot be
- * read; 3 no relay or controller, or the controller refused; 5 the
- * commissioning run found a fault; 6 check-host: the configured period
- * is not safe on this host.
+ * read (bind-relay: the rules file cannot be written); 3 no relay or
+ * controller, or the controller refused (bind-relay: no single relay
+ * board, or its serial number refused); 5 the commissioning run found a
+ * fault; 6 check-host: the configured period is not safe on this host.
  */
 #include <errno.h>
 #include <getopt.h>
@@ -25,6 +27,7 @@
 
 #include "gl_err.h"
 #include "re_app.h"
+#include "re_bindrelay.h"
 #include "re_calshow.h"
 #include "re_comm.h"
 #include "re_comm_report.h"
@@ -48,6 +51,7 @@ struct topts {
 	const char *find_addr; /* commission: the discovery probe's address */
 	int find_port;	       /* and port (0: the defaults) */
 	int seconds;	       /* check-host: the probe's length */
+	struct re_bindrelay_opts bind; /* bind-relay: --serial, --rules-file */
 	int version;
 };
 
@@ -62,6 +66,8 @@ static void usage(FILE *f)
 		"       roboelf-tech show-trace FILE [--window FROM:TO]\n"
 		"       roboelf-tech check-host[=SECONDS] [-c FILE] "
 		"[--period MS]\n"
+		"       roboelf-tech bind-relay [--serial S] [--rules-file "
+		"PATH]\n"
 		"\n"
 		"  commission DIR       the commissioning run; report in DIR\n"
 		"  show-calibration FILE  print a calibration file (and "
@@ -72,6 +78,10 @@ static void usage(FILE *f)
 		"for S s (10) and\n"
 		"                       name the shortest safe period "
 		"(check-host S: the same)\n"
+		"  bind-relay           write the udev rule that names the "
+		"relay board, by its\n"
+		"                       USB serial number, /dev/roboelf-relay "
+		"(also --bind-relay)\n"
 		"\n"
 		"  -c, --config FILE    configuration (default %s, else %s)\n"
 		"      --galil HOST[:PORT]  controller address (overrides the "
@@ -87,6 +97,10 @@ static void usage(FILE *f)
 		"                       (255.255.255.255, 50000)\n"
 		"      --window FROM:TO show-trace: only t_s FROM..TO seconds "
 		"(either may be empty)\n"
+		"      --serial S       bind-relay: the board of this USB "
+		"serial number\n"
+		"      --rules-file PATH  bind-relay: where the rule goes "
+		"(%s)\n"
 		"      --dmc DIR        the DMC programs --version names\n"
 		"  -h, --help           this text\n"
 		"      --version        the release, the DMC interface, the "
@@ -95,7 +109,7 @@ static void usage(FILE *f)
 		"exit: 0 done, 2 usage/config, 3 no relay/controller, "
 		"5 commissioning found a fault,\n"
 		"      6 check-host: the configured period is not safe here\n",
-		DEFAULT_CONFIG, re_app_system_config());
+		DEFAULT_CONFIG, re_app_system_config(), RE_BINDRELAY_RULES);
 }
 
 /* check-host's table: the verdict for each candidate period on probe @p.
@@ -320,6 +334,8 @@ static int opt_value(struct topts *o, int c, const char *arg)
 	case 'D': o->g.dmc = arg; return 0;
 	case 'w': o->window = arg; return 0;
 	case 'F': o->find_addr = arg; return 0;
+	case 'S': o->bind.serial = arg; return 0;
+	case 'R': o->bind.rules_file = arg; return 0;
 	case 'P':
 		return int_in(arg, 1, 65535, &o->find_port)
 			   ? bad("port", arg, "must be 1..65535")
@@ -364,6 +380,13 @@ static int operands(struct topts *o, int n, char **arg)
 	}
 	if (!strcmp(o->sub, "check-host"))
 		return host_seconds(o, NULL, n, arg);
+	if (!strcmp(o->sub, "bind-relay")) {
+		if (!n)
+			return 0;
+		fprintf(stderr, "roboelf-tech: error: bind-relay takes no "
+				"operand (roboelf-tech --help)\n");
+		return -1;
+	}
 	if (n != 1) {
 		fprintf(stderr,
 			"roboelf-tech: error: %s takes one %s (roboelf-tech "
@@ -383,7 +406,8 @@ static int operands(struct topts *o, int n, char **arg)
 static int parse_opts(int argc, char **argv, struct topts *o)
 {
 	static const char *const subs[] = {"commission", "show-calibration",
-					   "show-trace", "check-host"};
+					   "show-trace", "check-host",
+					   "bind-relay"};
 	static const struct option lo[] = {
 	    {"config", required_argument, NULL, 'c'},
 	    {"galil", required_argument, NULL, 'g'},
@@ -395,6 +419,9 @@ static int parse_opts(int argc, char **argv, struct topts *o)
 	    {"find-addr", required_argument, NULL, 'F'},
 	    {"find-port", required_argument, NULL, 'P'},
 	    {"dmc", required_argument, NULL, 'D'},
+	    {"serial", required_argument, NULL, 'S'},
+	    {"rules-file", required_argument, NULL, 'R'},
+	    {"bind-relay", no_argument, NULL, 'B'},
 	    {"help", no_argument, NULL, 'h'},
 	    {"version", no_argument, NULL, 'V'},
 	    {NULL, 0, NULL, 0},
@@ -409,11 +436,15 @@ static int parse_opts(int argc, char **argv, struct topts *o)
 		}
 		if (c == 'V')
 			o->version = 1;
+		else if (c == 'B')
+			o->sub = "bind-relay";
 		else if (opt_value(o, c, optarg) < 0)
 			return -1;
 	}
 	if (o->version)
 		return 0;
+	if (o->sub) /* --bind-relay */
+		return operands(o, argc - optind, argv + optind);
 	if (optind >= argc) {
 		usage(stderr);
 		return -1;
@@ -427,7 +458,7 @@ static int parse_opts(int argc, char **argv, struct topts *o)
 					argv + optind + 1);
 	fprintf(stderr,
 		"roboelf-tech: error: unknown command '%s': commission, "
-		"show-calibration, show-trace or check-host\n",
+		"show-calibration, show-trace, check-host or bind-relay\n",
 		o->sub);
 	return -1;
 }
@@ -448,6 +479,9 @@ int main(int argc, char **argv)
 		return show_calibration(&a, &o.g, o.file);
 	if (!strcmp(o.sub, "show-trace"))
 		return show_trace(o.file, o.window);
+	if (!strcmp(o.sub, "bind-relay"))
+		return re_bindrelay_run(&o.bind, re_bindrelay_list_sp, stdout,
+					stderr);
 	if (re_app_load_config(&a, &o.g) < 0)
 		return EXIT_USAGE;
 	a.config_path = o.g.config;
