@@ -188,6 +188,24 @@ static void test_dl_refused_running(void **state)
 	exchange(p, 0, "UL\r", "#B\r\nEN\r\n\x1a:");
 }
 
+/* A download before the first sample (galil-sim busy at start): the
+ * program is loaded, and its #AUTO does not start by itself afterwards. */
+static void test_dl_before_first_sample(void **state)
+{
+	struct tplant p;
+
+	(void)state;
+	assert_int_equal(tp_init(&p), 0);
+	ctrl_handle_open(p.c, 0);
+	exchange(&p, 0, "DL\r", "");
+	exchange(&p, 0, prog_text, "");
+	exchange(&p, 0, "\\", "::");
+	tp_step(&p, 5);
+	exchange(&p, 0, "MG _XQ0\r", " -1.0000\r\n:");
+	exchange(&p, 0, "XQ #AUTO,0\r", ":");
+	tp_free(&p);
+}
+
 /* A bad line answers '?' at once; the download is refused and erased. */
 static void test_dl_bad(void **state)
 {
@@ -383,6 +401,7 @@ int main(void)
 	    cmocka_unit_test_setup_teardown(test_dl_refused_running, setup,
 					    teardown),
 	    cmocka_unit_test_setup_teardown(test_dl_bad, setup, teardown),
+	    cmocka_unit_test(test_dl_before_first_sample),
 	    cmocka_unit_test_setup_teardown(test_unsolicited, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_unsolicited_full, setup,
 					    teardown),

@@ -143,22 +143,6 @@ void ctrl_free(struct ctrl *c)
 	free(c);
 }
 
-/* #AUTO of the program in memory starts in thread 0 at power-up. */
-static void start_auto(struct ctrl *c)
-{
-	uint64_t key;
-	int line;
-
-	c->auto_pending = 0;
-	if (ctrl_name_key("AUTO", 4, &key))
-		return;
-	line = ctrl_prog_label(&c->prog, key);
-	if (line < 0)
-		return;
-	ctrl_thread_start(c, 0, c->prog.first[line]);
-	ctrl_event(c, "#AUTO started in thread 0 at line %d", line);
-}
-
 void ctrl_step(struct ctrl *c, const struct ctrl_sense *in,
 	       struct ctrl_drive *out)
 {
@@ -166,8 +150,7 @@ void ctrl_step(struct ctrl *c, const struct ctrl_sense *in,
 		return;
 	ctrl_motion_sense(c, in);
 	ctrl_motion_sample(c);
-	if (c->auto_pending)
-		start_auto(c);
+	ctrl_thread_boot(c);
 	ctrl_threads_run(c);
 	ctrl_motion_drive(c, out);
 	c->time++;
@@ -205,6 +188,7 @@ int ctrl_download(struct ctrl *c, const char *text, size_t len, int *bad_line)
 
 	if (!c || (!text && len))
 		return GL_ERR_ARG;
+	ctrl_thread_boot(c);
 	if (ctrl_any_running(c)) {
 		c->tc = 17;
 		return GL_ERR_CTRL;

@@ -172,6 +172,7 @@ int ctrl_proto_host(struct ctrl *c, int h, const char *text)
 	char line[CTRL_LINE_MAX + 1];
 	int i, n;
 
+	ctrl_thread_boot(c);
 	if (hd->overflow) {
 		hd->overflow = 0;
 		c->tc = 5;
@@ -296,6 +297,7 @@ int ctrl_input(struct ctrl *c, int h, const uint8_t *buf, size_t len)
 		return GL_ERR_ARG;
 	if (!c->h[h].open)
 		ctrl_handle_open(c, h);
+	ctrl_thread_boot(c);
 	for (i = 0; i < len; i++) {
 		if (c->h[h].mode == CTRL_H_DL)
 			dl_byte(c, h, buf[i]);

@@ -233,3 +233,20 @@ void ctrl_autosubs_dispatch(struct ctrl *c)
 		enter_autosub(c, w, line);
 	}
 }
+
+void ctrl_thread_boot(struct ctrl *c)
+{
+	uint64_t key;
+	int line;
+
+	if (!c->auto_pending)
+		return;
+	c->auto_pending = 0;
+	if (ctrl_name_key("AUTO", 4, &key))
+		return;
+	line = ctrl_prog_label(&c->prog, key);
+	if (line < 0)
+		return;
+	ctrl_thread_start(c, 0, c->prog.first[line]);
+	ctrl_event(c, "#AUTO started in thread 0 at line %d", line);
+}

@@ -18,6 +18,16 @@
 void ctrl_xc_who(const struct ctrl_xc *x, char *buf, size_t cap);
 /* ctrl_tc_text() - the TC1 text of code @tc (static), or "" if unknown. */
 const char *ctrl_tc_text(int tc);
+/*
+ * ctrl_thread_boot() - the end of power-up: #AUTO of the program in memory
+ * starts in thread 0, once. Called at the first sample and before the first
+ * host byte or download, whichever comes first: a controller answers the
+ * host only once booted, so a download that arrives before the first sample
+ * meets the program as booted and is never followed by its own #AUTO
+ * starting by itself.
+ */
+void ctrl_thread_boot(struct ctrl *c);
+
 /* ctrl_any_running() - 1 when any of the 8 threads runs, else 0. */
 int ctrl_any_running(const struct ctrl *c);
 /*
