@@ -232,6 +232,17 @@ int re_config_load_file(const char *path, struct re_config *out, char *err,
 			size_t errlen);
 
 /*
+ * re_config_site_key() - the @i-th value only a site can know (from 0, in
+ * the order of the site template, config/roboelf-site.yaml, where each is
+ * FILL-IN), e.g. "controller.address", "axes[1].analog.reverse_v". A
+ * clinical configuration must write every one: one left out is refused
+ * (re_config_parse()) instead of taking the built-in default, which is
+ * galil-sim's robot.
+ * Return: the key in @buf (@cap bytes), or NULL past the last one.
+ */
+const char *re_config_site_key(int i, char *buf, size_t cap);
+
+/*
  * re_config_validate() - check the ranges and cross-field rules of @cfg,
  * e.g. after command-line overrides (--period, --relay, --galil).
  * @err: [out] optional; on error a message without position, e.g.

@@ -10,6 +10,7 @@
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -299,6 +300,107 @@ static bool is_loopback(const char *addr)
 	       !strncmp(addr, "[::1]", 5) || !strcmp(addr, "::1");
 }
 
+/* The values only a site can know (the site template's FILL-INs), by
+ * their offset in the configuration; the axes' for each axis. */
+struct site_key {
+	const char *key;
+	size_t off;
+};
+
+static const struct site_key site_top[] = {
+    {"controller.address", offsetof(struct re_config, controller.address)},
+    {"controller.power_output",
+     offsetof(struct re_config, controller.power_output)},
+    {"relay.port_clinical", offsetof(struct re_config, relay.port_clinical)},
+    {"relay.serial", offsetof(struct re_config, relay.serial)},
+    {"relay.protocol", offsetof(struct re_config, relay.protocol)},
+    {"relay.channel", offsetof(struct re_config, relay.channel)},
+    {"joystick.inputs", offsetof(struct re_config, joystick.inputs)},
+    {"joystick.active_low", offsetof(struct re_config, joystick.active_low)},
+};
+
+static const struct site_key site_axis[] = {
+    {"vmax", offsetof(struct re_config_axis, vmax_cps)},
+    {"travel_counts", offsetof(struct re_config_axis, travel_counts)},
+    {"kp", offsetof(struct re_config_axis, kp)},
+    {"ki", offsetof(struct re_config_axis, ki)},
+    {"kd", offsetof(struct re_config_axis, kd)},
+    {"torque_limit_v", offsetof(struct re_config_axis, torque_limit_v)},
+    {"analog.expected_range_v",
+     offsetof(struct re_config_axis, analog.expected_range_v)},
+    {"analog.reverse_v", offsetof(struct re_config_axis, analog.reverse_v)},
+    {"analog.forward_v", offsetof(struct re_config_axis, analog.forward_v)},
+};
+
+#define N_TOP  (int)(sizeof(site_top) / sizeof(site_top[0]))
+#define N_AXIS (int)(sizeof(site_axis) / sizeof(site_axis[0]))
+
+/* The @i-th site key's name in @buf and its field in @cfg (NULL: none). */
+static const void *site_field(const struct re_config *cfg, int i, char *buf,
+			      size_t cap)
+{
+	const struct site_key *k;
+	int ax = 0;
+
+	if (i < 0 || i >= N_TOP + RE_AXES * N_AXIS)
+		return NULL;
+	if (i < N_TOP) {
+		k = &site_top[i];
+		snprintf(buf, cap, "%s", k->key);
+		return (const char *)cfg + k->off;
+	}
+	ax = (i - N_TOP) / N_AXIS;
+	k = &site_axis[(i - N_TOP) % N_AXIS];
+	snprintf(buf, cap, "axes[%d].%s", ax, k->key);
+	return (const char *)&cfg->axes[ax] + k->off;
+}
+
+const char *re_config_site_key(int i, char *buf, size_t cap)
+{
+	static struct re_config any;
+
+	if (!buf || !cap)
+		return NULL;
+	return site_field(&any, i, buf, cap) ? buf : NULL;
+}
+
+/*
+ * Clinical, from a file: every value only the site can know is written
+ * there. The template has them as FILL-IN; a line deleted to silence that
+ * refusal would otherwise take the built-in default (galil-sim's robot).
+ * All of them at once, like the FILL-INs.
+ */
+static int check_site_keys(struct pctx *c, const struct re_config *cfg)
+{
+	char key[64], list[RE_CONFIG_ERR_MAX / 2] = "";
+	size_t used = 0;
+	int n = 0;
+	const void *f;
+
+	if (cfg->mode != RE_MODE_CLINICAL || !c->doc)
+		return GL_OK;
+	for (int i = 0; (f = site_field(cfg, i, key, sizeof(key))); i++) {
+		int w;
+
+		if (cfg_seen_mark(c, f))
+			continue;
+		n++;
+		w = snprintf(list + used, sizeof(list) - used, "%s'%s'",
+			     used ? ", " : "", key);
+		if (w > 0 && used + (size_t)w < sizeof(list))
+			used += (size_t)w;
+	}
+	if (!n)
+		return GL_OK;
+	return cfg_fail_at(c, cfg_seen_mark(c, &cfg->mode),
+			   "clinical mode: %d value%s of this site %s not "
+			   "written: %s. Each is a value of this robot "
+			   "(config/roboelf-site.yaml has it as FILL-IN); "
+			   "left out, it would take the built-in default, "
+			   "which is galil-sim's robot",
+			   n, n == 1 ? "" : "s", n == 1 ? "is" : "are", list);
+}
+
 /*
  * Clinical mode: a real relay through libserialport, on a device under
  * /dev (not a pseudo-terminal), and a controller that is not the local
@@ -339,7 +441,7 @@ static int check_clinical(struct pctx *c, const struct re_config *cfg)
 		    "'serial' must be set in clinical mode: the relay "
 		    "board's USB serial number, which 'roboelf-tech "
 		    "bind-relay' prints");
-	return GL_OK;
+	return check_site_keys(c, cfg);
 }
 
 /* An open potentiometer wiper reads about 0 V: the lowest reading the

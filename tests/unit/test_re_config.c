@@ -421,9 +421,11 @@ static void emit_axis(struct sbuf *b, const struct re_config_axis *a)
 	    a->encoder_failure.torque_v);
 	put(b,
 	    "    analog: {input: %d, expected_range_v: %.17g, "
-	    "range_tolerance: %.17g}\n",
+	    "range_tolerance: %.17g,\n             reverse_v: %.17g, "
+	    "forward_v: %.17g, absolute_tolerance_v: %.17g}\n",
 	    a->analog.input, a->analog.expected_range_v,
-	    a->analog.range_tolerance);
+	    a->analog.range_tolerance, a->analog.reverse_v,
+	    a->analog.forward_v, a->analog.absolute_tolerance_v);
 	put(b, "    allowed_error: %.17g\n    persistence_cycles: %d\n",
 	    a->allowed_error, a->persistence_cycles);
 	put(b, "    monotonic_margin_v: %.17g\n", a->monotonic_margin_v);
@@ -443,6 +445,7 @@ static void emit(struct sbuf *b, const struct re_config *c)
 	    c->controller.address, c->controller.model);
 	put(b, "  timeout_ms: %d\n  connect_timeout_ms: %d\n",
 	    c->controller.timeout_ms, c->controller.connect_timeout_ms);
+	put(b, "  power_output: %d\n", c->controller.power_output);
 	put(b, "relay:\n  port_clinical: \"%s\"\n  port_development: \"%s\"\n",
 	    c->relay.port_clinical, c->relay.port_development);
 	put(b, "  serial: \"%s\"\n", c->relay.serial);
@@ -666,6 +669,17 @@ static void test_readback_default(void **state)
 }
 
 /* A clinical configuration that passes every clinical rule. */
+/* The robot's values a clinical configuration must write (besides the
+ * controller's and the relay's): the development configuration's. */
+#define SITE_AXIS(range)                                                    \
+	"  - {vmax: 8000, travel_counts: " range ", kp: 6, ki: 1, kd: 64, "  \
+	"torque_limit_v: 5.0,\n     analog: {expected_range_v: 4.0, "       \
+	"reverse_v: 0.5, forward_v: 4.5}}\n"
+#define SITE_ROBOT                                                          \
+	"joystick:\n  inputs: [1, 2, 3, 4, 5, 6, 7, 8, 17, 18, 19, 20]\n"   \
+	"  active_low: false\naxes:\n" SITE_AXIS("100000")                   \
+	    SITE_AXIS("100000") SITE_AXIS("80000")
+
 static void test_clinical_accepted(void **state)
 {
 	struct re_config c;
@@ -676,10 +690,10 @@ static void test_clinical_accepted(void **state)
 	assert_int_equal(
 	    parse_text(
 		"mode: clinical\ncontroller:\n"
-		"  address: 10.0.0.2\nrelay:\n"
+		"  address: 10.0.0.2\n  power_output: 0\nrelay:\n"
 		"  port_clinical: /dev/serial/by-id/usb-TEST_relay-if00\n"
-		"  serial: A10KXYZ9\n"
-		"  channel: 2\n",
+		"  serial: A10KXYZ9\n  protocol: devantech\n"
+		"  channel: 2\n" SITE_ROBOT,
 		&c, err, sizeof(err)),
 	    GL_OK);
 	assert_string_equal(c.relay.serial, "A10KXYZ9");
@@ -985,9 +999,9 @@ static const char *const site_values[N_SITE_FILL] = {
     "0.5",
     "50",
     "3.0",
-    "3.0",
-    "1.0",
-    "4.0",
+    "3.9", /* C's potentiometer: each within range_tolerance of the */
+    "0.6", /* default of another, so that a deleted one is refused by */
+    "4.3", /* the site-key rule, not the span's (test_site_key_deleted) */
 };
 
 /* The whole of @path, NUL-terminated; the test fails if it cannot be read. */
@@ -1095,8 +1109,53 @@ static void test_site_template_filled(void **state)
 	assert_int_equal(cc->travel_counts, 60000);
 	assert_true(cc->kp == 5.5 && cc->ki == 0.5 && cc->kd == 50);
 	assert_true(cc->torque_limit_v == 3.0);
-	assert_true(cc->analog.reverse_v == 1.0 && cc->analog.forward_v == 4.0);
+	assert_true(cc->analog.expected_range_v == 3.9);
+	assert_true(cc->analog.reverse_v == 0.6 && cc->analog.forward_v == 4.3);
 	assert_int_equal(cc->unit, RE_UNIT_MM);
+	free(text);
+	free(tmpl);
+}
+
+/* The filled template with the line of every site value deleted in turn:
+ * refused, naming that key (it would take galil-sim's default); the keys
+ * are the template's FILL-INs, in order (re_config_site_key()). */
+static void test_site_key_deleted(void **state)
+{
+	char err[RE_CONFIG_ERR_MAX], want[256], key[64];
+	struct re_config c;
+	size_t len, k;
+	char *tmpl = slurp(SITE_FILE, &len), *text = fill_in(tmpl);
+
+	(void)state;
+	for (k = 0; k < N_SITE_FILL; k++) {
+		char *cut = strdup(text), *p = cut;
+
+		assert_non_null(re_config_site_key((int)k, key, sizeof(key)));
+		assert_string_equal(key, site_fill[k].path);
+		for (int l = 1; l < site_fill[k].line; l++)
+			p = strchr(p, '\n') + 1;
+		memmove(p, strchr(p, '\n') + 1, strlen(strchr(p, '\n') + 1) + 1);
+		assert_int_equal(parse_text(cut, &c, err, sizeof(err)),
+				 GL_ERR_CONFIG);
+		/* three have a rule of their own, checked first */
+		if (k == 0)
+			snprintf(want, sizeof(want), "'address' 127.0.0.1:23023 "
+				 "is a loopback address; clinical mode needs the "
+				 "real controller");
+		else if (k == 2 || k == 3)
+			snprintf(want, sizeof(want),
+				 "'%s' must be set in clinical mode",
+				 k == 2 ? "port_clinical" : "serial");
+		else
+			snprintf(want, sizeof(want),
+				 "clinical mode: 1 value of this site is not "
+				 "written: '%s'.",
+				 site_fill[k].path);
+		if (!strstr(err, want))
+			fail_msg("%s deleted: %s", site_fill[k].path, err);
+		free(cut);
+	}
+	assert_null(re_config_site_key((int)N_SITE_FILL, key, sizeof(key)));
 	free(text);
 	free(tmpl);
 }
@@ -1196,6 +1255,7 @@ int main(void)
 	    cmocka_unit_test(test_dump),
 	    cmocka_unit_test(test_site_template_refused),
 	    cmocka_unit_test(test_site_template_filled),
+	    cmocka_unit_test(test_site_key_deleted),
 	    cmocka_unit_test(test_fill_in_anywhere),
 	    cmocka_unit_test(test_fill_in_list_cut),
 	};
