@@ -10,8 +10,9 @@
 #   make lint     clang-format dry run and cppcheck
 #   make fuzz     every libFuzzer target for FUZZ_SECONDS (default 600) each
 #   make install / uninstall   (PREFIX, DESTDIR)
-#   make deb      the Debian package build/roboelf_<version>_<arch>.deb
+#   make deb      the Debian packages build/roboelf{,-sim}_<version>_<arch>.deb
 #   make fresh    README's two commands in a minimal Debian 12 root (root only)
+#   make pkgtest  the two packages installed, used, purged in such a root (root only)
 #
 # Source layout conventions (so that adding a file needs no Makefile edit):
 #   pc/base/*.c          shared base: clock, files, YAML -> $(BUILD)/lib/libbase.a
@@ -172,7 +173,7 @@ asan: deps
 # The scripts run with only the commands of docs/commands.md on their PATH
 # (tools/cmdtable.sh), as the tests do (tests/run-all.sh).
 CMDPATH = $(CURDIR)/$(BUILD)/cmdpath
-.PHONY: cmdpath fresh
+.PHONY: cmdpath fresh pkgtest
 cmdpath:
 	@sh tools/cmdtable.sh path $(CMDPATH)
 
@@ -189,6 +190,13 @@ bench: deps
 fresh: deps
 	@$(MAKE) --no-print-directory cmdpath
 	@BUILD=$(BUILD) ROBOELF_SYSPATH="$$PATH" PATH=$(CMDPATH) sh tools/fresh.sh
+
+# The two Debian packages installed, used and purged in a copy of that
+# Debian 12 root (root only; SKIPPED otherwise; tests/pkg/pkgtest.sh;
+# ROBOELF_DEBROOT: where the pristine root is kept, default $(BUILD)/fresh)
+pkgtest: deps
+	@$(MAKE) --no-print-directory cmdpath
+	@BUILD=$(BUILD) ROBOELF_SYSPATH="$$PATH" PATH=$(CMDPATH) sh tests/pkg/pkgtest.sh
 
 # The soak: seeded random joystick use with pot noise and transient invalid
 # states (tests/system/test_sys_soak.c); make check runs it for 60 s.
@@ -290,7 +298,15 @@ DATADIR = $(PREFIX)/share/roboelf
 DOCDIR = $(PREFIX)/share/doc/roboelf
 MAN1 := $(wildcard docs/*.1)
 MAN5 := $(wildcard docs/*.5)
-DOC_FILES := $(shell find docs -type f ! -name '.*' 2>/dev/null | LC_ALL=C sort)
+# The developer's documents (the code's layout, the command table, fuzzing,
+# the man pages' sources: read with man) stay in the source tree.
+DEV_DOCS := docs/architecture.md docs/commands.md docs/fuzzing.md $(MAN1) $(MAN5)
+DOC_FILES := $(filter-out $(DEV_DOCS),$(shell find docs -type f ! -name '.*' 2>/dev/null | \
+	LC_ALL=C sort))
+# The site's state (the clinical template's paths): the calibration files
+# and the log with the traces, shared by the operators' group roboelf.
+STATE_DIRS := /var/lib/roboelf /var/log/roboelf
+STATE_GROUP := roboelf
 PATHS_STAMP := $(BUILD)/gen/paths
 $(call obj,pc/base/base_paths.c): ALL_CFLAGS += -DROBOELF_DATADIR='"$(DATADIR)"' \
 	-DROBOELF_SYSCONFDIR='"$(SYSCONFDIR)"'
@@ -315,6 +331,21 @@ install: all
 	$(INSTALL) -d "$(DESTDIR)$(SYSCONFDIR)/roboelf"
 	[ -e "$(DESTDIR)$(SYSCONFDIR)/roboelf/roboelf.yaml" ] || \
 		$(INSTALL) -m 644 config/roboelf-site.yaml "$(DESTDIR)$(SYSCONFDIR)/roboelf/roboelf.yaml"
+	@# the site's state: 2770 root:roboelf (setgid: what roboelf writes
+	@# there belongs to the group); the group is given when it exists and
+	@# this is root (the package's postinst makes it), else said
+	$(INSTALL) -d -m 2770 $(addprefix "$(DESTDIR),$(addsuffix ",$(STATE_DIRS)))
+	@if [ "$$(id -u)" = 0 ] && getent group $(STATE_GROUP) >/dev/null; then \
+		chgrp $(STATE_GROUP) $(addprefix "$(DESTDIR),$(addsuffix ",$(STATE_DIRS))) || exit 1; \
+	else echo "install: $(STATE_DIRS) are not the operators' yet: as root," \
+		"groupadd --system $(STATE_GROUP); chgrp $(STATE_GROUP) $(STATE_DIRS)" \
+		"(docs/technician.md, \"Installation\")"; fi
+	$(INSTALL) -m 755 tools/demo.sh "$(DESTDIR)$(DATADIR)/demo.sh"
+	@# the link's ifupdown hook: rto_min on the controller's route
+	@# (docs/link.md); an existing (edited) one is kept
+	$(INSTALL) -d "$(DESTDIR)$(SYSCONFDIR)/network/if-up.d"
+	[ -e "$(DESTDIR)$(SYSCONFDIR)/network/if-up.d/roboelf" ] || \
+		$(INSTALL) -m 755 packaging/ifupdown/roboelf "$(DESTDIR)$(SYSCONFDIR)/network/if-up.d/roboelf"
 	$(INSTALL) -m 644 README.md "$(DESTDIR)$(DOCDIR)/"
 	@for f in $(DOC_FILES); do \
 		$(INSTALL) -D -m 644 "$$f" "$(DESTDIR)$(DOCDIR)/$$f" || exit 1; done
@@ -324,6 +355,9 @@ uninstall:
 	rm -f $(addprefix "$(DESTDIR)$(PREFIX)/share/man/man1/",$(notdir $(MAN1)))
 	rm -f $(addprefix "$(DESTDIR)$(PREFIX)/share/man/man5/",$(notdir $(MAN5)))
 	rm -rf "$(DESTDIR)$(DATADIR)" "$(DESTDIR)$(DOCDIR)"
+	@# the site's calibration, log and traces are kept; only empty
+	@# directories go
+	-rmdir $(addprefix "$(DESTDIR),$(addsuffix ",$(STATE_DIRS))) 2>/dev/null
 
 # ---- missing packages and the Debian package ---------------------
 # have-deps: before compiling, name the missing Debian packages and `make deps`

@@ -30,7 +30,6 @@
  */
 #include <errno.h>
 #include <getopt.h>
-#include <limits.h>
 #include <sched.h>
 #include <signal.h>
 #include <stdio.h>
@@ -492,11 +491,9 @@ static int cleanup(struct app *a)
 /* The console: the board in each axis's unit (or counts, --counts). */
 static void open_console(struct app *a, int counts)
 {
-	char abs[PATH_MAX];
-
 	re_console_open(&a->con, stdout, STDIN_FILENO);
-	re_console_log_path(
-	    &a->con, realpath(a->cfg.log.path, abs) ? abs : a->cfg.log.path);
+	/* absolute since the start (re_app_load_config()) */
+	re_console_log_path(&a->con, a->cfg.log.path);
 	for (int i = 0; i < RE_AXES; i++)
 		re_console_units(&a->con, i, re_unit_name(a->cfg.axes[i].unit),
 				 a->cfg.axes[i].counts_per_unit);

@@ -7,8 +7,8 @@
 # through the simulator's control port: each axis forward and back, a brief
 # invalid switch state that must not trip, and finally a potentiometer fault
 # that must trip the E-stop. It ends by naming the flight recorder's trace
-# of that fault (kept in $BUILD/demo/) and the PNG pages roboelf
-# roboelf-tech show-trace drew from it, and the directory $BUILD/demo/run-<time>
+# of that fault (kept in $BUILD/demo/; installed: ./roboelf-demo/) and the PNG
+# pages roboelf-tech show-trace drew from it, and the directory .../run-<time>
 # where roboelf ran (its log, calibration file and output). roboelf's board
 # keeps to the bottom of the terminal; this narration scrolls above it.
 # roboelf is stopped by a SIGTERM to itself (an orderly quit), every other
@@ -20,9 +20,22 @@
 set -u
 set -m # each background job in its own process group, stopped as a group
 BUILD=${BUILD:-build}
-TOP=$(cd "$(dirname "$0")/.." && pwd)
-cd "$TOP" || exit 1
-BIN=$(cd "${ROBOELF_BIN:-$BUILD/bin}" && pwd) || exit 1
+HERE=$(cd "$(dirname "$0")" && pwd) || exit 1
+if [ -f "$HERE/../dmc/MANIFEST" ]; then
+	# the source tree (tools/demo.sh, make demo): its programs and dmc/,
+	# the demo's files in $BUILD/demo
+	TOP=$(cd "$HERE/.." && pwd)
+	cd "$TOP" || exit 1
+	BIN=$(cd "${ROBOELF_BIN:-$BUILD/bin}" && pwd) || exit 1
+	OUTBASE=$TOP/$BUILD/demo
+else
+	# installed (package roboelf-sim: /usr/share/roboelf/demo.sh): the
+	# data directory holds dmc/ and config/, the programs are on PATH, the
+	# demo's files go to ./roboelf-demo
+	TOP=$HERE
+	BIN=${ROBOELF_BIN:-$(dirname "$(command -v galil-sim || echo /usr/bin/galil-sim)")}
+	OUTBASE=$PWD/roboelf-demo
+fi
 TMP=$(mktemp -d /tmp/roboelf-demo.XXXXXX)
 SIM_PID=""; RE_PID=""
 
@@ -86,7 +99,7 @@ read -r _ _ _ addr _ CPORT _ RELAY <"$TMP/sim.out"
 say "galil-sim at $addr, control port $CPORT, relay $RELAY"
 
 say "checking and downloading dmc/ with galil-load"
-"$BIN/galil-load" -a "$addr" --start dmc/ || die "galil-load failed"
+"$BIN/galil-load" -a "$addr" --config "$TOP/config/roboelf.yaml" --start "$TOP/dmc/" || die "galil-load failed"
 
 if [ "${INTERACTIVE:-}" = 1 ]; then
 	exec 3</dev/tty
@@ -152,7 +165,7 @@ stop_roboelf() {
 	wait "$RE_PID" 2>/dev/null
 	RE_PID=""
 }
-RUN="$TOP/$BUILD/demo/run-$(date +%Y%m%d-%H%M%S)"
+RUN="$OUTBASE/run-$(date +%Y%m%d-%H%M%S)"
 mkdir -p "$RUN" || die "cannot make $RUN"
 say "starting roboelf (full calibration); its log and calibration file go to $RUN"
 start_roboelf full
@@ -238,7 +251,7 @@ say "relay: $(ctl relay); $(grep -o -m1 'FAULT ENCODER:.*' "$RUN/roboelf.out" | 
 say "waiting for the flight recorder's trace of the fault (written 2 s after it)"
 wait_line "$RUN/roboelf.log" 'trace: .* written' 10 || die "no trace of the fault was written"
 trace=$(sed -n 's/.* trace: \(.*\) written (.*/\1/p' "$RUN/roboelf.log" | head -n 1)
-OUT="$TOP/$BUILD/demo"
+OUT=$OUTBASE
 mkdir -p "$OUT" && cp "$trace" "$OUT/" || die "cannot keep the trace in $OUT"
 trace="$OUT/$(basename "$trace")"
 "$BIN/roboelf-tech" show-trace "$trace" >"$TMP/show.out" 2>"$TMP/show.err" ||

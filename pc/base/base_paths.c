@@ -5,6 +5,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <unistd.h>
 
 /* Set by the Makefile from PREFIX and SYSCONFDIR; these defaults are the
@@ -64,4 +65,35 @@ int base_paths_dmc_dir(char *out, size_t len)
 		(int)sizeof(manifest))
 		return -1;
 	return access(manifest, F_OK) == 0 ? 0 : -1;
+}
+
+int base_paths_absolute(const char *cwd, const char *path, char *out,
+			size_t len)
+{
+	size_t c = strlen(cwd);
+	int n;
+
+	if (*path == '/' || !*path) {
+		n = snprintf(out, len, "%s", path);
+	} else if (cwd[0] != '/') {
+		n = -1;
+	} else {
+		while (path[0] == '.' && path[1] == '/') {
+			path += 2;
+			while (*path == '/')
+				path++;
+		}
+		if (!strcmp(path, "."))
+			path = "";
+		while (c > 1 && cwd[c - 1] == '/')
+			c--; /* "/home/x/" and "/" alike */
+		n = snprintf(out, len, "%.*s%s%s", (int)c, cwd,
+			     *path && cwd[c - 1] != '/' ? "/" : "", path);
+	}
+	if (n < 0 || (size_t)n >= len) {
+		if (len)
+			out[0] = '\0';
+		return -1;
+	}
+	return 0;
 }

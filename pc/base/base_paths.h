@@ -57,4 +57,22 @@ int base_paths_sysconf(const char *name, char *out, size_t len);
  */
 int base_paths_dmc_dir(char *out, size_t len);
 
+/*
+ * base_paths_absolute() - @path as an absolute path, for a file the
+ * configuration names relative to the directory a program is started in
+ * (the log, the calibration file, the traces): printed in full wherever
+ * it is named, so that nobody has to know where the program was started.
+ * Purely textual: nothing is looked up, ".." and links are left alone.
+ * @cwd:  the working directory, absolute (getcwd() at start)
+ * @path: an absolute path (copied as it is), a relative one, or "" (copied:
+ *        nothing configured)
+ * @out:  out: @cwd + "/" + @path, with @path's leading "./" dropped ("."
+ *        alone gives @cwd) and no "//" when @cwd is "/"
+ * @len:  size of @out in bytes
+ * Return: 0, or -1 when @cwd is not absolute or the result does not fit
+ *         (@out then holds "").
+ */
+int base_paths_absolute(const char *cwd, const char *path, char *out,
+			size_t len);
+
 #endif /* BASE_PATHS_H */

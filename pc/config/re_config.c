@@ -27,6 +27,7 @@
 #include <string.h>
 
 #include "base_file.h"
+#include "base_paths.h"
 #include "base_yaml.h"
 #include "gl_err.h"
 #include "gl_hash.h"
@@ -283,6 +284,36 @@ void re_config_relay_cfg(const struct re_config *cfg, struct re_relay_cfg *out)
 	out->off_len = r->off_len;
 	snprintf(out->icstation_state, sizeof(out->icstation_state), "%s",
 		 r->icstation_state);
+}
+
+int re_config_absolute(struct re_config *cfg, const char *cwd, char *err,
+		       size_t errlen)
+{
+	static const char *const names[] = {"calibration.file", "log.path",
+					    "recorder.dir"};
+	char *field[] = {cfg->calibration.file, cfg->log.path,
+			 cfg->recorder.dir};
+	char out[3][RE_PATH_MAX];
+
+	for (int i = 0; i < 3; i++) {
+		if (base_paths_absolute(cwd, field[i], out[i], RE_PATH_MAX) ==
+		    0)
+			continue;
+		if (cwd[0] != '/')
+			snprintf(err, errlen,
+				 "%s: '%s' is relative to the working "
+				 "directory, which is not known",
+				 names[i], field[i]);
+		else
+			snprintf(err, errlen,
+				 "%s: '%s' in '%s' is longer than %d bytes: "
+				 "give an absolute path",
+				 names[i], field[i], cwd, RE_PATH_MAX - 1);
+		return GL_ERR_CONFIG;
+	}
+	for (int i = 0; i < 3; i++)
+		memcpy(field[i], out[i], RE_PATH_MAX);
+	return GL_OK;
 }
 
 uint64_t re_config_hash(const struct re_config *cfg)

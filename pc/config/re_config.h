@@ -275,6 +275,22 @@ void re_config_relay_cfg(const struct re_config *cfg, struct re_relay_cfg *out);
 uint64_t re_config_hash(const struct re_config *cfg);
 
 /*
+ * re_config_absolute() - the files the configuration names relative to the
+ * directory a program is started in - calibration.file, log.path and
+ * recorder.dir (unless "") - made absolute against @cwd
+ * (base_paths_absolute()). Called once at start, before anything is opened:
+ * every line that names one of them then names it in full, and nothing is
+ * resolved later (no allocation, no lookup in the cycle).
+ * @cwd: the working directory at start, absolute; "" when it is not known
+ *       (a relative name is then an error)
+ * Return: GL_OK, or GL_ERR_CONFIG with @err naming the field and the value
+ * (the result longer than RE_PATH_MAX - 1 bytes, or no working directory);
+ * @cfg is then unchanged.
+ */
+int re_config_absolute(struct re_config *cfg, const char *cwd, char *err,
+		       size_t errlen);
+
+/*
  * re_config_dump() - a one-paragraph summary for the log (no newline).
  * @buf: [out] NUL-terminated, truncated to @cap.
  * Return: the length the full summary needs (as snprintf).

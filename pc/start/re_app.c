@@ -4,10 +4,12 @@
 #include "re_app.h"
 
 #include <errno.h>
+#include <limits.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "base_clock.h"
@@ -158,6 +160,22 @@ int re_app_print_version(const char *prog, struct re_app_args *o)
 	return 0;
 }
 
+/* The log, the calibration file and the traces named in full from here
+ * on: relative names resolved against the directory the program was
+ * started in, once, before anything is opened (re_config_absolute()).
+ * Return: 0, or -1 (said on stderr). */
+static int absolute_paths(struct app *a)
+{
+	char cwd[PATH_MAX];
+
+	if (!getcwd(cwd, sizeof(cwd)))
+		cwd[0] = '\0'; /* only an error for a relative name */
+	if (re_config_absolute(&a->cfg, cwd, a->err, sizeof(a->err)) == GL_OK)
+		return 0;
+	fprintf(stderr, "%s: error: %s\n", a->prog, a->err);
+	return -1;
+}
+
 int re_app_load_config(struct app *a, struct re_app_args *g)
 {
 	re_app_find_config(g);
@@ -181,6 +199,8 @@ int re_app_load_config(struct app *a, struct re_app_args *g)
 			a->prog, BASE_PATHS_ROOT_ENV);
 		return -1;
 	}
+	if (absolute_paths(a) < 0)
+		return -1;
 	if (re_config_validate(&a->cfg, a->err, sizeof(a->err)) != GL_OK ||
 	    check_analog(&a->cfg, a->err, sizeof(a->err)) != GL_OK) {
 		fprintf(stderr, "%s: error: %s\n", a->prog, a->err);
@@ -197,6 +217,10 @@ int re_app_open_log(struct app *a, const struct re_app_args *g)
 	char dump[1536];
 	int rc;
 
+	/* the log, its rotations and the calibration file are shared by the
+	 * operators' group (/var/log/roboelf and /var/lib/roboelf, mode
+	 * 2770): group write is kept whatever the login's umask */
+	umask(umask(0) & ~(mode_t)S_IWGRP);
 	lc.max_bytes = (size_t)a->cfg.log.max_bytes;
 	lc.keep = a->cfg.log.keep; /* 1..9, checked by the config loader */
 	rc = re_log_open(&a->log, a->cfg.log.path, &lc);

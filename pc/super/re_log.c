@@ -28,8 +28,10 @@ static int re_log_open_fd(struct re_log *lg)
 {
 	struct stat st;
 
+	/* group-writable (within the umask): every operator of the group
+	 * roboelf appends to the one log of /var/log/roboelf */
 	lg->fd =
-	    open(lg->path, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+	    open(lg->path, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0664);
 	if (lg->fd < 0)
 		return GL_ERR_SYS;
 	if (fstat(lg->fd, &st) != 0) {

@@ -1112,6 +1112,12 @@ static void test_site_template_filled(void **state)
 	assert_true(cc->analog.expected_range_v == 3.9);
 	assert_true(cc->analog.reverse_v == 0.6 && cc->analog.forward_v == 4.3);
 	assert_int_equal(cc->unit, RE_UNIT_MM);
+	/* the site's state in its place: the package makes these
+	 * directories for the group roboelf (docs/technician.md) */
+	assert_string_equal(c.calibration.file,
+			    "/var/lib/roboelf/roboelf-calibration.txt");
+	assert_string_equal(c.log.path, "/var/log/roboelf/roboelf.log");
+	assert_string_equal(c.recorder.dir, ""); /* next to the log */
 	free(text);
 	free(tmpl);
 }
@@ -1158,6 +1164,57 @@ static void test_site_key_deleted(void **state)
 	assert_null(re_config_site_key((int)N_SITE_FILL, key, sizeof(key)));
 	free(text);
 	free(tmpl);
+}
+
+/* Relative names made absolute against the working directory, once; an
+ * absolute one and "" (traces next to the log) kept; a result too long,
+ * or no working directory, refused with the field named and nothing
+ * changed. */
+static void test_absolute(void **state)
+{
+	struct re_config c, before;
+	char err[RE_CONFIG_ERR_MAX], cwd[300], want[400];
+
+	(void)state;
+	re_config_defaults(&c);
+	assert_string_equal(c.calibration.file, "roboelf-calibration.txt");
+	strcpy(c.log.path, "./logs/roboelf.log");
+	assert_int_equal(re_config_absolute(&c, "/home/op", err, sizeof(err)),
+			 GL_OK);
+	assert_string_equal(c.calibration.file,
+			    "/home/op/roboelf-calibration.txt");
+	assert_string_equal(c.log.path, "/home/op/logs/roboelf.log");
+	assert_string_equal(c.recorder.dir, "");
+	strcpy(c.recorder.dir, "traces");
+	assert_int_equal(re_config_absolute(&c, "/srv", err, sizeof(err)),
+			 GL_OK);
+	assert_string_equal(c.calibration.file,
+			    "/home/op/roboelf-calibration.txt");
+	assert_string_equal(c.recorder.dir, "/srv/traces");
+
+	re_config_defaults(&c);
+	strcpy(c.log.path, "/var/log/roboelf/roboelf.log");
+	before = c;
+	assert_int_equal(re_config_absolute(&c, "", err, sizeof(err)),
+			 GL_ERR_CONFIG);
+	assert_string_equal(err, "calibration.file: 'roboelf-calibration.txt' "
+				 "is relative to the working directory, "
+				 "which is not known");
+	assert_memory_equal(&c, &before, sizeof(c));
+	strcpy(c.calibration.file, "/var/lib/roboelf/cal.txt");
+	memset(cwd, 'd', sizeof(cwd));
+	cwd[0] = '/';
+	cwd[250] = '\0';
+	strcpy(c.recorder.dir, "traces");
+	before = c;
+	assert_int_equal(re_config_absolute(&c, cwd, err, sizeof(err)),
+			 GL_ERR_CONFIG);
+	snprintf(want, sizeof(want),
+		 "recorder.dir: 'traces' in '%s' is longer than 255 bytes: "
+		 "give an absolute path",
+		 cwd);
+	assert_string_equal(err, want);
+	assert_memory_equal(&c, &before, sizeof(c));
 }
 
 /* The placeholder is found wherever it is: quoted, in a list, in a flow
@@ -1256,6 +1313,7 @@ int main(void)
 	    cmocka_unit_test(test_site_template_refused),
 	    cmocka_unit_test(test_site_template_filled),
 	    cmocka_unit_test(test_site_key_deleted),
+	    cmocka_unit_test(test_absolute),
 	    cmocka_unit_test(test_fill_in_anywhere),
 	    cmocka_unit_test(test_fill_in_list_cut),
 	};

@@ -10,6 +10,7 @@
  *   roboelf-tech show-trace FILE [--window FROM:TO]
  *   roboelf-tech check-host[=SECONDS] [-c FILE] [--period MS]
  *   roboelf-tech bind-relay [--serial S] [--rules-file PATH]
+ *   roboelf-tech --print KEY [-c FILE]
  *
  * Exit codes: 0 done; 2 usage, configuration or a file that cannot be
  * read (bind-relay: the rules file cannot be written); 3 no relay or
@@ -26,6 +27,7 @@
 #include <unistd.h>
 
 #include "gl_err.h"
+#include "gl_link.h"
 #include "re_app.h"
 #include "re_bindrelay.h"
 #include "re_calshow.h"
@@ -52,6 +54,7 @@ struct topts {
 	int find_port;	       /* and port (0: the defaults) */
 	int seconds;	       /* check-host: the probe's length */
 	struct re_bindrelay_opts bind; /* bind-relay: --serial, --rules-file */
+	const char *print;     /* --print KEY */
 	int version;
 };
 
@@ -68,6 +71,7 @@ static void usage(FILE *f)
 		"[--period MS]\n"
 		"       roboelf-tech bind-relay [--serial S] [--rules-file "
 		"PATH]\n"
+		"       roboelf-tech --print KEY [-c FILE]\n"
 		"\n"
 		"  commission DIR       the commissioning run; report in DIR\n"
 		"  show-calibration FILE  print a calibration file (and "
@@ -105,6 +109,10 @@ static void usage(FILE *f)
 		"  -h, --help           this text\n"
 		"      --version        the release, the DMC interface, the "
 		"files it uses\n"
+		"      --print KEY      one checked value: controller.address, "
+		"controller.host,\n"
+		"                       mode, log.path, calibration.file (in "
+		"full)\n"
 		"\n"
 		"exit: 0 done, 2 usage/config, 3 no relay/controller, "
 		"5 commissioning found a fault,\n"
@@ -196,6 +204,45 @@ static int show_calibration(struct app *a, struct re_app_args *g,
 	return re_calshow_print(file, allowed, RE_AXES, stdout, stderr) == GL_OK
 		   ? 0
 		   : EXIT_USAGE;
+}
+
+/* --print KEY: one value of the configuration, read and checked as
+ * roboelf reads it (a template not filled in is refused), for scripts
+ * that must not parse YAML (the link's ifupdown hook). Return: 0 printed,
+ * EXIT_USAGE (unknown KEY, configuration refused: said on stderr). */
+static int print_key(struct app *a, struct re_app_args *g, const char *key)
+{
+	static const char *const keys[] = {"controller.address",
+					   "controller.host", "mode",
+					   "log.path", "calibration.file"};
+	char host[RE_PATH_MAX], port[16];
+	size_t k = 0, n = sizeof(keys) / sizeof(keys[0]);
+
+	while (k < n && strcmp(key, keys[k]))
+		k++;
+	if (k == n) {
+		fprintf(stderr,
+			"roboelf-tech: error: --print '%s': not a key it "
+			"prints (controller.address, controller.host, mode, "
+			"log.path, calibration.file)\n",
+			key);
+		return EXIT_USAGE;
+	}
+	if (re_app_load_config(a, g) < 0)
+		return EXIT_USAGE;
+	if (k == 1 &&
+	    gl_link_addr_split(a->cfg.controller.address, host, sizeof(host),
+			       port, sizeof(port)) != GL_OK) {
+		fprintf(stderr, "roboelf-tech: error: invalid address '%s'\n",
+			a->cfg.controller.address);
+		return EXIT_USAGE;
+	}
+	printf("%s\n", k == 0	? a->cfg.controller.address
+		       : k == 1 ? host
+		       : k == 2 ? re_mode_name(a->cfg.mode)
+		       : k == 3 ? a->cfg.log.path
+				: a->cfg.calibration.file);
+	return 0;
 }
 
 /* show-trace: the trace checked, summarised and drawn. */
@@ -424,6 +471,7 @@ static int parse_opts(int argc, char **argv, struct topts *o)
 	    {"bind-relay", no_argument, NULL, 'B'},
 	    {"help", no_argument, NULL, 'h'},
 	    {"version", no_argument, NULL, 'V'},
+	    {"print", required_argument, NULL, 'K'},
 	    {NULL, 0, NULL, 0},
 	};
 	int c;
@@ -438,13 +486,20 @@ static int parse_opts(int argc, char **argv, struct topts *o)
 			o->version = 1;
 		else if (c == 'B')
 			o->sub = "bind-relay";
+		else if (c == 'K')
+			o->print = optarg;
 		else if (opt_value(o, c, optarg) < 0)
 			return -1;
 	}
-	if (o->version)
+	if (o->version || (o->print && optind == argc))
 		return 0;
 	if (o->sub) /* --bind-relay */
 		return operands(o, argc - optind, argv + optind);
+	if (o->print) {
+		fprintf(stderr, "roboelf-tech: error: --print takes no "
+				"command\n");
+		return -1;
+	}
 	if (optind >= argc) {
 		usage(stderr);
 		return -1;
@@ -475,6 +530,8 @@ int main(int argc, char **argv)
 	re_app_root_note(a.prog);
 	if (o.version)
 		return re_app_print_version(a.prog, &o.g);
+	if (o.print)
+		return print_key(&a, &o.g, o.print);
 	if (!strcmp(o.sub, "show-calibration"))
 		return show_calibration(&a, &o.g, o.file);
 	if (!strcmp(o.sub, "show-trace"))
