@@ -98,6 +98,11 @@ static void put_sq(FILE *gp, const char *s)
 	}
 }
 
+/* The words of the decoded joystick command and of the program's motion
+ * command (docs/dmc-interface.md, ZAC: -1 invalid, 0 none, k+1 command k). */
+static const char *const cmd_words[8] = {"invalid", "none",  "A fwd", "A rev",
+					 "B fwd",   "B rev", "C fwd", "C rev"};
+
 /* Terminal, output, data settings, the window and the fault mark. */
 static void page_start(FILE *gp, const char *png, const char *path,
 		       const struct re_trace_hdr *h, const char *what,
@@ -111,19 +116,22 @@ static void page_start(FILE *gp, const char *png, const char *path,
 	put_sq(gp, png);
 	fputs("'\nset datafile separator ','\nset datafile columnheaders\n"
 	      "set grid\nset key outside right top\n"
-	      "set lmargin at screen 0.17\nset rmargin at screen 0.82\n",
+	      "set lmargin at screen 0.20\nset rmargin at screen 0.80\n"
+	      "set tmargin 2\n",
 	      gp);
 	if (w && w->have_from)
 		snprintf(from, sizeof(from), "%.6f", w->from_s);
 	if (w && w->have_to)
 		snprintf(to, sizeof(to), "%.6f", w->to_s);
 	fprintf(gp, "set xrange [%s:%s]\n", from, to);
+	/* the fault's line through each panel, its word above the panel:
+	 * never on a trace */
 	if (h->have_fault)
 		fprintf(gp,
 			"set arrow 1 from %.6f, graph 0 to %.6f, graph 1 "
 			"nohead lc rgb 'red' lw 2 front\n"
-			"set label 1 'FAULT' at %.6f, graph 0.93 right offset "
-			"-0.5,0 tc rgb 'red' front\n",
+			"set label 1 'FAULT' at %.6f, graph 1 center offset "
+			"0,0.7 tc rgb 'red' front\n",
 			h->fault_t_s, h->fault_t_s, h->fault_t_s);
 	fputs("set multiplot layout ", gp);
 	fprintf(gp, "%d,1 title \"", panels);
@@ -145,28 +153,51 @@ static void plot_file(FILE *gp, const char *path)
 	fputs("'\n", gp);
 }
 
+/* Counts per unit of axis @a and the unit's name, when @u is the trace's
+ * configuration and gives the axis a unit; else 1 and "counts". */
+static double axis_scale(const struct re_trace_hdr *h, int a,
+			 const struct re_traceshow_units *u, const char **unit)
+{
+	*unit = "counts";
+	if (!u || u->config_hash != h->config_hash)
+		return 1;
+	for (int i = 0; i < u->n && i < RE_TRACE_AXES; i++)
+		if (!strcmp(u->name[i], h->axis[a]) && u->per_unit[i] > 0) {
+			*unit = u->unit[i];
+			return u->per_unit[i];
+		}
+	return 1;
+}
+
 static void axis_page(FILE *gp, const char *path, const char *png,
 		      const struct re_trace_hdr *h, int a,
-		      const struct re_traceshow_win *w)
+		      const struct re_traceshow_win *w,
+		      const struct re_traceshow_units *u)
 {
-	const char *x = h->axis[a];
-	char what[64];
+	const char *x = h->axis[a], *unit;
+	double per = axis_scale(h, a, u, &unit);
+	char what[96];
 
-	snprintf(what, sizeof(what), "axis %s", x);
+	if (per != 1 || strcmp(unit, "counts"))
+		snprintf(what, sizeof(what), "axis %s, in %s (%g counts/%s)",
+			 x, unit, per, unit);
+	else
+		snprintf(what, sizeof(what), "axis %s, in counts", x);
 	page_start(gp, png, path, h, what, w, 3);
 	plot_file(gp, path);
 	fprintf(gp,
-		"set ylabel 'position, counts'\n"
-		"plot file using 't_s':'%s_enc' with steps lw 2 title "
-		"'encoder', '' using 't_s':'%s_ref' with steps dt 2 title "
-		"'commanded (_RP)'\n",
-		x, x);
+		"set ylabel 'position, %s'\n"
+		"plot file using 't_s':(column('%s_enc') / %.6g) with steps "
+		"lw 2 title 'encoder', '' using 't_s':(column('%s_ref') / "
+		"%.6g) with steps dt 2 title 'commanded (_RP)'\n",
+		unit, x, per, x, per);
 	fprintf(gp,
-		"set ylabel 'velocity, counts/s'\n"
-		"plot file using 't_s':'%s_vel_cps' with steps lw 2 title "
-		"'actual (_TV)', '' using 't_s':'%s_vcmd_cps' with steps dt 2 "
-		"title 'commanded'\n",
-		x, x);
+		"set ylabel 'velocity, %s/s'\n"
+		"plot file using 't_s':(column('%s_vel_cps') / %.6g) with "
+		"steps lw 2 title 'actual (_TV)', '' using "
+		"'t_s':(column('%s_vcmd_cps') / %.6g) with steps dt 2 title "
+		"'commanded'\n",
+		unit, x, per, x, per);
 	fprintf(
 	    gp,
 	    "set ylabel 'potentiometer, V'\n"
@@ -180,31 +211,56 @@ static void axis_page(FILE *gp, const char *path, const char *png,
 	fputs("unset multiplot\n", gp);
 }
 
-/* Lane @k of a value normalised by @max: k + 0.8 v / max. */
-static void lanes_page(FILE *gp, const char *path, const char *png,
-		       const struct re_trace_hdr *h,
-		       const struct re_traceshow_win *w)
+/* The joystick's switches, lane i: i + 0.8 when closed (raw bit 1). */
+static void joy_panel(FILE *gp)
 {
-	page_start(gp, png, path, h, "joystick, relay, timing", w, 3);
-	plot_file(gp, path);
-	fputs("set ylabel 'joystick inputs (raw bit; up: 1)'\nset ytics (", gp);
+	fputs("set ylabel 'joystick switch (raw bit; up: 1)'\nset ytics (", gp);
 	for (int i = 0; i < 12; i++)
 		fprintf(gp, "%s'%s' %d", i ? ", " : "", joy_names[i], i);
 	fputs(")\nset yrange [-0.5:12]\nplot for [i=0:11] file using "
 	      "'t_s':(i + 0.8 * ((int(column('joy_raw')) >> i) & 1)) with "
 	      "steps lw 2 notitle\n",
 	      gp);
-	fputs("set ylabel ''\nset ytics ('jcmd 0..6' 0, 'mcmd 0..6' 1, "
-	      "'phase: start, service, armed, FAULT' 2, "
-	      "'relay: ?, off, on' 3, 'link ok' 4)\nset yrange [-0.5:5]\n"
-	      "plot file using 't_s':(0.8 * column('jcmd') / 6) with steps "
-	      "lw 2 title 'joystick command', '' using 't_s':(1 + 0.8 * "
-	      "column('mcmd') / 6) with steps lw 2 title 'motion command', "
-	      "'' using 't_s':(2 + 0.8 * column('phase') / 3) with steps lw 2 "
-	      "title 'phase', '' using 't_s':(3 + 0.8 * column('relay') / 2) "
-	      "with steps lw 2 title 'relay', '' using 't_s':(4 + 0.8 * "
-	      "column('link_ok')) with steps lw 2 title 'link'\n",
+}
+
+/* The decoded joystick command and the program's motion command, in
+ * words: the motion command thin over the wide joystick line. */
+static void cmd_panel(FILE *gp)
+{
+	fputs("set ylabel 'command'\nset ytics (", gp);
+	for (int v = -1; v <= 6; v++)
+		fprintf(gp, "%s'%s' %d", v > -1 ? ", " : "", cmd_words[v + 1],
+			v);
+	fputs(")\nset yrange [-1.5:6.5]\n"
+	      "plot file using 't_s':'jcmd' with steps lw 6 lc rgb '#99bbff' "
+	      "title 'joystick', '' using 't_s':'mcmd' with steps lw 2 lc "
+	      "rgb 'black' title 'motion'\n",
 	      gp);
+}
+
+/* Phase, relay and link: each on lanes of its own, a word per value. */
+static void state_panel(FILE *gp)
+{
+	fputs("set ylabel 'state'\nset ytics ('start-up' 0, 'service' 1, "
+	      "'armed' 2, 'FAULT' 3, 'relay unconfirmed' 4.5, 'relay off' "
+	      "5.5, 'relay on' 6.5, 'link lost' 8, 'link ok' 9)\n"
+	      "set yrange [-0.5:9.5]\n"
+	      "plot file using 't_s':'phase' with steps lw 2 title 'phase', "
+	      "'' using 't_s':(4.5 + column('relay')) with steps lw 2 title "
+	      "'relay', '' using 't_s':(8 + column('link_ok')) with steps lw "
+	      "2 title 'link'\n",
+	      gp);
+}
+
+static void lanes_page(FILE *gp, const char *path, const char *png,
+		       const struct re_trace_hdr *h,
+		       const struct re_traceshow_win *w)
+{
+	page_start(gp, png, path, h, "joystick, relay, timing", w, 4);
+	plot_file(gp, path);
+	joy_panel(gp);
+	cmd_panel(gp);
+	state_panel(gp);
 	fprintf(gp,
 		"set ylabel 'ms'\nset ytics auto\nset yrange [0:*]\n"
 		"plot file using 't_s':'age_ms' with steps lw 2 title 'reply "
@@ -224,32 +280,63 @@ static void png_name(const char *path, const char *tag, char *buf, size_t cap)
 	snprintf(buf, cap, "%.*s-%s.png", (int)n, path, tag);
 }
 
-static int plot_pages(const char *path, const struct re_trace_hdr *h,
-		      const struct re_traceshow_win *w, FILE *out, FILE *err)
+void re_traceshow_script(FILE *gp, const char *path,
+			 const struct re_trace_hdr *h,
+			 const struct re_traceshow_win *w,
+			 const struct re_traceshow_units *u)
 {
-	char png[RE_TRACE_AXES + 1][1100];
+	char png[1100];
+
+	for (int a = 0; a < h->n_axes; a++) {
+		png_name(path, h->axis[a], png, sizeof(png));
+		axis_page(gp, path, png, h, a, w, u);
+	}
+	png_name(path, "timing", png, sizeof(png));
+	lanes_page(gp, path, png, h, w);
+}
+
+static int plot_pages(const char *path, const struct re_trace_hdr *h,
+		      const struct re_traceshow_win *w,
+		      const struct re_traceshow_units *u, FILE *out, FILE *err)
+{
+	char png[1100];
 	FILE *gp = popen("gnuplot", "w");
-	int np = re_traceshow_pages(h->n_axes);
 
 	if (!gp) {
 		fprintf(err, "roboelf-tech: error: cannot run gnuplot: %s\n",
 			strerror(errno));
 		return EXIT_PLOT;
 	}
-	for (int a = 0; a < h->n_axes; a++) {
-		png_name(path, h->axis[a], png[a], sizeof(png[a]));
-		axis_page(gp, path, png[a], h, a, w);
-	}
-	png_name(path, "timing", png[h->n_axes], sizeof(png[0]));
-	lanes_page(gp, path, png[h->n_axes], h, w);
+	re_traceshow_script(gp, path, h, w, u);
 	if (pclose(gp) != 0) {
 		fprintf(err, "roboelf-tech: error: gnuplot failed for '%s'\n",
 			path);
 		return EXIT_PLOT;
 	}
-	for (int p = 0; p < np; p++)
-		fprintf(out, "wrote %s\n", png[p]);
+	for (int p = 0; p <= h->n_axes; p++) {
+		png_name(path, p < h->n_axes ? h->axis[p] : "timing", png,
+			 sizeof(png));
+		fprintf(out, "wrote %s\n", png);
+	}
 	return 0;
+}
+
+/* Which units the positions are drawn in, and why. */
+static void say_units(const struct re_trace_hdr *h,
+		      const struct re_traceshow_units *u, FILE *out)
+{
+	if (!u)
+		fprintf(out, "positions in counts: no configuration loaded\n");
+	else if (u->config_hash != h->config_hash)
+		fprintf(out,
+			"positions in counts: the configuration '%s' (hash "
+			"%016" PRIx64 ") is not this trace's\n",
+			u->config, u->config_hash);
+	else
+		fprintf(out,
+			"positions in the console's units, from the "
+			"configuration '%s' (the trace's hash)\n",
+			u->config);
 }
 
 /* Cycles inside the window; the first and last time. */
@@ -283,7 +370,7 @@ static void summary(const char *path, const struct re_trace_hdr *h,
 }
 
 int re_traceshow_run(const char *path, const struct re_traceshow_win *w,
-		     FILE *out, FILE *err)
+		     const struct re_traceshow_units *u, FILE *out, FILE *err)
 {
 	struct re_trace_hdr h;
 	struct re_trace_rec *r = NULL;
@@ -307,6 +394,7 @@ int re_traceshow_run(const char *path, const struct re_traceshow_win *w,
 		return EXIT_BAD;
 	}
 	summary(path, &h, r, out);
+	say_units(&h, u, out);
 	n = in_window(r, h.n_records, w);
 	free(r);
 	if (n == 0) {
@@ -323,5 +411,5 @@ int re_traceshow_run(const char *path, const struct re_traceshow_win *w,
 			"deps installs gnuplot-nox): no plots\n");
 		return EXIT_BAD;
 	}
-	return plot_pages(path, &h, w, out, err);
+	return plot_pages(path, &h, w, u, out, err);
 }

@@ -163,7 +163,7 @@ static int check_seal(const char *text, size_t len, const struct re_config *cfg,
 	return rc;
 }
 
-static int check_program(gl_link *l, const struct re_config *cfg,
+int re_ctl_check_program(gl_link *l, const struct re_config *cfg,
 			 struct re_ctl_info *info, struct re_seal *seal,
 			 char *err, size_t errlen)
 {
@@ -272,7 +272,7 @@ int re_ctl_take_over(gl_link *l, const struct re_config *cfg,
 		       gl_strerror(rc));
 		return rc;
 	}
-	return check_program(l, cfg, info, seal, err, errlen);
+	return re_ctl_check_program(l, cfg, info, seal, err, errlen);
 }
 
 /* ---- configuration --------------------------------------------------------

@@ -75,6 +75,18 @@ int re_ctl_take_over(gl_link *l, const struct re_config *cfg,
 		     size_t errlen);
 
 /*
+ * re_ctl_check_program() - what re_ctl_take_over() checks of the program,
+ * touching no handle: upload it (UL), check galil-load's identity stamp
+ * and that it is sealed with exactly the values @cfg gives. The program
+ * may run or be halted; nothing is written.
+ * @info: [in,out] program_id filled. @seal: [out] the seal table.
+ * Return: as re_ctl_take_over() after its handles.
+ */
+int re_ctl_check_program(gl_link *l, const struct re_config *cfg,
+			 struct re_ctl_info *info, struct re_seal *seal,
+			 char *err, size_t errlen);
+
+/*
  * re_ctl_halt() - make the controller safe before anything else: prun=0
  * (the program is halted on purpose), HX (every thread), AB 1;MO ABC, and
  * read back every motor off (_MOA.._MOC = 1).

@@ -675,7 +675,7 @@ int sys_case_start(struct sys_case *c, struct sys_env *e,
 		       c->sim.ctl_port);
 		goto fail;
 	}
-	if (run_load(c) < 0 || start_roboelf(c, o) < 0)
+	if ((!o->no_load && run_load(c) < 0) || start_roboelf(c, o) < 0)
 		goto fail;
 	if (o->no_ready)
 		return 0;

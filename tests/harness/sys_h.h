@@ -8,7 +8,8 @@
  *
  * One struct sys_case per test case: a fresh galil-sim (free ports, its
  * virtual relay linked inside the temporary directory), dmc/ checked,
- * downloaded and started with galil-load, and roboelf started against both
+ * downloaded and started with galil-load (unless no_load), and roboelf
+ * started against both
  * with command-line options; the case is ready when roboelf prints
  * "RoboELF Ready for Use". The case talks to galil-sim's control port
  * (fault injection, the `state` line, the `events` log with simulated
@@ -109,6 +110,8 @@ struct sys_opts {
 				 valgrind and its options), or NULL */
 	int ready_timeout_ms; /* 0: 20 s ("file"), 150 s ("full") */
 	int no_ready;	      /* don't wait for Ready */
+	int no_load;	      /* galil-sim left without a program (no
+				 galil-load) */
 	/* galil-sim elsewhere (tests/net): run it through @sim_wrap (see
 	 * proc_sim_start_wrapped()) listening on every interface; roboelf and
 	 * galil-load use @sim_addr, the control port @ctl_addr. NULL: local */

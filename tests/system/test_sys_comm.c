@@ -10,6 +10,8 @@
  * forward limit switch of axis A ...", "... [y/N]") and answers through
  * galil-sim's control port (joy, limit) and roboelf-tech's stdin (y).
  *
+ * ROBOELF_SYS_FILTER=PATTERN runs only the matching tests.
+ *
  * roboelf supervises, and nothing else: given one of the options that
  * moved to roboelf-tech it exits 2 with one line naming the command.
  * roboelf-tech's command line, and bind-relay refusing a serial number
@@ -158,6 +160,59 @@ static char *slurp(const char *path)
 	return buf;
 }
 
+/* @dir/@name.gp holds the text @fmt makes. */
+static void script_has(const char *dir, const char *name, const char *fmt,
+		       ...) __attribute__((format(printf, 3, 4)));
+
+static void script_has(const char *dir, const char *name, const char *fmt,
+		       ...)
+{
+	char path[600], want[1024];
+	const char *gp;
+	va_list ap;
+
+	va_start(ap, fmt);
+	vsnprintf(want, sizeof(want), fmt, ap);
+	va_end(ap);
+	snprintf(path, sizeof(path), "%s/%s.gp", dir, name);
+	gp = slurp(path);
+	if (!gp)
+		fail_msg("no script %s", path);
+	if (!strstr(gp, want))
+		fail_msg("%s lacks\n%s\nin\n%.3000s", path, want, gp);
+}
+
+/* The plots' scripts: only the one of the failed step (@fail_plot, NULL:
+ * none) carries the FAIL label, with the start of @why (the failed
+ * check's words, up to where its label wraps). */
+static void check_scripts(const char *dir, const char *fail_plot,
+			  const char *why)
+{
+	static const char *const plots[] = {"joystick", "limits",
+					    "relay",	"pots-at-rest",
+					    "move-A",	"move-B",
+					    "move-C"};
+	char path[600], want[160];
+
+	const char *fix = why ? strstr(why, " - fix:") : NULL;
+	int n = why ? (fix ? (int)(fix - why) : (int)strlen(why)) : 0;
+
+	snprintf(want, sizeof(want), "set label 99 \"FAIL: %.*s", n < 75 ? n : 75,
+		 why ? why : "");
+	for (size_t i = 0; i < sizeof(plots) / sizeof(plots[0]); i++) {
+		const char *gp;
+		int mine = fail_plot && !strcmp(plots[i], fail_plot);
+
+		snprintf(path, sizeof(path), "%s/%s.gp", dir, plots[i]);
+		gp = slurp(path);
+		if (mine && (!gp || !strstr(gp, want)))
+			fail_msg("%s lacks\n%s\nin\n%.3000s", path, want,
+				 gp ? gp : "(no file)");
+		if (!mine && gp && strstr(gp, "FAIL"))
+			fail_msg("%s has a FAIL mark:\n%.3000s", path, gp);
+	}
+}
+
 static int is_png(const char *dir, const char *name)
 {
 	char path[600], head[8] = {0};
@@ -207,19 +262,114 @@ static void test_clean_robot(void **state)
 				    "record's user field, 4 bytes signed): "
 				    "491519 in both; seen 491519 and 491519 "
 				    "(put back to 0)"));
-	assert_non_null(strstr(rep, "PASS  ul-identical"));
+	assert_non_null(strstr(rep, "PASS  program          UL: galil-load's "
+				    "stamp "));
+	assert_non_null(strstr(rep, "plots: 7 PNG file(s) in "));
 	assert_non_null(
 	    strstr(rep, "encoder: asked the program for +2000 counts"));
 	assert_true(is_png(dir, "pots-at-rest.png"));
 	assert_true(is_png(dir, "move-A.png"));
 	assert_true(is_png(dir, "move-B.png"));
 	assert_true(is_png(dir, "move-C.png"));
+	assert_true(is_png(dir, "joystick.png"));
+	assert_true(is_png(dir, "limits.png"));
+	assert_true(is_png(dir, "relay.png"));
+	check_scripts(dir, NULL, NULL);
+	/* each passing plot carries its limits, its targets, what was asked */
+	script_has(dir, "pots-at-rest",
+		   "%.3f with lines dt 2 lc rgb 'red' title 'noise limit: "
+		   "%.1f mV peak to peak (half the tolerance)', %.3f with "
+		   "lines dt 2 lc rgb 'red' notitle\n",
+		   5.0, 10.0, -5.0);
+	script_has(dir, "move-A",
+		   "set multiplot layout 2,1 title \"axis A: +2000 counts at "
+		   "2000 counts/s and the way back\"\n");
+	script_has(dir, "move-B",
+		   "$asked using 1:2 with lines dt 2 lc rgb 'black' title "
+		   "'expected: 2000 counts/s to the target and back', %s",
+		   "");
+	script_has(dir, "move-C", "lc rgb 'dark-green' title 'target +2000 "
+				  "counts (");
+	script_has(dir, "move-A",
+		   "set title 'the potentiometer against the encoder: +0.0400 "
+		   "mV/count expected'\n");
+	script_has(dir, "move-A",
+		   "title 'expected: (forward_v - reverse_v) / "
+		   "travel_counts'\n");
+	script_has(dir, "joystick", "'PRESS B forward' at ");
+	script_has(dir, "limits", "'TRIP C rev' at ");
+	script_has(dir, "relay", "'relay OFF' at ");
 	/* the run leaves the robot safe: relay off, every motor off */
 	assert_true(sys_state(&c, st, sizeof(st)) >= 0);
 	assert_non_null(strstr(st, " relay=off "));
 	assert_true(sys_state_num(st, "A.mo") == 1 &&
 		    sys_state_num(st, "B.mo") == 1 &&
 		    sys_state_num(st, "C.mo") == 1);
+	sys_case_stop(&c);
+}
+
+/* galil-sim holding no program: the run stops at its first step, before
+ * any prompt, with the reason and the fix (exit 5); nothing else said. */
+static void test_no_program(void **state)
+{
+	struct sys_case c;
+	struct sys_opts o = {0};
+	char dir[256], *re_args[] = {(char *)"commission", dir, (char *)"--wait",
+				     (char *)"5", NULL};
+	static const char why[] = "the controller holds no program stamped by "
+				  "galil-load: run galil-load with dmc/ first";
+	static const char fix[] =
+	    "load dmc/ with galil-load --config and the configuration this "
+	    "run uses (docs/technician.md, section 4), then run the "
+	    "commissioning again";
+	char want[4096], path[320];
+	const char *out, *rep;
+	size_t pos = 0;
+
+	(void)state;
+	snprintf(dir, sizeof(dir), "%s/comm-noprog", env.dir);
+	o.re_args = re_args;
+	o.tech = 1;
+	o.no_ready = 1;
+	o.no_load = 1;
+	if (sys_case_start(&c, &env, &o) < 0)
+		fail_msg("case start: %s", c.err);
+	assert_int_equal(drive(&c, NULL, &pos), 5);
+	out = proc_output(&c.re, PROC_STDOUT);
+	snprintf(want, sizeof(want),
+		 "roboelf-tech: opening the E-stop relay '%s' (motor power "
+		 "stays off)\n"
+		 "roboelf-tech: connecting to the controller at %s:%d\n"
+		 "roboelf-tech: controller DMC4030 Rev 1.2h-sim, serial "
+		 "403001\n"
+		 "roboelf-tech: halting the controller program; every motor "
+		 "off\n"
+		 "roboelf-tech: controller configured and read back; motor "
+		 "power off\n"
+		 "commission: step 1 of 8: what the run needs: the relay, the "
+		 "controller, the program\n"
+		 "commission: FAILED at step needs (program): %s - fix: %s\n"
+		 "commission: report %s/commissioning.txt, 0 plot(s)\n"
+		 "roboelf-tech: motor power was never switched on; bye\n",
+		 c.relay_link, c.sim_addr, c.sim.port, why, fix, dir);
+	if (strcmp(out, want) != 0)
+		fail_msg("stdout\n%s\nnot\n%s", out, want);
+	snprintf(path, sizeof(path), "%s/commissioning.txt", dir);
+	rep = slurp(path);
+	assert_non_null(rep);
+	snprintf(want, sizeof(want),
+		 "\n== needs\n"
+		 "PASS  relay            the E-stop relay answers and is off: "
+		 "no motor power\n"
+		 "PASS  controller       the controller at %s:%d answers (MG "
+		 "_BN 403001)\n"
+		 "FAIL  program          %s\n"
+		 "      fix: %s\n\n== the controller reports of itself\n",
+		 c.sim_addr, c.sim.port, why, fix);
+	if (!strstr(rep, want))
+		fail_msg("the report lacks\n%s\nin\n%s", want, rep);
+	assert_non_null(strstr(rep, "motor power switched on during the run: "
+				    "never\n"));
 	sys_case_stop(&c);
 }
 
@@ -279,6 +429,7 @@ struct wrong {
 	int exit;
 	const char *line;   /* the console's verdict (prefix) */
 	const char *report; /* a line of the report (substring), or NULL */
+	const char *plot;   /* the failed step's plot, or NULL */
 };
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -295,58 +446,58 @@ static const struct wrong wrongs[] = {
      "did: the switch of B forward channel a is wired to input 7 - fix: "
      "exchange the wires on inputs 5 and 7 (or the two numbers in "
      "joystick.inputs)",
-     NULL},
+     NULL, "joystick"},
     {"--miswire", "dead-input:6", 5,
      "commission: FAILED at step joystick (B forward): dead switch: input 6 "
      "(B forward channel b) did not close; the other channel did - fix: ",
-     NULL},
+     NULL, "joystick"},
     {"--miswire", "joystick-polarity", 5,
      "commission: FAILED at step joystick (polarity): with nothing pressed "
      "all 12 joystick inputs read 1, which the configuration (active_low: "
      "false) takes for closed: the polarity is the wrong way round - fix: "
      "set joystick.active_low: true",
-     NULL},
+     NULL, "joystick"},
     {"--miswire", "limits-swapped:B", 5,
      "commission: FAILED at step limits (B fwd): swapped: the forward limit "
      "switch of axis B was held and the controller saw the reverse limit "
      "switch of axis B - fix: exchange the forward and reverse limit switch "
      "wires of that axis",
-     NULL},
+     NULL, "limits"},
     {"--miswire", "relay-unwired", 5,
      "commission: FAILED at step relay (open): with the relay OFF the "
      "amplifiers report power (MG _TA0 = 0, bit 3 'under-voltage' clear; "
      "reference: TA): the relay does not switch the motors' power",
-     NULL},
+     NULL, "relay"},
     {"--miswire", "encoder-reversed:A", 5,
      "commission: FAILED at step motion (A): encoder reversed: asked for "
      "+2000 counts, the encoder counted -",
-     NULL},
+     NULL, "move-A"},
     {"--miswire", "pot-reversed:C", 5,
      "commission: FAILED at step motion (C): potentiometer reversed: -0.",
-     NULL},
+     NULL, "move-C"},
     {"--deviate", "mg-join", 0, "commission: PASSED: every step passed",
      "NOTE  mg-separate      sent 'MG -1,-2'; reference (MG): each number "
      "keeps its sign position (' -1.0000 -2.0000'); seen '-1.0000-2.0000' "
-     "(roboelf and galil-load read one value per MG: safe)"},
+     "(roboelf and galil-load read one value per MG: safe)", NULL},
     {"--deviate", "mo-moving", 0, "commission: PASSED: every step passed",
      "NOTE  mo-moving        MO A during a 300-count move; reference (MO): "
      "not valid while in motion; seen accepted (the motor went off while "
      "moving; dmc/ and roboelf send AB 1 first, galil-load waits for the "
-     "stop: safe)"},
+     "stop: safe)", NULL},
     {"--deviate", "dm-exists", 0, "commission: PASSED: every step passed",
      "NOTE  dm-exists        DM cmqz[4] twice; reference (DM): silent on an "
      "array that exists (UNCONFIRMED); first ':', second ':'; dmc/ "
-     "deallocates every array first (DA *[]): safe on either"},
+     "deallocates every array first (DA *[]): safe on either", NULL},
     {"--deviate", "za-16bit", 5,
      "commission: FAILED at step firmware (za-range): ZA ,,491519, then MG "
      "_ZAC and QR; reference (ZA; the record's user field, 4 bytes signed): "
      "491519 in both; seen 491519 and 32767 (put back to 0)",
-     NULL},
+     NULL, NULL},
     {"--deviate", "qr-header", 5,
      "commission: FAILED at step firmware (qr-record): QR; reference (QR, "
      "QZ): a record of the announced length whose header names axes A-C; "
      "the record did not decode",
-     NULL},
+     NULL, NULL},
 };
 
 /* Each miswiring and deviation galil-sim models, found at its step. */
@@ -374,6 +525,8 @@ static void test_wrong_robot(void **state)
 		if (w->report && !strstr(rep, w->report))
 			fail_msg("%s %s: the report lacks '%s':\n%s", w->opt,
 				 w->arg, w->report, rep);
+		check_scripts(dir, w->plot,
+			      w->plot ? strstr(w->line, "): ") + 3 : NULL);
 		sys_case_stop(&c);
 	}
 }
@@ -600,11 +753,15 @@ int main(void)
 	    cmocka_unit_test(test_moved_options),
 	    cmocka_unit_test(test_tech_usage),
 	    cmocka_unit_test(test_bind_relay_refused),
+	    cmocka_unit_test(test_no_program),
 	    cmocka_unit_test(test_clean_robot),
 	    cmocka_unit_test(test_kill_during_move),
 	    cmocka_unit_test(test_wrong_robot),
 	    cmocka_unit_test(test_find_controller),
 	};
+	const char *filter = getenv("ROBOELF_SYS_FILTER");
 
+	if (filter && *filter)
+		cmocka_set_test_filter(filter);
 	return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -3,7 +3,8 @@
  * and a fake clock (no galil-sim): what the technician does (or fails to
  * do) is played from the prompt callback; the words of each verdict, the
  * end of the run in the safe state after a link failure and after Ctrl-C,
- * and the report written whole or not at all. The whole run against
+ * what the run needs checked before any prompt, the report written whole
+ * or not at all and a failed step's plot marked FAIL. The whole run against
  * galil-sim, with each miswiring, is tests/system/test_sys_comm.c.
  */
 #include <setjmp.h>
@@ -31,6 +32,7 @@ static struct {
 	int64_t now_ns;
 	int broken_after; /* commands until the link breaks; -1 never */
 	int stop_all, relay_off;
+	int relay_gone; /* the relay's check fails */
 	int press; /* the technician presses what is asked */
 	volatile sig_atomic_t quit;
 	int quit_on_press; /* set quit when asked to press */
@@ -76,6 +78,13 @@ static const char *f_ctrl_error(void *ud, int *code)
 	return "Unrecognized command";
 }
 
+static int f_relay_check(void *ud, char *why, size_t cap)
+{
+	(void)ud;
+	snprintf(why, cap, "%s", w.relay_gone ? "the port is gone" : "");
+	return w.relay_gone ? GL_ERR_RELAY : GL_OK;
+}
+
 static int f_relay_off(void *ud)
 {
 	(void)ud;
@@ -99,6 +108,7 @@ static void f_sleep_until(void *ud, int64_t t)
 static const struct re_io_ops ops = {
     .command = f_command,
     .ctrl_error = f_ctrl_error,
+    .relay_check = f_relay_check,
     .relay_off = f_relay_off,
     .now_ns = f_now,
     .sleep_until = f_sleep_until,
@@ -212,14 +222,43 @@ static void test_link_breaks(void **state)
 {
 	struct re_comm *c = *state;
 
-	snprintf(c->model, sizeof(c->model), "DMC4030 Rev 1.2h");
-	snprintf(cfg.controller.model, sizeof(cfg.controller.model), "DMC4030");
-	w.broken_after = 3;
+	w.broken_after = 0;
 	assert_int_equal(re_comm_run(c), GL_ERR_BROKEN);
-	assert_string_equal(c->failed_step, "identity");
+	assert_string_equal(c->failed_step, "needs");
 	assert_int_equal(w.relay_off, 1);
 	assert_string_equal(c->item[c->n - 2].name, "link");
 	assert_string_equal(c->item[c->n - 1].name, "safe");
+}
+
+/* What the run needs comes first: a relay that does not answer, or no
+ * program to read, stops the run at step 1 with the fix, before any
+ * prompt to the technician. */
+static void test_needs_first(void **state)
+{
+	struct re_comm *c = *state;
+
+	w.relay_gone = 1;
+	assert_int_equal(re_comm_run(c), GL_ERR_MISMATCH);
+	assert_string_equal(c->failed_step, "needs");
+	assert_string_equal(c->item[0].name, "relay");
+	assert_string_equal(c->item[0].text,
+			    "the E-stop relay does not answer: the port is "
+			    "gone");
+	assert_int_equal(w.stop_all, 1);
+	re_comm_init(c);
+	c->io = &io;
+	c->cfg = &cfg;
+	c->ui.say = tech_say;
+	w.relay_gone = 0;
+	w.quit_on_press = 1; /* a prompt would stop the run: none comes */
+	assert_int_equal(re_comm_run(c), GL_ERR_MISMATCH);
+	assert_int_equal(w.quit, 0);
+	assert_string_equal(c->failed_step, "needs");
+	assert_string_equal(c->item[2].name, "program");
+	assert_string_equal(c->item[2].fix,
+			    "load dmc/ with galil-load --config and the "
+			    "configuration this run uses (docs/technician.md, "
+			    "section 4), then run the commissioning again");
 }
 
 /* Ctrl-C while the technician is asked to press: interrupted, safe. */
@@ -235,6 +274,52 @@ static void test_interrupted(void **state)
 	assert_string_equal(c->item[c->n - 1].name, "interrupted");
 	assert_int_equal(w.stop_all, 1);
 	assert_int_equal(w.relay_off, 1);
+}
+
+static const char *slurp(const char *path)
+{
+	static char buf[65536];
+	FILE *f = fopen(path, "r");
+	size_t n;
+
+	assert_non_null(f);
+	n = fread(buf, 1, sizeof(buf) - 1, f);
+	buf[n] = '\0';
+	fclose(f);
+	return buf;
+}
+
+/* A step that failed: its plot carries the red FAIL label with what was
+ * seen, under the title, which leaves a line for it. */
+static void test_plot_fail(void **state)
+{
+	struct re_comm *c = *state;
+	struct re_comm_where where = {"127.0.0.1:23", "cfg.yaml",
+				      "2026-11-25 08:00:00 UTC"};
+	char dir[] = "/tmp/test_re_comm_XXXXXX", path[128], err[256];
+	const char *gp;
+	int plots = -1;
+
+	w.press = 0;
+	assert_non_null(mkdtemp(dir));
+	assert_int_equal(rc_step_joystick(c), GL_OK);
+	assert_int_equal(
+	    re_comm_report(c, &where, dir, &plots, err, sizeof(err)), GL_OK);
+	snprintf(path, sizeof(path), "%s/joystick.gp", dir);
+	gp = slurp(path);
+	if (!strstr(gp, "set label 99 \"FAIL: nothing closed within 1 s of "
+			"asking for A forward (inputs 1 and 2)\" at screen "
+			"0.02, screen 0.949 left tc rgb 'red' front\n"
+			"set multiplot layout 1,1 title \"the joystick "
+			"switches: up is closed\\n\"\n"))
+		fail_msg("no FAIL label in\n%s", gp);
+	assert_non_null(strstr(gp, "set label 1 'PRESS A forward' at "));
+	unlink(path);
+	snprintf(path, sizeof(path), "%s/joystick.png", dir);
+	unlink(path);
+	snprintf(path, sizeof(path), "%s/%s", dir, RE_COMM_REPORT_NAME);
+	unlink(path);
+	assert_int_equal(rmdir(dir), 0);
 }
 
 /* The report: whole, in the directory; an unwritable place refused with
@@ -253,7 +338,13 @@ static void test_report(void **state)
 	assert_int_equal(rc_step_joystick(c), GL_OK);
 	assert_int_equal(
 	    re_comm_report(c, &where, dir, &plots, err, sizeof(err)), GL_OK);
-	assert_int_equal(plots, 0);
+	assert_int_equal(plots, 1); /* the joystick's lanes */
+	snprintf(path, sizeof(path), "%s/joystick.gp", dir);
+	assert_null(strstr(slurp(path), "FAIL"));
+	assert_non_null(strstr(slurp(path), "set label 12 'RELEASE' at "));
+	unlink(path);
+	snprintf(path, sizeof(path), "%s/joystick.png", dir);
+	assert_int_equal(unlink(path), 0);
 	snprintf(path, sizeof(path), "%s/%s", dir, RE_COMM_REPORT_NAME);
 	f = fopen(path, "r");
 	assert_non_null(f);
@@ -275,7 +366,7 @@ static void test_report(void **state)
 	assert_non_null(strstr(err, "/file/commissioning.txt': Not a "
 				    "directory"));
 	unlink(path);
-	rmdir(dir);
+	assert_int_equal(rmdir(dir), 0);
 }
 
 int main(void)
@@ -289,8 +380,10 @@ int main(void)
 					    teardown),
 	    cmocka_unit_test_setup_teardown(test_limits_rest, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_link_breaks, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_needs_first, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_interrupted, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_report, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_plot_fail, setup, teardown),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

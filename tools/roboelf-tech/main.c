@@ -7,7 +7,7 @@
  *                [--relay PORT] [--log FILE] [--wait S]
  *                [--find-addr A] [--find-port P]
  *   roboelf-tech show-calibration FILE [-c FILE]
- *   roboelf-tech show-trace FILE [--window FROM:TO]
+ *   roboelf-tech show-trace FILE [--window FROM:TO] [-c FILE]
  *   roboelf-tech check-host[=SECONDS] [-c FILE] [--period MS]
  *   roboelf-tech bind-relay [--serial S] [--rules-file PATH]
  *   roboelf-tech --print KEY [-c FILE]
@@ -66,7 +66,7 @@ static void usage(FILE *f)
 		"                    [--log FILE] [--wait S] [--find-addr A] "
 		"[--find-port P]\n"
 		"       roboelf-tech show-calibration FILE [-c FILE]\n"
-		"       roboelf-tech show-trace FILE [--window FROM:TO]\n"
+		"       roboelf-tech show-trace FILE [--window FROM:TO] [-c FILE]\n"
 		"       roboelf-tech check-host[=SECONDS] [-c FILE] "
 		"[--period MS]\n"
 		"       roboelf-tech bind-relay [--serial S] [--rules-file "
@@ -245,9 +245,36 @@ static int print_key(struct app *a, struct re_app_args *g, const char *key)
 	return 0;
 }
 
-/* show-trace: the trace checked, summarised and drawn. */
-static int show_trace(const char *file, const char *window)
+/* The console's units of each axis (deg, mm) from the configuration, for
+ * show-trace. Return: @u, or NULL when the configuration does not load. */
+static const struct re_traceshow_units *trace_units(struct app *a,
+						    struct re_app_args *g,
+						    struct re_traceshow_units *u)
 {
+	re_app_find_config(g);
+	if (re_config_load_file(g->config, &a->cfg, a->err, sizeof(a->err)) !=
+	    GL_OK)
+		return NULL;
+	memset(u, 0, sizeof(*u));
+	u->config = g->config;
+	u->config_hash = re_config_hash(&a->cfg);
+	for (int i = 0; i < RE_AXES && i < RE_TRACE_AXES; i++) {
+		const struct re_config_axis *x = &a->cfg.axes[i];
+
+		snprintf(u->name[i], sizeof(u->name[i]), "%s", x->name);
+		snprintf(u->unit[i], sizeof(u->unit[i]), "%s",
+			 re_unit_name(x->unit));
+		u->per_unit[i] = x->counts_per_unit;
+		u->n = i + 1;
+	}
+	return u;
+}
+
+/* show-trace: the trace checked, summarised and drawn. */
+static int show_trace(struct app *a, struct re_app_args *g, const char *file,
+		      const char *window)
+{
+	static struct re_traceshow_units units;
 	struct re_traceshow_win w;
 
 	if (window && re_traceshow_window(window, &w) < 0) {
@@ -258,7 +285,8 @@ static int show_trace(const char *file, const char *window)
 		    window);
 		return EXIT_USAGE;
 	}
-	return re_traceshow_run(file, window ? &w : NULL, stdout, stderr);
+	return re_traceshow_run(file, window ? &w : NULL,
+				trace_units(a, g, &units), stdout, stderr);
 }
 
 static void comm_say(void *ud, const char *line)
@@ -535,7 +563,7 @@ int main(int argc, char **argv)
 	if (!strcmp(o.sub, "show-calibration"))
 		return show_calibration(&a, &o.g, o.file);
 	if (!strcmp(o.sub, "show-trace"))
-		return show_trace(o.file, o.window);
+		return show_trace(&a, &o.g, o.file, o.window);
 	if (!strcmp(o.sub, "bind-relay"))
 		return re_bindrelay_run(&o.bind, re_bindrelay_list_sp, stdout,
 					stderr);

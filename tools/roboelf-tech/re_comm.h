@@ -5,26 +5,30 @@
  *
  * Steps, in order; the run stops at the first step that fails, with what
  * was seen, what it means and the fix:
- *   1 identity   the controller's model, firmware, serial, handles (^R^V,
+ *   1 needs      before anything is asked of the technician: the relay
+ *                answers, the controller answers, and it holds the program
+ *                galil-load stamped and sealed with this configuration,
+ *                which starts (the motion step runs in it)
+ *   2 identity   the controller's model, firmware, serial, handles (^R^V,
  *                MG _BN, ID, TH, WH) - reported, the model checked
- *   2 firmware   every behaviour of the firmware dmc/ and the supervisor
+ *   3 firmware   every behaviour of the firmware dmc/ and the supervisor
  *                rely on, each by a probe whose expected answer is quoted
  *                from the command reference (re_comm_fw.c)
- *   3 joystick   each command's two switches asked for in turn and seen on
+ *   4 joystick   each command's two switches asked for in turn and seen on
  *                the configured inputs (swapped pair, dead switch, wrong
  *                polarity named as such)
- *   4 pots       each potentiometer at rest: range and noise
- *   5 limits     each limit switch reads inactive at rest, then each is
+ *   5 pots       each potentiometer at rest: range and noise
+ *   6 limits     each limit switch reads inactive at rest, then each is
  *                asked for in turn (tripped by hand) and seen on its input
- *   6 relay      the relay closes and opens motor power, seen as the
+ *   7 relay      the relay closes and opens motor power, seen as the
  *                amplifiers' under-voltage on the controller (_TA0 bit 3)
- *   7 motion     the controller program started and in its service state
+ *   8 motion     the controller program started and in its service state
  *                (its watchdog, bounds and fault handling on), per axis a
  *                small torque-limited move each way asked of it: the
  *                encoder counts with the motor, the potentiometer moves in
  *                the configured direction; then, with the program halted,
  *                two bounded direct probes (MO refused while moving, PT)
- * Motor power is switched on only in steps 6 and 7, each time after the
+ * Motor power is switched on only in steps 7 and 8, each time after the
  * technician confirmed it, and is off again at the end of the step.
  *
  * The run talks to the controller through struct re_io (the supervisor's
@@ -49,6 +53,7 @@
 #define RE_COMM_NOISE_N 50  /* potentiometer samples at rest */
 #define RE_COMM_TRACE_N 400 /* samples of one axis's move */
 #define RE_COMM_IDTEXT	1024
+#define RE_COMM_MOVE_CPS 2000 /* speed of a small move, counts/s */
 
 enum re_comm_res {
 	RE_COMM_PASS = 0, /* as expected */
@@ -75,12 +80,35 @@ struct re_comm_ui {
 	int (*confirm)(void *ud, const char *question);
 };
 
-/* One axis's small move: time, encoder, potentiometer. */
+/* One axis's small move and the way back: time (ms after the first
+ * request), encoder, potentiometer; what was asked, for the plot's
+ * target and expected lines. */
 struct re_comm_trace {
 	int n;
+	int counts;	  /* the move asked for, counts (back: -counts) */
+	int back_i;	  /* the first sample of the way back, 0: none */
+	double t_back_ms; /* when the way back was asked for */
+	double t0_ms;	  /* rc_now_ms() of the first request */
+	double enc0;	  /* encoder before the move, counts */
+	double pot0_v;	  /* potentiometer before the move (mean), V */
 	double t_ms[RE_COMM_TRACE_N];
 	double enc[RE_COMM_TRACE_N];
 	double pot_v[RE_COMM_TRACE_N];
+};
+
+/* What a hand-operated step saw, as lanes: the set of switches (bit i:
+ * lane i) at each change, and when the technician was asked for what;
+ * times in ms from the step's start. For the step's plot. */
+#define RE_COMM_LANE_N 256
+#define RE_COMM_ASK_N  32
+struct re_comm_lanes {
+	int n, n_ask;
+	double t0_ms;  /* rc_now_ms() at the step's start */
+	double end_ms; /* the last sample */
+	double t_ms[RE_COMM_LANE_N];
+	unsigned mask[RE_COMM_LANE_N];
+	double ask_ms[RE_COMM_ASK_N];
+	char ask[RE_COMM_ASK_N][24];
 };
 
 struct re_comm {
@@ -108,6 +136,9 @@ struct re_comm {
 	double noise_v[RE_AXES][RE_COMM_NOISE_N];
 	int noise_n;
 	struct re_comm_trace trace[RE_AXES];
+	/* the joystick's 12 switches, the 6 limit switches; the relay step:
+	 * bit 0 the relay on, bit 1 the amplifiers see power */
+	struct re_comm_lanes joy, lim, amp;
 };
 
 /*

@@ -1,5 +1,5 @@
 /*
- * re_comm_fw.c - commissioning steps 1 and 2: the controller's identity,
+ * re_comm_fw.c - commissioning steps 2 and 3: the controller's identity,
  * and the firmware behaviour dmc/ and the supervisor rely on, each checked
  * by a probe whose expected answer is quoted from the DMC-4000 command
  * reference (the page is named in the item). Motor power stays off; every
@@ -17,7 +17,6 @@
 #include <string.h>
 
 #include "gl_err.h"
-#include "gl_ident.h"
 #include "re_comm.h"
 #include "re_comm_steps.h"
 #include "re_comm_util.h"
@@ -385,46 +384,6 @@ static int probe_za(struct re_comm *c)
 	return GL_OK;
 }
 
-/* UL returns the downloaded text: galil-load's stamp still matches. */
-static int probe_upload(struct re_comm *c)
-{
-	char *buf;
-	uint64_t id = 0;
-	int n, rc;
-
-	if (!c->link)
-		return GL_OK;
-	buf = malloc(RE_CTL_UPLOAD_MAX); /* start-up code, not the cycle */
-	if (!buf)
-		return GL_ERR_NOMEM;
-	n = gl_link_upload(c->link, buf, RE_CTL_UPLOAD_MAX, 0);
-	rc = n < 0 ? n : gl_ident_verify(buf, (size_t)n, &id);
-	free(buf);
-	if (rc == GL_OK)
-		re_comm_add(c, STEP, "ul-identical", RE_COMM_PASS, NULL,
-			    "UL; reference (UL): the program as downloaded "
-			    "(UNCONFIRMED byte for byte); galil-load's stamp "
-			    "%016llX matches the uploaded text",
-			    (unsigned long long)id);
-	else if (rc == GL_ERR_FORMAT)
-		re_comm_add(c, STEP, "ul-identical", RE_COMM_NOTE, NULL,
-			    "UL: the controller holds no program stamped by "
-			    "galil-load, so the upload was not compared; "
-			    "galil-load's own read-back checks it when the "
-			    "program is loaded");
-	else if (rc == GL_ERR_MISMATCH)
-		re_comm_add(c, STEP, "ul-identical", RE_COMM_FAIL,
-			    "load dmc/ with galil-load again; if its read-back "
-			    "fails too, UL changes the text on this firmware: "
-			    "report it",
-			    "UL: the uploaded text does not match galil-load's "
-			    "stamp %016llX",
-			    (unsigned long long)id);
-	else
-		return rc;
-	return GL_OK;
-}
-
 /* What only a running program shows: why dmc/ is safe on both readings. */
 static const struct {
 	const char *name, *text;
@@ -449,7 +408,7 @@ int rc_step_firmware(struct re_comm *c)
 {
 	int (*const probe[])(struct re_comm *) = {
 	    probe_unknown, probe_tm,  probe_mg,	    probe_dm, probe_handle,
-	    probe_cn,	   probe_in9, probe_record, probe_za, probe_upload,
+	    probe_cn,	   probe_in9, probe_record, probe_za,
 	};
 	int rc;
 

@@ -1,5 +1,5 @@
 /*
- * re_comm_move.c - commissioning steps 6 and 7, the only ones with motor
+ * re_comm_move.c - commissioning steps 7 and 8, the only ones with motor
  * power: the relay seen switching the amplifiers' power (_TA0 bit 3, the
  * under-voltage of axes A-D on a DMC-40x0: command reference, TA), and per
  * axis a small torque-limited move each way, in which the encoder must
@@ -30,14 +30,25 @@
 
 #define TA_UNDERVOLT 8	  /* _TA0 bit 3: under-voltage, axes A-D */
 #define RC_AMP_MS    1000 /* the amplifiers see power change within */
-#define RC_MOVE_CPS  2000 /* speed of a small move, counts/s */
+#define RC_MOVE_CPS  RE_COMM_MOVE_CPS
 #define RC_MOVE_TL_V 2.0  /* torque limit during the moves, V */
 #define RC_MOVE_MS   4000 /* deadline of one small move */
 #define RC_SAMPLE_MS 10
 
+/* The relay step's lanes: bit 0 the relay on (@relay), bit 1 the
+ * amplifiers see power (_TA0 bit 3 clear). */
+static void amp_mark(struct re_comm *c, struct re_comm_lanes *l,
+		     unsigned relay, int ta0)
+{
+	if (l)
+		rc_lane_mark(c, l, relay | (ta0 & TA_UNDERVOLT ? 0u : 2u));
+}
+
 /* Wait until _TA0 bit 3 is @want (1 set, 0 clear): the time it took,
- * ms, or -1 after RC_AMP_MS. */
-static int amp_wait(struct re_comm *c, int want, double *ms, int *ta0)
+ * ms, or -1 after RC_AMP_MS. Each reading goes to the lanes @l (NULL:
+ * none) with the relay's state @relay. */
+static int amp_wait(struct re_comm *c, int want, struct re_comm_lanes *l,
+		    unsigned relay, double *ms, int *ta0)
 {
 	double t0 = rc_now_ms(c), v = 0;
 	int rc;
@@ -46,6 +57,7 @@ static int amp_wait(struct re_comm *c, int want, double *ms, int *ta0)
 		if ((rc = rc_num(c, "_TA0", &v)) != GL_OK)
 			return rc;
 		*ta0 = (int)v;
+		amp_mark(c, l, relay, *ta0);
 		*ms = rc_now_ms(c) - t0;
 		if (((*ta0 & TA_UNDERVOLT) != 0) == want)
 			return GL_OK;
@@ -105,8 +117,10 @@ int rc_step_relay(struct re_comm *c)
 	double ms, v = 0;
 	int rc, ta0;
 
+	rc_lane_start(c, &c->amp);
 	if ((rc = rc_num(c, "_TA0", &v)) != GL_OK)
 		return rc;
+	amp_mark(c, &c->amp, 0, (int)v);
 	if (!((int)v & TA_UNDERVOLT)) {
 		re_comm_add(c, "relay", "open", RE_COMM_FAIL,
 			    "wire the relay's contacts into the amplifiers' "
@@ -125,7 +139,8 @@ int rc_step_relay(struct re_comm *c)
 		    (int)v);
 	if ((rc = power_on(c, "relay")) != GL_OK)
 		return rc == GL_ERR_MISMATCH || rc == GL_ERR_RELAY ? GL_OK : rc;
-	if ((rc = amp_wait(c, 0, &ms, &ta0)) != GL_OK)
+	rc_lane_ask(c, &c->amp, "relay ON");
+	if ((rc = amp_wait(c, 0, &c->amp, 1, &ms, &ta0)) != GL_OK)
 		return rc;
 	if (ms < 0)
 		return close_fail(c, ta0);
@@ -133,7 +148,8 @@ int rc_step_relay(struct re_comm *c)
 		    "relay ON: bit 3 of _TA0 cleared after %.0f ms", ms);
 	if ((rc = c->io->ops->relay_off(c->io->ud)) != GL_OK)
 		return rc;
-	if ((rc = amp_wait(c, 1, &ms, &ta0)) != GL_OK)
+	rc_lane_ask(c, &c->amp, "relay OFF");
+	if ((rc = amp_wait(c, 1, &c->amp, 0, &ms, &ta0)) != GL_OK)
 		return rc;
 	if (ms < 0)
 		re_comm_add(c, "relay", "reopen", RE_COMM_FAIL,
@@ -225,6 +241,22 @@ static int move_request(struct re_comm *c, int ax, double target)
 	return rc_cmd(c, cmd, NULL, 0) < 0 ? GL_ERR_CTRL : GL_OK;
 }
 
+/* The trace of a move asked for at @t0 (ms): the first move sets its
+ * origin and start, a second one is the way back. */
+static void trace_start(struct re_comm_trace *tr, int counts, double t0,
+			const struct move_res *m)
+{
+	if (tr->n == 0) {
+		tr->counts = counts;
+		tr->t0_ms = t0;
+		tr->enc0 = m->enc0;
+		tr->pot0_v = m->pot0;
+	} else if (!tr->back_i) {
+		tr->back_i = tr->n;
+		tr->t_back_ms = t0 - tr->t0_ms;
+	}
+}
+
 /* A service move of @counts on axis @ax, sampled (into the trace when
  * @trace) until the profiler ended, a fault latched or RC_MOVE_MS. */
 static int move_axis(struct re_comm *c, int ax, int counts, int trace,
@@ -243,12 +275,14 @@ static int move_axis(struct re_comm *c, int ax, int counts, int trace,
 		return rc;
 	m->enc0 = v[0];
 	t0 = rc_now_ms(c);
+	if (trace)
+		trace_start(tr, counts, t0, m);
 	for (;;) {
 		rc_sleep_ms(c, RC_SAMPLE_MS);
 		if ((rc = move_sample(c, x, a->analog.input, v)) != GL_OK)
 			return rc;
 		if (trace && tr->n < RE_COMM_TRACE_N) {
-			tr->t_ms[tr->n] = rc_now_ms(c) - t0;
+			tr->t_ms[tr->n] = rc_now_ms(c) - tr->t0_ms;
 			tr->enc[tr->n] = v[0];
 			tr->pot_v[tr->n++] = v[1];
 		}
@@ -513,7 +547,7 @@ static int enter_service(struct re_comm *c)
 	}
 	if ((rc = power_on(c, "motion")) != GL_OK)
 		return rc == GL_ERR_MISMATCH || rc == GL_ERR_RELAY ? GL_OK : rc;
-	if ((rc = amp_wait(c, 0, &ms, &ta0)) != GL_OK)
+	if ((rc = amp_wait(c, 0, NULL, 1, &ms, &ta0)) != GL_OK)
 		return rc;
 	c->hbpc = re_ctl_session();
 	rc = re_ctl_service(c->io, &c->hbpc, &f, err, sizeof(err));
@@ -542,7 +576,7 @@ static int moves(struct re_comm *c)
 			return rc;
 		move_judge(c, ax, c->move_counts, &m);
 		if (c->failed_step ||
-		    (rc = move_axis(c, ax, -c->move_counts, 0, &m)) != GL_OK)
+		    (rc = move_axis(c, ax, -c->move_counts, 1, &m)) != GL_OK)
 			return rc;
 	}
 	return rc;

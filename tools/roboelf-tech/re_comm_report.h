@@ -1,8 +1,9 @@
 /*
  * re_comm_report.h - the commissioning run's report: a text file
  * DIR/commissioning.txt (every step, probe and check with its result, the
- * controller's identity, the fix of the failed step) and the plots it drew
- * with gnuplot (DIR/pots-at-rest.png, DIR/move-A.png ...).
+ * controller's identity, the fix of the failed step) and the plots
+ * (re_comm_plot.h: DIR/pots-at-rest.gp and .png, DIR/move-A.gp and .png
+ * ...).
  *
  * Every file is written whole or not at all (a temporary file renamed;
  * the text through base_durable_write()). A missing gnuplot leaves the

@@ -138,3 +138,26 @@ int rc_safe(struct re_comm *c)
 		rc = GL_ERR_CTRL;
 	return rc < 0 ? rc : rr;
 }
+
+void rc_lane_start(struct re_comm *c, struct re_comm_lanes *l)
+{
+	memset(l, 0, sizeof(*l));
+	l->t0_ms = rc_now_ms(c);
+}
+
+void rc_lane_mark(struct re_comm *c, struct re_comm_lanes *l, unsigned mask)
+{
+	l->end_ms = rc_now_ms(c) - l->t0_ms;
+	if (l->n < RE_COMM_LANE_N && (l->n == 0 || l->mask[l->n - 1] != mask)) {
+		l->t_ms[l->n] = l->end_ms;
+		l->mask[l->n++] = mask;
+	}
+}
+
+void rc_lane_ask(struct re_comm *c, struct re_comm_lanes *l, const char *what)
+{
+	if (l->n_ask >= RE_COMM_ASK_N)
+		return;
+	l->ask_ms[l->n_ask] = rc_now_ms(c) - l->t0_ms;
+	snprintf(l->ask[l->n_ask++], sizeof(l->ask[0]), "%s", what);
+}

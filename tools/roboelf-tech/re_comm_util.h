@@ -80,4 +80,14 @@ int rc_safe(struct re_comm *c);
  */
 int rc_guard(struct re_comm *c, int on);
 
+/*
+ * rc_lane_start() - @l starts now (cleared). rc_lane_mark() - the set
+ * @mask seen now: kept when it differs from the last one (the end time
+ * moves on anyway). rc_lane_ask() - the technician is asked for @what now.
+ * Entries beyond the arrays are dropped.
+ */
+void rc_lane_start(struct re_comm *c, struct re_comm_lanes *l);
+void rc_lane_mark(struct re_comm *c, struct re_comm_lanes *l, unsigned mask);
+void rc_lane_ask(struct re_comm *c, struct re_comm_lanes *l, const char *what);
+
 #endif /* RE_COMM_UTIL_H */

@@ -1,5 +1,5 @@
 /*
- * re_comm_wire.c - commissioning steps 3-5, with motor power off: the
+ * re_comm_wire.c - commissioning steps 4-6, with motor power off: the
  * joystick switches asked for in turn and seen on the configured inputs,
  * the potentiometers at rest (range, noise), the limit switches at rest
  * and tripped by hand one at a time.
@@ -77,9 +77,11 @@ static int joy_mask(struct re_comm *c, unsigned *mask)
 }
 
 /* Wait until the set @fn reads is steady and (@want_any) not empty, or
- * (!@want_any) empty; *@timed_out on the deadline c->wait_ms. */
+ * (!@want_any) empty; *@timed_out on the deadline c->wait_ms. Every set
+ * read goes to the lanes @l. */
 static int wait_mask(struct re_comm *c, int (*fn)(struct re_comm *, unsigned *),
-		     int want_any, unsigned *mask, int *timed_out)
+		     struct re_comm_lanes *l, int want_any, unsigned *mask,
+		     int *timed_out)
 {
 	double t0 = rc_now_ms(c), since = t0;
 	unsigned last = ~0u;
@@ -91,6 +93,7 @@ static int wait_mask(struct re_comm *c, int (*fn)(struct re_comm *, unsigned *),
 
 		if ((rc = fn(c, mask)) != GL_OK)
 			return rc;
+		rc_lane_mark(c, l, *mask);
 		now = rc_now_ms(c);
 		if (*mask != last) {
 			last = *mask;
@@ -129,11 +132,12 @@ static int joy_rest(struct re_comm *c)
 {
 	unsigned mask;
 	char list[512];
-	int rc = joy_mask(c, &mask);
-	int al = c->cfg->joystick.active_low;
+	int rc, al = c->cfg->joystick.active_low;
 
-	if (rc != GL_OK)
+	rc_lane_start(c, &c->joy);
+	if ((rc = joy_mask(c, &mask)) != GL_OK)
 		return rc;
+	rc_lane_mark(c, &c->joy, mask);
 	if (mask == (1u << NJOY) - 1) {
 		re_comm_add(c, "joystick", "polarity", RE_COMM_FAIL,
 			    al ? "set joystick.active_low: false (a closed "
@@ -217,6 +221,7 @@ static void joy_judge(struct re_comm *c, int k, unsigned mask, int timed_out)
 
 int rc_step_joystick(struct re_comm *c)
 {
+	char ask[24];
 	unsigned mask;
 	int rc, to;
 
@@ -226,13 +231,18 @@ int rc_step_joystick(struct re_comm *c)
 		rc_say(c, "PRESS and hold the joystick %s (inputs %d and %d)",
 		       cmd_name[k], c->cfg->joystick.inputs[2 * k],
 		       c->cfg->joystick.inputs[2 * k + 1]);
-		if ((rc = wait_mask(c, joy_mask, 1, &mask, &to)) != GL_OK)
+		snprintf(ask, sizeof(ask), "PRESS %s", cmd_name[k]);
+		rc_lane_ask(c, &c->joy, ask);
+		if ((rc = wait_mask(c, joy_mask, &c->joy, 1, &mask, &to)) !=
+		    GL_OK)
 			return rc;
 		joy_judge(c, k, mask, to);
 		if (c->failed_step)
 			return GL_OK;
 		rc_say(c, "RELEASE the joystick %s", cmd_name[k]);
-		if ((rc = wait_mask(c, joy_mask, 0, &mask, &to)) != GL_OK)
+		rc_lane_ask(c, &c->joy, "RELEASE");
+		if ((rc = wait_mask(c, joy_mask, &c->joy, 0, &mask, &to)) !=
+		    GL_OK)
 			return rc;
 		if (to) {
 			re_comm_add(c, "joystick", cmd_name[k], RE_COMM_FAIL,
@@ -389,12 +399,14 @@ static void lim_judge(struct re_comm *c, int i, unsigned mask, int to)
 
 int rc_step_limits(struct re_comm *c)
 {
-	char nm[48];
+	char nm[48], ask[24];
 	unsigned mask;
 	int rc, to;
 
+	rc_lane_start(c, &c->lim);
 	if ((rc = lim_mask(c, &mask)) != GL_OK)
 		return rc;
+	rc_lane_mark(c, &c->lim, mask);
 	if (mask) {
 		re_comm_add(c, "limits", "rest", RE_COMM_FAIL,
 			    "if the axis is not at that end: a switch stuck, "
@@ -409,13 +421,19 @@ int rc_step_limits(struct re_comm *c)
 	for (int i = 0; i < 2 * RE_AXES; i++) {
 		rc_say(c, "TRIP %s by hand and hold it",
 		       lim_name(i, nm, sizeof(nm)));
-		if ((rc = wait_mask(c, lim_mask, 1, &mask, &to)) != GL_OK)
+		snprintf(ask, sizeof(ask), "TRIP %c %s", 'A' + i / 2,
+			 i % 2 ? "rev" : "fwd");
+		rc_lane_ask(c, &c->lim, ask);
+		if ((rc = wait_mask(c, lim_mask, &c->lim, 1, &mask, &to)) !=
+		    GL_OK)
 			return rc;
 		lim_judge(c, i, mask, to);
 		if (c->failed_step)
 			return GL_OK;
 		rc_say(c, "RELEASE %s", nm);
-		if ((rc = wait_mask(c, lim_mask, 0, &mask, &to)) != GL_OK)
+		rc_lane_ask(c, &c->lim, "RELEASE");
+		if ((rc = wait_mask(c, lim_mask, &c->lim, 0, &mask, &to)) !=
+		    GL_OK)
 			return rc;
 		if (to) {
 			re_comm_add(c, "limits", nm, RE_COMM_FAIL,
