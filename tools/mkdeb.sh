@@ -31,6 +31,9 @@ PKG=packaging/deb
 DEB=$BUILD/deb
 root=$DEB/root
 version=$(sed -n 's/^#define ROBOELF_VERSION[ \t]*"\(.*\)"/\1/p' pc/base/base_version.h)
+# DEB_VERSION_SUFFIX (e.g. +rebuilt1): a later package of the same sources,
+# for the package test's upgrade
+[ -n "$version" ] && version=$version${DEB_VERSION_SUFFIX:-}
 arch=$(dpkg --print-architecture)
 out=$BUILD/roboelf_${version}_${arch}.deb
 out_sim=$BUILD/roboelf-sim_${version}_${arch}.deb

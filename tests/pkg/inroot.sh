@@ -67,6 +67,25 @@ ls /tmp/demo/roboelf-demo/roboelf-trace-*.csv >/dev/null 2>&1 || fail "the demo 
 cd /tmp || fail "no /tmp"
 ok "the installed demo ran (roboelf-sim): its trace and 4 plots in /tmp/demo/roboelf-demo"
 
+# an upgrade to the same sources rebuilt as a later version keeps the
+# operator's edit of the conffile, the calibration file and the log
+cal=/var/lib/roboelf/roboelf-calibration.txt
+cp /tmp/demo/roboelf-demo/*calibration*.txt "$cal" 2>/dev/null || printf 'calibration of this robot\n' >"$cal"
+sed -i 's|^  address: FILL-IN|  address: 192.0.2.10|' /etc/roboelf/roboelf.yaml || fail "editing the conffile"
+before=$(md5sum /etc/roboelf/roboelf.yaml "$cal" "$log")
+apt-get install -y -qq --no-install-recommends /root/pkg/up/roboelf_*.deb /root/pkg/up/roboelf-sim_*.deb \
+	>>/root/pkg/apt.log 2>&1 || fail "the upgrade: $(tail -n 5 /root/pkg/apt.log)"
+cd /tmp || fail "no /tmp"
+now=$(dpkg-query -W -f '${Version} ' roboelf roboelf-sim)
+case $now in *+rebuilt1\ *+rebuilt1\ ) ;; *) fail "after the upgrade: versions $now" ;; esac
+[ "$(md5sum /etc/roboelf/roboelf.yaml "$cal" "$log")" = "$before" ] ||
+	fail "the upgrade changed: $(md5sum /etc/roboelf/roboelf.yaml "$cal" "$log")"
+for d in /var/lib/roboelf /var/log/roboelf; do
+	[ "$(stat -c '%a %U:%G' "$d")" = "2770 root:roboelf" ] || fail "after the upgrade, $d: $(stat -c '%a %U:%G' "$d")"
+done
+ok "upgraded to $now: the edited conffile, the calibration file and the log unchanged"
+rm -f "$cal"
+
 apt-get purge -y -qq roboelf-sim roboelf >>/root/pkg/apt.log 2>&1 || fail "apt-get purge: $(tail -n 5 /root/pkg/apt.log)"
 [ ! -e /var/lib/roboelf ] || fail "the empty /var/lib/roboelf was kept"
 [ -f "$log" ] || fail "the purge deleted the log"

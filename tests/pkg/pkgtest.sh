@@ -34,6 +34,14 @@ for d in $(sed -n 's/^deb: //p' "$dir/deb.log"); do
 	cp "$d" "$root/root/pkg/" || fail "cannot copy $d"
 done
 [ "$(ls "$root/root/pkg" | wc -l)" = 2 ] || fail "make deb said: $(cat "$dir/deb.log")"
+# the same sources rebuilt as a later version, for the upgrade
+DEB_VERSION_SUFFIX=+rebuilt1 make -s --no-print-directory BUILD="$BUILD" deb >"$dir/deb-up.log" 2>&1 ||
+	{ cat "$dir/deb-up.log"; fail "make deb (the upgrade)"; }
+mkdir "$root/root/pkg/up" || fail "cannot make the root's /root/pkg/up"
+for d in $(sed -n 's/^deb: //p' "$dir/deb-up.log"); do
+	cp "$d" "$root/root/pkg/up/" && rm -f "$d" || fail "cannot copy $d"
+done
+[ "$(ls "$root/root/pkg/up" | wc -l)" = 2 ] || fail "make deb (the upgrade) said: $(cat "$dir/deb-up.log")"
 cp tests/pkg/inroot.sh "$root/root/pkg/" || fail "cannot copy inroot.sh"
 echo "pkgtest: the packages in a fresh Debian 12 root ($root); output in $dir/run.log"
 sh tools/debroot.sh run "$root" sh /root/pkg/inroot.sh >"$dir/run.log" 2>&1
