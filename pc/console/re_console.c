@@ -285,6 +285,8 @@ static void ctrl_text(const struct re_status *st, char *buf, size_t cap)
 
 	if (!st->have_za)
 		snprintf(buf, cap, "no data");
+	else if (st->ctrl_ours) /* not a cause: the first one is above */
+		snprintf(buf, cap, "stopped by the supervisor (code %d)", f);
 	else if ((st->za.state == RE_DMC_FAULT || f) && st->za.faxis >= 1 &&
 		 st->za.faxis <= 3)
 		snprintf(buf, cap, "FAULT %s axis %c (code %d)", w ? w : "?",

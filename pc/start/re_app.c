@@ -237,14 +237,38 @@ int re_app_open_log(struct app *a, const struct re_app_args *g)
 	return 0;
 }
 
+/* The relay never closed: what the amplifiers say of motor power (MG
+ * _TA0 bit 3, under-voltage), when the controller is ours and answers;
+ * "" when not known (the relay's state says nothing of wiring that
+ * bypasses it). */
+static void amp_said(struct app *a, char *buf, size_t cap)
+{
+	double ta0;
+
+	buf[0] = '\0';
+	if (!a->real.link || !a->ctl_ours ||
+	    re_io_read(&a->io, "_TA0", &ta0, a->cfg.controller.timeout_ms) !=
+		GL_OK)
+		return;
+	if ((long)ta0 & 8)
+		snprintf(buf, cap, "; the amplifiers report no motor power");
+	else
+		snprintf(buf, cap,
+			 ", yet the amplifiers report motor power (MG _TA0 = "
+			 "%ld, no under-voltage): the relay does not switch it",
+			 (long)ta0);
+}
+
 /* Power-off, the reverse of power-on: the program back to its safe
  * state, every motor off and read back, then the relay off and closed.
  * What was confirmed is said, on the screen and in the log. */
 void re_app_power_off(struct app *a, int latched)
 {
-	char what[192] = "";
+	char what[192] = "", amp[128] = "";
 	int rc = GL_OK;
 
+	if (!a->powered)
+		amp_said(a, amp, sizeof(amp));
 	if (a->sup)
 		rc = re_super_shutdown(a->sup, what, sizeof(what));
 	else if (a->real.link && a->ctl_ours)
@@ -257,11 +281,11 @@ void re_app_power_off(struct app *a, int latched)
 	a->real.link = NULL;
 	if (!a->powered) {
 		re_console_msg(&a->con,
-			       "%s: motor power was never "
-			       "switched on; %s",
-			       a->prog,
+			       "%s: the E-stop relay was never "
+			       "switched on%s; %s",
+			       a->prog, amp,
 			       latched ? "a fault was latched" : "bye");
-		re_log_msg(&a->log, RE_LOG_INFO, "stop: motor power never on");
+		re_log_msg(&a->log, RE_LOG_INFO, "stop: relay never on%s", amp);
 		return;
 	}
 	if (!what[0])

@@ -101,6 +101,11 @@ static int send_stop(struct re_super *s, const char *cmd)
 				   s->pub.cfg.fault_cmd_timeout_ms);
 
 	s->confirm.stop_fresh = 0;
+	/* a command sent and not answered in time may still have arrived
+	 * (a slow reply, a stalled link): "not delivered" would be a guess;
+	 * so may one on a new connection that timed out (its connect or its
+	 * reply: both look the same from here) */
+	s->confirm.stop_maybe = rc == GL_ERR_TIMEOUT || rc == GL_ERR_PROTO;
 	if ((rc == GL_ERR_BROKEN || rc == GL_ERR_CLOSED ||
 	     rc == GL_ERR_TIMEOUT || rc == GL_ERR_SYS || rc == GL_ERR_PROTO) &&
 	    s->pub.io.ops->stop_fresh && s->pub.cfg.fresh_stop_ms > 0) {
@@ -108,6 +113,7 @@ static int send_stop(struct re_super *s, const char *cmd)
 					       sizeof(s->resp),
 					       s->pub.cfg.fresh_stop_ms);
 		s->confirm.stop_fresh = 1;
+		s->confirm.stop_maybe |= rc == GL_ERR_TIMEOUT;
 	}
 	s->confirm.stop_ms = ns_to_ms(now_ns(s) - t0);
 	return rc;
@@ -233,6 +239,12 @@ static int motors_off(struct re_super *s)
 	return GL_OK;
 }
 
+/* The controller answered the stop (':' or '?'): the link works. */
+static int stop_answered(int stop_rc)
+{
+	return stop_rc >= 0 || stop_rc == GL_ERR_CTRL;
+}
+
 /* ---- root cause ---------------------------------------------------------- */
 
 /* Motor power lost on every axis while the relay was meant closed: when
@@ -280,8 +292,8 @@ static void foreign_from_program(struct re_super *s)
  * amplifier error runs at once when our relay cuts the power, while pcflt
  * waits for the next pass. A motor the servo or an amplifier switched off
  * has its own code (8 ER, 12 OA ...) or fault. */
-static int own_doing(const struct re_super *s, const struct re_za *za,
-		     double det)
+int re_react_own_doing(const struct re_super *s, const struct re_za *za,
+		       double det)
 {
 	return za->fcode == RE_DMC_F_SUPERVISOR ||
 	       (za->fcode == RE_DMC_F_MOTOROFF &&
@@ -303,7 +315,7 @@ static void consequences(struct re_super *s, const struct re_fault *f)
 	/* RELAY_POWER is the program's power loss, named with its cause */
 	if (s->confirm.stop_rc < 0 || re_fault_is_ctrl(f->id) ||
 	    f->id == RE_F_RELAY_POWER || program_fault(s, &za, &det) != GL_OK ||
-	    !za.fcode || own_doing(s, &za, det))
+	    !za.fcode || re_react_own_doing(s, &za, det))
 		return;
 	re_ctrl_fault(&za, (long long)det, &c);
 	if (re_fault_what_units(&c, s->pub.cfg.axis_names, &s->pub.cfg.units,
@@ -314,25 +326,52 @@ static void consequences(struct re_super *s, const struct re_fault *f)
 /* ---- the FAULT line -------------------------------------------------------
  */
 
+/* What is known of the stop: delivered when the controller answered it
+ * (':' or '?'); sent on the link and not answered in time, not known; else
+ * not delivered, with why. */
+static void stop_text(const struct re_confirm *c, char *buf, size_t cap)
+{
+	const char *mo = c->motors_rc == GL_OK ? " motors off confirmed;"
+					       : " motors off not confirmed;";
+
+	if (c->stop_rc == GL_ERR_CTRL)
+		snprintf(buf, cap,
+			 " the controller answered the stop command with an "
+			 "error (?);%s",
+			 mo);
+	else if (c->stop_rc >= 0)
+		snprintf(buf, cap, "%s", mo);
+	else if (c->stop_maybe)
+		snprintf(buf, cap,
+			 " no answer to the stop command in time (%s): "
+			 "whether the controller got it is not known; motors "
+			 "off not confirmed;",
+			 gl_strerror(c->stop_rc));
+	else
+		snprintf(buf, cap,
+			 " stop command not delivered (%s); motors off not "
+			 "confirmed;",
+			 gl_strerror(c->stop_rc));
+}
+
 /* " Safe state confirmed: ..." or " NOT CONFIRMED: ... PRESS THE HARDWARE
  * E-STOP NOW." - inserted before the recovery text. */
 static size_t confirm_text(const struct re_super *s, char *buf, size_t cap)
 {
 	const struct re_confirm *c = &s->confirm;
+	char stop[192];
 
 	if (c->relay_rc == GL_OK && c->motors_rc == GL_OK)
 		return (size_t)snprintf(
 		    buf, cap,
 		    " Safe state confirmed: motor power off (relay open), "
 		    "motors off.");
+	stop_text(c, stop, sizeof(stop));
 	return (size_t)snprintf(
-	    buf, cap, " NOT CONFIRMED:%s%s%s PRESS THE HARDWARE E-STOP NOW.",
+	    buf, cap, " NOT CONFIRMED:%s%s PRESS THE HARDWARE E-STOP NOW.",
 	    c->relay_rc == GL_OK ? " motor power off (relay open) confirmed;"
 				 : " relay open not confirmed;",
-	    c->stop_rc < 0	    ? " stop command not delivered;"
-	    : c->motors_rc == GL_OK ? " motors off confirmed;"
-				    : " motors off not confirmed;",
-	    c->stop_rc < 0 ? " the controller did not answer." : "");
+	    stop);
 }
 
 /* " Another program had connected to the controller (handle C)." */
@@ -413,10 +452,24 @@ static const char *rc_text(int rc, const char *ok)
 	return rc >= 0 ? ok : gl_strerror(rc);
 }
 
+/* The log's "controller stop: ...": as the FAULT line, with the error. */
+static const char *stop_log(const struct re_confirm *c, char *buf, size_t cap)
+{
+	if (c->stop_rc >= 0)
+		return "delivered";
+	snprintf(buf, cap, "%s (%s)",
+		 c->stop_rc == GL_ERR_CTRL ? "delivered, answered ?"
+		 : c->stop_maybe	   ? "no answer in time, delivery "
+					     "not known"
+					   : "not delivered",
+		 gl_strerror(c->stop_rc));
+	return buf;
+}
+
 static void log_fault(struct re_super *s)
 {
 	const struct re_confirm *c = &s->confirm;
-	char *t = s->text;
+	char *t = s->text, stop[96];
 	size_t cap = sizeof(s->text), n;
 
 	n = (size_t)snprintf(
@@ -425,7 +478,7 @@ static void log_fault(struct re_super *s)
 	    "off: %s%s%s | cycle %llu, reply age %.1f ms",
 	    s->pub.fault_line,
 	    c->relay_rc == GL_OK ? "confirmed" : "NOT confirmed",
-	    rc_text(c->stop_rc, "delivered"),
+	    stop_log(c, stop, sizeof(stop)),
 	    c->stop_fresh ? " over a new connection" : "", c->stop_ms,
 	    c->motors_rc == GL_OK ? "confirmed" : "NOT confirmed",
 	    s->verdict[0] ? " | " : "", s->verdict,
@@ -479,8 +532,11 @@ int re_super_fault(struct re_super *s, const struct re_fault *f)
 	s->confirm.stop_rc = stop_controller(s, &fault);
 	/* 3. the relay's off confirmed; 4. the motors read back */
 	s->confirm.relay_rc = relay_finish(s, relay_rc);
-	s->confirm.motors_rc =
-	    s->confirm.stop_rc >= 0 ? motors_off(s) : s->confirm.stop_rc;
+	/* a stop answered '?' reached the controller: what it did is read
+	 * back like any other */
+	s->confirm.motors_rc = stop_answered(s->confirm.stop_rc)
+				   ? motors_off(s)
+				   : s->confirm.stop_rc;
 	relay_or_power(s, &fault);
 	consequences(s, &fault);
 	foreign_from_program(s);

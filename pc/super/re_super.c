@@ -665,6 +665,24 @@ static void axis_status(const struct re_super *s, int i,
 	out->margin_v = s->pub.encres[i].margin_v;
 }
 
+/* The program's latched fault came from our stop: after a fault of our
+ * own finding (not one the program latched first), the record's stop
+ * code of the axis it names stands for its detail. Fault 12 (our pcflt)
+ * says so in its own name already. */
+static int ctrl_ours(const struct re_super *s)
+{
+	const struct re_za *za = &s->pub.za;
+	double det = 0;
+
+	if (!s->pub.latched || re_fault_is_ctrl(s->pub.fault.id) ||
+	    !s->pub.have_za || !za->fcode || za->fcode == RE_DMC_F_SUPERVISOR)
+		return 0;
+	if (za->faxis >= 1 && za->faxis <= s->pub.cfg.n_axes &&
+	    s->pub.have_record)
+		det = s->pub.rec.axis[za->faxis - 1].stop_code;
+	return re_react_own_doing(s, za, det);
+}
+
 void re_super_status(const struct re_super *s, struct re_status *st)
 {
 	memset(st, 0, sizeof(*st));
@@ -693,6 +711,7 @@ void re_super_status(const struct re_super *s, struct re_status *st)
 	st->have_za = s->pub.have_za;
 	st->mode_name = s->pub.cfg.mode_name ? s->pub.cfg.mode_name : "";
 	st->latched = s->pub.latched;
+	st->ctrl_ours = ctrl_ours(s);
 	st->fault_line = re_super_fault_line(s);
 	st->uptime_s = (double)(now_ns(s) - s->t0_ns) / 1e9;
 }

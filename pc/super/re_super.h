@@ -125,6 +125,8 @@ struct re_confirm {
 	int relay_rc;	/* relay off: GL_OK when confirmed */
 	int stop_rc;	/* the stop command: >= 0 delivered */
 	int stop_fresh; /* 1: delivered over a new connection */
+	int stop_maybe; /* 1: no answer in time: whether the controller
+			   got it is not known */
 	int motors_rc;	/* GL_OK: every motor read back off */
 	double stop_ms; /* time to deliver the stop, ms */
 };
@@ -151,6 +153,11 @@ struct re_status {
 	int have_za;
 	const char *mode_name;
 	int latched;
+	/* the controller's latched fault is the result of this supervisor's
+	 * own stop (a motor found off by our MO, every amplifier without
+	 * power after our relay's off; not 12, which names us itself): the
+	 * board says so */
+	int ctrl_ours;
 	const char *fault_line; /* "" when none */
 	int log_failing;	/* a log entry could not be written */
 	unsigned foreign;	/* handles another program opened (1 = A) */

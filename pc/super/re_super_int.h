@@ -79,4 +79,14 @@ struct re_super {
 	char text[2048];
 };
 
+/*
+ * re_react_own_doing() - the program's latched fault @za (detail @det) is
+ * the result of this supervisor's own stop: 12 (pcflt), a motor found off
+ * whose stop code says a command stopped it, every amplifier without
+ * power once our relay's off was confirmed (re_react.c).
+ * Return: 1 or 0.
+ */
+int re_react_own_doing(const struct re_super *s, const struct re_za *za,
+		       double det);
+
 #endif /* RE_SUPER_INT_H */

@@ -53,7 +53,7 @@ expect port-option 2 "roboelf: error: 'address' '127.0.0.1:99999' is not HOST, H
 	-- -c "$tmp/ok.yaml" --galil 127.0.0.1:99999 --calibration file
 
 expect no-relay 3 "roboelf: error: cannot open the E-stop relay '$tmp/no-relay': No such file or directory (is galil-sim running, or the relay plugged in?)
-roboelf: motor power was never switched on; bye" \
+roboelf: the E-stop relay was never switched on; bye" \
 	-- -c "$tmp/ok.yaml" --calibration file
 [ -e "$tmp/no-relay" ] && fail "no-relay: the relay path was created"
 
@@ -64,7 +64,7 @@ sed -e 's#^mode: .*#mode: clinical#' -e 's#^  port_clinical: .*#  port_clinical:
     -e 's#^  serial: .*#  serial: A10KXYZ9#' -e 's#address: "127.0.0.1:23023"#address: "192.0.2.1"#' \
     "$tmp/ok.yaml" >"$tmp/clinical.yaml"
 expect unbound 3 "roboelf: error: relay '/dev/null': cannot read its USB serial number: not a serial port known to libserialport
-roboelf: motor power was never switched on; bye" \
+roboelf: the E-stop relay was never switched on; bye" \
 	-- -c "$tmp/clinical.yaml" --calibration file
 # without relay.serial: refused by the configuration check (exit 2)
 sed 's#^  serial: .*#  serial: ""#' "$tmp/clinical.yaml" >"$tmp/noserial.yaml"

@@ -350,7 +350,7 @@ static void test_no_program(void **state)
 		 "controller, the program\n"
 		 "commission: FAILED at step needs (program): %s - fix: %s\n"
 		 "commission: report %s/commissioning.txt, 0 plot(s)\n"
-		 "roboelf-tech: motor power was never switched on; bye\n",
+		 "roboelf-tech: the E-stop relay was never switched on; the amplifiers report no motor power; bye\n",
 		 c.relay_link, c.sim_addr, c.sim.port, why, fix, dir);
 	if (strcmp(out, want) != 0)
 		fail_msg("stdout\n%s\nnot\n%s", out, want);
@@ -500,6 +500,46 @@ static const struct wrong wrongs[] = {
      NULL, NULL},
 };
 
+/* The farewell states only what is known of motor power, and that is
+ * true in galil-sim (its state line's motor power, "power="): "the E-stop
+ * relay was never switched on" with what the amplifiers report
+ * (relay-unwired: motor power, the relay bypassed), never "motor power
+ * was never switched on". */
+static void farewell_true(struct sys_case *c, const struct wrong *w)
+{
+	static const char never[] = "roboelf-tech: the E-stop relay was never "
+				    "switched on";
+	const char *out = proc_output(&c->re, PROC_STDOUT), *p;
+	char st[4096];
+	double power;
+
+	if (strstr(out, "motor power was never switched on"))
+		fail_msg("%s %s: a farewell states what is not known:\n%s",
+			 w->opt, w->arg, out);
+	if (!strcmp(w->arg, "relay-unwired") &&
+	    !strstr(out, "roboelf-tech: the E-stop relay was never switched "
+			 "on, yet the amplifiers report motor power (MG _TA0 "
+			 "= 0, no under-voltage): the relay does not switch "
+			 "it; "))
+		fail_msg("%s %s: no '%s, yet the amplifiers report motor "
+			 "power ...' in:\n%s",
+			 w->opt, w->arg, never, out);
+	p = strstr(out, never);
+	if (!p)
+		return;
+	if (sys_state(c, st, sizeof(st)) < 0)
+		fail_msg("%s %s: %s", w->opt, w->arg, c->err);
+	power = sys_state_num(st, "power");
+	p += strlen(never);
+	if ((!strncmp(p, ", yet the amplifiers report motor power", 39) &&
+	     power != 1) ||
+	    (!strncmp(p, "; the amplifiers report no motor power", 38) &&
+	     power != 0))
+		fail_msg("%s %s: the farewell '%.200s' is false: galil-sim's "
+			 "state: %s",
+			 w->opt, w->arg, p - strlen(never), st);
+}
+
 /* Each miswiring and deviation galil-sim models, found at its step. */
 static void test_wrong_robot(void **state)
 {
@@ -527,6 +567,7 @@ static void test_wrong_robot(void **state)
 				 w->arg, w->report, rep);
 		check_scripts(dir, w->plot,
 			      w->plot ? strstr(w->line, "): ") + 3 : NULL);
+		farewell_true(&c, w);
 		sys_case_stop(&c);
 	}
 }

@@ -16,7 +16,11 @@
  *    injection to "relay off" and to the last "axis <X> motor off"), within
  *    the deadline of docs/safety.md ("Deadlines") plus SLACK_MS;
  *  - that the controller obeyed the supervisor's stop command (the log
- *    entry does not say "rejected"), where the controller is reachable;
+ *    entry does not say "answered ?"), where the controller is reachable;
+ *  - that every fact the FAULT line and its log entry state is true in
+ *    galil-sim's event log (sys_truth_check(): class and axis of the first
+ *    cause, consequences, stop delivered, relay open, power and motors
+ *    off);
  *  - roboelf exits 4 (fault latched) on SIGTERM afterwards, and the FAULT
  *    entry names a flight-recorder trace that parses and holds
  *    the cycles before the fault and the fault cycle.
@@ -43,6 +47,7 @@
 #include "re_calfile.h"
 #include "re_trace.h"
 #include "sys_h.h"
+#include "sys_truth.h"
 
 #define SLACK_MS      25   /* scheduling allowance on a busy 2-core box */
 #define HOLD_MS	      300  /* no motion over this after the safe state */
@@ -169,7 +174,7 @@ static void match_fault_line(struct sys_case *c, const struct expect *x,
 	if (sys_log_find(c, " FAULT ", line, logline, sizeof(logline)) < 0)
 		fail_msg("%s: %s", x->name, c->err);
 	/* the stop and motors-off command must have been obeyed */
-	if (!x->link_down && strstr(logline, "rejected"))
+	if (!x->link_down && strstr(logline, "answered ?"))
 		fail_msg("%s: the controller rejected the supervisor's stop "
 			 "command:\n%s",
 			 x->name, logline);
@@ -203,6 +208,8 @@ static void expect_fault(struct sys_case *c, const struct expect *x,
 	record(x, m);
 	match_fault_line(c, x, line);
 	if (sys_check_safe(c, x->relay_may_be_on, HOLD_MS) < 0)
+		fail_msg("%s: %s", x->name, c->err);
+	if (sys_truth_check(c, line, x->t_inj, 0) < 0)
 		fail_msg("%s: %s", x->name, c->err);
 	if (x->d_relay >= 0 && m->relay_ms > x->d_relay + SLACK_MS)
 		fail_msg("%s: relay off after %.0f ms, deadline %.0f ms "
@@ -359,7 +366,9 @@ static void pot_at_rest(const char *name, const char *req, int axis,
 static void test_pot_offset(void **state)
 {
 	(void)state;
-	pot_at_rest("pot offset", "pot A offset 0.5", 0, RE_F_ENCPOT);
+	/* B, the demo's fault: the program, told to stop, finds A off
+	 * first; nothing may name A */
+	pot_at_rest("pot offset", "pot B offset 0.5", 1, RE_F_ENCPOT);
 }
 
 /* An open wiper reads 0 V, which no potentiometer of this robot can read:
@@ -982,7 +991,8 @@ static void test_power_cycle(void **state)
 		m.motors_ms = -1;
 		record(&x, &m);
 		match_fault_line(&cs, &x, line);
-		if (sys_check_safe(&cs, 0, HOLD_MS) < 0)
+		if (sys_check_safe(&cs, 0, HOLD_MS) < 0 ||
+		    sys_truth_check(&cs, line, x.t_inj, 0) < 0)
 			fail_msg("%s", cs.err);
 		if (m.relay_ms > x.d_relay + SLACK_MS)
 			fail_msg("relay off %.0f ms after the power cycle, "

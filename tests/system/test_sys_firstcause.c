@@ -38,6 +38,7 @@
 #include <cmocka.h>
 
 #include "sys_exact_h.h"
+#include "sys_truth.h"
 
 static struct sys_env env;
 static struct sx_fixture fx;
@@ -124,7 +125,8 @@ static void test_relay_writefail(void **state)
 		 "the hardware E-stop now, check the relay board, its USB "
 		 "cable and its power, then restart roboelf");
 	sx_expect_text("the FAULT line", tpl, line, NULL, 0);
-	if (sys_check_safe(&cs, 0, SX_HOLD_MS) < 0)
+	if (sys_check_safe(&cs, 0, SX_HOLD_MS) < 0 ||
+	    sys_truth_check(&cs, line, t, 0) < 0)
 		fail_msg("%s", cs.err);
 	if (t_mo > SYS_MAINMS + 1 + SX_SLACK_MS || w1 - w0 > d_pc + SX_SLACK_MS)
 		fail_msg("too late: motors off %.0f ms, FAULT entry %.0f ms",
@@ -227,7 +229,8 @@ static void sigstop(const char *name, int phase_ms, int delay_ms)
 	if (num[0] < t_cont - t_stop - 2 * sx_p(&env))
 		fail_msg("the stall named is %.0f ms, it was stopped %.0f ms",
 			 num[0], t_cont - t_stop);
-	if (sys_check_safe(&cs, 0, SX_HOLD_MS) < 0)
+	if (sys_check_safe(&cs, 0, SX_HOLD_MS) < 0 ||
+	    sys_truth_check(&cs, line, t_stop, 0) < 0)
 		fail_msg("%s", cs.err);
 	if (t_mo > env.wdto_ms + SYS_MAINMS + 1 + SX_SLACK_MS ||
 	    t_relay > 2 * sx_p(&env) + SX_SLACK_MS)
@@ -337,7 +340,8 @@ static void test_link_and_relay_lost(void **state)
 			"(deadline 2P + fresh stop = %.0f, wall)",
 			t_link - t0, t_relay - t0, t_off, t_mo, SYS_MAINMS + 1,
 			w1 - w0, 2 * sx_p(&env) + FRESH_STOP_MS);
-	if (sys_check_safe(&cs, 0, SX_HOLD_MS) < 0)
+	if (sys_check_safe(&cs, 0, SX_HOLD_MS) < 0 ||
+	    sys_truth_check(&cs, line, t0, 0) < 0)
 		fail_msg("%s", cs.err);
 	if (t_mo > SYS_MAINMS + 1 + SX_SLACK_MS)
 		fail_msg("motors off %.0f ms after the unplug", t_mo);
@@ -349,8 +353,8 @@ static void test_link_and_relay_lost(void **state)
 	snprintf(tpl, sizeof(tpl),
 		 "FAULT ESTOP: the E-stop relay stopped answering (relay '%s': "
 		 "link lost (hang-up)). NOT CONFIRMED: relay open not "
-		 "confirmed; stop command not delivered; the controller did "
-		 "not answer. PRESS THE HARDWARE E-STOP NOW. Recovery: press "
+		 "confirmed; stop command not delivered ({s}); motors off not "
+		 "confirmed; PRESS THE HARDWARE E-STOP NOW. Recovery: press "
 		 "the hardware E-stop now, check the relay's USB cable and "
 		 "power, then restart roboelf",
 		 cs.relay_link);

@@ -41,6 +41,7 @@
 #include <cmocka.h>
 
 #include "sys_exact_h.h"
+#include "sys_truth.h"
 
 /* Recovery text of the MOTION fault of another program's move, as
  * roboelf prints it (pc/super/re_fault.c; docs/operator.md section 7). */
@@ -175,7 +176,8 @@ static void foreign_move(const char *name, const char *line1, const char *cmd1,
 	i = sx_wait_event(&cs, "relay off", NULL, t_conn, 3000);
 	t_relay = cs.ev[i].t_ms;
 	t_mo = sx_wait_motors_off(&cs, t_conn, 3000);
-	if (sys_check_safe(&cs, 0, SX_HOLD_MS) < 0)
+	if (sys_check_safe(&cs, 0, SX_HOLD_MS) < 0 ||
+	    sys_truth_check(&cs, line, t0, 1u << (h - 'A')) < 0)
 		fail_msg("%s", cs.err);
 	a1 = sx_state_num(&cs, "A.act");
 	i = sys_event_find(&cs, "axis A begin", t0);

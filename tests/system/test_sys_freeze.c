@@ -31,6 +31,7 @@
 #include <cmocka.h>
 
 #include "sys_phase_h.h"
+#include "sys_truth.h"
 
 #define FREEZE_MS	2000
 #define FREEZE_SLACK_MS 5 /* see check_stall_line() */
@@ -146,6 +147,8 @@ static void freeze_one(const struct ph_instant *in)
 		check_stall_line(what, line);
 		if (sys_check_safe(&cs, 0, RIG_HOLD_MS) < 0)
 			rig_fail("%s: after SIGCONT: %s", what, cs.err);
+		else if (sys_truth_check(&cs, line, t_sig, 0) < 0)
+			rig_fail("%s: %s", what, cs.err);
 	}
 	proc_signal(&cs.re, SIGTERM);
 	if (proc_wait_exit(&cs.re, RIG_EXIT_WAIT_MS, &status) < 0)

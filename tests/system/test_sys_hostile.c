@@ -28,6 +28,7 @@
 
 #include "re_seal.h"
 #include "sys_h.h"
+#include "sys_truth.h"
 
 #define SLACK_MS      25  /* scheduling allowance on a busy 2-core box */
 #define HOLD_MS	      300 /* no motion over this after the safe state */
@@ -90,6 +91,8 @@ static void hostile(const struct hcase *h)
 	if (sys_ctl(&c, "joy A neutral") < 0 ||
 	    sys_check_safe(&c, 0, HOLD_MS) < 0)
 		fail_msg("'%s': not safe: %s", h->write, c.err);
+	if (sys_truth_check(&c, line, t0, 0) < 0)
+		fail_msg("'%s': %s", h->write, c.err);
 	if (sys_state(&c, st, sizeof(st)) < 0)
 		fail_msg("%s", c.err);
 	a1 = sys_state_num(st, "A.act");

@@ -49,6 +49,7 @@
 #include <cmocka.h>
 
 #include "sys_exact_h.h"
+#include "sys_truth.h"
 
 #define REFUSE_WAIT_MS 5000 /* a refused roboelf has exited */
 #define LOCK_REFUSE_MS 1000 /* a lock refusal: no I/O, no wait */
@@ -546,7 +547,8 @@ static void test_load_force(void **state)
 		fail_msg("galil-load --force exited with %d, not 0\n--- "
 			 "stderr:\n%s",
 			 code, proc_output(&re2, PROC_STDERR));
-	if (sys_check_safe(&cs, 0, SX_HOLD_MS) < 0)
+	if (sys_check_safe(&cs, 0, SX_HOLD_MS) < 0 ||
+	    sys_truth_check(&cs, line, t0, 1u << (h - 'A')) < 0)
 		fail_msg("%s", cs.err);
 	if (t_relay - t_hx > 2.0 * sx_p(&env) + SX_SLACK_MS ||
 	    t_mo - t_hx > 2.0 * sx_p(&env) + SYS_MAINMS + SX_SLACK_MS)

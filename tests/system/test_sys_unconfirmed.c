@@ -38,6 +38,7 @@
 
 #include "re_check.h"
 #include "sys_phase_h.h"
+#include "sys_truth.h"
 
 #define WEDGE_EXIT_MS 1000 /* SIGTERM to exit with a wedged relay */
 
@@ -159,14 +160,17 @@ static void link_loss(const struct link_case *lc)
 				 "confirmed: %s",
 				 lc->name, logline);
 	} else if (!strstr(line, "NOT CONFIRMED") ||
-		   !strstr(line, "stop command not delivered") ||
+		   (!strstr(line, "stop command not delivered (") &&
+		    !strstr(line, "no answer to the stop command in time (")) ||
 		   !strstr(line, "PRESS THE HARDWARE E-STOP NOW") ||
 		   !strstr(logline, "over a new connection") ||
 		   !strstr(logline, "motors off: NOT confirmed")) {
 		rig_fail("%s: the FAULT line or the log does not say that the "
-			 "stop was not delivered:\n    %s",
+			 "stop was not delivered or not answered:\n    %s",
 			 lc->name, logline);
 	}
+	if (sys_truth_check(&cs, line, t_link, 0) < 0)
+		rig_fail("%s: %s", lc->name, cs.err);
 	if (t_relay - t_link > lc->d_relay + RIG_SLACK_MS)
 		rig_fail("%s: relay off after %.0f ms, deadline %.0f ms",
 			 lc->name, t_relay - t_link, lc->d_relay);
@@ -251,6 +255,8 @@ static void wedged(const char *name, const char *fault_req, enum re_fault_id id,
 			 t_mo - t_f, d_motors);
 	/* the wedged board keeps motor power on: the motors are off */
 	if (sys_check_safe(&cs, 1, RIG_HOLD_MS) < 0)
+		rig_fail("%s: %s", name, cs.err);
+	else if (sys_truth_check(&cs, line, t_w, 0) < 0)
 		rig_fail("%s: %s", name, cs.err);
 	/* the power-off waits relay.off_deadline_ms (50) for the relay,
 	 * never for the wedged board itself */

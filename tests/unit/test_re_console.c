@@ -235,6 +235,16 @@ static void test_status_words(void **state)
 	st.za = (struct re_za){.state = RE_DMC_ARMED}; /* before thread 1 */
 	re_console_format_line(&st, line, sizeof(line));
 	assert_non_null(strstr(line, "ctrl=\"armed\""));
+	/* the program's fault that the supervisor's own stop caused (it
+	 * found A off after B's fault had switched every motor off): said
+	 * as such, never as a motor-off fault on A */
+	st.za = (struct re_za){
+	    .state = RE_DMC_FAULT, .fcode = RE_DMC_F_MOTOROFF, .faxis = 1};
+	st.ctrl_ours = 1;
+	re_console_format_line(&st, line, sizeof(line));
+	assert_non_null(
+	    strstr(line, "ctrl=\"stopped by the supervisor (code 10)\""));
+	assert_null(strstr(line, "axis A"));
 }
 
 /* Line @n (0-based) of @text into @out (without its newline). */

@@ -580,6 +580,57 @@ static void test_super_power_loss_ours(void **state)
 	}
 }
 
+/*
+ * The board's word for what the program latched after our fault: B's
+ * potentiometer (our encoder/pot check) latches the supervisor's fault;
+ * our "MO ABC" landing mid-pass makes the program find A off first and
+ * latch 10 on A with stop code 7 (AB): that is our stop's doing
+ * (ctrl_ours), never a motor-off fault on A; stop code 8 on A would be
+ * the controller's own (a consequence); 12 (pcflt) names the supervisor
+ * in its own words already (FAULT SUPERVISOR).
+ */
+static void test_super_ctrl_ours(void **state)
+{
+	static const struct {
+		int fcode, faxis, stop_code, ours;
+	} cases[] = {{10, 1, 7, 1},
+		     {10, 1, 4, 1},
+		     {12, 0, 0, 0},
+		     {10, 1, 8, 0},
+		     {4, 2, 1, 0}};
+	struct re_status st;
+
+	for (size_t k = 0; k < sizeof(cases) / sizeof(cases[0]); k++) {
+		setup(state);
+		assert_int_equal(run(2), RE_OK);
+		fk.relay_check_rc = GL_ERR_RELAY; /* a fault of roboelf's */
+		assert_int_equal(step(), RE_FAULT);
+		re_super_status(&sup, &st);
+		assert_int_equal(st.ctrl_ours, 0); /* nothing latched yet */
+		fk.rec.axis[1].za =
+		    2 + 10 * cases[k].fcode + 1000 * cases[k].faxis;
+		for (int a = 0; a < 3; a++) {
+			fk.rec.axis[a].status |= GL_AXST_MOTOR_OFF;
+			fk.rec.axis[a].stop_code = cases[k].stop_code;
+		}
+		step();
+		re_super_status(&sup, &st);
+		assert_int_equal(st.za.fcode, cases[k].fcode);
+		assert_int_equal(st.ctrl_ours, cases[k].ours);
+	}
+	/* the program's own fault, found first, is the cause: never ours */
+	setup(state);
+	assert_int_equal(run(2), RE_OK);
+	fk.rec.axis[1].za = 2 + 10 * 10 + 1000 * 1;
+	fk.rec.axis[0].status |= GL_AXST_MOTOR_OFF;
+	fk.rec.axis[0].stop_code = 7;
+	snprintf(fk.mg_fdet, sizeof(fk.mg_fdet), " 7.0000");
+	assert_int_equal(step(), RE_FAULT);
+	assert_int_equal(sup.pub.fault.id, RE_F_CTRL_MOTOROFF);
+	re_super_status(&sup, &st);
+	assert_int_equal(st.ctrl_ours, 0);
+}
+
 /* A closed connection: COMM fault. */
 static void test_super_comm_fault(void **state)
 {
@@ -1022,6 +1073,7 @@ int main(void)
 	    cmocka_unit_test_setup(test_super_comm_fault, setup),
 	    cmocka_unit_test_setup(test_super_foreign_named, setup),
 	    cmocka_unit_test_setup(test_super_consequences, setup),
+	    cmocka_unit_test_setup(test_super_ctrl_ours, setup),
 	    cmocka_unit_test_setup(test_super_power_loss_ours, setup),
 	    cmocka_unit_test_setup(test_super_relay_lost, setup),
 	    cmocka_unit_test_setup(test_super_controller_fault, setup),

@@ -369,6 +369,10 @@ static int cmd_ab(struct ctrl_xc *x, const char *a)
 	if (v != 0 && v != 1)
 		return 6;
 	ctrl_xc_who(x, who, sizeof(who));
+	/* a host's stop is an event even when nothing moves: the system
+	 * tests' ground truth for "stop command delivered" */
+	if (x->thread < 0)
+		ctrl_event(x->c, "AB %d received (%s)", (int)v, who);
 	for (i = 0; i < CTRL_AXES; i++)
 		ctrl_motion_abort(x->c, i, who);
 	if (v == 0) {
@@ -395,6 +399,8 @@ static int cmd_shmo(struct ctrl_xc *x, const char *a, int on)
 		    (on || !(c->cfg.deviate & CTRL_DEV_MO_MOVING)))
 			return 7; /* deviation mo-moving: MO accepted */
 	ctrl_xc_who(x, who, sizeof(who));
+	if (!on && x->thread < 0) /* as AB: the stop arrived */
+		ctrl_event(c, "MO received (%s)", who);
 	snprintf(why, sizeof(why), "MO (%s)", who);
 	for (i = 0; i < CTRL_AXES; i++) {
 		struct ctrl_axis *ax = &c->ax[i];
