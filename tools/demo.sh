@@ -36,6 +36,11 @@ else
 	BIN=${ROBOELF_BIN:-$(dirname "$(command -v galil-sim || echo /usr/bin/galil-sim)")}
 	OUTBASE=$PWD/roboelf-demo
 fi
+# ROBOELF_DEMO_CONFIG=FILE: roboelf and galil-load use FILE, and roboelf's
+# log, traces and calibration file go where FILE says (the package test:
+# /var/log/roboelf, /var/lib/roboelf); by default the development
+# configuration, with the log and the calibration file in the run's directory
+CONFIG=${ROBOELF_DEMO_CONFIG:-$TOP/config/roboelf.yaml}
 TMP=$(mktemp -d /tmp/roboelf-demo.XXXXXX)
 SIM_PID=""; RE_PID=""
 
@@ -99,7 +104,7 @@ read -r _ _ _ addr _ CPORT _ RELAY <"$TMP/sim.out"
 say "galil-sim at $addr, control port $CPORT, relay $RELAY"
 
 say "checking and downloading dmc/ with galil-load"
-"$BIN/galil-load" -a "$addr" --config "$TOP/config/roboelf.yaml" --start "$TOP/dmc/" || die "galil-load failed"
+"$BIN/galil-load" -a "$addr" --config "$CONFIG" --start "$TOP/dmc/" || die "galil-load failed"
 
 if [ "${INTERACTIVE:-}" = 1 ]; then
 	exec 3</dev/tty
@@ -127,8 +132,8 @@ start_roboelf() { # start_roboelf full|file
 	local size
 	size=$(tty_size)
 	(cd "$RUN" && exec script -qfec "stty rows ${size% *} cols ${size#* }; \
-		exec '$BIN/roboelf' -c '$TOP/config/roboelf.yaml' \
-		--galil '$addr' --relay '$TMP/relay' --calibration $1 --log '$RUN/roboelf.log'" \
+		exec '$BIN/roboelf' -c '$CONFIG' \
+		--galil '$addr' --relay '$TMP/relay' --calibration $1 $LOGOPT" \
 		"$RUN/roboelf.out" </dev/null) &
 	RE_PID=$!
 }
@@ -167,7 +172,17 @@ stop_roboelf() {
 }
 RUN="$OUTBASE/run-$(date +%Y%m%d-%H%M%S)"
 mkdir -p "$RUN" || die "cannot make $RUN"
-say "starting roboelf (full calibration); its log and calibration file go to $RUN"
+if [ -n "${ROBOELF_DEMO_CONFIG:-}" ]; then
+	LOG=$("$BIN/roboelf-tech" --print log.path -c "$CONFIG") || die "cannot read log.path of $CONFIG"
+	LOGOPT=""
+	KEPT="the places $CONFIG names (log: $LOG)"
+	say "starting roboelf (full calibration); its log, traces and calibration file go where $CONFIG says (log: $LOG)"
+else
+	LOG=$RUN/roboelf.log
+	LOGOPT="--log '$LOG'"
+	KEPT=$RUN
+	say "starting roboelf (full calibration); its log and calibration file go to $RUN"
+fi
 start_roboelf full
 wait_line "$RUN/roboelf.out" 'RoboELF Ready for Use' 60 || die "roboelf did not become ready"
 
@@ -220,7 +235,7 @@ if [ "${INTERACTIVE:-}" = 1 ]; then
 		esac
 	done
 	stop_roboelf
-	say "the log and the calibration file are kept in $RUN"
+	say "the log and the calibration file are kept in $KEPT"
 	exit 0
 fi
 
@@ -249,8 +264,8 @@ say "relay: $(ctl relay); $(grep -o -m1 'FAULT ENCODER:.*' "$RUN/roboelf.out" | 
 # The flight recorder: the fault's trace is written
 # recorder.after_fault_s (2 s) after the fault; kept in $BUILD/demo and drawn.
 say "waiting for the flight recorder's trace of the fault (written 2 s after it)"
-wait_line "$RUN/roboelf.log" 'trace: .* written' 10 || die "no trace of the fault was written"
-trace=$(sed -n 's/.* trace: \(.*\) written (.*/\1/p' "$RUN/roboelf.log" | head -n 1)
+wait_line "$LOG" 'trace: .* written' 10 || die "no trace of the fault was written"
+trace=$(sed -n 's/.* trace: \(.*\) written (.*/\1/p' "$LOG" | head -n 1)
 OUT=$OUTBASE
 mkdir -p "$OUT" && cp "$trace" "$OUT/" || die "cannot keep the trace in $OUT"
 trace="$OUT/$(basename "$trace")"
@@ -261,5 +276,9 @@ stop_roboelf
 stop "$SIM_PID"; SIM_PID=""
 say "the fault's trace: $trace"
 say "its plots: $(sed -n 's/^wrote //p' "$TMP/show.out" | tr '\n' ' ')"
-say "the log, the calibration file and roboelf's output are kept in $RUN"
+if [ "$KEPT" = "$RUN" ]; then
+	say "the log, the calibration file and roboelf's output are kept in $RUN"
+else
+	say "the log and the calibration file are kept in $KEPT; roboelf's output in $RUN"
+fi
 exit 0

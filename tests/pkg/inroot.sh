@@ -67,10 +67,27 @@ ls /tmp/demo/roboelf-demo/roboelf-trace-*.csv >/dev/null 2>&1 || fail "the demo 
 cd /tmp || fail "no /tmp"
 ok "the installed demo ran (roboelf-sim): its trace and 4 plots in /tmp/demo/roboelf-demo"
 
+# the installed roboelf against the installed galil-sim, by an operator,
+# from a directory that is not the source tree, with the development
+# configuration's robot and the site's places: Ready, the demo's fault, and
+# the log, the trace and the calibration file where they belong
+sed -e 's|^  file: .*|  file: /var/lib/roboelf/roboelf-calibration.txt|' \
+	-e 's|^  path: .*|  path: /var/log/roboelf/roboelf.log|' \
+	/usr/share/roboelf/config/roboelf.yaml >/tmp/var.yaml || fail "var.yaml"
+chmod 644 /tmp/var.yaml
+mkdir /tmp/demo2 && chown op2 /tmp/demo2 || fail "no /tmp/demo2"
+(cd /tmp/demo2 && ROBOELF_DEMO_CONFIG=/tmp/var.yaml setpriv --reuid=op2 --regid=op2 --init-groups \
+	/usr/share/roboelf/demo.sh) >/root/pkg/demo2.log 2>&1 </dev/null ||
+	fail "the demo in the site's places: exit $?: $(tail -c 600 /root/pkg/demo2.log)"
+cal=/var/lib/roboelf/roboelf-calibration.txt
+[ -f "$cal" ] || fail "no calibration file $cal: $(ls -l /var/lib/roboelf)"
+ls /var/log/roboelf/roboelf-trace-*.csv >/dev/null 2>&1 || fail "no trace in /var/log/roboelf: $(ls /var/log/roboelf)"
+grep -q 'FAULT ENCODER: axis B' "$log" || fail "no FAULT ENCODER in $log"
+grep -q 'RoboELF Ready for Use' /tmp/demo2/roboelf-demo/run-*/roboelf.out || fail "roboelf was never Ready"
+ok "roboelf on galil-sim as op2: Ready, FAULT ENCODER on B; $cal, $(ls /var/log/roboelf/roboelf-trace-*.csv | head -n 1) and $log"
+
 # an upgrade to the same sources rebuilt as a later version keeps the
 # operator's edit of the conffile, the calibration file and the log
-cal=/var/lib/roboelf/roboelf-calibration.txt
-cp /tmp/demo/roboelf-demo/*calibration*.txt "$cal" 2>/dev/null || printf 'calibration of this robot\n' >"$cal"
 sed -i 's|^  address: FILL-IN|  address: 192.0.2.10|' /etc/roboelf/roboelf.yaml || fail "editing the conffile"
 before=$(md5sum /etc/roboelf/roboelf.yaml "$cal" "$log")
 apt-get install -y -qq --no-install-recommends /root/pkg/up/roboelf_*.deb /root/pkg/up/roboelf-sim_*.deb \
@@ -84,7 +101,7 @@ for d in /var/lib/roboelf /var/log/roboelf; do
 	[ "$(stat -c '%a %U:%G' "$d")" = "2770 root:roboelf" ] || fail "after the upgrade, $d: $(stat -c '%a %U:%G' "$d")"
 done
 ok "upgraded to $now: the edited conffile, the calibration file and the log unchanged"
-rm -f "$cal"
+rm -f "$cal"* /var/log/roboelf/roboelf-trace-*
 
 apt-get purge -y -qq roboelf-sim roboelf >>/root/pkg/apt.log 2>&1 || fail "apt-get purge: $(tail -n 5 /root/pkg/apt.log)"
 [ ! -e /var/lib/roboelf ] || fail "the empty /var/lib/roboelf was kept"
