@@ -314,6 +314,7 @@ static int open_recorder(struct app *a)
 		return -1;
 	}
 	a->rec = &rec;
+	re_console_trace_key(&a->con, 1); /* key t: a trace now */
 	return 0;
 }
 

@@ -148,7 +148,7 @@ done
 # check that runs the sanitized programs runs in both.
 once_only() {
 	case $1 in
-	commands* | contracts* | deb.sh | docs* | fuzz_short.sh | have_deps.sh | includes.sh | layers* | modtests.sh | nodisc.sh | safety_trace.sh) return 0 ;;
+	commands* | contracts* | deb.sh | docs* | fuzz_short.sh | have_deps.sh | includes.sh | layers* | modtests.sh | nodisc.sh | quotes.sh | safety_trace.sh) return 0 ;;
 	*) return 1 ;;
 	esac
 }

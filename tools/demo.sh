@@ -62,7 +62,34 @@ cleanup() {
 trap cleanup EXIT
 trap 'exit 130' INT TERM
 
-say() { printf '\n\033[1mdemo: %s\033[0m\n' "$*" >&2; }
+tty_size() { # prints "ROWS COLS" of this terminal, or "24 80"
+	local size
+	size=$(stty size 2>/dev/null </dev/tty)
+	case "$size" in [1-9]*\ [1-9]*) echo "$size" ;; *) echo "24 80" ;; esac
+}
+# say TEXT: one narration line, wrapped at word boundaries to this
+# terminal's width (continuation lines indented by two spaces) so that
+# the terminal never cuts or wraps it by itself; a word wider than the
+# terminal (a path) whole on a line of its own, so that it can be copied.
+# Written in one piece, so that roboelf's board is not drawn inside it.
+say() {
+	local size text
+	size=$(tty_size)
+	text=$(printf '%s\n' "demo: $*" | awk -v w="$(( ${size#* } - 1 ))" '
+	function out(s) { printf "\033[1m%s\033[0m\n", s }
+	{
+		line = ""
+		for (i = 1; i <= NF; i++) {
+			if (line != "" && length(line) + 1 + length($i) <= w) {
+				line = line " " $i; continue
+			}
+			if (line != "") out(line)
+			line = (length($i) + 2 <= w && i > 1) ? "  " $i : $i
+		}
+		if (line != "") out(line)
+	}')
+	printf '\n%s\n' "$text" >&2
+}
 die() { say "FAILED: $*"; exit 1; }
 
 # wait_line FILE PATTERN SECONDS - wait until FILE has a line matching PATTERN.
@@ -119,29 +146,31 @@ fi
 # live status board here (on the bottom lines; this narration scrolls
 # above it) while its output is also kept in a file to watch. It runs in
 # $RUN: the calibration table and the log stay there after the demo.
+# Its input is /dev/null, not that pseudo-terminal: the keys are the
+# demo's, none reaches roboelf, and its board says so ("no keyboard
+# here") instead of offering keys that would do nothing.
 # script(1) gives its pseudo-terminal the size of its standard input, which
 # is /dev/null here (the keys are the demo's): without the stty below
 # roboelf would lay its board out for 80x24 whatever this terminal's size,
 # in the middle of a taller one, over the narration.
-tty_size() { # prints "ROWS COLS" of this terminal, or "24 80"
-	local size
-	size=$(stty size 2>/dev/null </dev/tty)
-	case "$size" in [1-9]*\ [1-9]*) echo "$size" ;; *) echo "24 80" ;; esac
-}
 start_roboelf() { # start_roboelf full|file
 	local size
 	size=$(tty_size)
 	(cd "$RUN" && exec script -qfec "stty rows ${size% *} cols ${size#* }; \
 		exec '$BIN/roboelf' -c '$CONFIG' \
-		--galil '$addr' --relay '$TMP/relay' --calibration $1 $LOGOPT" \
+		--galil '$addr' --relay '$TMP/relay' --calibration $1 $LOGOPT </dev/null" \
 		"$RUN/roboelf.out" </dev/null) &
 	RE_PID=$!
 }
 # child_of PID: PID's first child (roboelf is script's child); the kernel
-# lists a process's children in /proc, so no ps is needed
+# lists a process's children in /proc, so no ps is needed. The list ends
+# without a newline, so read fails at its end though it read the pid:
+# the pid is tested, not read's status (else roboelf was never found, and
+# got its SIGTERM only with script's, 10 s later, its last words lost)
 child_of() {
-	local c
-	read -r c _ <"/proc/$1/task/$1/children" 2>/dev/null && echo "$c"
+	local c=""
+	read -r c _ <"/proc/$1/task/$1/children" 2>/dev/null
+	[ -n "$c" ] && echo "$c"
 }
 # resize_roboelf: this terminal was resized: so is roboelf's (its board is
 # redrawn for the new size on the SIGWINCH that stty makes the kernel send)
@@ -259,7 +288,11 @@ ctl "joy B fwd" >/dev/null
 ctl "pot B offset 0.5" >/dev/null
 wait_line "$RUN/roboelf.out" 'FAULT ENCODER:' 5 || die "the potentiometer fault did not trip"
 [ "$(ctl relay)" = off ] || die "the relay is still on after the fault"
-say "relay: $(ctl relay); $(grep -o -m1 'FAULT ENCODER:.*' "$RUN/roboelf.out" | tr -d '\r')"
+# the FAULT line whole from the log (roboelf.out holds it as the board
+# wrapped it for the screen: its first row only would be cut)
+wait_line "$LOG" ' FAULT FAULT ENCODER:' 5 || die "the fault is not in the log"
+fault=$(sed -n 's/^[^ ]* FAULT \(FAULT ENCODER: [^|]*[^| ]\) |.*/\1/p' "$LOG" | head -n 1)
+say "relay: $(ctl relay); $fault"
 
 # The flight recorder: the fault's trace is written
 # recorder.after_fault_s (2 s) after the fault; kept in $BUILD/demo and drawn.
@@ -271,9 +304,9 @@ mkdir -p "$OUT" && cp "$trace" "$OUT/" || die "cannot keep the trace in $OUT"
 trace="$OUT/$(basename "$trace")"
 "$BIN/roboelf-tech" show-trace "$trace" >"$TMP/show.out" 2>"$TMP/show.err" ||
 	die "roboelf-tech show-trace failed: $(cat "$TMP/show.err")"
-say "demo finished: stopping roboelf and galil-sim"
-stop_roboelf
-stop "$SIM_PID"; SIM_PID=""
+# said while roboelf's board still holds the bottom of the screen: once
+# it ends, its fault panel stays there, and only one short line follows,
+# so that the panel's first line stays on a 24-line screen
 say "the fault's trace: $trace"
 say "its plots: $(sed -n 's/^wrote //p' "$TMP/show.out" | tr '\n' ' ')"
 if [ "$KEPT" = "$RUN" ]; then
@@ -281,4 +314,7 @@ if [ "$KEPT" = "$RUN" ]; then
 else
 	say "the log and the calibration file are kept in $KEPT; roboelf's output in $RUN"
 fi
+stop_roboelf
+stop "$SIM_PID"; SIM_PID=""
+say "demo finished: roboelf and galil-sim stopped"
 exit 0

@@ -134,6 +134,7 @@ void re_plan_super_cfg(const struct re_plan *p, const struct re_config *cfg,
 		}
 		out->pot_input[i] = cfg->axes[i].analog.input;
 	}
+	out->units.invalid_timeout_ms = cfg->joystick.invalid_timeout_ms;
 	out->fault_cmd_timeout_ms = cfg->controller.timeout_ms;
 	out->fresh_stop_ms = p->fresh_stop_ms;
 	out->relay_off_ms = p->relay_off_ms;

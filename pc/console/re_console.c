@@ -3,6 +3,7 @@
  * See re_console.h.
  */
 #include "re_console.h"
+#include "re_console_int.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -20,10 +21,6 @@
 #define ANSI_GREEN  "\033[32m"
 #define ANSI_YELLOW "\033[33m"
 #define ANSI_OFF    "\033[0m"
-
-static const char *const cmd_names[7] = {
-    "none", "A fwd", "A rev", "B fwd", "B rev", "C fwd", "C rev",
-};
 
 /* A second, non-blocking open file description of a terminal or pipe
  * @fd (reopened through /proc, so the shell's own description is left
@@ -143,9 +140,29 @@ static void board_erase(struct re_console *c)
 
 static void term_size(struct re_console *c, int *cols, int *rows);
 
+/* The length of the next line of @text in @room columns: up to the last
+ * space that fits; a word longer than @room whole (a path is never split:
+ * the terminal wraps it, and a copy of it gets it whole). */
+static int wrap_len(const char *text, int room)
+{
+	int n = (int)strlen(text), k;
+
+	if (n <= room)
+		return n;
+	for (k = room; k > 0 && text[k] != ' '; k--)
+		;
+	if (k > 0)
+		return k;
+	while (text[k] && text[k] != ' ')
+		k++;
+	return k;
+}
+
 /* @text on the output; on a terminal wrapped at word boundaries to the
- * terminal's width (continuation lines indented by two spaces), so that
- * nothing wraps by itself; in @colour when given. */
+ * terminal's width (continuation lines indented by two spaces; a word
+ * wider than that, a path, on a line of its own from the first column),
+ * so that nothing wraps by itself but such a word; in @colour when
+ * given. */
 static void put_wrapped(struct re_console *c, const char *text,
 			const char *colour)
 {
@@ -158,18 +175,12 @@ static void put_wrapped(struct re_console *c, const char *text,
 	term_size(c, &cols, &rows);
 	w = cols - 1;
 	while (*text || first) {
-		int room = first ? w : w - 2, n = (int)strlen(text);
+		int room = first ? w : w - 2, n;
 
 		if (room < 20)
 			room = 20;
-		if (n > room) {
-			n = room;
-			while (n > room / 2 && text[n] != ' ')
-				n--;
-			if (text[n] != ' ')
-				n = room;
-		}
-		fprintf(c->out, "%s%s%.*s%s\n", first ? "" : "  ",
+		n = wrap_len(text, room);
+		fprintf(c->out, "%s%s%.*s%s\n", first || n > room ? "" : "  ",
 			colour ? colour : "", n, text, colour ? ANSI_OFF : "");
 		text += n;
 		while (*text == ' ')
@@ -262,90 +273,12 @@ void re_console_fault(struct re_console *c, const char *line)
 
 /* ---- texts ------------------------------------------------------------- */
 
-static const char *relay_text(enum re_relay_state r)
-{
-	switch (r) {
-	case RE_RELAY_ON: return "ON";
-	case RE_RELAY_OFF: return "OFF (power cut)";
-	default: return "UNKNOWN";
-	}
-}
-
-static const char *cmd_text(int k)
-{
-	if (k < 0)
-		return "invalid";
-	return k <= 6 ? cmd_names[k] : "?";
-}
-
-static void ctrl_text(const struct re_status *st, char *buf, size_t cap)
-{
-	int f = st->have_za ? st->za.fcode : 0;
-	const char *w = re_dmc_fcode_words(f);
-
-	if (!st->have_za)
-		snprintf(buf, cap, "no data");
-	else if (st->ctrl_ours) /* not a cause: the first one is above */
-		snprintf(buf, cap, "stopped by the supervisor (code %d)", f);
-	else if ((st->za.state == RE_DMC_FAULT || f) && st->za.faxis >= 1 &&
-		 st->za.faxis <= 3)
-		snprintf(buf, cap, "FAULT %s axis %c (code %d)", w ? w : "?",
-			 (char)('A' + st->za.faxis - 1), f);
-	else if (st->za.state == RE_DMC_FAULT || f)
-		snprintf(buf, cap, "FAULT %s (code %d)", w ? w : "?", f);
-	else if (st->za.state == RE_DMC_ARMED && !st->za.mneut &&
-		 st->za.jcmd > 0)
-		snprintf(buf, cap, "armed, release the joystick");
-	else
-		snprintf(buf, cap, "%s",
-			 st->za.state == RE_DMC_ARMED	  ? "armed"
-			 : st->za.state == RE_DMC_SERVICE ? "service"
-							  : "safe");
-}
-
-#define AT_SOFT_PCT 0.5	  /* within this of 0 or 100 %: at a soft limit */
-#define STILL_CPS   100.0 /* |velocity| below this: not moving */
-
-/* At a soft limit: +1 forward, -1 reverse, 0 not (or no calibration). */
-static int at_soft(const struct re_axis_status *a)
-{
-	if (a->pos_pct < 0)
-		return 0;
-	if (a->pos_pct >= 100 - AT_SOFT_PCT)
-		return 1;
-	return a->pos_pct <= AT_SOFT_PCT ? -1 : 0;
-}
-
-/* What the axis does now: never "moving" while it stands at a soft limit
- * (the tracking profiler stays busy there) or with its motor off. */
-static const char *motion_text(const struct re_axis_status *a)
-{
-	if (a->motor_off)
-		return "off";
-	if (at_soft(a) && a->vel_cps < STILL_CPS && a->vel_cps > -STILL_CPS)
-		return "at-lim";
-	return a->moving ? "moving" : "stopped";
-}
-
-/* Hard limit switches (FWD, REV, F+R) or, without one, a soft limit
- * reached (sF, sR). */
-static const char *limit_text(const struct re_axis_status *a)
-{
-	if (a->fwd_limit && a->rev_limit)
-		return "F+R";
-	if (a->fwd_limit)
-		return "FWD";
-	if (a->rev_limit)
-		return "REV";
-	return at_soft(a) > 0 ? "sF" : at_soft(a) < 0 ? "sR" : "-";
-}
-
 int re_console_format_line(const struct re_status *st, char *buf, size_t cap)
 {
 	char ctl[48];
 	size_t n;
 
-	ctrl_text(st, ctl, sizeof(ctl));
+	re_con_ctrl_text(st, ctl, sizeof(ctl));
 	n = (size_t)snprintf(buf, cap,
 			     "status %.1fs mode=%s relay=%s link=%s"
 			     " ctrl=\"%s\"",
@@ -365,9 +298,9 @@ int re_console_format_line(const struct re_status *st, char *buf, size_t cap)
 					      " exp=%.3fV margin=%.3fV",
 					      a->pot_expected_v, a->margin_v);
 		if (n < cap)
-			n += (size_t)snprintf(buf + n, cap - n,
-					      " vel=%.0f %s lim=%s", a->vel_cps,
-					      motion_text(a), limit_text(a));
+			n += (size_t)snprintf(
+			    buf + n, cap - n, " vel=%.0f %s lim=%s", a->vel_cps,
+			    re_con_motion_text(a), re_con_limit_text(a));
 	}
 	if (n < cap)
 		n += (size_t)snprintf(buf + n, cap - n,
@@ -460,22 +393,36 @@ static void board_printf(struct re_console *c, int width, const char *fmt, ...)
 	frame_line(c, line, width);
 }
 
+/* @v, never "-0" at its printed precision (@scale 1: whole, 10: one
+ * decimal, 100: two). */
+static double no_neg_zero(double v, double scale)
+{
+	return v * scale > -0.5 && v < 0 ? 0.0 : v;
+}
+
 /* Counts in the axis's unit ("  -12.35 deg"), or as counts ("  -12345 cnt")
  * when counts are asked for or the scale is not known: 12 characters; a
- * speed (@per_s) in the same unit per second without its name: 8. */
+ * speed (@per_s) in the same unit per second ("  5.1 deg/s", "  0.8 mm/s",
+ * "  512 cnt/s"): 11. Never "-0". */
 static void unit_text(const struct re_console *c, int i, double counts,
 		      int per_s, char *buf, size_t cap)
 {
 	const struct re_console_axis *u = &c->ax[i];
+	char per[16];
 
-	if (c->counts || u->per_unit <= 0)
-		snprintf(buf, cap, per_s ? "%6.0f/s" : "%8.0f cnt", counts);
-	else if (per_s)
-		snprintf(buf, cap, "%6.1f/s", counts / u->per_unit);
-	else if (counts / u->per_unit > -0.005 && counts / u->per_unit < 0)
-		snprintf(buf, cap, "%8.2f %-3s", 0.0, u->unit); /* not -0.00 */
-	else
-		snprintf(buf, cap, "%8.2f %-3s", counts / u->per_unit, u->unit);
+	if (c->counts || u->per_unit <= 0) {
+		snprintf(buf, cap, per_s ? "%5.0f cnt/s" : "%8.0f cnt",
+			 no_neg_zero(counts, 1));
+		return;
+	}
+	if (!per_s) {
+		snprintf(buf, cap, "%8.2f %-3s",
+			 no_neg_zero(counts / u->per_unit, 100), u->unit);
+		return;
+	}
+	snprintf(per, sizeof(per), "%s/s", u->unit);
+	snprintf(buf, cap, "%5.1f %-5s", no_neg_zero(counts / u->per_unit, 10),
+		 per);
 }
 
 static void board_axis(struct re_console *c, const struct re_status *st, int i,
@@ -492,10 +439,11 @@ static void board_axis(struct re_console *c, const struct re_status *st, int i,
 			 a->pot_expected_v,
 			 col(c, a->margin_v < 0 ? ANSI_RED : ""), a->margin_v,
 			 col(c, a->margin_v < 0 ? ANSI_OFF : ""));
-	board_printf(c, width, "%-2.2s %s %s %5.3f %s %s %-7s %-3s %s",
+	/* the state says "off" for a motor off: no column of its own */
+	board_printf(c, width, "%-2.2s %s %s %5.3f %s %s %-7s %s",
 		     st->axis_names[i], pos, b, a->pot_v, exp, vel,
-		     st->link_ok ? motion_text(a) : "STALE", limit_text(a),
-		     a->motor_off ? "off" : "on");
+		     st->link_ok ? re_con_motion_text(a) : "STALE",
+		     re_con_limit_text(a));
 }
 
 /* During a calibration: the axis's phase, a bar of its position over the
@@ -517,17 +465,16 @@ static void board_cal_axis(struct re_console *c, const struct re_status *st,
 	board_printf(c, width, "%-2.2s %-15s %s %3.0f%% %s %5.3f %4.0f s %s",
 		     st->axis_names[i], p->phase ? p->phase : "-", b,
 		     p->pct < 0 ? 0 : p->pct, pos, a->pot_v, p->left_s,
-		     st->link_ok ? motion_text(a) : "STALE");
+		     st->link_ok ? re_con_motion_text(a) : "STALE");
 }
 
 static void board_axes(struct re_console *c, const struct re_status *st,
 		       int width)
 {
 	if (!c->cal.active) {
-		board_printf(c, width,
-			     "%-2s %12s %-18s %5s %-12s %8s %-7s %-3s %s", "ax",
-			     "position", "  |soft  limits|", "pot V",
-			     "expect margin", "speed", "state", "lim", "mot");
+		board_printf(c, width, "%-2s %12s %-18s %5s %-12s %11s %-7s %s",
+			     "ax", "position", "  |soft  limits|", "pot V",
+			     "expect margin", "speed", "state", "lim");
 		for (int i = 0; i < st->n_axes; i++)
 			board_axis(c, st, i, width);
 		return;
@@ -539,24 +486,46 @@ static void board_axes(struct re_console *c, const struct re_status *st,
 		board_cal_axis(c, st, i, width);
 }
 
-/* The kept FAULT, wrapped at word boundaries into at most 5 lines.
- * Return: the lines added. */
-static int board_faults(struct re_console *c, int width)
+/* Screen rows a line of @vis characters takes on a terminal @width wide. */
+static int rows_of(int vis, int width)
+{
+	return vis <= width ? 1 : (vis + width - 1) / width;
+}
+
+/* @text (@n bytes, no colour) on a line of its own, never cut: a word
+ * wider than the board (a path) takes the rows it needs. Return: those
+ * rows. */
+static int board_whole(struct re_console *c, int width, const char *text, int n,
+		       const char *colour)
+{
+	if (n < width)
+		board_printf(c, width, "%s%.*s%s", col(c, colour), n, text,
+			     col(c, colour[0] ? ANSI_OFF : ""));
+	else
+		frame_add(c, "%s%.*s%s\n", col(c, colour), n, text,
+			  col(c, colour[0] ? ANSI_OFF : ""));
+	return rows_of(n, width);
+}
+
+/* The kept FAULT, wrapped at word boundaries (a word wider than the board
+ * whole), in at most @max rows: a FAULT too long for them ends with where
+ * it is whole. Return: the rows added. */
+static int board_faults(struct re_console *c, int width, int max)
 {
 	const char *p = c->fault;
 	int w = width - 1, k = 0;
 
-	while (*p && k < 5) {
-		int n = (int)strlen(p);
+	while (*p) {
+		int n = wrap_len(p, w);
 
-		if (n > w) {
-			n = w;
-			while (n > w / 2 && p[n] != ' ')
-				n--;
+		if (k + rows_of(n, width) >= max && p[n]) {
+			board_printf(c, width,
+				     "%s(the whole FAULT is above "
+				     "the board and in the log)%s",
+				     col(c, ANSI_RED), col(c, ANSI_OFF));
+			return k + 1;
 		}
-		board_printf(c, width, "%s%.*s%s", col(c, ANSI_RED), n, p,
-			     col(c, ANSI_OFF));
-		k++;
+		k += board_whole(c, width, p, n, ANSI_RED);
 		p += n;
 		while (*p == ' ')
 			p++;
@@ -576,49 +545,81 @@ static void hist_stamp(const struct re_console_event *h, char *buf, size_t cap)
 		snprintf(buf, cap, "[up %8.3f s]", h->t_s);
 }
 
-/* The later faults and warnings, newest first, at most @room lines
- * (the last of them the log's path). */
+/* @prefix (@pvis visible characters, may hold colour) then @text wrapped
+ * at word boundaries, continuation rows indented by two spaces, a word
+ * wider than a row whole on its own; added to the frame when @emit.
+ * Return: the screen rows it takes. */
+static int board_wrap(struct re_console *c, int width, const char *prefix,
+		      int pvis, const char *text, int emit)
+{
+	int rows = 0, first = 1;
+
+	while (*text || first) {
+		int lead = first ? pvis : 2, room = width - 1 - lead, n;
+
+		if (room < 10)
+			room = 10;
+		n = wrap_len(text, room);
+		if (n > room && !first)
+			lead = 0; /* a path: whole, from the first column */
+		if (emit && n > room)
+			frame_add(c, "%s%.*s\n", first ? prefix : "", n, text);
+		else if (emit)
+			board_printf(c, width, "%s%.*s", first ? prefix : "  ",
+				     n, text);
+		rows += rows_of(lead + n, width);
+		text += n;
+		while (*text == ' ')
+			text++;
+		first = 0;
+	}
+	return rows;
+}
+
+/* The later faults and warnings, newest first, wrapped, in at most @room
+ * rows (the last two of them the log's path, said, then whole on its
+ * own). */
 static void board_history(struct re_console *c, int width, int room)
 {
-	int n = c->nhist < room - 1 ? c->nhist : room - 1;
+	int left = room - 2, shown = 0;
 
-	if (room < 1 || (!c->nhist && !c->fault[0]))
+	if (room < 2 || (!c->nhist && !c->fault[0]))
 		return;
-	for (int i = 0; i < n; i++) {
+	for (int i = 0; i < c->nhist; i++, shown++) {
 		const struct re_console_event *h = &c->hist[i];
-		char times[16] = "", at[32];
+		char times[16] = "", at[32], pre[96];
+		const char *text = h->text;
+		int fault = h->level == RE_LOG_FAULT, pvis, need;
 
 		if (h->count > 1)
 			snprintf(times, sizeof(times), " (x%u)", h->count);
-		const char *text = h->text;
-
 		/* "FAULT COMM: ..." is shown as "later FAULT COMM: ..." */
-		if (h->level == RE_LOG_FAULT && !strncmp(text, "FAULT ", 6))
+		if (fault && !strncmp(text, "FAULT ", 6))
 			text += 6;
 		hist_stamp(h, at, sizeof(at));
-		board_printf(
-		    c, width, "%s %s%s%s%s%s %s", at,
-		    col(c, h->level == RE_LOG_FAULT ? ANSI_RED : ANSI_YELLOW),
-		    h->level == RE_LOG_FAULT ? "later FAULT" : "WARN",
-		    col(c, ANSI_OFF), times, text == h->text ? ":" : "", text);
+		pvis = snprintf(pre, sizeof(pre), "%s %s%s%s ", at,
+				fault ? "later FAULT" : "WARN", times,
+				text == h->text ? ":" : "");
+		snprintf(pre, sizeof(pre), "%s %s%s%s%s%s ", at,
+			 col(c, fault ? ANSI_RED : ANSI_YELLOW),
+			 fault ? "later FAULT" : "WARN", col(c, ANSI_OFF),
+			 times, text == h->text ? ":" : "");
+		need = board_wrap(c, width, pre, pvis, text, 0);
+		if (need > left)
+			break;
+		board_wrap(c, width, pre, pvis, text, 1);
+		left -= need;
 	}
 	if (!c->log_path[0])
 		return;
-	if (c->nhist > n)
-		board_printf(c, width, "%d older not shown; all in the log %s",
-			     c->nhist - n, c->log_path);
+	if (c->nhist > shown)
+		board_printf(c, width, "%d older not shown; all in the log:",
+			     c->nhist - shown);
 	else
 		board_printf(c, width,
-			     "every fault and warning is in the log %s",
-			     c->log_path);
-}
-
-static int any_motor_on(const struct re_status *st)
-{
-	for (int i = 0; i < st->n_axes; i++)
-		if (!st->axis[i].motor_off)
-			return 1;
-	return 0;
+			     "every fault and warning is in the log:");
+	/* the path whole on its own line, so that it can be copied */
+	board_whole(c, width, c->log_path, (int)strlen(c->log_path), "");
 }
 
 /* The terminal's size (80x24 when it cannot be read). */
@@ -635,13 +636,23 @@ static void term_size(struct re_console *c, int *cols, int *rows)
 	}
 }
 
+/* Key u has something to switch: counts shown, or an axis with a unit. */
+static int units_key(const struct re_console *c, const struct re_status *st)
+{
+	for (int i = 0; i < st->n_axes && !c->counts; i++)
+		if (c->ax[i].per_unit > 0)
+			return 1;
+	return c->counts;
+}
+
 /* The last line: what the operator can do now. During a calibration
  * only Ctrl-C is read (as a signal); the keys once the board runs, and
- * only from a terminal. */
+ * only from a terminal, each only when its action is there (t with the
+ * flight recorder, u with a unit to switch). */
 static void board_keys(struct re_console *c, const struct re_status *st,
 		       int width)
 {
-	const char *other = c->counts ? "units" : "counts";
+	const char *latched = st->latched ? "LATCHED: every motor off; " : "";
 
 	if (c->cal.active)
 		board_printf(c, width,
@@ -652,30 +663,34 @@ static void board_keys(struct re_console *c, const struct re_status *st,
 	else if (!c->tty_in)
 		board_printf(c, width,
 			     "%sno keyboard here: Ctrl-C or SIGTERM quits",
-			     st->latched ? "LATCHED: every motor off; " : "");
+			     latched);
 	else
-		board_printf(c, width, "%skeys: q quit  t trace  u %s",
-			     st->latched ? "LATCHED: every motor off; " : "",
-			     other);
+		board_printf(c, width, "%skeys: q quit%s%s%s", latched,
+			     c->trace_key ? "  t trace" : "",
+			     units_key(c, st) ? "  u " : "",
+			     !units_key(c, st) ? ""
+			     : c->counts       ? "units"
+					       : "counts");
 }
 
 /* The board's lines for a terminal @width x @rows, added to the frame. */
 static void board_build(struct re_console *c, const struct re_status *st,
 			int width, int rows)
 {
-	char ctl[64];
+	char ctl[64], moving[64];
 	int lines;
 
-	ctrl_text(st, ctl, sizeof(ctl));
+	re_con_ctrl_text(st, ctl, sizeof(ctl));
 	board_printf(
 	    c, width, "RoboELF  mode %s  up %.0f s  relay %s%s%s  link %s",
 	    st->mode_name, st->uptime_s,
 	    col(c, st->relay == RE_RELAY_ON ? ANSI_GREEN : ANSI_YELLOW),
-	    relay_text(st->relay), col(c, ANSI_OFF),
+	    re_con_relay_text(st->relay), col(c, ANSI_OFF),
 	    st->link_ok ? "ok" : "DOWN (stale)");
-	lines = 1 + board_faults(c, width);
-	/* the rest of the board: column header, axes, three lines */
-	lines += 1 + st->n_axes + 3;
+	/* the rest of the board: column header, axes, three lines; the FAULT
+	 * may take the room kept for messages but one line */
+	lines = 1 + 1 + st->n_axes + 3;
+	lines += board_faults(c, width, rows - 1 - lines);
 	board_history(c, width, rows - 1 - RE_CONSOLE_ROOM - lines);
 	board_axes(c, st, width);
 	board_printf(c, width,
@@ -685,10 +700,9 @@ static void board_build(struct re_console *c, const struct re_status *st,
 		     (unsigned long long)st->wd_warnings, st->period_ms,
 		     st->late_last_ms, st->late_worst_ms,
 		     (unsigned long long)st->overruns);
+	re_con_moving_text(st, moving, sizeof(moving));
 	board_printf(c, width, "controller %s  joystick %s  moving %s", ctl,
-		     st->have_za ? cmd_text(st->za.jcmd) : "-",
-		     st->have_za && any_motor_on(st) ? cmd_text(st->za.mcmd)
-						     : "-");
+		     st->have_za ? re_con_cmd_text(st->za.jcmd) : "-", moving);
 	board_keys(c, st, width);
 }
 
@@ -697,6 +711,32 @@ static void board_build(struct re_console *c, const struct re_status *st,
  * text up by the lines it takes (LFs from the text cursor, then back up),
  * so that nothing written there is overwritten; a shorter one clears the
  * lines it gives back. The text cursor is saved and restored around it. */
+/* Visible characters of @len bytes of @text (colour sequences skipped). */
+static int vis_len(const char *text, size_t len)
+{
+	int vis = 0;
+
+	for (size_t i = 0; i < len; i++) {
+		if (text[i] != '\033') {
+			vis++;
+			continue;
+		}
+		while (i < len && text[i] != 'm')
+			i++;
+	}
+	return vis;
+}
+
+/* Screen rows the lines of @text take on a terminal @width wide. */
+static int board_rows(const char *text, int width)
+{
+	int n = 0;
+
+	for (const char *e; (e = strchr(text, '\n')); text = e + 1)
+		n += rows_of(vis_len(text, (size_t)(e - text)), width);
+	return n;
+}
+
 static void board_place(struct re_console *c, const char *text, int n, int rows)
 {
 	int old = c->board_lines, top = rows - n + 1;
@@ -712,12 +752,15 @@ static void board_place(struct re_console *c, const char *text, int n, int rows)
 		frame_add(c, "\033[1;%dr", top - 1);
 	for (int r = rows - old + 1; r < top; r++)
 		frame_add(c, "\033[%d;1H\033[2K", r);
-	for (int i = 0; i < n; i++) {
+	for (int r = top; r <= rows; r++)
+		frame_add(c, "\033[%d;1H\033[2K", r);
+	/* a line wider than the screen (a path, whole) wraps on by itself
+	 * into the rows counted for it */
+	for (int r = top; *text; text = strchr(text, '\n') + 1) {
 		const char *e = strchr(text, '\n');
 
-		frame_add(c, "\033[%d;1H\033[2K%.*s", top + i, (int)(e - text),
-			  text);
-		text = e + 1;
+		frame_add(c, "\033[%d;1H%.*s", r, (int)(e - text), text);
+		r += rows_of(vis_len(text, (size_t)(e - text)), c->cols);
 	}
 	frame_add(c, "\0338");
 }
@@ -730,9 +773,9 @@ static void board_draw(struct re_console *c, const struct re_status *st,
 
 	board_build(c, st, width, rows);
 	len = c->frame_len - start;
-	n = count_lines(c->frame + start, len);
 	memcpy(c->lines, c->frame + start, len);
 	c->lines[len] = '\0';
+	n = board_rows(c->lines, width);
 	c->frame_len = start;
 	board_place(c, c->lines, n, rows);
 	len = c->frame_len;

@@ -8,8 +8,10 @@
  * for C, from the configuration's counts_per_unit; encoder counts when
  * asked for (re_console_counts(), key u) or when the scale is not known -
  * a bar over the travel with the soft limits marked '|', potentiometer
- * volts against the expected value and the margin left, velocity, motion
- * state, limit switches, motor on/off; relay state, watchdog latency
+ * volts against the expected value and the margin left, speed in the
+ * same unit per second (deg/s, mm/s, cnt/s), motion state (one source
+ * with the "moving" summary: re_console_int.h), limit switches; relay
+ * state, watchdog latency
  * last/worst, loop period, lateness and overruns, controller fault,
  * operating mode).
  * The board is drawn at absolute positions on the bottom lines of the
@@ -24,13 +26,17 @@
  * (repeats of one kind folded into one line with a count), each stamped
  * with when it happened on the header's "up" clock ("[up 12.100 s]": a
  * time since the start, never an interval since the first fault), and
- * the log file's path (re_console_log_path()). Every board line is cut to the
- * terminal's width (never wraps); a terminal narrower than RE_CONSOLE_MIN_COLS
- * or lower than RE_CONSOLE_MIN_ROWS gets the status lines instead, said once; a
- * resize redraws the board from the top of the screen. Colour only on a
- * terminal and only when NO_COLOR is unset (no-color.org) and TERM is not
- * "dumb". The keyboard is in raw mode (no echo, no line buffering) from
- * re_console_raw() to re_console_close(), and does not echo from
+ * the log file's path (re_console_log_path()) on a line of its own. The FAULT
+ * is wrapped at word boundaries, whole (in the rows the board can spare); a
+ * path wider than the terminal is printed whole on a line of its own (the
+ * terminal wraps it, a copy gets it whole), its rows counted; every other
+ * board line is cut to the terminal's width (never wraps). Messages above
+ * the board are wrapped the same way. A terminal narrower than
+ * RE_CONSOLE_MIN_COLS or lower than RE_CONSOLE_MIN_ROWS gets the status lines
+ * instead, said once; a resize redraws the board from the top of the screen.
+ * Colour only on a terminal and only when NO_COLOR is unset (no-color.org) and
+ * TERM is not "dumb". The keyboard is in raw mode (no echo, no line buffering)
+ * from re_console_raw() to re_console_close(), and does not echo from
  * re_console_quiet() on (the start-up and the calibration) but for the
  * answer to a question.
  *
@@ -111,6 +117,7 @@ struct re_console {
 	uint64_t nfaults;   /* FAULT lines shown in all */
 	struct re_console_axis ax[RE_SUPER_AXES];
 	int counts;		      /* show encoder counts instead of units */
+	int trace_key;		      /* key t writes a trace (a recorder) */
 	struct re_calib_progress cal; /* cal.active: calibration lines */
 };
 
@@ -213,6 +220,15 @@ void re_console_calib(struct re_console *c, const struct re_calib_progress *p);
  */
 void re_console_units(struct re_console *c, int axis, const char *unit,
 		      double counts_per_unit);
+
+/*
+ * re_console_trace_key() - @on: key t writes a trace (the flight recorder
+ * runs), so the board offers it; 0 (the default): t is not shown. Key u
+ * is shown only when an axis has a unit to switch from (re_console_units())
+ * and q only when there is a keyboard, so that no key is offered that does
+ * nothing.
+ */
+void re_console_trace_key(struct re_console *c, int on);
 
 /*
  * re_console_counts() - @on: show encoder counts (and counts/s) on the

@@ -98,3 +98,8 @@ void re_console_echo(struct re_console *c, int on)
 	else
 		set_quiet(c);
 }
+
+void re_console_trace_key(struct re_console *c, int on)
+{
+	c->trace_key = !!on;
+}

@@ -5,6 +5,7 @@
 #include "re_start.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -630,6 +631,14 @@ static int calib_load(struct app *a)
 	return EXIT_USAGE;
 }
 
+/* The centre of axis @i's calibrated travel in whole counts: an integer,
+ * so that a centre of -0.4 counts is said "0", never "-0". */
+static long long centre_counts(const struct app *a, int i)
+{
+	return llround((a->cal->axis[i].soft_rev + a->cal->axis[i].soft_fwd) /
+		       2);
+}
+
 /* What will move and where, said before anything moves; the choice is the
  * operator's (the prompt) or the command line's. Return: 0, EXIT_USAGE. */
 static int choose_calibration(struct app *a)
@@ -670,11 +679,10 @@ static int choose_calibration(struct app *a)
 		re_start_progress(
 		    a,
 		    "calibration from the file: every axis will move "
-		    "to the centre of its calibrated travel (A %.0f, "
-		    "B %.0f, C %.0f counts)",
-		    (a->cal->axis[0].soft_rev + a->cal->axis[0].soft_fwd) / 2,
-		    (a->cal->axis[1].soft_rev + a->cal->axis[1].soft_fwd) / 2,
-		    (a->cal->axis[2].soft_rev + a->cal->axis[2].soft_fwd) / 2);
+		    "to the centre of its calibrated travel (A %lld, "
+		    "B %lld, C %lld counts)",
+		    centre_counts(a, 0), centre_counts(a, 1),
+		    centre_counts(a, 2));
 	return 0;
 }
 

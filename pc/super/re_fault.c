@@ -14,7 +14,9 @@
  *
  * Placeholders: {a} axis name, {s} text, {i0}..{i3} integers ("unknown" for
  * RE_VAL_UNKNOWN), {x0}..{x3} the same in hex with 0x, {f0}..{f3} reals
- * (integral values without decimals, others with 3). Every recovery text is
+ * (integral values without decimals, others with 3), {j0} the joystick's
+ * switch word i0 in words, {jto} the joystick's invalid-input timeout
+ * (" of 500 ms", or nothing when not known). Every recovery text is
  * written for an operator standing next to the patient.
  */
 struct re_fault_msg {
@@ -67,7 +69,7 @@ static const struct re_fault_msg re_fault_table[] = {
 	 "axis {a}: the controller found the motor off while armed: {s} (stop code {i0})",
 	 "press the E-stop and keep it pressed, check that axis {a} moves freely and nothing blocks it, check its motor and encoder cables, then restart roboelf"},
 	{RE_F_CTRL_INPUT, RE_FC_INPUT,
-	 "invalid joystick switch state {x0} held longer than the invalid-input timeout",
+	 "invalid joystick state held longer than the invalid-input timeout{jto}: {j0}",
 	 "release the joysticks, press the E-stop and keep it pressed, check the joystick cables and switches, then restart roboelf"},
 	{RE_F_COMM, RE_FC_COMM,
 	 "communication with the controller failed: {s}",
@@ -347,6 +349,65 @@ static int re_expand_units(struct re_out *o, const char *key, size_t klen,
 	return 0;
 }
 
+/* The joystick's switch word @word (bit 2k: switch a of command k, bit
+ * 2k + 1: its twin b; commands A forward, A reverse, B forward ...) in
+ * words: "A forward (switches a and b) and B forward (switches a and b)
+ * closed at once", "A reverse (switch a only) closed". */
+static void re_fmt_switches(struct re_out *o, long long word,
+			    const char *const *names)
+{
+	int n = 0, total = 0;
+	char tmp[64];
+
+	if (word <= 0 || word >= 1 << 12) { /* RE_VAL_UNKNOWN is negative */
+		re_out_str(o, word == 0 ? "no switch closed"
+					: "the switches closed are not known");
+		return;
+	}
+	for (int k = 0; k < 6; k++)
+		total += (word >> (2 * k) & 3) != 0;
+	for (int k = 0; k < 6; k++) {
+		long long two = word >> (2 * k) & 3;
+		int ax = k / 2;
+
+		if (!two)
+			continue;
+		snprintf(tmp, sizeof(tmp), "%s%s %s (%s)",
+			 !n		 ? ""
+			 : n + 1 < total ? ", "
+					 : " and ",
+			 names && names[ax] ? names[ax] : re_axis_letters[ax],
+			 k % 2 ? "reverse" : "forward",
+			 two == 3   ? "switches a and b"
+			 : two == 1 ? "switch a only"
+				    : "switch b only");
+		re_out_str(o, tmp);
+		n++;
+	}
+	re_out_str(o, total > 1 ? " closed at once" : " closed");
+}
+
+/* "{j0}": the switch word i0 in words; "{jto}": " of <timeout> ms" or
+ * nothing. Return 0 if @key is neither. */
+static int re_expand_joy(struct re_out *o, const char *key, size_t klen,
+			 const struct re_fault *f, const struct re_view *v)
+{
+	char tmp[48];
+
+	if (klen == 2 && !strncmp(key, "j0", 2)) {
+		re_fmt_switches(o, f->i[0], v->names);
+		return 1;
+	}
+	if (klen != 3 || strncmp(key, "jto", 3))
+		return 0;
+	if (v->units && v->units->invalid_timeout_ms > 0) {
+		snprintf(tmp, sizeof(tmp), " of %d ms",
+			 v->units->invalid_timeout_ms);
+		re_out_str(o, tmp);
+	}
+	return 1;
+}
+
 /* Expand one placeholder @key (without braces); return 0 if unknown. */
 static int re_expand(struct re_out *o, const char *key, size_t klen,
 		     const struct re_fault *f, const struct re_view *v)
@@ -355,7 +416,8 @@ static int re_expand(struct re_out *o, const char *key, size_t klen,
 	char tmp[48];
 	int k;
 
-	if (re_expand_units(o, key, klen, f, v))
+	if (re_expand_units(o, key, klen, f, v) ||
+	    re_expand_joy(o, key, klen, f, v))
 		return 1;
 	if (klen == 1 && key[0] == 'a') {
 		re_out_str(o, re_axis_name(f, names));

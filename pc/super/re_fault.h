@@ -58,7 +58,9 @@ enum re_fclass {
  *   RE_F_CTRL_POWER      (fault 8 on every axis: motor power cut)
  *   RE_F_CTRL_MOTOROFF   a; i0 stop code; s: re_stop_reason() (fault 10)
  * INPUT
- *   RE_F_CTRL_INPUT      i0 raw switch word jraw (fault 3)
+ *   RE_F_CTRL_INPUT      i0 raw switch word jraw (fault 3), shown as
+ *                        the switches closed ("{j0}"); the timeout from
+ *                        struct re_fault_units ("{jto}")
  * COMM
  *   RE_F_COMM            s: what failed ("cannot read record: timeout")
  *   RE_F_CTRL_TCPERR     i0 handle number _IA4 (fault 7)
@@ -206,11 +208,13 @@ void re_fault_set(struct re_fault *f, enum re_fault_id id, int axis);
  * NULL name or counts_per_unit <= 0: counts only. In the templates,
  * "{i0c}" is "<i0> counts", followed by " (<i0 in units> <unit>)" when
  * the fault's axis has a unit; "{r12}" is " (<i1> to <i2> in units
- * <unit>)" or nothing.
+ * <unit>)" or nothing; "{jto}" is " of <invalid_timeout_ms> ms" or
+ * nothing.
  */
 struct re_fault_units {
 	const char *name[RE_FAULT_UNIT_AXES];
 	double counts_per_unit[RE_FAULT_UNIT_AXES];
+	int invalid_timeout_ms; /* joystick's, for "{jto}"; 0: not known */
 };
 
 /*

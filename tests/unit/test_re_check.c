@@ -553,15 +553,21 @@ static void test_ctrl_fault_texts(void **state)
 	re_fault_format(&f, NULL, line, sizeof(line));
 	assert_string_equal(
 	    line,
-	    "FAULT INPUT: invalid joystick switch state 0x30c held longer than "
-	    "the invalid-input timeout. Recovery: release the joysticks, press "
-	    "the E-stop and keep it pressed, check the joystick cables and "
-	    "switches, then restart roboelf");
+	    "FAULT INPUT: invalid joystick state held longer than the "
+	    "invalid-input timeout: A reverse (switches a and b) and C forward "
+	    "(switches a and b) closed at once. Recovery: release the "
+	    "joysticks, press the E-stop and keep it pressed, check the "
+	    "joystick cables and switches, then restart roboelf");
+	re_ctrl_fault(&z, 0x10, &f);
+	re_fault_format(&f, NULL, line, sizeof(line));
+	assert_non_null(strstr(line, "FAULT INPUT: invalid joystick state held "
+				     "longer than the invalid-input timeout: "
+				     "B forward (switch a only) closed. "));
 	re_ctrl_fault(&z, RE_VAL_UNKNOWN, &f);
 	re_fault_format(&f, NULL, line, sizeof(line));
-	assert_non_null(strstr(line, "FAULT INPUT: invalid joystick switch "
-				     "state unknown held longer than the "
-				     "invalid-input timeout. "));
+	assert_non_null(strstr(line, "FAULT INPUT: invalid joystick state held "
+				     "longer than the invalid-input timeout: "
+				     "the switches closed are not known. "));
 	z.fcode = 5;
 	z.faxis = 3;
 	re_ctrl_fault(&z, 3, &f);
@@ -1016,7 +1022,7 @@ static void test_docs_list_every_template(void **state)
  * without units, or for an axis without one, exactly the counts. */
 static void test_format_units(void **state)
 {
-	struct re_fault_units u = {{"deg", "deg", "mm"}, {1000, 1000, 250}};
+	struct re_fault_units u = {{"deg", "deg", "mm"}, {1000, 1000, 250}, 0};
 	struct re_fault f;
 	char line[512];
 
@@ -1050,6 +1056,25 @@ static void test_format_units(void **state)
 	f.i[0] = RE_VAL_UNKNOWN;
 	re_fault_what_units(&f, NULL, &u, line, sizeof(line));
 	assert_non_null(strstr(line, "at least unknown, above"));
+	/* the joysticks A forward and B forward together (0x33): the
+	 * switches and the timeout in words, never the word in hex */
+	re_fault_set(&f, RE_F_CTRL_INPUT, -1);
+	f.i[0] = 0x33;
+	u.invalid_timeout_ms = 500;
+	re_fault_what_units(&f, NULL, &u, line, sizeof(line));
+	assert_string_equal(line, "invalid joystick state held longer than "
+				  "the invalid-input timeout of 500 ms: A "
+				  "forward (switches a and b) and B forward "
+				  "(switches a and b) closed at once");
+	f.i[0] = 0x8 | 0x100 | 0x800;
+	re_fault_what_units(&f, NULL, &u, line, sizeof(line));
+	assert_string_equal(line,
+			    "invalid joystick state held longer than "
+			    "the invalid-input timeout of 500 ms: A "
+			    "reverse (switch b only), C forward (switch "
+			    "a only) and C reverse (switch b only) closed "
+			    "at once");
+	re_fault_set(&f, RE_F_CTRL_POSERR, 2);
 	u.counts_per_unit[2] = 0; /* scale not known: counts only */
 	f.i[0] = 801;
 	re_fault_what_units(&f, NULL, &u, line, sizeof(line));

@@ -303,21 +303,32 @@ static void test_units_and_bar(void **state)
 	line_of(buf, 1, l, sizeof(l));
 	assert_string_equal(l,
 			    "ax     position   |soft  limits|   pot V expect "
-			    "margin    speed state   lim mot");
+			    "margin       speed state   lim");
 	line_of(buf, 2, l, sizeof(l));
 	assert_string_equal(l, "A    -12.35 deg [-|----#-------|-] 2.500     -"
-			       "      -   -1.5/s stopped -   on");
+			       "      -  -1.5 deg/s stopped -");
 	line_of(buf, 3, l, sizeof(l));
 	assert_string_equal(l, "B     49.00 deg [-|------------#-] 2.500     -"
-			       "      -    0.0/s at-lim  sF  on");
+			       "      -   0.0 deg/s at-lim  sF");
 	line_of(buf, 4, l, sizeof(l));
 	assert_string_equal(l, "C    -52.00 mm  [#|------------|-] 2.500     -"
-			       "      -    0.0/s at-lim  sR  on");
+			       "      -   0.0 mm/s  at-lim  sR");
+	/* a speed that rounds to zero is never "-0.0" */
+	st.axis[2].vel_cps = -40;
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 4, l, sizeof(l));
+	assert_string_equal(l, "C    -52.00 mm  [#|------------|-] 2.500     -"
+			       "      -   0.0 mm/s  at-lim  sR");
 	re_console_counts(&c, 1);
 	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
 	line_of(buf, 2, l, sizeof(l));
 	assert_string_equal(l, "A    -12345 cnt [-|----#-------|-] 2.500     -"
-			       "      -  -1500/s stopped -   on");
+			       "      - -1500 cnt/s stopped -");
+	st.axis[2].vel_cps = -0.4; /* counts: never "-0" */
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 4, l, sizeof(l));
+	assert_string_equal(l, "C    -52000 cnt [#|------------|-] 2.500     -"
+			       "      -     0 cnt/s at-lim  sR");
 	re_console_counts(&c, 0);
 	re_console_units(&c, 0, "deg", 0); /* scale not known: counts */
 	st.axis[0].have_soft = 0;	   /* not calibrated: '?' */
@@ -325,12 +336,12 @@ static void test_units_and_bar(void **state)
 	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
 	line_of(buf, 2, l, sizeof(l));
 	assert_string_equal(l, "A    -12345 cnt [????????????????] 2.500     -"
-			       "      -  -1500/s stopped -   on");
+			       "      - -1500 cnt/s stopped -");
 	st.link_ok = 0; /* the last values, marked */
 	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
 	line_of(buf, 3, l, sizeof(l));
 	assert_string_equal(l, "B     49.00 deg [-|------------#-] 2.500     -"
-			       "      -    0.0/s STALE   sF  on");
+			       "      -   0.0 deg/s STALE   sF");
 }
 
 static void event(struct re_console *c, double t, enum re_log_level lvl,
@@ -372,7 +383,7 @@ static void test_history(void **state)
 		 "Recovery: restart roboelf");
 	event(&c, 4.25, RE_LOG_FAULT, RE_EV_LATER, "FAULT ESTOP: relay lost");
 	n = re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
-	assert_int_equal(n, 12);
+	assert_int_equal(n, 13);
 	line_of(buf, 1, l, sizeof(l));
 	assert_string_equal(l,
 			    "FAULT COMM: the link is gone. Recovery: restart "
@@ -383,22 +394,24 @@ static void test_history(void **state)
 	assert_string_equal(l, "[up    1.600 s] WARN (x2): watchdog: reply "
 			       "after 90 ms");
 	line_of(buf, 4, l, sizeof(l));
-	assert_string_equal(l, "every fault and warning is in the log "
-			       "/var/log/roboelf.log");
+	assert_string_equal(l, "every fault and warning is in the log:");
+	line_of(buf, 5, l, sizeof(l)); /* whole, on its own: copied */
+	assert_string_equal(l, "/var/log/roboelf.log");
 	for (int i = 0; i < 10; i++)
 		event(&c, 5 + i, RE_LOG_WARN, RE_EV_OTHER, "x");
 	/* 24 rows: 4 kept for messages and 1 spare; header, the fault's one
 	 * line, column header, 3 axes and 3 lines: 9; the history gets 10:
-	 * the 9 newest (of 12) and the log line */
+	 * the 8 newest (of 12) and the log's two lines */
 	n = re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
 	assert_int_equal(n, 19);
 	line_of(buf, 2, l, sizeof(l));
 	assert_string_equal(l, "[up   14.000 s] WARN: x");
+	line_of(buf, 9, l, sizeof(l));
+	assert_string_equal(l, "[up    7.000 s] WARN: x");
 	line_of(buf, 10, l, sizeof(l));
-	assert_string_equal(l, "[up    6.000 s] WARN: x");
+	assert_string_equal(l, "4 older not shown; all in the log:");
 	line_of(buf, 11, l, sizeof(l));
-	assert_string_equal(l, "3 older not shown; all in the log "
-			       "/var/log/roboelf.log");
+	assert_string_equal(l, "/var/log/roboelf.log");
 }
 
 /* A later fault 46 ms after the first, 12.1 s after the start: its line
@@ -711,16 +724,22 @@ static void snap_fault(const struct snap_case *k, struct re_fault *f)
 	}
 	if (k->id == RE_F_CTRL_POSERR)
 		f->i[0] = 500;
+	if (k->id == RE_F_CTRL_INPUT) /* A forward and B forward together */
+		f->i[0] = 0x33;
 }
 
-/* The FAULT line as the supervisor composes it: what happened, what was
+/* The FAULT line as the supervisor composes it: what happened (positions
+ * also in the robot's units, the configured joystick timeout), what was
  * confirmed, the recovery. */
 static void snap_line(const struct re_fault *f, char *line, size_t cap)
 {
 	static const char *const names[] = {"A", "B", "C"};
+	static const struct re_fault_units u = {
+	    {"deg", "deg", "mm"}, {1000, 1000, 1000}, 500};
 	char text[768], *rec;
 
-	assert_true(re_fault_format(f, names, text, sizeof(text)) > 0);
+	assert_true(re_fault_format_units(f, names, &u, text, sizeof(text)) >
+		    0);
 	rec = strstr(text, ". Recovery: ");
 	assert_non_null(rec);
 	snprintf(line, cap,
@@ -744,8 +763,9 @@ static void test_snapshot_faults(void **state)
 		const struct snap_case *sc = &snap_cases[k];
 
 		re_console_open(&c, devnull, -1);
-		c.tty_out = 1; /* the board's panel and history */
-		c.tty_in = 1;  /* the keys line */
+		c.tty_out = 1;		     /* the board's panel and history */
+		c.tty_in = 1;		     /* the keys line */
+		re_console_trace_key(&c, 1); /* roboelf's recorder runs */
 		re_console_log_path(&c, "/var/log/roboelf/roboelf.log");
 		latched_status(&c, &st);
 		st.za.fcode = sc->dmc_fcode;
@@ -780,6 +800,7 @@ static void test_snapshot_phases(void **state)
 	(void)state;
 	re_console_open(&c, stdout, -1);
 	c.tty_in = 1;
+	re_console_trace_key(&c, 1); /* roboelf's recorder runs */
 	re_console_log_path(&c, "/var/log/roboelf/roboelf.log");
 	latched_status(&c, &st);
 	st.latched = 0;
@@ -851,6 +872,148 @@ static void test_snapshot_phases(void **state)
 	snapshot(&c, &st, "phase-armed");
 }
 
+/* The per-axis state and the "moving" summary come from the same axis
+ * states: an axis still running down after the joystick's release
+ * (the program's command already "none") is "moving" in both; an axis
+ * held against its soft limit (the command still "A fwd") is "at-lim"
+ * and not in the summary. */
+static void test_moving_one_source(void **state)
+{
+	static struct re_console c;
+	static char buf[RE_CONSOLE_FRAME];
+	struct re_status st;
+	char l[256];
+
+	(void)state;
+	re_console_open(&c, stdout, -1);
+	calibrated(&c, &st);
+	st.have_za = 1;
+	st.za = (struct re_za){.state = RE_DMC_ARMED, .mneut = 1};
+	st.axis[1].moving = 1; /* B running down: mcmd 0 already */
+	st.axis[1].vel_cps = 6800;
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 3, l, sizeof(l));
+	assert_string_equal(l, "B      2.00 deg [-|------#-----|-] 2.500     -"
+			       "      -   6.8 deg/s moving  -");
+	line_of(buf, 6, l, sizeof(l));
+	assert_string_equal(l, "controller armed  joystick none  moving B fwd");
+	st.axis[1].moving = 0;
+	st.axis[1].vel_cps = 0;
+	st.za.jcmd = 1; /* A fwd held, A at its forward soft limit */
+	st.za.mcmd = 1;
+	st.axis[0].moving = 1; /* the tracking profiler stays busy there */
+	st.axis[0].pos_pct = 100;
+	st.axis[0].enc_counts = 49000;
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 2, l, sizeof(l));
+	assert_string_equal(l, "A     49.00 deg [-|------------#-] 2.500     -"
+			       "      -   0.0 deg/s at-lim  sF");
+	line_of(buf, 6, l, sizeof(l));
+	assert_string_equal(l, "controller armed  joystick A fwd  moving none");
+	st.axis[2].moving = 1; /* two at once, one in reverse */
+	st.axis[2].vel_cps = -2500;
+	st.axis[1].moving = 1;
+	st.axis[1].vel_cps = 900;
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 6, l, sizeof(l));
+	assert_string_equal(l,
+			    "controller armed  joystick A fwd  moving B fwd, "
+			    "C rev");
+	st.link_ok = 0; /* stale values: no summary made of them */
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 6, l, sizeof(l));
+	assert_string_equal(l, "controller armed  joystick A fwd  moving -");
+}
+
+/* A key is offered only where it works: t with the flight recorder, u
+ * with a unit to switch from, none without a keyboard. */
+static void test_keys_offered(void **state)
+{
+	static struct re_console c;
+	static char buf[RE_CONSOLE_FRAME];
+	struct re_status st;
+	char l[256];
+
+	(void)state;
+	re_console_open(&c, stdout, -1);
+	calibrated(&c, &st);
+	c.tty_in = 1;
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 7, l, sizeof(l));
+	assert_string_equal(l, "keys: q quit  u counts"); /* no recorder */
+	re_console_trace_key(&c, 1);
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 7, l, sizeof(l));
+	assert_string_equal(l, "keys: q quit  t trace  u counts");
+	re_console_counts(&c, 1);
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 7, l, sizeof(l));
+	assert_string_equal(l, "keys: q quit  t trace  u units");
+	re_console_counts(&c, 0);
+	for (int i = 0; i < 3; i++) /* no scale known: counts only */
+		re_console_units(&c, i, "deg", 0);
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 7, l, sizeof(l));
+	assert_string_equal(l, "keys: q quit  t trace");
+	c.tty_in = 0; /* the demo: roboelf's input is not a keyboard */
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 7, l, sizeof(l));
+	assert_string_equal(l, "no keyboard here: Ctrl-C or SIGTERM quits");
+}
+
+#define LONG_DIR                                                               \
+	"/home/operator/theatre-2/roboelf-runs/2026-11-29/"                    \
+	"a-directory-with-a-rather-long-name"
+
+/* Nothing cut, nothing split: a path wider than the terminal is printed
+ * whole on a line of its own (the trace message above the board, the
+ * log under the fault panel), the FAULT wrapped at word boundaries to
+ * its last word. */
+static void test_paths_whole(void **state)
+{
+	static struct re_console c;
+	static char buf[RE_CONSOLE_FRAME];
+	const char *path = LONG_DIR "/roboelf-trace-20261129-061500.csv";
+	struct re_status st;
+	char l[256], out[2048];
+	FILE *f = tmpfile();
+	size_t n;
+
+	(void)state;
+	assert_non_null(f);
+	re_console_open(&c, f, -1);
+	c.tty_out = 1; /* wrapped as on a terminal (80 wide: no size) */
+	re_console_msg(&c, "roboelf: trace %s written (1200 cycles)", path);
+	rewind(f);
+	n = fread(out, 1, sizeof(out) - 1, f);
+	out[n] = '\0';
+	assert_string_equal(out, "roboelf: trace\n" LONG_DIR
+				 "/roboelf-trace-20261129-061500.csv\n"
+				 "  written (1200 cycles)\n");
+	fclose(f);
+	re_console_open(&c, stdout, -1);
+	c.tty_out = 1;
+	calibrated(&c, &st);
+	re_console_log_path(&c, LONG_DIR "/roboelf.log");
+	snprintf(c.fault, sizeof(c.fault),
+		 "FAULT COMM: cannot write %s (No space left on device). "
+		 "Recovery: free some space, then restart roboelf",
+		 path);
+	assert_int_equal(re_console_render(&c, &st, 80, 24, buf, sizeof(buf)),
+			 13);
+	line_of(buf, 1, l, sizeof(l));
+	assert_string_equal(l, "FAULT COMM: cannot write");
+	line_of(buf, 2, l, sizeof(l));
+	assert_string_equal(l, path);
+	line_of(buf, 3, l, sizeof(l));
+	assert_string_equal(l, "(No space left on device). Recovery: free "
+			       "some space, then restart roboelf");
+	line_of(buf, 4, l, sizeof(l));
+	assert_string_equal(l, "every fault and warning is in the log:");
+	line_of(buf, 5, l, sizeof(l));
+	assert_string_equal(l, LONG_DIR "/roboelf.log");
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -860,6 +1023,9 @@ int main(void)
 	    cmocka_unit_test(test_history_times),
 	    cmocka_unit_test(test_event_lines),
 	    cmocka_unit_test(test_quiet_no_echo),
+	    cmocka_unit_test(test_moving_one_source),
+	    cmocka_unit_test(test_keys_offered),
+	    cmocka_unit_test(test_paths_whole),
 	    cmocka_unit_test(test_snapshot_faults),
 	    cmocka_unit_test(test_snapshot_phases),
 	    cmocka_unit_test(test_stalled_reader_never_blocks),
