@@ -159,8 +159,9 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(LINK_LIBS) $$(wildcard tests/$$*.ldfl
 		$(LINK_LIBS) $(LIBS)
 
 # ---- test, demo, bench -------------------------------------------------------
+# The build first, on every core.
 check test: deps
-	@$(MAKE) --no-print-directory tests
+	@$(MAKE) --no-print-directory -j$$(nproc) tests
 	@BUILD=$(BUILD) tests/run-all.sh
 
 # The sanitizer run looks for memory and undefined-behaviour errors: every
