@@ -13,7 +13,8 @@
 /* ---- the message table ---------------------------------------------------
  *
  * Placeholders: {a} axis name, {s} text, {i0}..{i3} integers ("unknown" for
- * RE_VAL_UNKNOWN), {x0}..{x3} the same in hex with 0x, {f0}..{f3} reals
+ * RE_VAL_UNKNOWN), {x0}..{x3} the same in hex with 0x, {t0}..{t3} the
+ * threads of a bit mask in words ("threads 1 and 2", "none"), {f0}..{f3} reals
  * (integral values without decimals, others with 3), {j0} the joystick's
  * switch word i0 in words, {jto} the joystick's invalid-input timeout
  * (" of 500 ms", or nothing when not known). Every recovery text is
@@ -120,7 +121,7 @@ static const struct re_fault_msg re_fault_table[] = {
 	 "the controller latched unknown fault code {i0} (axis {i1}, detail {i2})",
 	 "press the E-stop and keep it pressed, reload the controller program with galil-load, then restart roboelf"},
 	{RE_F_THREAD, RE_FC_PROGRAM,
-	 "controller thread {i0} is not running (thread bits {x1})",
+	 "controller thread {i0} is not running (running: {t1})",
 	 "press the E-stop and keep it pressed, restart roboelf; if it happens again, reload the program with galil-load"},
 	{RE_F_STATE, RE_FC_PROGRAM,
 	 "the controller program left the armed state (state {i0})",
@@ -408,6 +409,30 @@ static int re_expand_joy(struct re_out *o, const char *key, size_t klen,
 	return 1;
 }
 
+/* The threads of bit mask @bits (0..7) in words: "threads 0, 2 and 3",
+ * "thread 1", "none". */
+static void re_thread_list(char *buf, size_t cap, long long bits)
+{
+	int n = 0, seen = 0;
+	size_t used;
+
+	for (int t = 0; t < 8; t++)
+		n += (bits >> t) & 1;
+	used = (size_t)snprintf(buf, cap, "%s", n == 0   ? "none"
+					       : n == 1 ? "thread"
+							: "threads");
+	for (int t = 0; t < 8 && used < cap; t++) {
+		if (!((bits >> t) & 1))
+			continue;
+		seen++;
+		used += (size_t)snprintf(buf + used, cap - used, "%s%d",
+					 seen == 1   ? " "
+					 : seen == n ? " and "
+						     : ", ",
+					 t);
+	}
+}
+
 /* Expand one placeholder @key (without braces); return 0 if unknown. */
 static int re_expand(struct re_out *o, const char *key, size_t klen,
 		     const struct re_fault *f, const struct re_view *v)
@@ -439,6 +464,8 @@ static int re_expand(struct re_out *o, const char *key, size_t klen,
 	else if (key[0] == 'x')
 		snprintf(tmp, sizeof(tmp), "0x%llx",
 			 (unsigned long long)f->i[k]);
+	else if (key[0] == 't')
+		re_thread_list(tmp, sizeof(tmp), f->i[k]);
 	else
 		return 0;
 	re_out_str(o, tmp);

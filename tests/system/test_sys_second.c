@@ -538,8 +538,8 @@ static void test_load_force(void **state)
 	    h, t_hx - t_conn, t_relay - t_hx, 2.0 * sx_p(&env), t_mo - t_hx,
 	    2.0 * sx_p(&env) + SYS_MAINMS);
 	snprintf(tpl, sizeof(tpl),
-		 "FAULT PROGRAM: controller thread 0 is not running (thread "
-		 "bits 0x{n})." SX_OTHER_PROG SX_SAFE_OK REC_THREAD,
+		 "FAULT PROGRAM: controller thread 0 is not running "
+		 "(running: none)." SX_OTHER_PROG SX_SAFE_OK REC_THREAD,
 		 h);
 	sx_expect_text("roboelf's FAULT line", tpl, line, NULL, 0);
 	code = load_exit(&re2, 60000);

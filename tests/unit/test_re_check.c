@@ -720,18 +720,30 @@ static void test_check_record(void **state)
 	struct gl_record rec;
 	struct re_fault f;
 	struct re_za z;
+	char line[256];
 
 	(void)state;
 	fill_record(&rec);
 	assert_int_equal(re_check_record(&rec, 3, 1, &z, &f), RE_OK);
 	assert_int_equal(z.state, 1);
 	assert_int_equal(z.hbdmc, 17);
-	/* Thread 1 stopped while armed. */
+	/* Thread 1 stopped while armed: the threads that run, in words. */
 	rec.threads = 0x01;
 	assert_int_equal(re_check_record(&rec, 3, 1, &z, &f), RE_FAULT);
 	assert_int_equal(f.id, RE_F_THREAD);
 	assert_int_equal(f.i[0], 1);
 	assert_int_equal(f.i[1], 1);
+	re_fault_what(&f, NULL, line, sizeof(line));
+	assert_string_equal(line, "controller thread 1 is not running "
+				  "(running: thread 0)");
+	f.i[1] = 0x0D;
+	re_fault_what(&f, NULL, line, sizeof(line));
+	assert_string_equal(line, "controller thread 1 is not running "
+				  "(running: threads 0, 2 and 3)");
+	f.i[1] = 0;
+	re_fault_what(&f, NULL, line, sizeof(line));
+	assert_string_equal(line, "controller thread 1 is not running "
+				  "(running: none)");
 	/* ... which is fine while not armed (state 0). */
 	rec.axis[1].za = 0;
 	assert_int_equal(re_check_record(&rec, 3, 0, &z, &f), RE_OK);

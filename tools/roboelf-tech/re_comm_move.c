@@ -314,13 +314,17 @@ static void judge_stopped(struct re_comm *c, int ax, int counts,
 {
 	const struct re_config_axis *a = &c->cfg->axes[ax];
 	double moved = m->enc1 - m->enc0, er = a->position_error_limit_counts;
-	char why[96];
+	const char *w = re_dmc_fcode_words((int)m->fcode);
+	char why[160], on[16] = "";
 
+	if (m->faxis >= 1 && m->faxis <= RE_AXES)
+		snprintf(on, sizeof(on), " on axis %s",
+			 c->cfg->axes[(int)m->faxis - 1].name);
 	if (m->latched)
 		snprintf(why, sizeof(why),
-			 "the controller program latched fault %.0f "
-			 "(axis %.0f) and switched the motors off",
-			 m->fcode, m->faxis);
+			 "the controller program latched the fault %s%s "
+			 "(code %.0f) and switched the motors off",
+			 w ? w : "of an unknown code", on, m->fcode);
 	else
 		snprintf(why, sizeof(why), "the deadline of %d ms",
 			 RC_MOVE_MS + 500);
