@@ -61,7 +61,7 @@ static const struct dmc_cmd table[] = {
     {"DL", DMC_CMD_SIM},
     {"DM", DMC_CMD_SIM},
     {"DP", DMC_CMD_SIM},
-    {"DR", 0},
+    {"DR", DMC_CMD_SIM},
     {"DT", 0},
     {"DV", 0},
     {"EA", 0},

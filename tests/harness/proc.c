@@ -325,6 +325,7 @@ void proc_kill(struct proc *p)
 static int sim_parse_ready(struct proc_sim *s, const char *line)
 {
 	char relay[256] = "";
+	const char *udp;
 
 	if (sscanf(line,
 		   "galil-sim: listening on %*[0-9.]:%d control %d "
@@ -332,6 +333,10 @@ static int sim_parse_ready(struct proc_sim *s, const char *line)
 		   &s->port, &s->ctl_port, relay) < 2)
 		return -1;
 	snprintf(s->relay, sizeof(s->relay), "%s", relay);
+	/* " udp <port>" follows the relay (and " disc <port>") when on */
+	udp = strstr(line, " udp ");
+	if (udp && sscanf(udp, " udp %d", &s->udp_port) != 1)
+		return -1;
 	return 0;
 }
 

@@ -103,13 +103,15 @@ struct proc_sim {
 	int port;	 /* controller TCP port */
 	int ctl_port;	 /* control port */
 	char relay[256]; /* relay pty path as printed */
+	int udp_port;	 /* UDP command port (--udp-port), 0 = off */
 };
 
 /*
  * proc_sim_start() - start @bin_dir/galil-sim --port 0 --control-port 0
  * [--relay-link @relay_link, or --no-relay-link when NULL] [@extra...] and
  * wait (@timeout_ms) for its line
- * "galil-sim: listening on 127.0.0.1:<port> control <port> relay <path>".
+ * "galil-sim: listening on 127.0.0.1:<port> control <port> relay <path>"
+ * (with " udp <port>" at its end when @extra asks for --udp-port).
  * @extra: optional NULL-terminated extra arguments, or NULL.
  * Return: 0, or -1 (the process is killed and reaped).
  */

@@ -143,7 +143,10 @@ static void test_errors(void **state)
 	ctl_err(f, "block C 2", "error: bad value '2' (0 or 1)");
 	ctl_err(f, "link wobble",
 		"error: usage: link <ok|drop|stall|delay "
-		"MS>");
+		"MS> [tcp|stream]");
+	ctl_err(f, "link ok stream",
+		"error: usage: link <ok|drop|stall|delay "
+		"MS> [tcp|stream]");
 	ctl_err(f, "link delay -1", "error: bad delay '-1' (0..60000 ms)");
 	ctl_err(f, "relay toggle", "error: usage: relay [on|off]");
 	ctl_err(f, "relayfault melt",

@@ -33,6 +33,7 @@
 struct opts {
 	int port, control_port;
 	int disc_port;		 /* --disc-port N, -1: no discovery answer */
+	int udp_port;		 /* --udp-port N, -1: no UDP command port */
 	const char *listen_addr; /* --listen, NULL: 127.0.0.1 */
 	const char *plant, *relay_link, *protocol;
 	unsigned long seed;
@@ -59,7 +60,7 @@ static void usage(FILE *f)
 	fprintf(
 	    f,
 	    "usage: galil-sim [--port N] [--control-port M] [--listen ADDR]\n"
-	    "                 [--disc-port N] [--plant FILE]\n"
+	    "                 [--disc-port N] [--udp-port N] [--plant FILE]\n"
 	    "                 [--relay-link PATH | --no-relay-link]\n"
 	    "                 [--relay-protocol NAME] [--seed N] [--verbose]\n"
 	    "                 [--no-amp-undervoltage] [--power-output N]\n"
@@ -76,6 +77,10 @@ static void usage(FILE *f)
 	    "UDP port N\n"
 	    "                      of ADDR (Galil's is 50000; 0 = any; "
 	    "default: off)\n"
+	    "  --udp-port N        also answer commands on UDP port N of ADDR "
+	    "(UDP handles,\n"
+	    "                      the DR record stream; 0 = any; default: "
+	    "off)\n"
 	    "  --plant FILE        robot model (default: built in, see "
 	    "config/plant.yaml)\n"
 	    "  --relay-link PATH   symbolic link to the relay pty (default "
@@ -160,12 +165,14 @@ static int parse_opt(int c, const char *arg, struct opts *o)
 	case 'p':
 	case 'c':
 	case 'D':
+	case 'U':
 		if (parse_ulong(arg, 65535, &v) < 0) {
 			fprintf(stderr, "galil-sim: bad port '%s'\n", arg);
 			return -1;
 		}
 		*(c == 'p'   ? &o->port
 		  : c == 'c' ? &o->control_port
+		  : c == 'U' ? &o->udp_port
 			     : &o->disc_port) = (int)v;
 		return 0;
 	case 'P': o->plant = arg; return 0;
@@ -224,6 +231,7 @@ static int parse_args(int argc, char **argv, struct opts *o)
 	    {"control-port", required_argument, NULL, 'c'},
 	    {"listen", required_argument, NULL, 'L'},
 	    {"disc-port", required_argument, NULL, 'D'},
+	    {"udp-port", required_argument, NULL, 'U'},
 	    {"plant", required_argument, NULL, 'P'},
 	    {"relay-link", required_argument, NULL, 'l'},
 	    {"no-relay-link", no_argument, NULL, 'n'},
@@ -309,7 +317,7 @@ static int run_bench(double seconds)
 	return 0;
 }
 
-/* The command and control ports, and the discovery port when asked for.
+/* The command and control ports, and the discovery and UDP ports when asked.
  * Return: 0, or 1 (the message is printed). */
 static int open_ports(struct sim *s, const struct opts *o, struct sim_net **net)
 {
@@ -327,10 +335,17 @@ static int open_ports(struct sim *s, const struct opts *o, struct sim_net **net)
 		sim_net_free(*net);
 		return 1;
 	}
+	if (o->udp_port >= 0 &&
+	    sim_net_open_udp(*net, o->listen_addr, o->udp_port, err,
+			     sizeof(err)) < 0) {
+		fprintf(stderr, "galil-sim: %s\n", err);
+		sim_net_free(*net);
+		return 1;
+	}
 	return 0;
 }
 
-/* The ready line; " disc <port>" only when discovery is on, so that the
+/* The ready line; " disc <port>" / " udp <port>" only when on, so that the
  * line stays what it was for everything that does not ask for it. */
 static void print_ready(struct sim *s, const struct opts *o,
 			const struct sim_net *net)
@@ -340,6 +355,8 @@ static void print_ready(struct sim *s, const struct opts *o,
 	       sim_net_control_port(net), sim_relay_tty(sim_get_relay(s)));
 	if (sim_net_disc_port(net) > 0)
 		printf(" disc %d", sim_net_disc_port(net));
+	if (sim_net_udp_port(net) > 0)
+		printf(" udp %d", sim_net_udp_port(net));
 	printf("\n");
 	fflush(stdout);
 }
@@ -375,6 +392,7 @@ int main(int argc, char **argv)
 	    .port = DEFAULT_PORT,
 	    .control_port = DEFAULT_CONTROL_PORT,
 	    .disc_port = -1,
+	    .udp_port = -1,
 	    .relay_link = DEFAULT_RELAY_LINK,
 	    .protocol = DEFAULT_PROTOCOL,
 	    .power_output = -1,

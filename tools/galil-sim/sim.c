@@ -392,6 +392,15 @@ enum sim_link sim_link(const struct sim *s, double *delay_ms)
 	return s->link;
 }
 
+enum sim_link sim_link_on(const struct sim *s, int stream, double *delay_ms)
+{
+	enum sim_link_scope other = stream ? SIM_SCOPE_TCP : SIM_SCOPE_STREAM;
+
+	if (delay_ms)
+		*delay_ms = s->link_delay_ms;
+	return s->link_scope == other ? SIM_LINK_OK : s->link;
+}
+
 void sim_set_disconnect(struct sim *s, void (*fn)(void *ud), void *ud)
 {
 	s->disconnect = fn;

@@ -196,6 +196,21 @@ void sim_set_event_hook(struct sim *s,
  */
 enum sim_link sim_link(const struct sim *s, double *delay_ms);
 
+/* Where a link fault applies ("link stall tcp", "link delay 50 stream"). */
+enum sim_link_scope {
+	SIM_SCOPE_ALL,	  /* the TCP command port and the UDP port */
+	SIM_SCOPE_TCP,	  /* the TCP command port only */
+	SIM_SCOPE_STREAM, /* the UDP port only: records and UDP replies */
+};
+
+/*
+ * sim_link_on() - the link fault as one side of the command port sees it:
+ * @stream 1 for the UDP port (the DR record stream and the replies to UDP
+ * handles), 0 for the TCP connections. SIM_LINK_OK when the fault injected
+ * is scoped to the other side. @delay_ms: as sim_link().
+ */
+enum sim_link sim_link_on(const struct sim *s, int stream, double *delay_ms);
+
 /*
  * sim_line_fault() - a line fault injected and not yet used: @first 0 for
  * "link once" (the next command line any host begins), 1 for "link first"

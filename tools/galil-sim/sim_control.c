@@ -296,14 +296,33 @@ static int req_line_fault(struct sim *s, char **arg, int n, struct out *o)
 	return ok(o);
 }
 
+#define LINK_USAGE "usage: link <ok|drop|stall|delay MS> [tcp|stream]"
+
+/* A last word "tcp" or "stream" scopes the fault; it is taken off @n. */
+static enum sim_link_scope link_scope(char **arg, int *n)
+{
+	if (*n > 1 && !strcmp(arg[*n - 1], "tcp")) {
+		(*n)--;
+		return SIM_SCOPE_TCP;
+	}
+	if (*n > 1 && !strcmp(arg[*n - 1], "stream")) {
+		(*n)--;
+		return SIM_SCOPE_STREAM;
+	}
+	return SIM_SCOPE_ALL;
+}
+
 static int req_link(struct sim *s, char **arg, int n, struct out *o)
 {
+	static const char *const scope_word[] = {"", " tcp", " stream"};
+	enum sim_link_scope scope;
 	enum sim_link l;
 	double ms = 0;
 
 	if (!strcmp(arg[0], "once") || !strcmp(arg[0], "first"))
 		return req_line_fault(s, arg, n, o);
-	if (!strcmp(arg[0], "ok") && n == 1)
+	scope = link_scope(arg, &n);
+	if (!strcmp(arg[0], "ok") && n == 1 && scope == SIM_SCOPE_ALL)
 		l = SIM_LINK_OK;
 	else if (!strcmp(arg[0], "drop") && n == 1)
 		l = SIM_LINK_DROP;
@@ -312,17 +331,18 @@ static int req_link(struct sim *s, char **arg, int n, struct out *o)
 	else if (!strcmp(arg[0], "delay") && n == 2)
 		l = SIM_LINK_DELAY;
 	else
-		return fail(o, "usage: link <ok|drop|stall|delay MS>");
+		return fail(o, LINK_USAGE);
 	if (n == 2 && parse_num(arg[1], 0, 60000, &ms) < 0)
 		return fail(o, "bad delay '%s' (0..60000 ms)", arg[1]);
 	s->link = l;
 	s->link_delay_ms = ms;
+	s->link_scope = scope;
 	if (l == SIM_LINK_OK) { /* and no line fault either */
 		s->line_once.kind = s->line_first.kind = SIM_LINE_NONE;
 		s->line_once.arg = s->line_first.arg = 0;
 	}
-	sim_event(s, "inject: link %s%s%s", arg[0], n == 2 ? " " : "",
-		  n == 2 ? arg[1] : "");
+	sim_event(s, "inject: link %s%s%s%s", arg[0], n == 2 ? " " : "",
+		  n == 2 ? arg[1] : "", scope_word[scope]);
 	if (l == SIM_LINK_DROP && s->disconnect)
 		s->disconnect(s->disconnect_ud);
 	return ok(o);
@@ -550,7 +570,7 @@ static const struct request requests[] = {
     {"enc", 2, 3, req_enc, "enc <A|B|C> <ok|stuck|slip COUNTS>"},
     {"block", 2, 2, req_block, "block <A|B|C> <0|1>"},
     {"limit", 3, 3, req_limit, "limit <A|B|C> <fwd|rev> <press|release>"},
-    {"link", 1, 3, req_link, "link <ok|drop|stall|delay MS>"},
+    {"link", 1, 3, req_link, "link <ok|drop|stall|delay MS> [tcp|stream]"},
     {"relay", 0, 1, req_relay, "relay [on|off]"},
     {"relayfault", 1, 1, req_relayfault,
      "relayfault <ok|unplug|writefail|wedge>"},

@@ -39,6 +39,7 @@ struct sim {
 
 	enum sim_link link;
 	double link_delay_ms;
+	enum sim_link_scope link_scope;	  /* which side the link fault hits */
 	struct sim_line_fault line_once;  /* "link once": the next line */
 	struct sim_line_fault line_first; /* "link first": new connections */
 	void (*disconnect)(void *ud);

@@ -15,6 +15,7 @@
 #include "ctrl_prog.h"
 #include "ctrl_proto.h"
 #include "ctrl_store.h"
+#include "ctrl_stream.h"
 #include "ctrl_thread.h"
 #include "ctrl_var.h"
 #include "gl_err.h"
@@ -154,6 +155,7 @@ void ctrl_step(struct ctrl *c, const struct ctrl_sense *in,
 	ctrl_threads_run(c);
 	ctrl_motion_drive(c, out);
 	c->time++;
+	ctrl_stream_sample(c);
 }
 
 double ctrl_sample_ms(const struct ctrl *c)

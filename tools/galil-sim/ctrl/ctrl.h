@@ -81,6 +81,9 @@ void ctrl_free(struct ctrl *c);
 
 /* ctrl_handle_open/close() - a host connects to / leaves handle h (0..7). */
 void ctrl_handle_open(struct ctrl *c, int h);
+/* ctrl_handle_open_udp() - a UDP peer takes handle h (0..7): _IHh2 = 1, and
+ * the handle may receive the DR record stream. */
+void ctrl_handle_open_udp(struct ctrl *c, int h);
 void ctrl_handle_close(struct ctrl *c, int h);
 
 /*
@@ -173,6 +176,18 @@ int ctrl_handle_close_by(const struct ctrl *c, int h);
  * and #TCPERR runs if the program has it.
  */
 void ctrl_handle_lost(struct ctrl *c, int h);
+
+/*
+ * ctrl_stream_take() - the oldest data record the DR stream queued (one
+ * whole record, the QR bytes, for one datagram) into @buf.
+ * @h: [out] optional, the handle (0..7) it is for.
+ * Return: its length, or 0 when none is queued or @cap is too small.
+ */
+size_t ctrl_stream_take(struct ctrl *c, int *h, uint8_t *buf, size_t cap);
+
+/* ctrl_stream_lost() - records dropped because nobody took them in time
+ * (more than 64 waiting). */
+uint64_t ctrl_stream_lost(const struct ctrl *c);
 
 /* ctrl_handle_peer() - optional: ports and peer address, for TH and _IH. */
 void ctrl_handle_peer(struct ctrl *c, int h, int local_port, uint32_t peer_ip,

@@ -1,7 +1,8 @@
 /*
  * ctrl_cmd.c - the command table and the general commands (TC TH WH QZ QR
  * CF CW SB CB OB OP TI TA TB DM DA LV LA LL LS UL DL BP BN BV NO TM VF PF
- * LZ IH CN EO ID MT). The argument parsers are in ctrl_args.c.
+ * LZ IH CN EO ID MT; DR is ctrl_stream.c). The argument parsers are in
+ * ctrl_args.c.
  *
  * A command not in the table answers TC 1: nothing is accepted silently.
  */
@@ -21,6 +22,7 @@
 #include "ctrl_prog.h"
 #include "ctrl_rec.h"
 #include "ctrl_store.h"
+#include "ctrl_stream.h"
 #include "ctrl_thread.h"
 #include "ctrl_var.h"
 #include "gl_record.h"
@@ -31,6 +33,7 @@
 
 static int cmd_general(struct ctrl_xc *x, const char *name, const char *a);
 static int cmd_mg(struct ctrl_xc *x, const char *name, const char *a);
+static int cmd_dr(struct ctrl_xc *x, const char *name, const char *a);
 
 struct cmd_ent {
 	char name[3];
@@ -64,6 +67,7 @@ static const struct cmd_ent cmd_table[] = {
     {"DL", GE, F_HOST},
     {"DM", GE, 0},
     {"DP", AX, F_ASSIGN},
+    {"DR", cmd_dr, 0},
     {"EN", FL, F_PROG},
     {"EO", GE, 0},
     {"ER", AX, F_ASSIGN},
@@ -247,9 +251,10 @@ static int cmd_th(struct ctrl_xc *x)
 			continue;
 		}
 		ip_text(c->h[h].peer_ip, ip, sizeof(ip));
-		ctrl_buf_printf(
-		    &c->tmp, "IH%c TCP PORT %d TO IP ADDRESS %s PORT %d\r\n",
-		    'A' + h, c->h[h].local_port, ip, c->h[h].peer_port);
+		ctrl_buf_printf(&c->tmp,
+				"IH%c %s PORT %d TO IP ADDRESS %s PORT %d\r\n",
+				'A' + h, c->h[h].udp ? "UDP" : "TCP",
+				c->h[h].local_port, ip, c->h[h].peer_port);
 	}
 	return 0;
 }
@@ -335,7 +340,7 @@ static int ih_names(char h, int i, int sender)
 
 /*
  * IHh=>r closes handles: h = A..H, S (the sender), T (every other one);
- * r = -2 / -3 TCP (-1 UDP: the simulator has none, nothing to close). The
+ * r = -1 the UDP ones among them, -2 the TCP ones, -3 both. The
  * network layer closes them once the sender's reply has gone
  * (ctrl_handle_close_by()); the event names the command and its sender.
  */
@@ -355,13 +360,13 @@ static int cmd_ih(struct ctrl_xc *x, const char *a)
 		return 6;
 	if (h != 'S' && h != 'T' && (h < 'A' || h >= 'A' + CTRL_HANDLES))
 		return 6;
-	if (!strcmp(a, "-1"))
-		return 0;
 	ctrl_xc_who(x, who, sizeof(who));
 	for (i = 0; i < CTRL_HANDLES; i++) {
 		struct ctrl_handle *hd = &c->h[i];
 
 		if (!hd->open || hd->close_wanted || !ih_names(h, i, x->handle))
+			continue;
+		if ((a[1] == '1' && !hd->udp) || (a[1] == '2' && hd->udp))
 			continue;
 		hd->close_wanted = 1;
 		hd->close_by = x->handle;
@@ -790,6 +795,12 @@ static int cmd_id(struct ctrl_xc *x)
 			"FW, %s\r\nDMC, 4030, Rev 1\r\nAMP1, 43040, Rev 1\r\n",
 			x->c->model);
 	return 0;
+}
+
+static int cmd_dr(struct ctrl_xc *x, const char *name, const char *a)
+{
+	(void)name;
+	return ctrl_stream_cmd(x, a);
 }
 
 static int cmd_mg(struct ctrl_xc *x, const char *name, const char *a)

@@ -24,6 +24,7 @@
  *   ctrl_mg.c     MG and its formatters
  *   ctrl_axcmd.c  axis commands (SP AC ... PA PR BG ST SH MO TP ...)
  *   ctrl_rec.c    the QR data record
+ *   ctrl_stream.c DR: the data record as a stream to a UDP handle
  *   ctrl_store.c  DL into program memory; BP BN BV into flash
  *   ctrl_cmd.c    command table and the general commands
  *   ctrl_exec.c   statement dispatch, run-time errors, the line scheduler
@@ -58,6 +59,10 @@
 #define CTRL_OUT_MAX	      (4u << 20) /* bytes kept for a host, at most */
 #define CTRL_SERIAL_MAX	      65536 /* bytes kept for the (absent) serial port */
 #define CTRL_TV_SAMPLES	      256   /* TV averaging window, samples (~0.25 s) */
+#define CTRL_DR_MIN	      2 /* DR n0 at least (gclib's DMC-40x0 clamp) */
+#define CTRL_DR_MAX	      30000 /* DR n0 at most (choice) */
+#define CTRL_DR_QUEUE	      64    /* stream records waiting for net/ */
+#define CTRL_REC_MAX	      370   /* record bytes, >= GL_REC_MAX_BYTES */
 
 #define CTRL_NHANDLES	 (CTRL_HANDLES + 1)
 #define CTRL_PRIV_HANDLE CTRL_HANDLES /* ctrl_command()'s private port */
@@ -265,6 +270,7 @@ enum ctrl_hmode {
 
 struct ctrl_handle {
 	int open;
+	int udp; /* a UDP session (_IHh2 1), else TCP (2) */
 	int close_wanted;
 	int close_by;	    /* handle whose IH asked, -1: none to wait for */
 	char close_why[48]; /* "IHT from handle B", for the event */
@@ -280,6 +286,23 @@ struct ctrl_handle {
 	struct ctrl_buf out; /* bytes for the host */
 	int local_port, peer_port;
 	uint32_t peer_ip;
+};
+
+/* ---- DR: records waiting to be sent (ctrl_stream.c) ------------------ */
+
+struct ctrl_stream_rec {
+	int handle; /* where it goes */
+	uint16_t len;
+	uint8_t b[CTRL_REC_MAX];
+};
+
+struct ctrl_stream {
+	int n;	  /* _DR0: samples between records, 0 = off */
+	int h;	  /* _DR1: the handle 0..7 */
+	int left; /* samples until the next record */
+	int head, count;
+	struct ctrl_stream_rec q[CTRL_DR_QUEUE];
+	uint64_t lost; /* records dropped because the queue was full */
 };
 
 /* ---- what BN / BP / BV keep over a power cycle ----------------------- */
@@ -332,6 +355,7 @@ struct ctrl {
 	int edepth;	 /* expression nesting, bounded */
 
 	struct ctrl_handle h[CTRL_NHANDLES];
+	struct ctrl_stream dr;	/* DR */
 	struct ctrl_buf serial; /* output routed to the serial port */
 	struct ctrl_buf tmp;	/* output of the running statement */
 	struct ctrl_flash flash;

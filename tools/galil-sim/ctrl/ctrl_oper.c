@@ -43,6 +43,8 @@ static int digit_op(struct ctrl_xc *x, const char *code, int d, double *v)
 		*v = (int[]){CTRL_AXES, 52, 26, 36}[d];
 	else if (!strcmp(code, "ED") && (d == 0 || d == 1 || d == 4))
 		*v = d == 0 ? c->ed_line : d == 1 ? c->ed_thread : x->thread;
+	else if (!strcmp(code, "DR") && d <= 1)
+		*v = d == 0 ? c->dr.n : c->dr.h;
 	else if (!strcmp(code, "OP") && d == 0)
 		*v = c->outputs & 0xFFFF;
 	else if (!strcmp(code, "CN") && d <= 4)
@@ -122,7 +124,7 @@ static int ih_op(struct ctrl *c, const char *rest, double *v)
 		*v = c->h[h].open ? (double)(int32_t)c->h[h].peer_ip : 0;
 		return 0;
 	case 1: *v = c->h[h].open ? c->h[h].peer_port : 0; return 0;
-	case 2: *v = c->h[h].open ? 2 : 0; return 0;
+	case 2: *v = c->h[h].open ? (c->h[h].udp ? 1 : 2) : 0; return 0;
 	case 3:
 	case 4: *v = 0; return 0;
 	}

@@ -27,6 +27,7 @@
 #include "ctrl_exec.h"
 #include "ctrl_out.h"
 #include "ctrl_store.h"
+#include "ctrl_stream.h"
 #include "ctrl_thread.h"
 #include "gl_err.h"
 
@@ -45,6 +46,7 @@ void ctrl_handle_open(struct ctrl *c, int h)
 	ctrl_buf_clear(&hd->out);
 	ctrl_buf_clear(&hd->dl);
 	hd->open = 1;
+	hd->udp = 0;
 	hd->close_wanted = 0;
 	hd->close_by = -1;
 	hd->close_why[0] = '\0';
@@ -52,6 +54,14 @@ void ctrl_handle_open(struct ctrl *c, int h)
 	hd->len = 0;
 	hd->overflow = 0;
 	hd->semis = 0;
+}
+
+void ctrl_handle_open_udp(struct ctrl *c, int h)
+{
+	if (!c || h < 0 || h >= CTRL_HANDLES)
+		return;
+	ctrl_handle_open(c, h);
+	c->h[h].udp = 1;
 }
 
 void ctrl_handle_close(struct ctrl *c, int h)
@@ -65,7 +75,9 @@ void ctrl_handle_close(struct ctrl *c, int h)
 		ctrl_event(c, "download on handle %c abandoned", 'A' + h);
 	if (hd->open && hd->close_wanted && hd->close_why[0])
 		ctrl_event(c, "handle %c closed by %s", 'A' + h, hd->close_why);
+	ctrl_stream_handle_closed(c, h);
 	hd->open = 0;
+	hd->udp = 0;
 	hd->close_wanted = 0;
 	hd->close_by = -1;
 	hd->close_why[0] = '\0';
@@ -350,4 +362,5 @@ void ctrl_proto_reset(struct ctrl *c)
 		}
 	}
 	ctrl_buf_clear(&c->serial);
+	ctrl_stream_reset(c);
 }

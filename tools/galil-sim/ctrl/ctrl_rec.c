@@ -86,7 +86,7 @@ int ctrl_record(struct ctrl *c, uint8_t *buf, size_t cap)
 		r.outputs[i] = (uint8_t)(c->outputs >> (8 * i));
 	}
 	for (i = 0; i < CTRL_HANDLES; i++)
-		r.handles[i] = c->h[i].open ? 2 : 0;
+		r.handles[i] = c->h[i].open ? (c->h[i].udp ? 1 : 2) : 0;
 	r.error_code = (uint8_t)c->tc;
 	for (i = 0; i < CTRL_THREADS; i++)
 		if (c->th[i].running)

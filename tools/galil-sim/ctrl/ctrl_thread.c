@@ -56,6 +56,7 @@ static const struct {
     {67, "Too many arrays or variables"},
     {123, "TCP lost sync"},
     {126, "Closed Ethernet handle"},
+    {133, "Handle must be UDP"},
     {134, "All motors must be in MO for this command"},
 };
 

@@ -5,12 +5,14 @@
 #include <errno.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
+#include <stdio.h>
 #include <string.h>
 #include <sys/socket.h>
 #include <unistd.h>
 #include <arpa/inet.h>
 
 #include "base_clock.h"
+#include "gl_record.h"
 #include "gl_err.h"
 #include "sim.h"
 #include "sim_cmdport.h"
@@ -19,12 +21,28 @@
 
 #define CMDPORT_READ_CHUNK 4096 /* bytes per recv() */
 #define CMDPORT_DL_BAD_LEN 100	/* SIM_LINE_DLREJECT: an over-long line */
+#define CMDPORT_UDP_BURST  8	/* datagrams read per wake-up */
+
+/* Does a host (a TCP connection or a UDP peer) hold this handle? */
+static int conn_used(const struct sim_cmdport_conn *c)
+{
+	return c->fd >= 0 || c->udp;
+}
+
+/* The link fault this handle's side sees (sim_link_on()). */
+static enum sim_link conn_link(const struct sim_cmdport *cp,
+			       const struct sim_cmdport_conn *c,
+			       double *delay_ms)
+{
+	return sim_link_on(cp->sim, c->udp, delay_ms);
+}
 
 void sim_cmdport_init(struct sim_cmdport *cp, struct sim *s)
 {
 	memset(cp, 0, sizeof(*cp));
 	cp->sim = s;
 	cp->lfd = -1;
+	cp->ufd = -1;
 	cp->rng = 1;
 	for (int h = 0; h < CTRL_HANDLES; h++) {
 		cp->conn[h].fd = -1;
@@ -49,10 +67,12 @@ static void conn_close(struct sim_cmdport *cp, int h, const char *why)
 	struct sim_cmdport_conn *c = &cp->conn[h];
 	struct ctrl *ctl = sim_ctrl(cp->sim);
 
-	if (c->fd < 0)
+	if (!conn_used(c))
 		return;
-	close(c->fd);
+	if (c->fd >= 0)
+		close(c->fd);
 	c->fd = -1;
+	c->udp = 0;
 	c->out_len = 0;
 	c->nchunk = 0;
 	if (why && !ctrl_handle_close_wanted(ctl, h))
@@ -67,27 +87,46 @@ void sim_cmdport_shutdown(struct sim_cmdport *cp)
 	if (cp->lfd >= 0)
 		close(cp->lfd);
 	cp->lfd = -1;
+	if (cp->ufd >= 0)
+		close(cp->ufd);
+	cp->ufd = -1;
+	cp->uport = 0;
 }
 
 void sim_cmdport_disconnect_all(void *ud)
 {
 	struct sim_cmdport *cp = ud;
-	const char *why = sim_link(cp->sim, NULL) == SIM_LINK_DROP
-			      ? "link drop"
-			      : "power cycle";
+	int drop = sim_link(cp->sim, NULL) == SIM_LINK_DROP;
 
-	for (int h = 0; h < CTRL_HANDLES; h++)
-		conn_close(cp, h, why);
+	for (int h = 0; h < CTRL_HANDLES; h++) {
+		/* a drop scoped to one side leaves the other side's handles */
+		if (drop && conn_link(cp, &cp->conn[h], NULL) != SIM_LINK_DROP)
+			continue;
+		conn_close(cp, h, drop ? "link drop" : "power cycle");
+	}
 }
 
 int sim_cmdport_listen_fd(const struct sim_cmdport *cp)
 {
-	return sim_link(cp->sim, NULL) == SIM_LINK_STALL ? -1 : cp->lfd;
+	return sim_link_on(cp->sim, 0, NULL) == SIM_LINK_STALL ? -1 : cp->lfd;
 }
 
 int sim_cmdport_fd(const struct sim_cmdport *cp, int h)
 {
 	return h >= 0 && h < CTRL_HANDLES ? cp->conn[h].fd : -1;
+}
+
+/* A fresh handle @h: empty queues, its "link first" fault armed. */
+static void conn_reset(struct sim_cmdport *cp, int h)
+{
+	struct sim_cmdport_conn *c = &cp->conn[h];
+
+	c->out_len = 0;
+	c->nchunk = 0;
+	sim_line_fault(cp->sim, 1, &c->pending);
+	c->silent = c->midline = c->dl_reject = 0;
+	c->dl_line = -1;
+	c->line_len = 0;
 }
 
 void sim_cmdport_accept(struct sim_cmdport *cp)
@@ -100,9 +139,10 @@ void sim_cmdport_accept(struct sim_cmdport *cp)
 	if (fd < 0)
 		return;
 	inet_ntop(AF_INET, &sa.sin_addr, ip, sizeof(ip));
-	for (h = 0; h < CTRL_HANDLES && cp->conn[h].fd >= 0; h++)
+	for (h = 0; h < CTRL_HANDLES && conn_used(&cp->conn[h]); h++)
 		;
-	if (h == CTRL_HANDLES || sim_link(cp->sim, NULL) == SIM_LINK_DROP) {
+	if (h == CTRL_HANDLES ||
+	    sim_link_on(cp->sim, 0, NULL) == SIM_LINK_DROP) {
 		close(fd); /* all handles busy, or the link is down */
 		cp->refused++;
 		sim_event(cp->sim, "connection from %s:%d refused (%s)", ip,
@@ -113,13 +153,8 @@ void sim_cmdport_accept(struct sim_cmdport *cp)
 	}
 	sim_sock_nonblock(fd);
 	setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof(one));
+	conn_reset(cp, h);
 	cp->conn[h].fd = fd;
-	cp->conn[h].out_len = 0;
-	cp->conn[h].nchunk = 0;
-	sim_line_fault(cp->sim, 1, &cp->conn[h].pending);
-	cp->conn[h].silent = cp->conn[h].midline = cp->conn[h].dl_reject = 0;
-	cp->conn[h].dl_line = -1;
-	cp->conn[h].line_len = 0;
 	ctrl_handle_open(sim_ctrl(cp->sim), h);
 	ctrl_handle_peer(sim_ctrl(cp->sim), h, cp->port,
 			 ntohl(sa.sin_addr.s_addr), ntohs(sa.sin_port));
@@ -144,7 +179,7 @@ void sim_cmdport_read(struct sim_cmdport *cp, int h)
 		conn_close(cp, h, r == 0 ? "peer" : strerror(errno));
 		return;
 	}
-	if (sim_link(cp->sim, NULL) == SIM_LINK_STALL)
+	if (sim_link_on(cp->sim, 0, NULL) == SIM_LINK_STALL)
 		return; /* lost on the wire */
 	conn_input(cp, h, buf, (size_t)r);
 }
@@ -169,7 +204,7 @@ static void conn_fill(struct sim_cmdport *cp, int h, int64_t now)
 {
 	struct sim_cmdport_conn *c = &cp->conn[h];
 	double delay_ms;
-	enum sim_link link = sim_link(cp->sim, &delay_ms);
+	enum sim_link link = conn_link(cp, c, &delay_ms);
 	size_t got;
 
 	if (link == SIM_LINK_STALL) {
@@ -238,7 +273,7 @@ static void conn_shape(struct sim_cmdport *cp, int h,
 
 	if (room <= SIM_WIRE_GROWTH || c->nchunk > SIM_CMDPORT_CHUNKS - 2)
 		return; /* no room: conn_fill() sends it unshaped */
-	if (sim_link(cp->sim, &delay_ms) == SIM_LINK_DELAY)
+	if (conn_link(cp, c, &delay_ms) == SIM_LINK_DELAY)
 		late = (int64_t)(delay_ms * 1000);
 	got = ctrl_output(sim_ctrl(cp->sim), h, cp->reply,
 			  room - SIM_WIRE_GROWTH);
@@ -372,7 +407,7 @@ static void conn_input(struct sim_cmdport *cp, int h, const uint8_t *buf,
 	size_t n;
 	int end;
 
-	while (len && c->fd >= 0 && !c->silent) {
+	while (len && conn_used(c) && !c->silent) {
 		for (n = 0; n < len && !is_line_end(c, buf[n]); n++)
 			;
 		end = n < len;
@@ -402,7 +437,7 @@ static void conn_input(struct sim_cmdport *cp, int h, const uint8_t *buf,
  * program, the private port or a gone sender leave nothing to wait for. */
 static int reply_gone(struct sim_cmdport *cp, int by)
 {
-	return by < 0 || by >= CTRL_HANDLES || cp->conn[by].fd < 0 ||
+	return by < 0 || by >= CTRL_HANDLES || !conn_used(&cp->conn[by]) ||
 	       (cp->conn[by].out_len == 0 &&
 		ctrl_output_pending(sim_ctrl(cp->sim), by) == 0);
 }
@@ -414,19 +449,183 @@ static void close_wanted(struct sim_cmdport *cp)
 	struct ctrl *c = sim_ctrl(cp->sim);
 
 	for (int h = 0; h < CTRL_HANDLES; h++) {
-		if (cp->conn[h].fd >= 0 && ctrl_handle_close_wanted(c, h) &&
+		if (conn_used(&cp->conn[h]) && ctrl_handle_close_wanted(c, h) &&
 		    reply_gone(cp, ctrl_handle_close_by(c, h)))
 			conn_close(cp, h, NULL);
 	}
 }
 
+/* ---- UDP: handles, replies and the record stream ----------------------- */
+
+int sim_cmdport_udp_open(struct sim_cmdport *cp, const char *addr, int port,
+			 char *err, size_t errlen)
+{
+	struct sockaddr_in sa = {.sin_family = AF_INET};
+	socklen_t len = sizeof(sa);
+
+	addr = addr ? addr : "127.0.0.1";
+	if (cp->ufd >= 0 || port < 0 || port > 65535 ||
+	    inet_pton(AF_INET, addr, &sa.sin_addr) != 1) {
+		snprintf(err, errlen, "invalid UDP port '%s:%d'", addr, port);
+		return GL_ERR_ARG;
+	}
+	sa.sin_port = htons((uint16_t)port);
+	cp->ufd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+	if (cp->ufd < 0 ||
+	    bind(cp->ufd, (struct sockaddr *)&sa, sizeof(sa)) < 0 ||
+	    getsockname(cp->ufd, (struct sockaddr *)&sa, &len) < 0) {
+		snprintf(err, errlen, "cannot bind the UDP port %s:%d: %s",
+			 addr, port, strerror(errno));
+		if (cp->ufd >= 0)
+			close(cp->ufd);
+		cp->ufd = -1;
+		return GL_ERR_SYS;
+	}
+	sim_sock_nonblock(cp->ufd);
+	cp->uport = ntohs(sa.sin_port);
+	return 0;
+}
+
+int sim_cmdport_udp_fd(const struct sim_cmdport *cp)
+{
+	return cp->ufd;
+}
+
+/* The handle of the UDP peer @sa: its own, or the lowest free one opened
+ * for it. Return: the handle, or -1 (refused, with its event). */
+static int udp_handle(struct sim_cmdport *cp, const struct sockaddr_in *sa)
+{
+	uint32_t ip = ntohl(sa->sin_addr.s_addr);
+	uint16_t port = ntohs(sa->sin_port);
+	char a[INET_ADDRSTRLEN] = "?";
+	int h;
+
+	for (h = 0; h < CTRL_HANDLES; h++)
+		if (cp->conn[h].udp && cp->conn[h].peer_ip == ip &&
+		    cp->conn[h].peer_port == port)
+			return h;
+	inet_ntop(AF_INET, &sa->sin_addr, a, sizeof(a));
+	for (h = 0; h < CTRL_HANDLES && conn_used(&cp->conn[h]); h++)
+		;
+	if (h == CTRL_HANDLES ||
+	    sim_link_on(cp->sim, 1, NULL) == SIM_LINK_DROP) {
+		cp->refused++;
+		sim_event(cp->sim, "datagram from %s:%d refused (%s)", a, port,
+			  h == CTRL_HANDLES ? "all 8 handles busy"
+					    : "link drop");
+		return -1;
+	}
+	conn_reset(cp, h);
+	cp->conn[h].udp = 1;
+	cp->conn[h].peer_ip = ip;
+	cp->conn[h].peer_port = port;
+	ctrl_handle_open_udp(sim_ctrl(cp->sim), h);
+	ctrl_handle_peer(sim_ctrl(cp->sim), h, cp->uport, ip, port);
+	sim_event(cp->sim, "handle %c opened from %s:%d (UDP)", 'A' + h, a,
+		  port);
+	return h;
+}
+
+/* A datagram ends its line: a CR is added when its last line has none. */
+static size_t udp_terminate(uint8_t *buf, size_t len)
+{
+	size_t e = len;
+
+	while (e && buf[e - 1] == '\n')
+		e--;
+	if (e == 0 || buf[e - 1] != '\r')
+		buf[len++] = '\r';
+	return len;
+}
+
+void sim_cmdport_udp_read(struct sim_cmdport *cp)
+{
+	uint8_t buf[CMDPORT_READ_CHUNK + 1];
+	struct sockaddr_in sa;
+	socklen_t sl;
+	ssize_t r;
+	int h;
+
+	for (int i = 0; cp->ufd >= 0 && i < CMDPORT_UDP_BURST; i++) {
+		sl = sizeof(sa);
+		r = recvfrom(cp->ufd, buf, CMDPORT_READ_CHUNK, 0,
+			     (struct sockaddr *)&sa, &sl);
+		if (r < 0)
+			return; /* nothing more (or an error: the next poll) */
+		if (sim_link_on(cp->sim, 1, NULL) == SIM_LINK_STALL)
+			continue; /* lost on the wire */
+		if ((h = udp_handle(cp, &sa)) < 0)
+			continue;
+		conn_input(cp, h, buf, udp_terminate(buf, (size_t)r));
+		/* this datagram's reply is one datagram of its own */
+		if (cp->conn[h].udp)
+			conn_fill(cp, h, base_now_us());
+	}
+}
+
+/* The DR records the controller made: one chunk (datagram) each, for an
+ * open UDP handle; under the stream side's stall or drop they are lost. */
+static void stream_fill(struct sim_cmdport *cp, int64_t now)
+{
+	uint8_t rec[GL_REC_MAX_BYTES];
+	double delay_ms;
+	size_t n;
+	int h;
+
+	while (
+	    (n = ctrl_stream_take(sim_ctrl(cp->sim), &h, rec, sizeof(rec)))) {
+		enum sim_link l = sim_link_on(cp->sim, 1, &delay_ms);
+
+		if (h < 0 || h >= CTRL_HANDLES || !cp->conn[h].udp ||
+		    l == SIM_LINK_STALL || l == SIM_LINK_DROP)
+			continue;
+		conn_queue(&cp->conn[h], rec, n,
+			   now + (l == SIM_LINK_DELAY
+				      ? (int64_t)(delay_ms * 1000)
+				      : 0));
+	}
+}
+
+/* Send the due chunks of UDP handle @h, each as one datagram. */
+static void udp_flush(struct sim_cmdport *cp, int h, int64_t now)
+{
+	struct sim_cmdport_conn *c = &cp->conn[h];
+	struct sockaddr_in sa = {.sin_family = AF_INET};
+	size_t start = 0;
+	int k;
+
+	sa.sin_addr.s_addr = htonl(c->peer_ip);
+	sa.sin_port = htons(c->peer_port);
+	for (k = 0; k < c->nchunk && c->chunk[k].due_us <= now; k++) {
+		if (sendto(cp->ufd, c->out + start, c->chunk[k].end - start,
+			   MSG_NOSIGNAL, (struct sockaddr *)&sa,
+			   sizeof(sa)) < 0 &&
+		    sim_sock_again(errno))
+			break; /* the socket is full: try again later */
+		start = c->chunk[k].end; /* sent, or lost as on a network */
+	}
+	memmove(c->out, c->out + start, c->out_len - start);
+	c->out_len -= start;
+	memmove(c->chunk, c->chunk + k,
+		(size_t)(c->nchunk - k) * sizeof(c->chunk[0]));
+	c->nchunk -= k;
+	for (k = 0; k < c->nchunk; k++)
+		c->chunk[k].end -= start;
+}
+
 void sim_cmdport_flush(struct sim_cmdport *cp, int64_t now_us)
 {
 	for (int h = 0; h < CTRL_HANDLES; h++) {
-		if (cp->conn[h].fd < 0)
+		if (!conn_used(&cp->conn[h]))
 			continue;
 		conn_fill(cp, h, now_us);
-		conn_flush(cp, h, now_us);
+	}
+	stream_fill(cp, now_us);
+	for (int h = 0; h < CTRL_HANDLES; h++) {
+		if (cp->conn[h].udp)
+			udp_flush(cp, h, now_us);
+		else if (cp->conn[h].fd >= 0)
+			conn_flush(cp, h, now_us);
 	}
 	close_wanted(cp);
 }

@@ -20,6 +20,15 @@
  * corrupts its line N. Lines that meet no fault go to the controller as
  * the bytes arrive, as before.
  *
+ * UDP (sim_cmdport_udp_open()): the controller answers commands on a UDP
+ * port too. A datagram from a peer (address and port) that has no handle
+ * opens one, the lowest free (_IHh2 = 1); the commands of each datagram
+ * are answered in one datagram (a datagram that does not end its line is
+ * given a CR). The DR record stream (ctrl_stream_take()) goes to its UDP
+ * handle, one record per datagram. A handle closes only by IH, a link
+ * drop or a power cycle. Link faults are per side (sim_link_on()): the
+ * TCP connections, or the UDP port (its replies and the records).
+ *
  * IH closing: a handle the controller marks (ctrl_handle_close_wanted()) is
  * closed after the reply of the IH command has gone to its sender. Opening
  * and closing a connection are events ("handle A opened from ...",
@@ -49,7 +58,10 @@ struct sim_cmdport_chunk {
 
 /* One command connection = one controller handle. */
 struct sim_cmdport_conn {
-	int fd; /* -1 = free; slot index = controller handle */
+	int fd;	 /* TCP socket, -1 = none; slot index = controller handle */
+	int udp; /* 1: a UDP peer holds the handle (fd stays -1) */
+	uint32_t peer_ip;   /* UDP peer, host order */
+	uint16_t peer_port; /* UDP peer port */
 	uint8_t out[SIM_CMDPORT_OUT_CAP];
 	size_t out_len;
 	struct sim_cmdport_chunk chunk[SIM_CMDPORT_CHUNKS];
@@ -71,6 +83,8 @@ struct sim_cmdport {
 	struct sim *sim;  /* served, not owned */
 	int lfd;	  /* listener, -1 = none */
 	int port;	  /* bound port number */
+	int ufd;	  /* UDP command socket, -1 = none */
+	int uport;	  /* its bound port, 0 = none */
 	uint64_t refused; /* connections refused (all 8 busy, link dropped) */
 	uint32_t rng;	  /* SIM_LINE_CHUNKS piece sizes */
 	struct sim_cmdport_conn conn[CTRL_HANDLES];
@@ -92,6 +106,28 @@ void sim_cmdport_init(struct sim_cmdport *cp, struct sim *s);
  */
 int sim_cmdport_listen(struct sim_cmdport *cp, const char *addr, int port,
 		       char *err, size_t errlen);
+
+/*
+ * sim_cmdport_udp_open() - also answer commands on UDP @addr:@port (0 = any
+ * free port; cp->uport tells which) and send the DR stream there.
+ * @addr: dotted IPv4 address, NULL for 127.0.0.1.
+ * @err: [out] the reason on failure; @errlen its size.
+ * Return: 0, GL_ERR_ARG (bad address, already open) or GL_ERR_SYS.
+ */
+int sim_cmdport_udp_open(struct sim_cmdport *cp, const char *addr, int port,
+			 char *err, size_t errlen);
+
+/* sim_cmdport_udp_fd() - the UDP socket to poll for input, -1 = none. */
+int sim_cmdport_udp_fd(const struct sim_cmdport *cp);
+
+/*
+ * sim_cmdport_udp_read() - the datagrams waiting (at most 8): each to its
+ * peer's handle (opened if new: event "handle A opened from
+ * 127.0.0.1:40000 (UDP)"; refused with an event when all 8 handles are
+ * busy or the stream side's link is dropped), its reply queued as one
+ * datagram. Under SIM_LINK_STALL on the stream side they are read and lost.
+ */
+void sim_cmdport_udp_read(struct sim_cmdport *cp);
 
 /*
  * sim_cmdport_shutdown() - close every connection (no event, the
@@ -132,9 +168,11 @@ void sim_cmdport_accept(struct sim_cmdport *cp);
 void sim_cmdport_read(struct sim_cmdport *cp, int h);
 
 /*
- * sim_cmdport_flush() - take every handle's controller output into its
- * queue (due at @now_us, or @now_us + the delay under SIM_LINK_DELAY;
- * discarded under SIM_LINK_STALL), send what is due (without blocking),
+ * sim_cmdport_flush() - take every handle's controller output and the DR
+ * records into its queue (due at @now_us, or @now_us + the delay under
+ * SIM_LINK_DELAY; discarded under SIM_LINK_STALL; each side under its own
+ * sim_link_on()), send what is due (without blocking; on a UDP handle
+ * each queued chunk is one datagram, and one that cannot go is lost),
  * then close the handles IH wants closed whose IH reply has gone.
  * @now_us: CLOCK_MONOTONIC time, microseconds.
  */

@@ -26,7 +26,7 @@
 #include "sim_relay.h"
 
 #define NET_CATCHUP_SAMPLES 100 /* samples stepped per pass when late */
-#define NET_POLL_MAX	    (5 + CTRL_HANDLES + SIM_CTLPORT_CLIENTS)
+#define NET_POLL_MAX	    (6 + CTRL_HANDLES + SIM_CTLPORT_CLIENTS)
 
 struct sim_net {
 	struct sim *sim;
@@ -105,6 +105,17 @@ int sim_net_disc_port(const struct sim_net *n)
 	return n->disc.port;
 }
 
+int sim_net_open_udp(struct sim_net *n, const char *addr, int port, char *err,
+		     size_t errlen)
+{
+	return sim_cmdport_udp_open(&n->cmd, addr, port, err, errlen);
+}
+
+int sim_net_udp_port(const struct sim_net *n)
+{
+	return n->cmd.uport;
+}
+
 void sim_net_stats(const struct sim_net *n, struct sim_net_stats *out)
 {
 	*out = n->stats;
@@ -161,8 +172,8 @@ static void step_due(struct sim_net *n)
 }
 
 /* Fill @fds; @slot[i] says what fds[i] is: -1 timer, -2 command listener,
- * -3 control listener, -4 relay, -5 discovery, 0..7 command conn, 100+i
- * control client. */
+ * -3 control listener, -4 relay, -5 discovery, -6 UDP command port, 0..7
+ * command conn, 100+i control client. */
 static int build_poll(struct sim_net *n, struct pollfd *fds, int *slot)
 {
 	int k = 0, fd, rfd = sim_relay_fd(sim_get_relay(n->sim));
@@ -190,6 +201,10 @@ static int build_poll(struct sim_net *n, struct pollfd *fds, int *slot)
 	if (n->disc.fd >= 0) {
 		fds[k] = (struct pollfd){n->disc.fd, POLLIN, 0};
 		slot[k++] = -5;
+	}
+	if ((fd = sim_cmdport_udp_fd(&n->cmd)) >= 0) {
+		fds[k] = (struct pollfd){fd, POLLIN, 0};
+		slot[k++] = -6;
 	}
 	for (int i = 0; i < SIM_CTLPORT_CLIENTS; i++) {
 		if ((fd = sim_ctlport_fd(&n->ctl, i)) >= 0) {
@@ -245,6 +260,7 @@ static void dispatch(struct sim_net *n, int slot)
 	case -3: sim_ctlport_accept(&n->ctl); break;
 	case -4: relay_service(n); break;
 	case -5: disc_service(n); break;
+	case -6: sim_cmdport_udp_read(&n->cmd); break;
 	default:
 		if (slot >= 0 && slot < CTRL_HANDLES)
 			sim_cmdport_read(&n->cmd, slot);

@@ -84,6 +84,20 @@ int sim_net_open_disc(struct sim_net *n, const char *addr, int port, char *err,
 int sim_net_disc_port(const struct sim_net *n);
 
 /*
+ * sim_net_open_udp() - also answer commands on UDP @addr:@port, where UDP
+ * handles open and the DR record stream goes (sim_cmdport.h).
+ * @addr: dotted IPv4 address, NULL for 127.0.0.1.
+ * @port: 0 = any free port (sim_net_udp_port() tells which).
+ * @err: [out] the reason on failure; @errlen its size.
+ * Return: 0, GL_ERR_ARG (bad address, or already open), GL_ERR_SYS.
+ */
+int sim_net_open_udp(struct sim_net *n, const char *addr, int port, char *err,
+		     size_t errlen);
+
+/* sim_net_udp_port() - the bound UDP command port, 0 when it is off. */
+int sim_net_udp_port(const struct sim_net *n);
+
+/*
  * sim_net_run() - serve in real time until the "quit" request or until
  * *@stop becomes non-zero (set it from a signal handler; NULL = never).
  * What is queued is flushed once more before it returns (the "ok" of quit).
