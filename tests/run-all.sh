@@ -74,7 +74,8 @@ alone() {
 	# unit and simulator tests that time real waits (the relay's and the
 	# link's deadlines, the clock, the real-time set-up, the ports)
 	unit/test_re_relay* | unit/test_gl_link | unit/test_base_clock | unit/test_re_rt | \
-		unit/test_re_io | sim/test_sim_net | sim/test_sim_relay | sim/test_sim_speed) return 0 ;;
+		unit/test_re_io | sim/test_sim_net | sim/test_sim_relay | sim/test_sim_speed | \
+		sim/test_sim_stream) return 0 ;;
 	*) return 1 ;;
 	esac
 }
