@@ -466,6 +466,8 @@ static int enter_service(struct app *a)
 static void log_calibration(struct app *a, const char *how, double secs,
 			    int filled)
 {
+	char took[32];
+
 	for (int i = 0; i < a->cal->n_axes; i++) {
 		const struct re_caltable *t = &a->cal->axis[i];
 
@@ -483,10 +485,16 @@ static void log_calibration(struct app *a, const char *how, double secs,
 			   "their own (the PC was late) and were fitted from "
 			   "their neighbours",
 			   filled);
-	re_log_msg(&a->log, RE_LOG_INFO, "calibration (%s) done in %.1f s", how,
-		   secs);
-	re_console_msg(&a->con, "roboelf: calibration (%s) done in %.1f s", how,
-		       secs);
+	/* under a second in ms: "0.0 s" for a robot already at its centre
+	 * read like a time never measured */
+	if (secs < 1.0)
+		snprintf(took, sizeof(took), "%.0f ms", secs * 1000.0);
+	else
+		snprintf(took, sizeof(took), "%.1f s", secs);
+	re_log_msg(&a->log, RE_LOG_INFO, "calibration (%s) done in %s", how,
+		   took);
+	re_console_msg(&a->con, "roboelf: calibration (%s) done in %s", how,
+		       took);
 }
 
 static void stamp_calset(struct app *a)
