@@ -6,60 +6,39 @@
 #include "re_comm_plot.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "base_durable.h"
+#include "re_comm_util.h"
 
 #define SCRIPT_MAX (64 * 1024)
 #define PLOT_W	   900
 #define MOVE_H	   700		    /* a move's page, pixels */
 #define LANES_H(n) (300 + 40 * (n)) /* a page of @n lanes */
 
-struct buf {
-	char *p;
-	size_t n, cap;
-};
-
-static void put(struct buf *b, const char *fmt, ...)
-    __attribute__((format(printf, 2, 3)));
-
-static void put(struct buf *b, const char *fmt, ...)
-{
-	va_list ap;
-	int k;
-
-	if (b->n >= b->cap)
-		return;
-	va_start(ap, fmt);
-	k = vsnprintf(b->p + b->n, b->cap - b->n, fmt, ap);
-	va_end(ap);
-	b->n = k < 0 ? b->cap : b->n + (size_t)k;
-}
-
 /* @s as the inside of a gnuplot double-quoted string: \ and " escaped,
  * wrapped at a space after @width characters (a "\n" in the string). */
-static void put_dq(struct buf *b, const char *s, int width)
+static void put_dq(struct rc_text *b, const char *s, int width)
 {
 	int col = 0;
 
 	for (; *s; s++, col++) {
 		if (*s == ' ' && col >= width) {
-			put(b, "\\n");
+			rc_text_put(b, "\\n");
 			col = 0;
 			continue;
 		}
-		put(b, "%s%c", *s == '\\' || *s == '"' ? "\\" : "", *s);
+		rc_text_put(b, "%s%c", *s == '\\' || *s == '"' ? "\\" : "", *s);
 	}
 }
 
 /* @s as the inside of a gnuplot single-quoted string ('' is a quote). */
-static void put_sq(struct buf *b, const char *s)
+static void put_sq(struct rc_text *b, const char *s)
 {
 	for (; *s; s++)
-		put(b, "%s%c", *s == '\'' ? "'" : "", *s);
+		rc_text_put(b, "%s%c", *s == '\'' ? "'" : "", *s);
 }
 
 /* The FAIL item of step @step named @name (any name: NULL), or NULL. */
@@ -94,30 +73,32 @@ static int fail_lines(const char *s)
 /* The red "FAIL: <text>" under the title line of a page @height pixels
  * high, for the panels that follow until unset; the page's title then
  * carries fail_pad() blank lines, so that nothing is drawn under it. */
-static void put_fail(struct buf *b, const struct re_comm_item *it, int height)
+static void put_fail(struct rc_text *b, const struct re_comm_item *it,
+		     int height)
 {
-	put(b, "set label 99 \"FAIL: ");
+	rc_text_put(b, "set label 99 \"FAIL: ");
 	put_dq(b, it->text, FAIL_WRAP);
-	put(b, "\" at screen 0.02, screen %.3f left tc rgb 'red' front\n",
-	    1 - 40.0 / height);
+	rc_text_put(b,
+		    "\" at screen 0.02, screen %.3f left tc rgb 'red' front\n",
+		    1 - 40.0 / height);
 }
 
 /* The blank lines a page title carries for a FAIL label (@it, NULL:
  * none), as gnuplot string text. */
-static void fail_pad(struct buf *b, const struct re_comm_item *it)
+static void fail_pad(struct rc_text *b, const struct re_comm_item *it)
 {
 	for (int i = it ? fail_lines(it->text) : 0; i > 0; i--)
-		put(b, "\\n");
+		rc_text_put(b, "\\n");
 }
 
 /* Write @dir/@name.gp and draw it into @dir/@name.png (@height pixels).
  * Return: 1 drawn, 0 written but not drawn, -1 not written. */
-static int emit(const char *dir, const char *name, const struct buf *script,
+static int emit(const char *dir, const char *name, const struct rc_text *script,
 		int height)
 {
 	static char cmd[4096];
 	char gp[1024], png[1024], tmp[1100];
-	struct buf b = {cmd, 0, sizeof(cmd)};
+	struct rc_text b = {cmd, 0, sizeof(cmd)};
 	FILE *f;
 
 	snprintf(gp, sizeof(gp), "%s/%s.gp", dir, name);
@@ -126,12 +107,12 @@ static int emit(const char *dir, const char *name, const struct buf *script,
 	if (script->n >= script->cap ||
 	    base_durable_write(gp, script->p, script->n, 0644) != 0)
 		return -1;
-	put(&b, "set terminal png size %d,%d noenhanced\nset output '", PLOT_W,
-	    height);
+	rc_text_put(&b, "set terminal png size %d,%d noenhanced\nset output '",
+		    PLOT_W, height);
 	put_sq(&b, tmp);
-	put(&b, "'\nload '");
+	rc_text_put(&b, "'\nload '");
 	put_sq(&b, gp);
-	put(&b, "'\nunset multiplot\nset output\n");
+	rc_text_put(&b, "'\nunset multiplot\nset output\n");
 	if (b.n >= b.cap || !(f = popen("gnuplot 2>/dev/null", "w")))
 		return 0;
 	fputs(cmd, f);
@@ -151,7 +132,7 @@ static double pot_tol_v(const struct re_config_axis *a)
 
 /* One panel of pots-at-rest: axis @ax about the middle of its span, mV,
  * with the noise limit's lines. */
-static void noise_panel(const struct re_comm *c, int ax, struct buf *b)
+static void noise_panel(const struct re_comm *c, int ax, struct rc_text *b)
 {
 	const struct re_config_axis *a = &c->cfg->axes[ax];
 	double mn = 1e9, mx = -1e9, sum = 0, half = pot_tol_v(a) / 4 * 1e3;
@@ -165,16 +146,17 @@ static void noise_panel(const struct re_comm *c, int ax, struct buf *b)
 		mx = fmax(mx, c->noise_v[ax][i]);
 		sum += c->noise_v[ax][i];
 	}
-	put(b, "$pot%s << EOD\n", a->name);
+	rc_text_put(b, "$pot%s << EOD\n", a->name);
 	for (int i = 0; i < c->noise_n; i++)
-		put(b, "%d %.3f\n", i,
-		    (c->noise_v[ax][i] - (mn + mx) / 2) * 1e3);
-	put(b,
-	    "EOD\nset title 'axis %s, analog input %d: %.4f V mean, "
-	    "%.1f mV peak to peak; allowed range %.3f..%.3f V'\n",
-	    a->name, a->analog.input, sum / c->noise_n, (mx - mn) * 1e3, lo,
-	    hi);
-	put(b,
+		rc_text_put(b, "%d %.3f\n", i,
+			    (c->noise_v[ax][i] - (mn + mx) / 2) * 1e3);
+	rc_text_put(b,
+		    "EOD\nset title 'axis %s, analog input %d: %.4f V mean, "
+		    "%.1f mV peak to peak; allowed range %.3f..%.3f V'\n",
+		    a->name, a->analog.input, sum / c->noise_n, (mx - mn) * 1e3,
+		    lo, hi);
+	rc_text_put(
+	    b,
 	    "plot $pot%s using 1:2 with linespoints title 'reading', "
 	    "%.3f with lines dt 2 lc rgb 'red' title 'noise limit: %.1f mV "
 	    "peak to peak (half the tolerance)', %.3f with lines dt 2 lc "
@@ -185,31 +167,32 @@ static void noise_panel(const struct re_comm *c, int ax, struct buf *b)
 static int plot_noise(const struct re_comm *c, const char *dir, int *drawn)
 {
 	static char text[SCRIPT_MAX];
-	struct buf b = {text, 0, sizeof(text)};
+	struct rc_text b = {text, 0, sizeof(text)};
 	const struct re_comm_item *f = fail_of(c, "pots", NULL);
 	int r;
 
 	if (c->noise_n < 2)
 		return 0;
-	put(&b, "# roboelf-tech commission: the potentiometers at rest\n"
-		"set key outside below\nset grid\n"
-		"set offsets 0, 0, graph 0.15, graph 0.15\n"
-		"set xlabel 'sample (10 ms apart plus the reply time)'\n"
-		"set ylabel 'mV from the middle'\n");
+	rc_text_put(&b,
+		    "# roboelf-tech commission: the potentiometers at rest\n"
+		    "set key outside below\nset grid\n"
+		    "set offsets 0, 0, graph 0.15, graph 0.15\n"
+		    "set xlabel 'sample (10 ms apart plus the reply time)'\n"
+		    "set ylabel 'mV from the middle'\n");
 	if (f)
 		put_fail(&b, f, 300 * RE_AXES + 60);
-	put(&b,
-	    "set multiplot layout %d,1 title \"potentiometers at rest, "
-	    "motor power off: %d readings of each",
-	    RE_AXES, c->noise_n);
+	rc_text_put(&b,
+		    "set multiplot layout %d,1 title \"potentiometers at rest, "
+		    "motor power off: %d readings of each",
+		    RE_AXES, c->noise_n);
 	fail_pad(&b, f);
-	put(&b, "\"\n");
+	rc_text_put(&b, "\"\n");
 	for (int ax = 0; ax < RE_AXES; ax++) {
 		noise_panel(c, ax, &b);
 		if (f && ax == 0)
-			put(&b, "unset label 99\n");
+			rc_text_put(&b, "unset label 99\n");
 	}
-	put(&b, "unset multiplot\n");
+	rc_text_put(&b, "unset multiplot\n");
 	r = emit(dir, "pots-at-rest", &b, 300 * RE_AXES + 60);
 	*drawn += r > 0;
 	return r >= 0 ? 1 : -1;
@@ -230,30 +213,32 @@ static double move_end_ms(const struct re_comm_trace *t, double cps)
 /* The encoder's data, and the path asked for: at @cps from the start to
  * the target, there until the way back, and back at @cps. */
 static void move_data(const struct re_comm_trace *t, double cps, double slope,
-		      struct buf *b)
+		      struct rc_text *b)
 {
 	double ramp_ms = fabs((double)t->counts) / cps * 1e3;
 	double target = t->enc0 + t->counts;
 
-	put(b, "$enc << EOD\n");
+	rc_text_put(b, "$enc << EOD\n");
 	for (int i = 0; i < t->n; i++)
-		put(b, "%.1f %.0f %.4f %.4f\n", t->t_ms[i], t->enc[i],
-		    t->pot_v[i], t->pot0_v + (t->enc[i] - t->enc0) * slope);
-	put(b, "EOD\n$asked << EOD\n0 %.0f\n%.1f %.0f\n", t->enc0, ramp_ms,
-	    target);
+		rc_text_put(b, "%.1f %.0f %.4f %.4f\n", t->t_ms[i], t->enc[i],
+			    t->pot_v[i],
+			    t->pot0_v + (t->enc[i] - t->enc0) * slope);
+	rc_text_put(b, "EOD\n$asked << EOD\n0 %.0f\n%.1f %.0f\n", t->enc0,
+		    ramp_ms, target);
 	if (t->back_i)
-		put(b, "%.1f %.0f\n%.1f %.0f\n", t->t_back_ms, target,
-		    t->t_back_ms + ramp_ms, t->enc0);
+		rc_text_put(b, "%.1f %.0f\n%.1f %.0f\n", t->t_back_ms, target,
+			    t->t_back_ms + ramp_ms, t->enc0);
 	else
-		put(b, "%.1f %.0f\n", t->t_ms[t->n - 1], target);
-	put(b, "EOD\n");
+		rc_text_put(b, "%.1f %.0f\n", t->t_ms[t->n - 1], target);
+	rc_text_put(b, "EOD\n");
 }
 
 /* The encoder's panel of a move: the trace, the path asked for, the
  * target and the start. */
-static void enc_panel(const struct re_comm_trace *t, struct buf *b)
+static void enc_panel(const struct re_comm_trace *t, struct rc_text *b)
 {
-	put(b,
+	rc_text_put(
+	    b,
 	    "set title 'the encoder against the motor'\n"
 	    "set ylabel 'encoder, counts'\n"
 	    "plot $enc using 1:2 with lines lw 2 title 'encoder', "
@@ -275,34 +260,36 @@ static int plot_move(const struct re_comm *c, int ax, const char *dir,
 	const struct re_comm_item *f = fail_of(c, "motion", a->name);
 	double slope =
 	    (a->analog.forward_v - a->analog.reverse_v) / a->travel_counts;
-	struct buf b = {text, 0, sizeof(text)};
+	struct rc_text b = {text, 0, sizeof(text)};
 	char name[32];
 	int r;
 
 	if (t->n < 2)
 		return 0;
-	put(&b, "# roboelf-tech commission: axis %s, the small move\n",
-	    a->name);
+	rc_text_put(&b, "# roboelf-tech commission: axis %s, the small move\n",
+		    a->name);
 	move_data(t, RE_COMM_MOVE_CPS, slope, &b);
-	put(&b,
-	    "set key outside below\nset grid\n"
-	    "set offsets 0, 0, graph 0.15, graph 0.15\n"
-	    "set xrange [0:%.0f]\n"
-	    "set xlabel 'ms after the move was asked for'\n",
-	    move_end_ms(t, RE_COMM_MOVE_CPS));
+	rc_text_put(&b,
+		    "set key outside below\nset grid\n"
+		    "set offsets 0, 0, graph 0.15, graph 0.15\n"
+		    "set xrange [0:%.0f]\n"
+		    "set xlabel 'ms after the move was asked for'\n",
+		    move_end_ms(t, RE_COMM_MOVE_CPS));
 	if (f)
 		put_fail(&b, f, MOVE_H);
-	put(&b,
+	rc_text_put(
+	    &b,
 	    "set multiplot layout 2,1 title \"axis %s: %+d counts at %d "
 	    "counts/s and %s",
 	    a->name, t->counts, RE_COMM_MOVE_CPS,
 	    t->back_i ? "the way back" : "no way back (the run stopped)");
 	fail_pad(&b, f);
-	put(&b, "\"\n");
+	rc_text_put(&b, "\"\n");
 	enc_panel(t, &b);
 	if (f)
-		put(&b, "unset label 99\n");
-	put(&b,
+		rc_text_put(&b, "unset label 99\n");
+	rc_text_put(
+	    &b,
 	    "set title 'the potentiometer against the encoder: %+.4f "
 	    "mV/count expected'\n"
 	    "set ylabel 'potentiometer, V'\n"
@@ -325,20 +312,20 @@ struct lanes_plot {
 	char lane[RE_JOY_INPUTS][48];
 };
 
-static void lanes_data(const struct lanes_plot *p, struct buf *b)
+static void lanes_data(const struct lanes_plot *p, struct rc_text *b)
 {
 	const struct re_comm_lanes *l = p->l;
 
-	put(b, "$lanes << EOD\n");
+	rc_text_put(b, "$lanes << EOD\n");
 	for (int i = 0; i <= l->n; i++) {
 		unsigned m = l->mask[i < l->n ? i : l->n - 1];
 
-		put(b, "%.1f", i < l->n ? l->t_ms[i] : l->end_ms);
+		rc_text_put(b, "%.1f", i < l->n ? l->t_ms[i] : l->end_ms);
 		for (int k = 0; k < p->nl; k++)
-			put(b, " %u", (m >> k) & 1u);
-		put(b, "\n");
+			rc_text_put(b, " %u", (m >> k) & 1u);
+		rc_text_put(b, "\n");
 	}
-	put(b, "EOD\n");
+	rc_text_put(b, "EOD\n");
 }
 
 static int plot_lanes(const struct re_comm *c, const struct lanes_plot *p,
@@ -346,23 +333,24 @@ static int plot_lanes(const struct re_comm *c, const struct lanes_plot *p,
 {
 	static char text[SCRIPT_MAX];
 	const struct re_comm_item *f = fail_of(c, p->step, NULL);
-	struct buf b = {text, 0, sizeof(text)};
+	struct rc_text b = {text, 0, sizeof(text)};
 	int r;
 
 	if (p->l->n < 1)
 		return 0;
-	put(&b, "# roboelf-tech commission: %s\n", p->title);
+	rc_text_put(&b, "# roboelf-tech commission: %s\n", p->title);
 	lanes_data(p, &b);
-	put(&b,
-	    "set tmargin 9\nset grid xtics\n"
-	    "set xlabel 'ms after the step began'\n"
-	    "set yrange [-0.5:%d]\nset ytics (",
-	    p->nl);
+	rc_text_put(&b,
+		    "set tmargin 9\nset grid xtics\n"
+		    "set xlabel 'ms after the step began'\n"
+		    "set yrange [-0.5:%d]\nset ytics (",
+		    p->nl);
 	for (int k = 0; k < p->nl; k++)
-		put(&b, "%s'%s' %d.4", k ? ", " : "", p->lane[k], k);
-	put(&b, ")\n");
+		rc_text_put(&b, "%s'%s' %d.4", k ? ", " : "", p->lane[k], k);
+	rc_text_put(&b, ")\n");
 	for (int i = 0; i < p->l->n_ask; i++)
-		put(&b,
+		rc_text_put(
+		    &b,
 		    "set arrow %d from %.1f, graph 0 to %.1f, graph 1 nohead "
 		    "lc rgb 'gray'\nset label %d '%s' at %.1f, graph 1 rotate "
 		    "by 60 left offset 0,0.5\n",
@@ -370,9 +358,10 @@ static int plot_lanes(const struct re_comm *c, const struct lanes_plot *p,
 		    p->l->ask[i], p->l->ask_ms[i]);
 	if (f)
 		put_fail(&b, f, LANES_H(p->nl));
-	put(&b, "set multiplot layout 1,1 title \"%s", p->title);
+	rc_text_put(&b, "set multiplot layout 1,1 title \"%s", p->title);
 	fail_pad(&b, f);
-	put(&b,
+	rc_text_put(
+	    &b,
 	    "\"\nplot for [k=0:%d] $lanes using 1:(k + 0.8 * column(k + "
 	    "2)) with steps lw 2 notitle\nunset multiplot\n",
 	    p->nl - 1);

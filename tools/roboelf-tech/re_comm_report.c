@@ -3,39 +3,18 @@
  * (re_comm_report.h; the plots: re_comm_plot.h).
  */
 #include <errno.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include "base_durable.h"
+#include "re_comm_util.h"
 #include "gl_err.h"
 #include "re_comm_plot.h"
 #include "re_comm_report.h"
 
 #define REPORT_MAX (64 * 1024)
-
-struct buf {
-	char *p;
-	size_t n, cap;
-};
-
-static void put(struct buf *b, const char *fmt, ...)
-    __attribute__((format(printf, 2, 3)));
-
-static void put(struct buf *b, const char *fmt, ...)
-{
-	va_list ap;
-	int k;
-
-	if (b->n >= b->cap)
-		return;
-	va_start(ap, fmt);
-	k = vsnprintf(b->p + b->n, b->cap - b->n, fmt, ap);
-	va_end(ap);
-	b->n = k < 0 ? b->cap : b->n + (size_t)k;
-}
 
 void re_comm_summary(const struct re_comm *c, char *buf, size_t cap)
 {
@@ -58,17 +37,17 @@ void re_comm_summary(const struct re_comm *c, char *buf, size_t cap)
 		 c->n, notes);
 }
 
-static void put_lines(struct buf *b, const char *text)
+static void put_lines(struct rc_text *b, const char *text)
 {
 	while (*text) {
 		size_t n = strcspn(text, "\n");
 
-		put(b, "    %.*s\n", (int)n, text);
+		rc_text_put(b, "    %.*s\n", (int)n, text);
 		text += n + (text[n] == '\n');
 	}
 }
 
-static void put_items(const struct re_comm *c, struct buf *b)
+static void put_items(const struct re_comm *c, struct rc_text *b)
 {
 	const char *step = "";
 
@@ -76,11 +55,11 @@ static void put_items(const struct re_comm *c, struct buf *b)
 		const struct re_comm_item *it = &c->item[i];
 
 		if (strcmp(step, it->step))
-			put(b, "\n== %s\n", step = it->step);
-		put(b, "%s  %-16s %s\n", re_comm_res_name(it->res), it->name,
-		    it->text);
+			rc_text_put(b, "\n== %s\n", step = it->step);
+		rc_text_put(b, "%s  %-16s %s\n", re_comm_res_name(it->res),
+			    it->name, it->text);
 		if (it->res == RE_COMM_FAIL && it->fix[0])
-			put(b, "      fix: %s\n", it->fix);
+			rc_text_put(b, "      fix: %s\n", it->fix);
 	}
 }
 
@@ -88,7 +67,7 @@ int re_comm_report(const struct re_comm *c, const struct re_comm_where *w,
 		   const char *dir, int *plots, char *err, size_t errlen)
 {
 	static char text[REPORT_MAX];
-	struct buf b = {text, 0, sizeof(text)};
+	struct rc_text b = {text, 0, sizeof(text)};
 	char path[1024], line[1024];
 	int np = 0, bad = 0, r;
 
@@ -99,18 +78,21 @@ int re_comm_report(const struct re_comm *c, const struct re_comm_where *w,
 	}
 	re_comm_plots(c, dir, &np, &bad);
 	re_comm_summary(c, line, sizeof(line));
-	put(&b, "RoboELF commissioning report\n\ndate: %s\n", w->date);
-	put(&b, "controller: %s, serial %ld, at %s\nconfiguration: %s\n",
-	    c->model, c->serial, w->address, w->config);
-	put(&b, "motor power switched on during the run: %s\n",
-	    c->power_on_seen ? "yes (relay and motion steps)" : "never");
-	put(&b, "result: %s\n", line);
+	rc_text_put(&b, "RoboELF commissioning report\n\ndate: %s\n", w->date);
+	rc_text_put(&b,
+		    "controller: %s, serial %ld, at %s\nconfiguration: %s\n",
+		    c->model, c->serial, w->address, w->config);
+	rc_text_put(&b, "motor power switched on during the run: %s\n",
+		    c->power_on_seen ? "yes (relay and motion steps)"
+				     : "never");
+	rc_text_put(&b, "result: %s\n", line);
 	put_items(c, &b);
-	put(&b, "\n== the controller reports of itself\nID:\n");
+	rc_text_put(&b, "\n== the controller reports of itself\nID:\n");
 	put_lines(&b, c->id_text);
-	put(&b, "TH:\n");
+	rc_text_put(&b, "TH:\n");
 	put_lines(&b, c->th_text);
-	put(&b,
+	rc_text_put(
+	    &b,
 	    "\nplots: %d PNG file(s) in %s, each drawn from its gnuplot "
 	    "script (NAME.gp)%s\n",
 	    np, dir,

@@ -161,3 +161,16 @@ void rc_lane_ask(struct re_comm *c, struct re_comm_lanes *l, const char *what)
 	l->ask_ms[l->n_ask] = rc_now_ms(c) - l->t0_ms;
 	snprintf(l->ask[l->n_ask++], sizeof(l->ask[0]), "%s", what);
 }
+
+void rc_text_put(struct rc_text *b, const char *fmt, ...)
+{
+	va_list ap;
+	int k;
+
+	if (b->n >= b->cap)
+		return;
+	va_start(ap, fmt);
+	k = vsnprintf(b->p + b->n, b->cap - b->n, fmt, ap);
+	va_end(ap);
+	b->n = k < 0 ? b->cap : b->n + (size_t)k;
+}

@@ -8,6 +8,20 @@
 
 #include "re_comm.h"
 
+/* A text being written into a fixed buffer (the report, a plot's script). */
+struct rc_text {
+	char *p;
+	size_t n, cap; /* bytes written, the buffer's size */
+};
+
+/*
+ * rc_text_put() - append printf-style text to @b. Once the buffer is full
+ * (b->n >= b->cap) nothing more is written: the writer checks b->n < b->cap
+ * at the end to know the text is whole.
+ */
+void rc_text_put(struct rc_text *b, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+
 /* Technician-facing prompts start with this (tests wait for it). */
 #define RC_PROMPT "commission: "
 
