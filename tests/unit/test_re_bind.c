@@ -37,11 +37,11 @@
 #define FIX " (docs/technician.md, section 10)"
 
 /* Two boards as libserialport would describe them. */
-static const struct re_bind_port relay = {"/dev/ttyUSB0", "FT232R USB UART",
+static const struct re_bind_port relay = {"/dev/ttyTEST0", "FT232R USB UART",
 					  "A10KXYZ9", 0x0403, 0x6001};
-static const struct re_bind_port cable = {"/dev/ttyUSB1", "USB2.0-Serial", "",
+static const struct re_bind_port cable = {"/dev/ttyTEST1", "USB2.0-Serial", "",
 					  0x1a86, 0x7523};
-static const struct re_bind_port other = {"/dev/ttyUSB2", "FT232R USB UART",
+static const struct re_bind_port other = {"/dev/ttyTEST2", "FT232R USB UART",
 					  "B22QRST1", 0x0403, 0x6001};
 
 #define RULE_LINE(serial)                                                      \
@@ -145,7 +145,7 @@ static void test_choose_one(void **state)
 				 "it with --serial SERIAL");
 	assert_int_equal(re_bind_choose(&p[1], 1, NULL, &k, err, sizeof(err)),
 			 GL_ERR_NOENT);
-	assert_string_equal(err, "the one USB serial port, '/dev/ttyUSB1', has "
+	assert_string_equal(err, "the one USB serial port, '/dev/ttyTEST1', has "
 				 "no USB serial number: it cannot be bound; "
 				 "use a relay board that has one" FIX);
 	strcpy(p[0].serial, "A1*");
@@ -382,12 +382,12 @@ static void test_run_serial(void **state)
 	snprintf(
 	    want, sizeof(want),
 	    "bind-relay: 3 USB serial ports found:\n"
-	    "  /dev/ttyUSB0  USB 0403:6001  serial number 'A10KXYZ9'  FT232R "
+	    "  /dev/ttyTEST0  USB 0403:6001  serial number 'A10KXYZ9'  FT232R "
 	    "USB UART\n"
-	    "  /dev/ttyUSB1  USB 1a86:7523  serial number none  USB2.0-Serial\n"
-	    "  /dev/ttyUSB2  USB 0403:6001  serial number 'B22QRST1'  FT232R "
+	    "  /dev/ttyTEST1  USB 1a86:7523  serial number none  USB2.0-Serial\n"
+	    "  /dev/ttyTEST2  USB 0403:6001  serial number 'B22QRST1'  FT232R "
 	    "USB UART\n"
-	    "bind-relay: the relay board: /dev/ttyUSB2, USB 0403:6001, serial "
+	    "bind-relay: the relay board: /dev/ttyTEST2, USB 0403:6001, serial "
 	    "number 'B22QRST1'\n"
 	    "bind-relay: wrote %s:\n" RULE_LINE(
 		"B22QRST1") "bind-relay: next, as root: udevadm control "
@@ -395,7 +395,7 @@ static void test_run_serial(void **state)
 			    "trigger\n"
 			    "bind-relay: then check: ls -l /dev/roboelf-relay "
 			    "(a link to "
-			    "ttyUSB2)\n"
+			    "ttyTEST2)\n"
 			    "bind-relay: and set in the configuration (relay:) "
 			    "serial: "
 			    "B22QRST1\n",
@@ -439,7 +439,7 @@ static void test_run_refused(void **state)
 				    "board and run again, or name it with "
 				    "--serial SERIAL\n");
 	assert_non_null(strstr(r->out, "bind-relay: 2 USB serial ports found:\n"
-				       "  /dev/ttyUSB0"));
+				       "  /dev/ttyTEST0"));
 	assert_string_equal(file_text(r->rules), "old rule\n");
 	assert_int_equal(run(r, "C3"), 3);
 	assert_string_equal(r->err,
@@ -480,7 +480,7 @@ struct fake {
 
 static const struct fake fakes[] = {
     {"/dev/ttyS0", "ttyS0", NULL, SP_TRANSPORT_NATIVE, 0, 0},
-    {"/dev/ttyUSB0", "FT232R USB UART - A10KXYZ9", "A10KXYZ9", SP_TRANSPORT_USB,
+    {"/dev/ttyTEST0", "FT232R USB UART - A10KXYZ9", "A10KXYZ9", SP_TRANSPORT_USB,
      0x0403, 0x6001},
     {"/dev/rfcomm0", "rfcomm0", NULL, SP_TRANSPORT_BLUETOOTH, 0, 0},
     {"/dev/ttyACM0", "USB2.0-Serial", NULL, SP_TRANSPORT_USB, 0x1a86, 0x7523},
@@ -513,7 +513,7 @@ static const struct fake *fake_of(const struct sp_port *port)
 }
 
 /* The port of the fake whose name ends as @portname does (a node in the
- * test's directory stands for /dev/ttyUSB0 ...); else "not found". */
+ * test's directory stands for /dev/ttyTEST0 ...); else "not found". */
 enum sp_return __wrap_sp_get_port_by_name(const char *portname,
 					  struct sp_port **port_ptr)
 {
@@ -602,7 +602,7 @@ static void test_list_sp(void **state)
 	assert_int_equal(re_bindrelay_list_sp(p, 4, &n, err, sizeof(err)),
 			 GL_OK);
 	assert_int_equal(n, 2);
-	assert_string_equal(p[0].name, "/dev/ttyUSB0");
+	assert_string_equal(p[0].name, "/dev/ttyTEST0");
 	assert_string_equal(p[0].desc, "FT232R USB UART - A10KXYZ9");
 	assert_string_equal(p[0].serial, "A10KXYZ9");
 	assert_int_equal(p[0].vid, 0x0403);
@@ -635,7 +635,7 @@ static void test_usb_serial(void **state)
 	char err[RE_BIND_ERR_MAX], want[512];
 	FILE *f;
 
-	snprintf(node, sizeof(node), "%s/ttyUSB0", r->dir);
+	snprintf(node, sizeof(node), "%s/ttyTEST0", r->dir);
 	snprintf(link, sizeof(link), "%s/roboelf-relay", r->dir);
 	f = fopen(node, "w");
 	assert_non_null(f);
