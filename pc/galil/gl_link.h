@@ -24,6 +24,7 @@ typedef struct gl_link gl_link;
 #define GL_DEFAULT_PORT 23
 #define GL_ERRTEXT_LEN	128
 #define GL_LINE_MAX	80 /* controller command-line limit, bytes */
+#define GL_LINK_STREAM_READS_MAX 64 /* datagrams per gl_link_stream_read() */
 
 /*
  * gl_link_open() - connect to HOST[:PORT] (default port 23).
@@ -268,5 +269,116 @@ int gl_link_msg_fd(const gl_link *l);
  * and open a new one.
  */
 bool gl_link_broken(const gl_link *l);
+
+/* ---- the pipelined line and the record stream (docs/link.md, "The
+ * record as a stream") ---- */
+
+struct gl_stream_stats;
+
+/*
+ * gl_link_post() - send one command line on the command handle and return
+ * without waiting for its reply; gl_link_collect() takes the reply later.
+ * At most one line is outstanding. The line is checked as by
+ * gl_link_command(); the send does not wait (the socket's buffer takes a
+ * line of GL_LINE_MAX bytes at once unless the peer stopped reading).
+ * Return: GL_OK (sent whole); GL_ERR_BUSY (a line is still outstanding:
+ *         nothing sent); GL_ERR_AGAIN (the socket took nothing: nothing
+ *         sent, still in step); GL_ERR_ARG; GL_ERR_BROKEN; a send that
+ *         stopped half way breaks the link (GL_ERR_TIMEOUT).
+ */
+int gl_link_post(gl_link *l, const char *cmd);
+
+/*
+ * gl_link_collect() - take the reply to the posted line if it is all
+ * there, without waiting (reads what the socket holds).
+ * @text: [out] optional (NULL or @cap 0): the reply's data text,
+ *        NUL-terminated, as gl_link_command() gives it.
+ * Return: the text's length (>= 0) when the reply is complete (the line is
+ *         then no longer outstanding); GL_ERR_AGAIN (not complete yet, or
+ *         nothing posted: see gl_link_posted()); GL_ERR_CTRL after '?'
+ *         (TC1 is asked with the link's default timeout, as for a
+ *         command); GL_ERR_OVERFLOW; a stream error (the link is broken).
+ */
+int gl_link_collect(gl_link *l, char *text, size_t cap);
+
+/*
+ * gl_link_posted() - 1 while a posted line's reply is outstanding, else 0
+ * (also for NULL). Any other exchange on the command handle first waits,
+ * within its own deadline, for that reply and sets it aside (a '?' in it
+ * is counted in gl_link_post_errors()).
+ */
+int gl_link_posted(const gl_link *l);
+
+/*
+ * gl_link_post_errors() - posted replies set aside by another exchange
+ * that were '?' (0 for NULL): the caller that never collected them learns
+ * of them here.
+ */
+uint64_t gl_link_post_errors(const gl_link *l);
+
+/*
+ * gl_link_stream_open() - start the controller's data record stream to
+ * this PC: a UDP socket connected to the controller's address and
+ * @udp_port (the kernel then drops datagrams of any other sender), "WH"
+ * sent on it (resent every 20 ms until answered: UDP may lose it) for its
+ * handle letter, then "DR @n0_samples,<handle>" on the command handle;
+ * the reader (gl_stream) starts with the link's layout (QZ first if not
+ * known). Call after any "IHT=>-3" (which closes UDP handles too).
+ * Opening again closes the old stream first.
+ * @udp_port: the controller's UDP command port (60007 on a DMC-40x0).
+ * @n0_samples: samples between two records, 2..16383.
+ * @sample_ns: one controller sample in ns (> 0), for the reader.
+ * @timeout_ms: for the whole opening; 0 = the link default.
+ * @err: [out] optional, GL_ERRTEXT_LEN bytes: what failed, in words.
+ * Return: GL_OK; GL_ERR_ARG; GL_ERR_TIMEOUT (no answer to WH); GL_ERR_CTRL
+ *         (DR refused: gl_link_ctrl_error()); GL_ERR_PROTO (WH's answer is
+ *         not a handle); GL_ERR_SYS. On error no stream is open.
+ */
+int gl_link_stream_open(gl_link *l, int udp_port, unsigned n0_samples,
+			int64_t sample_ns, int timeout_ms,
+			char err[GL_ERRTEXT_LEN]);
+
+/*
+ * gl_link_stream_read() - read every datagram the stream socket holds
+ * (without waiting; at most GL_LINK_STREAM_READS_MAX per call, the rest
+ * stays for the next), judge each (gl_stream_feed()), and decode the
+ * newest accepted one into @rec.
+ * @now_ns: monotonic time now (base_clock), the reception time.
+ * Return: 1 when @rec holds a record newer than the last call's; 0 when
+ *         none arrived (or only dropped ones); GL_ERR_ARG (no stream);
+ *         GL_ERR_SYS.
+ */
+int gl_link_stream_read(gl_link *l, struct gl_record *rec, int64_t now_ns);
+
+/*
+ * gl_link_stream_age_ns() - ns since the last accepted record (since the
+ * stream opened when none was) at @now_ns; GL_ERR_ARG without a stream.
+ */
+int64_t gl_link_stream_age_ns(const gl_link *l, int64_t now_ns);
+
+/*
+ * gl_link_stream_stats() - the reader's counters (gl_stream.h) into @out;
+ * zeros without a stream. No return value.
+ */
+void gl_link_stream_stats(const gl_link *l, struct gl_stream_stats *out);
+
+/*
+ * gl_link_stream_info() - the stream's parameters: @handle (0..7 = A..H)
+ * and @n0 (samples), each optional. Return: 1 when a stream is open, 0
+ * when not (nothing written).
+ */
+int gl_link_stream_info(const gl_link *l, int *handle, unsigned *n0);
+
+/*
+ * gl_link_stream_fd() - the stream's socket, for poll() only; -1 when none.
+ */
+int gl_link_stream_fd(const gl_link *l);
+
+/*
+ * gl_link_stream_close() - "DR 0" on the command handle (within
+ * @timeout_ms, 0 = default; its failure is returned but the socket is
+ * closed anyway) and close the stream's socket. No stream: GL_OK.
+ */
+int gl_link_stream_close(gl_link *l, int timeout_ms);
 
 #endif /* GL_LINK_H */

@@ -74,6 +74,15 @@ struct re_io_ops {
 	enum re_relay_state (*relay_state)(void *ud);
 	/* re_log: one event; RE_LOG_FAULT is on disk (fsync) on return. */
 	int (*log)(void *ud, enum re_log_level lvl, const char *text);
+	/* The stream design (re_super_cfg.stream); NULL when the back-end
+	 * has none. gl_link_post(): send a line, its reply comes later. */
+	int (*post)(void *ud, const char *line);
+	/* gl_link_collect(): the posted line's reply if all there, without
+	 * waiting: its text length, GL_ERR_AGAIN, or an error. */
+	int (*collect)(void *ud, char *text, size_t cap);
+	/* gl_link_stream_read(): 1 and the newest record in @rec, 0 none
+	 * new, or an error; @now_ns is the time of reception. */
+	int (*stream)(void *ud, struct gl_record *rec, int64_t now_ns);
 	/* CLOCK_MONOTONIC, ns. */
 	int64_t (*now_ns)(void *ud);
 	/* Sleep until the absolute monotonic time @t_ns. */

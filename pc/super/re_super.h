@@ -99,6 +99,12 @@ struct re_super_cfg {
 	/* the supervisor's own decode of the joystick and its check of the
 	 * motion (re_xcheck.h); NULL: off */
 	const struct re_xcheck_cfg *xcheck;
+	/* 1: the record arrives as a stream (the controller's DR over UDP,
+	 * opened by the start-up: re_io's stream op), the heartbeat and the
+	 * read-back are posted on TCP and their replies collected in the next
+	 * cycle (re_io's post and collect ops): no wait in the cycle. 0: one
+	 * "hbpc=N;QR" round trip per cycle. docs/link.md. */
+	int stream;
 };
 
 /* Per-axis view for the status board. */
