@@ -75,7 +75,7 @@ alone() {
 	# link's deadlines, the clock, the real-time set-up, the ports)
 	unit/test_re_relay* | unit/test_gl_link | unit/test_base_clock | unit/test_re_rt | \
 		unit/test_re_io | sim/test_sim_net | sim/test_sim_relay | sim/test_sim_speed | \
-		sim/test_sim_stream) return 0 ;;
+		sim/test_sim_stream | sim/test_gl_link_udp) return 0 ;;
 	*) return 1 ;;
 	esac
 }

@@ -84,6 +84,7 @@ int gl_link_open(gl_link **out, const char *addr, int timeout_ms,
 	}
 	l->cmd.fd = -1;
 	l->msg.fd = -1;
+	l->st_fd = -1;
 	l->timeout_ms = timeout_ms;
 	gl_proto_init(&l->cmd.p);
 	gl_proto_init(&l->msg.p);
@@ -101,6 +102,8 @@ void gl_link_close(gl_link *l)
 	if (!l)
 		return;
 	gl_link_chan_close(&l->msg);
+	if (l->st_fd >= 0)
+		close(l->st_fd);
 	if (l->cmd.fd >= 0)
 		close(l->cmd.fd);
 	free(l);

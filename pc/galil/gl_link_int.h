@@ -10,8 +10,11 @@
  *   gl_link_rec.c  the data record (QR) and its layout (QZ)
  *   gl_link_dl.c   program download (DL) and upload (UL)
  *   gl_link_msg.c  the unsolicited message handle
+ *   gl_link_post.c a line sent now, its reply collected later
+ *   gl_link_udp.c  the record stream: the UDP handle, DR, the reader
  * Who uses whom: gl_link.c uses sock and io; sock uses io; cmd uses io;
- * ctrl, rec and dl use cmd and io; msg uses cmd, sock and io. No loop
+ * ctrl, rec and dl use cmd and io; msg uses cmd, sock and io; post uses
+ * cmd and io; udp uses rec, cmd, sock and io. No loop
  * (tests/checks/layers.sh). Not for the rest of the code base: gl_link.h
  * is the interface. Nothing here prints.
  */
@@ -25,6 +28,7 @@
 
 #include "gl_link.h"
 #include "gl_proto.h"
+#include "gl_stream.h"
 
 #define GL_LINK_MSG_READS_MAX 8 /* recv() calls per gl_link_message() */
 
@@ -46,6 +50,13 @@ struct gl_link {
 	int ctrl_code;
 	char ctrl_text[GL_ERRTEXT_LEN];
 	uint64_t tx_bytes, rx_bytes, round_trips;
+	/* the posted line (gl_link_post.c): its reply is outstanding */
+	bool posted;
+	uint64_t post_errors; /* posted replies set aside that were '?' */
+	/* the record stream (gl_link_udp.c): fd -1 when none */
+	int st_fd;
+	int st_handle; /* 0..7 = A..H */
+	struct gl_stream st;
 };
 
 /* What one exchange sends and awaits. */
@@ -129,6 +140,14 @@ int gl_link_xfer_end(gl_link *l, struct gl_chan *ch, const struct gl_xfer *x,
  */
 int gl_link_xfer(gl_link *l, struct gl_chan *ch, const struct gl_xfer *x,
 		 int timeout_ms, struct gl_reply *r);
+
+/*
+ * gl_link_post_settle() - before another exchange on the command handle:
+ * wait until @deadline for the posted line's reply (if one is
+ * outstanding) and set it aside ('?' counted in l->post_errors).
+ * Return: GL_OK, or a stream error (the channel is then broken).
+ */
+int gl_link_post_settle(gl_link *l, int64_t deadline);
 
 /* ---- gl_link_sock.c: the connection ---- */
 

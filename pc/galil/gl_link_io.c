@@ -145,6 +145,11 @@ int gl_link_xfer_begin(gl_link *l, struct gl_chan *ch, const struct gl_xfer *x,
 		return GL_ERR_BROKEN;
 	if (x->len > GL_LINE_MAX)
 		return GL_ERR_ARG;
+	if (ch == &l->cmd && l->posted) {
+		rc = gl_link_post_settle(l, deadline);
+		if (rc < 0)
+			return rc;
+	}
 	rc = x->seen_idle ? GL_OK : chan_drain_idle(l, ch);
 	if (rc < 0)
 		return rc;
@@ -187,6 +192,25 @@ int gl_link_xfer_end(gl_link *l, struct gl_chan *ch, const struct gl_xfer *x,
 	if (rc < 0)
 		return gl_link_chan_fail(ch, rc);
 	return gl_link_xfer_finish(l, ch, x->seen_idle);
+}
+
+/* The posted line's reply, awaited before another exchange. */
+int gl_link_post_settle(gl_link *l, int64_t deadline)
+{
+	struct gl_reply r;
+	int rc;
+
+	while ((rc = gl_proto_next(&l->cmd.p, &r)) == GL_ERR_AGAIN) {
+		rc = gl_link_chan_read(l, &l->cmd, deadline);
+		if (rc < 0)
+			return gl_link_chan_fail(&l->cmd, rc);
+	}
+	if (rc < 0)
+		return gl_link_chan_fail(&l->cmd, rc);
+	l->posted = false;
+	if (r.n_err)
+		l->post_errors++;
+	return gl_link_xfer_finish(l, &l->cmd, true);
 }
 
 int gl_link_xfer(gl_link *l, struct gl_chan *ch, const struct gl_xfer *x,

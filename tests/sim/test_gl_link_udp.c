@@ -1,0 +1,245 @@
+/*
+ * test_gl_link_udp.c - the link's record stream and posted lines
+ * (pc/galil/gl_link_udp.c, gl_link_post.c) against galil-sim over real
+ * sockets ($ROBOELF_BIN/galil-sim --udp-port 0): gl_link_stream_open()
+ * finds the UDP handle with WH and starts DR; records arrive n0 samples
+ * apart and are read without waiting; a stalled stream makes no record
+ * and ages; DR refused (n1 of a TCP handle is impossible here, so an
+ * interval the controller refuses) is reported with its text; a posted
+ * line is collected later, and another command waits for it first;
+ * gl_link_stream_close() stops the stream (DR 0).
+ *
+ * Every wait polls with a deadline.
+ */
+#include <poll.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "base_clock.h"
+#include "gl_err.h"
+#include "gl_link.h"
+#include "gl_stream.h"
+#include "proc.h"
+
+#define START_MS  5000 /* ready line deadline */
+#define REPLY_MS  2000 /* generous reply deadline */
+#define SAMPLE_NS 1000000 /* galil-sim's sample */
+
+struct fx {
+	struct proc_sim sim;
+	int ctl;
+	gl_link *l;
+	char addr[64];
+	char resp[65536];
+};
+
+static int teardown(void **state);
+
+static int setup(void **state)
+{
+	static char *const extra[] = {(char *)"--udp-port", (char *)"0", NULL};
+	const char *bin = getenv("ROBOELF_BIN");
+	struct fx *f = calloc(1, sizeof(*f));
+
+	if (!f)
+		return -1;
+	*state = f;
+	f->ctl = -1;
+	if (!bin || proc_sim_start(&f->sim, bin, NULL, extra, START_MS) < 0) {
+		fprintf(stderr, "galil-sim did not start (ROBOELF_BIN?)\n");
+		teardown(state);
+		return -1;
+	}
+	f->ctl = proc_ctl_connect(f->sim.ctl_port, REPLY_MS);
+	snprintf(f->addr, sizeof(f->addr), "127.0.0.1:%d", f->sim.port);
+	if (f->ctl < 0 || f->sim.udp_port <= 0 ||
+	    gl_link_open(&f->l, f->addr, REPLY_MS, NULL) != GL_OK) {
+		teardown(state);
+		return -1;
+	}
+	return 0;
+}
+
+static int teardown(void **state)
+{
+	struct fx *f = *state;
+
+	gl_link_close(f->l);
+	if (f->ctl >= 0)
+		close(f->ctl);
+	proc_kill(&f->sim.p);
+	free(f);
+	return 0;
+}
+
+static const char *ctl(struct fx *f, const char *req)
+{
+	if (proc_ctl_request(f->ctl, req, f->resp, sizeof(f->resp), REPLY_MS) <
+	    0)
+		fail_msg("no answer to '%s'", req);
+	return f->resp;
+}
+
+/* Read the stream until a new record came (1) or @ms passed (0). */
+static int next_record(struct fx *f, struct gl_record *rec, int ms)
+{
+	int64_t end = base_now_ms() + ms;
+	struct pollfd p = {.fd = gl_link_stream_fd(f->l), .events = POLLIN};
+	int rc;
+
+	do {
+		rc = gl_link_stream_read(f->l, rec, base_now_ns());
+		if (rc != 0)
+			return rc;
+		poll(&p, 1, 5);
+	} while (base_now_ms() < end);
+	return 0;
+}
+
+/* The stream opens on the handle WH names; records come n0 apart. */
+static void test_open_and_read(void **state)
+{
+	struct fx *f = *state;
+	struct gl_record rec;
+	struct gl_stream_stats st;
+	char err[GL_ERRTEXT_LEN], resp[64];
+	uint16_t first;
+	unsigned n0 = 0;
+	int h = -1;
+
+	assert_int_equal(gl_link_stream_open(f->l, f->sim.udp_port, 10,
+					     SAMPLE_NS, 0, err),
+			 GL_OK);
+	assert_int_equal(gl_link_stream_info(f->l, &h, &n0), 1);
+	assert_int_equal(n0, 10);
+	assert_int_equal(h, 1); /* TCP took A; the UDP peer B */
+	assert_true(gl_link_command(f->l, "MG _DR0,_DR1", resp, sizeof(resp),
+				    0) > 0);
+	assert_string_equal(resp, " 10.0000 1.0000");
+	assert_int_equal(next_record(f, &rec, REPLY_MS), 1);
+	first = rec.sample;
+	for (int i = 0; i < 5; i++)
+		assert_int_equal(next_record(f, &rec, REPLY_MS), 1);
+	gl_link_stream_stats(f->l, &st);
+	assert_true(st.accepted >= 6);
+	/* every record read: the samples advanced by n0 per record */
+	assert_int_equal((uint16_t)(rec.sample - first) % 10, 0);
+	assert_true((uint16_t)(rec.sample - first) >= 50);
+	assert_true(gl_link_stream_age_ns(f->l, base_now_ns()) < 1000000000);
+	assert_int_equal(gl_link_stream_close(f->l, 0), GL_OK);
+	assert_int_equal(gl_link_stream_info(f->l, NULL, NULL), 0);
+	assert_int_equal(gl_link_command(f->l, "MG _DR0", resp, sizeof(resp),
+					 0),
+			 (int)strlen(" 0.0000"));
+}
+
+/* A stalled stream: no record, the age grows; TCP still answers. */
+static void test_stall_ages(void **state)
+{
+	struct fx *f = *state;
+	struct gl_record rec;
+	char resp[64];
+	int64_t t0;
+
+	assert_int_equal(gl_link_stream_open(f->l, f->sim.udp_port, 5,
+					     SAMPLE_NS, 0, NULL),
+			 GL_OK);
+	assert_int_equal(next_record(f, &rec, REPLY_MS), 1);
+	assert_string_equal(ctl(f, "link stall stream"), "ok");
+	next_record(f, &rec, 50); /* what was on its way */
+	t0 = base_now_ns();
+	assert_int_equal(next_record(f, &rec, 300), 0);
+	assert_true(gl_link_stream_age_ns(f->l, base_now_ns()) >=
+		    base_now_ns() - t0);
+	assert_int_equal(gl_link_command(f->l, "MG 7", resp, sizeof(resp), 0),
+			 (int)strlen(" 7.0000"));
+	assert_string_equal(ctl(f, "link ok"), "ok");
+	assert_int_equal(next_record(f, &rec, REPLY_MS), 1);
+}
+
+/* An interval the controller refuses: its own words come back. */
+static void test_dr_refused(void **state)
+{
+	struct fx *f = *state;
+	char err[GL_ERRTEXT_LEN];
+	int code = 0;
+
+	assert_int_equal(gl_link_stream_open(f->l, f->sim.udp_port, 30001,
+					     SAMPLE_NS, 0, err),
+			 GL_ERR_ARG); /* beyond the reader's horizon */
+	assert_int_equal(gl_link_stream_open(f->l, f->sim.udp_port, 16383,
+					     SAMPLE_NS, 0, err),
+			 GL_OK);
+	assert_int_equal(gl_link_stream_close(f->l, 0), GL_OK);
+	/* no UDP port there: WH is never answered */
+	assert_int_equal(gl_link_stream_open(f->l, 9, 10, SAMPLE_NS, 300, err),
+			 GL_ERR_TIMEOUT);
+	assert_string_equal(err, "no answer to WH on UDP port 9");
+	assert_int_equal(gl_link_stream_info(f->l, NULL, NULL), 0);
+	(void)code;
+}
+
+/* A posted line's reply is collected later; a command waits for it. */
+static void test_post_collect(void **state)
+{
+	struct fx *f = *state;
+	char text[64];
+	int64_t end = base_now_ms() + REPLY_MS;
+	int rc;
+
+	assert_int_equal(gl_link_post(f->l, "hbx=5;MG hbx"), GL_OK);
+	assert_int_equal(gl_link_posted(f->l), 1);
+	assert_int_equal(gl_link_post(f->l, "MG 1"), GL_ERR_BUSY);
+	while ((rc = gl_link_collect(f->l, text, sizeof(text))) ==
+		   GL_ERR_AGAIN &&
+	       base_now_ms() < end)
+		poll(NULL, 0, 1);
+	assert_int_equal(rc, (int)strlen(" 5.0000"));
+	assert_string_equal(text, " 5.0000");
+	assert_int_equal(gl_link_posted(f->l), 0);
+	assert_int_equal(gl_link_collect(f->l, text, sizeof(text)),
+			 GL_ERR_AGAIN);
+	/* posted, then a command at once: it takes the posted reply first */
+	assert_int_equal(gl_link_post(f->l, "hbx=6"), GL_OK);
+	assert_int_equal(gl_link_command(f->l, "MG hbx", text, sizeof(text),
+					 0),
+			 (int)strlen(" 6.0000"));
+	assert_int_equal(gl_link_posted(f->l), 0);
+	assert_int_equal(gl_link_post_errors(f->l), 0);
+	/* a refused posted line set aside by a command is counted */
+	assert_int_equal(gl_link_post(f->l, "XYZZY"), GL_OK);
+	assert_int_equal(gl_link_command(f->l, "MG 2", text, sizeof(text), 0),
+			 (int)strlen(" 2.0000"));
+	assert_int_equal(gl_link_post_errors(f->l), 1);
+	/* a refused posted line collected: the controller's error */
+	assert_int_equal(gl_link_post(f->l, "XYZZY"), GL_OK);
+	end = base_now_ms() + REPLY_MS;
+	while ((rc = gl_link_collect(f->l, text, sizeof(text))) ==
+		   GL_ERR_AGAIN &&
+	       base_now_ms() < end)
+		poll(NULL, 0, 1);
+	assert_int_equal(rc, GL_ERR_CTRL);
+	assert_false(gl_link_broken(f->l));
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	    cmocka_unit_test_setup_teardown(test_open_and_read, setup,
+					    teardown),
+	    cmocka_unit_test_setup_teardown(test_stall_ages, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_dr_refused, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_post_collect, setup,
+					    teardown),
+	};
+
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
