@@ -282,9 +282,9 @@ struct gl_stream_stats;
  * gl_link_command(); the send does not wait (the socket's buffer takes a
  * line of GL_LINE_MAX bytes at once unless the peer stopped reading).
  * Return: GL_OK (sent whole); GL_ERR_BUSY (a line is still outstanding:
- *         nothing sent); GL_ERR_AGAIN (the socket took nothing: nothing
- *         sent, still in step); GL_ERR_ARG; GL_ERR_BROKEN; a send that
- *         stopped half way breaks the link (GL_ERR_TIMEOUT).
+ *         nothing sent); GL_ERR_ARG; GL_ERR_BROKEN; GL_ERR_TIMEOUT when the
+ *         socket did not take the whole line at once (the link is then
+ *         broken: a peer that stopped reading); GL_ERR_CLOSED, GL_ERR_SYS.
  */
 int gl_link_post(gl_link *l, const char *cmd);
 
@@ -294,8 +294,9 @@ int gl_link_post(gl_link *l, const char *cmd);
  * @text: [out] optional (NULL or @cap 0): the reply's data text,
  *        NUL-terminated, as gl_link_command() gives it.
  * Return: the text's length (>= 0) when the reply is complete (the line is
- *         then no longer outstanding); GL_ERR_AGAIN (not complete yet, or
- *         nothing posted: see gl_link_posted()); GL_ERR_CTRL after '?'
+ *         then no longer outstanding); GL_ERR_AGAIN (not complete yet);
+ *         GL_ERR_NOENT (nothing outstanding: none posted, or another
+ *         exchange took the reply, gl_link_posted()); GL_ERR_CTRL after '?'
  *         (TC1 is asked with the link's default timeout, as for a
  *         command); GL_ERR_OVERFLOW; a stream error (the link is broken).
  */

@@ -46,7 +46,7 @@ int gl_link_collect(gl_link *l, char *text, size_t cap)
 	if (!l)
 		return GL_ERR_ARG;
 	if (!l->posted)
-		return GL_ERR_AGAIN;
+		return GL_ERR_NOENT;
 	if (l->cmd.broken)
 		return GL_ERR_BROKEN;
 	while ((rc = gl_proto_next(&l->cmd.p, &r)) == GL_ERR_AGAIN) {

@@ -46,6 +46,12 @@ enum re_fclass {
  *   RE_F_CTRL_ENCODER    a; i0 stop code (controller fault 9)
  * WATCHDOG
  *   RE_F_WDOG_REPLY      i0 ms since the last good reply, i1 limit ms
+ *   RE_F_WDOG_STREAM     i0 ms since the last record of the stream, i1 limit
+ *   RE_F_WDOG_ACK        i0 ms since the controller last acknowledged a
+ *                        posted heartbeat, i1 limit ms
+ *   RE_F_WDOG_ECHO       i0 ms since the heartbeat the program's record
+ *                        echoes was sent (unknown: none recent), i1 limit
+ *                        ms, i2 the echo (hbpc mod 10000)
  *   RE_F_WDOG_HEARTBEAT  i0 hbdmc value, i1 ms frozen, i2 limit ms
  *   RE_F_WDOG_SAMPLE     i0 sample number, i1 ms frozen, i2 limit ms
  *   RE_F_CTRL_WATCHDOG   i0 ms without hbpc change (controller fault 2)
@@ -166,6 +172,9 @@ enum re_fault_id {
 	RE_F_READBACK,
 	RE_F_XC_DECODE,
 	RE_F_XC_MOTION,
+	RE_F_WDOG_STREAM,
+	RE_F_WDOG_ACK,
+	RE_F_WDOG_ECHO,
 	RE_F_COUNT
 };
 

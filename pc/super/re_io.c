@@ -168,6 +168,40 @@ static int real_command(void *ud, const char *cmd, char *resp, size_t cap,
 	return rc;
 }
 
+static int real_post(void *ud, const char *line)
+{
+	struct re_io_real *r = ud;
+
+	if (!r->link)
+		return GL_ERR_CLOSED;
+	r->last_run_ns = re_io_now_ns();
+	return gl_link_post(r->link, line);
+}
+
+static int real_collect(void *ud, char *text, size_t cap)
+{
+	struct re_io_real *r = ud;
+	short ev = 0;
+
+	if (!r->link)
+		return GL_ERR_CLOSED;
+	/* the reply's bytes are what the look saw on this socket */
+	look_take(r, RE_LOOK_CMD, gl_link_fd(r->link), &ev);
+	return gl_link_collect(r->link, text, cap);
+}
+
+static int real_stream(void *ud, struct gl_record *rec, int64_t now_ns)
+{
+	struct re_io_real *r = ud;
+	int rc;
+
+	if (!r->link)
+		return GL_ERR_CLOSED;
+	rc = gl_link_stream_read(r->link, rec, now_ns);
+	r->last_run_ns = re_io_now_ns();
+	return rc;
+}
+
 static const char *real_ctrl_error(void *ud, int *code)
 {
 	struct re_io_real *r = ud;
@@ -377,6 +411,9 @@ static const struct re_io_ops real_ops = {
     .record = real_record,
     .record_text = real_record_text,
     .command = real_command,
+    .post = real_post,
+    .collect = real_collect,
+    .stream = real_stream,
     .ctrl_error = real_ctrl_error,
     .message = real_message,
     .relay_check = real_relay_check,

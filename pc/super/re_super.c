@@ -90,6 +90,8 @@ int re_super_init(struct re_super *s, const struct re_io *io,
 	s->t0_ns = now_ns(s);
 	s->deadline_ns = s->t0_ns + cfg->period_ns; /* no previous cycle */
 	s->last_good_ns = s->t0_ns;
+	s->post_chunk = -1;
+	re_super_stream_reset(s, s->t0_ns);
 	re_alive_reset(&s->alive);
 	re_xcheck_reset(&s->xc, s->t0_ns);
 	return readback_init(s);
@@ -143,6 +145,7 @@ void re_super_start(struct re_super *s, const struct re_caltable *const *tables,
 	 * is one too */
 	s->last_end_ns = s->last_good_ns;
 	s->deadline_ns = s->last_good_ns + s->pub.period_ns;
+	re_super_stream_reset(s, s->last_good_ns);
 	re_alive_reset(&s->alive);
 }
 
@@ -234,45 +237,6 @@ static int check_stall(struct re_super *s, struct re_fault *f)
 	return RE_FAULT;
 }
 
-/* "hbpc=N" into @buf (32 bytes; N < RE_HBPC_WRAP, 10 digits at most)
- * without snprintf: the one command text built every cycle.
- * Return: its length. */
-static int hb_prefix(char *buf, long hb)
-{
-	char dig[16];
-	int n = 0;
-
-	memcpy(buf, "hbpc=", 5);
-	do {
-		dig[n++] = (char)('0' + hb % 10);
-		hb /= 10;
-	} while (hb > 0 && n < (int)sizeof(dig));
-	for (int i = 0; i < n; i++)
-		buf[5 + i] = dig[n - 1 - i];
-	buf[5 + n] = '\0';
-	return 5 + n;
-}
-
-/* s->prefix for @hb: the last one's digits counted up in place when @hb
- * is one more (as it is in every cycle but the wrap: no division), else
- * written anew. */
-static void hb_prefix_next(struct re_super *s, long hb)
-{
-	int i = s->prefix_len - 1;
-
-	if (s->prefix_len > 5 && hb == s->prefix_hb + 1) {
-		while (i >= 5 && s->prefix[i] == '9')
-			s->prefix[i--] = '0';
-		if (i >= 5) { /* else 99..9 + 1: one digit more */
-			s->prefix[i]++;
-			s->prefix_hb = hb;
-			return;
-		}
-	}
-	s->prefix_len = hb_prefix(s->prefix, hb);
-	s->prefix_hb = hb;
-}
-
 /* The round trip with the next chunk of the seal read back on the same
  * line: "hbpc=N;MG r1,...,rn;QR". */
 static int record_readback(struct re_super *s, int tmo)
@@ -297,8 +261,7 @@ static int exchange(struct re_super *s, struct re_fault *f)
 	int64_t now, age = 0, t0 = now_ns(s), over;
 	int rc, v, tmo = reply_timeout_ms(s);
 
-	s->pub.hbpc = (s->pub.hbpc + 1) % RE_HBPC_WRAP;
-	hb_prefix_next(s, s->pub.hbpc);
+	re_super_hb_next(s);
 	rc = s->pub.rb_n ? record_readback(s, tmo)
 			 : s->pub.io.ops->record(s->pub.io.ud, s->prefix,
 						 &s->pub.rec, tmo);
@@ -347,8 +310,10 @@ static void warn_watchdog(struct re_super *s)
 {
 	s->wd_warnings++;
 	snprintf(s->text, sizeof(s->text),
-		 "watchdog: reply after %.1f ms "
+		 "watchdog: %s after %.1f ms "
 		 "(non-critical limit %.1f ms, critical %.1f ms)",
+		 s->pub.cfg.stream ? "a record or the heartbeat's reply came"
+				   : "reply",
 		 ns_to_ms(s->pub.age_last_ns), ns_to_ms(s->noncrit_ns),
 		 ns_to_ms(s->pub.crit_ns));
 	re_io_logf(&s->pub.io, RE_LOG_WARN, "%s", s->text);
@@ -534,7 +499,7 @@ static int check_record(struct re_super *s, struct re_fault *f)
 	v = check_encpot(s, f);
 	if (v == RE_FAULT)
 		return v;
-	v = check_readback(s, f);
+	v = s->pub.cfg.stream ? RE_OK : check_readback(s, f);
 	if (v == RE_FAULT || !s->pub.expect)
 		return v;
 	v = check_uncmd(s, f);
@@ -546,15 +511,43 @@ static int check_record(struct re_super *s, struct re_fault *f)
 		     : v;
 }
 
+/* The record while latched: the stream's newest (none new: the last
+ * one stays), or a round trip. */
+static int latched_record(struct re_super *s)
+{
+	int rc;
+
+	if (!s->pub.cfg.stream)
+		return s->pub.io.ops->record(
+		    s->pub.io.ud, NULL, &s->pub.rec,
+		    (int)(s->pub.period_ns / BASE_NS_PER_MS) + 1);
+	rc = s->pub.io.ops->stream(s->pub.io.ud, &s->pub.rec, now_ns(s));
+	return rc == 1 ? GL_OK : rc == 0 ? GL_ERR_AGAIN : rc;
+}
+
+/* The stream design's checks: those of a record only on a fresh one (a
+ * cycle without one judged only its age), the echo, and the read-back
+ * whose reply was collected this cycle. */
+static int stream_checks(struct re_super *s, struct re_fault *f)
+{
+	int v = RE_OK;
+
+	if (s->fresh)
+		v = check_record(s, f);
+	if (v != RE_FAULT)
+		v = re_super_check_echo(s, f);
+	if (v != RE_FAULT)
+		v = check_readback(s, f);
+	return v;
+}
+
 static int latched_cycle(struct re_super *s)
 {
-	int rc =
-	    s->pub.io.ops->record(s->pub.io.ud, NULL, &s->pub.rec,
-				  (int)(s->pub.period_ns / BASE_NS_PER_MS) + 1);
+	int rc = latched_record(s);
 	struct re_fault scratch;
 
 	memset(&scratch, 0, sizeof(scratch));
-	s->pub.link_ok = rc == GL_OK;
+	s->pub.link_ok = rc == GL_OK || rc == GL_ERR_AGAIN;
 	if (rc == GL_OK) {
 		struct re_encpot_state st[RE_SUPER_AXES];
 
@@ -590,9 +583,10 @@ static int cycle_checks(struct re_super *s)
 	memset(&f, 0, sizeof(f));
 	if (check_stall(s, &f) == RE_FAULT)
 		return re_super_fault(s, &f);
-	v = exchange(s, &f);
+	v = s->pub.cfg.stream ? re_super_exchange_stream(s, &f)
+			      : exchange(s, &f);
 	warn = s->pub.link_ok && s->pub.age_last_ns > s->noncrit_ns;
-	if (s->pub.link_ok)
+	if (s->pub.link_ok && (!s->pub.cfg.stream || s->fresh))
 		watch_handles(s);
 	rv = check_relay(s, &rf);
 	if (rv == RE_FAULT)
@@ -601,7 +595,7 @@ static int cycle_checks(struct re_super *s)
 		return re_super_fault(s, &f);
 	if (warn)
 		warn_watchdog(s);
-	v = check_record(s, &f);
+	v = s->pub.cfg.stream ? stream_checks(s, &f) : check_record(s, &f);
 	if (v == RE_FAULT)
 		return re_super_fault(s, &f);
 	drain_messages(s);

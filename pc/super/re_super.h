@@ -105,6 +105,10 @@ struct re_super_cfg {
 	 * cycle (re_io's post and collect ops): no wait in the cycle. 0: one
 	 * "hbpc=N;QR" round trip per cycle. docs/link.md. */
 	int stream;
+	/* stream design: the program's echo of the last heartbeat it took
+	 * (re_za.hb_echo) may be at most this old (the critical limit plus
+	 * the program's pass and the record interval), ns; 0: not checked */
+	int64_t echo_limit_ns;
 };
 
 /* Per-axis view for the status board. */

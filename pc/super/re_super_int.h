@@ -10,6 +10,7 @@
 
 #define RE_LATE_BIN_US 50   /* lateness histogram resolution, us */
 #define RE_LATE_BINS   2001 /* 0 .. 100 ms, then one overflow bin */
+#define RE_SENT_RING   64   /* heartbeats remembered for the echo */
 
 struct re_super {
 	struct re_super_view pub; /* what it publishes (re_super.h) */
@@ -68,6 +69,20 @@ struct re_super {
 	char rb_chunk[RE_SEAL_MAX][64];
 	char rb_line[96];
 	char rb_reply[512];
+	/* the stream design (re_super_stream.c): the posted line, the
+	 * times of the last fresh record and of the last reply collected,
+	 * and the heartbeats sent lately (for the program's echo) */
+	int posted;	   /* a posted line's reply is outstanding */
+	int post_chunk;	   /* its read-back chunk, -1: none */
+	int fresh;	   /* this cycle's record is new */
+	int64_t rec_ns;	   /* the last fresh record */
+	int64_t ack_ns;	   /* the last reply to a posted line */
+	int64_t post_ns;   /* when the outstanding line was posted */
+	struct {
+		long hb;
+		int64_t ns;
+	} sent[RE_SENT_RING];
+	unsigned sent_n; /* heartbeats sent since the phase started */
 	/* scratch, preallocated */
 	char prefix[32]; /* "hbpc=N" of the last request ... */
 	long prefix_hb;	 /* ... its N ... */
@@ -88,5 +103,39 @@ struct re_super {
  */
 int re_react_own_doing(const struct re_super *s, const struct re_za *za,
 		       double det);
+
+/*
+ * re_super_hb_next() - the next heartbeat: s->pub.hbpc + 1 (mod
+ * RE_HBPC_WRAP) and its command "hbpc=N" in s->prefix
+ * (re_super_stream.c).
+ */
+void re_super_hb_next(struct re_super *s);
+
+/*
+ * re_super_stream_reset() - a phase starts (re_super_start, init): the
+ * record's and the acknowledgement's ages count from @now_ns, the
+ * heartbeats sent are forgotten (a posted line stays outstanding).
+ */
+void re_super_stream_reset(struct re_super *s, int64_t now_ns);
+
+/*
+ * re_super_exchange_stream() - the cycle's exchange in the stream design
+ * (re_super_cfg.stream): collect the reply to the line posted last cycle
+ * (the read-back chunk's text into s->rb_reply), post the next heartbeat
+ * with the next read-back chunk when none is outstanding, read the newest
+ * record of the stream (s->fresh), judge the record's and the
+ * acknowledgement's ages against the critical limit and set
+ * s->pub.age_last_ns for the warning. Never waits.
+ * Return: RE_OK, or RE_FAULT with @f filled (WDOG_STREAM, WDOG_ACK, COMM).
+ */
+int re_super_exchange_stream(struct re_super *s, struct re_fault *f);
+
+/*
+ * re_super_check_echo() - on a fresh record with the program's fields:
+ * the heartbeat its echo names was sent at most cfg.echo_limit_ns ago
+ * (a heartbeat this supervisor did not send counts as none).
+ * Return: RE_OK, or RE_FAULT with @f filled (RE_F_WDOG_ECHO).
+ */
+int re_super_check_echo(struct re_super *s, struct re_fault *f);
 
 #endif /* RE_SUPER_INT_H */

@@ -206,13 +206,15 @@ static void test_post_collect(void **state)
 	assert_string_equal(text, " 5.0000");
 	assert_int_equal(gl_link_posted(f->l), 0);
 	assert_int_equal(gl_link_collect(f->l, text, sizeof(text)),
-			 GL_ERR_AGAIN);
+			 GL_ERR_NOENT);
 	/* posted, then a command at once: it takes the posted reply first */
 	assert_int_equal(gl_link_post(f->l, "hbx=6"), GL_OK);
 	assert_int_equal(gl_link_command(f->l, "MG hbx", text, sizeof(text),
 					 0),
 			 (int)strlen(" 6.0000"));
 	assert_int_equal(gl_link_posted(f->l), 0);
+	assert_int_equal(gl_link_collect(f->l, text, sizeof(text)),
+			 GL_ERR_NOENT);
 	assert_int_equal(gl_link_post_errors(f->l), 0);
 	/* a refused posted line set aside by a command is counted */
 	assert_int_equal(gl_link_post(f->l, "XYZZY"), GL_OK);
