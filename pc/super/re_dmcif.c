@@ -21,18 +21,25 @@ int re_za_decode(int32_t zaa, int32_t zab, int32_t zac, struct re_za *out)
 	if (zaa < 0 || zaa > 999999 || zab < 0 || zac < 0)
 		return GL_ERR_RANGE;
 	z.hbdmc = zaa;
-	z.state = zab % 10;
-	z.fcode = (zab / 10) % 100;
-	z.faxis = zab / 1000;
+	z.state = zab % RE_ZAB_FCODE;
+	z.fcode = (zab / RE_ZAB_FCODE) % 100;
+	z.faxis = (zab / RE_ZAB_FAXIS) % 10;
+	z.hb_echo = zab / RE_ZAB_ECHO;
 	z.jraw = zac % RE_ZAC_JCMD;
 	z.jcmd = (zac / RE_ZAC_JCMD) % 8 - 1;
 	z.mcmd = (zac / RE_ZAC_MCMD) % 8;
 	z.mneut = zac / RE_ZAC_MNEUT;
 	if (z.state > RE_DMC_SERVICE || z.fcode > RE_DMC_F_MAX || z.faxis > 3 ||
-	    z.mcmd > 6 || z.jcmd > 6 || z.mneut > 1)
+	    z.hb_echo >= RE_HB_ECHO_MOD || z.mcmd > 6 || z.jcmd > 6 ||
+	    z.mneut > 1)
 		return GL_ERR_RANGE;
 	*out = z;
 	return GL_OK;
+}
+
+int re_hb_echo(long hbpc)
+{
+	return hbpc < 0 ? -1 : (int)(hbpc % RE_HB_ECHO_MOD);
 }
 
 const char *re_stop_reason(int stop_code)

@@ -50,6 +50,20 @@ enum re_dmc_fcode {
 	RE_DMC_F_MAX = 17,
 };
 
+/* ZAB = state + RE_ZAB_FCODE * fcode + RE_ZAB_FAXIS * faxis
+ *       + RE_ZAB_ECHO * hb_echo (dmc/roboelf.dmc #MAIN, dmc-interface.md;
+ * the echo since program 2.23: the DMC's hbemul, its modulus hbemod is
+ * RE_HB_ECHO_MOD) */
+#define RE_ZAB_FCODE   10L
+#define RE_ZAB_FAXIS   1000L
+#define RE_ZAB_ECHO    10000L
+#define RE_HB_ECHO_MOD 10000L
+/* The largest ZAB the program publishes (state 3, fcode 17, faxis 3, echo
+ * 9999): 99 993 173, a 4-byte record field. */
+#define RE_ZAB_MAX                                                             \
+	(RE_DMC_SERVICE + RE_ZAB_FCODE * RE_DMC_F_MAX + RE_ZAB_FAXIS * 3 +     \
+	 RE_ZAB_ECHO * (RE_HB_ECHO_MOD - 1))
+
 /* ZAC = jraw + RE_ZAC_JCMD * (jcmd + 1) + RE_ZAC_MCMD * mcmd
  *       + RE_ZAC_MNEUT * mneut (dmc/roboelf.dmc #MAIN, dmc-interface.md) */
 #define RE_ZAC_JCMD  4096L
@@ -64,22 +78,41 @@ struct re_za {
 	int32_t hbdmc; /* ZAA */
 	int state;     /* ZAB % 10 */
 	int fcode;     /* (ZAB / 10) % 100 */
-	int faxis;     /* ZAB / 1000: 1..3 = A..C, 0 none */
+	int faxis;     /* (ZAB / 1000) % 10: 1..3 = A..C, 0 none */
 	int jraw;      /* ZAC % 4096 */
 	int jcmd;      /* (ZAC / 4096) % 8 - 1: -1 invalid, 0, 1..6 */
 	int mcmd;      /* (ZAC / 32768) % 8: 0..6 */
 	int mneut;     /* ZAC / 262144: 1 once the joystick was seen neutral
 			* since arming (program 2.10) */
+	/* ZAB / 10000 (program 2.23): the last hbpc the program accepted as
+	 * the supervisor's heartbeat, mod RE_HB_ECHO_MOD, as the program's
+	 * last #MAIN pass before the record left it: in the safe state
+	 * (and its requests) every change of hbpc (no sequence is judged),
+	 * armed and in service only a change 1..hbmaxd steps after the last
+	 * one seen (one out of sequence is fault 14, not echoed); 0 before
+	 * any was accepted since XQ #AUTO (also the echo of an hbpc that is
+	 * 0 mod RE_HB_ECHO_MOD); frozen while a fault is latched (state 2
+	 * follows no heartbeat). re_hb_echo() gives the echo of a value. */
+	int hb_echo;
 };
 
 /*
  * re_za_decode() - decode ZAA, ZAB, ZAC (axes A, B, C's user fields).
  * @out: [out] filled only on success.
  * Return: GL_OK; GL_ERR_RANGE when a field is negative or a decoded value is
- *         outside its range (state > 3, fcode > 17, faxis > 3, jcmd > 6,
- *         mcmd > 6, mneut > 1, hbdmc > 999999); GL_ERR_ARG on NULL.
+ *         outside its range (state > 3, fcode > 17, faxis > 3, hb_echo >
+ *         9999, jcmd > 6, mcmd > 6, mneut > 1, hbdmc > 999999); GL_ERR_ARG
+ *         on NULL.
  */
 int re_za_decode(int32_t zaa, int32_t zab, int32_t zac, struct re_za *out);
+
+/*
+ * re_hb_echo() - the echo (struct re_za hb_echo) the program publishes
+ * once it accepted the heartbeat @hbpc (0 .. RE_HBPC_WRAP - 1, as the
+ * supervisor writes it): @hbpc mod RE_HB_ECHO_MOD.
+ * Return: 0 .. RE_HB_ECHO_MOD - 1; -1 when @hbpc is negative.
+ */
+int re_hb_echo(long hbpc);
 
 /*
  * re_stop_reason() - text for a stop code: 8 "position error above the

@@ -3,11 +3,12 @@
  * #GUARD, #FORGN, #HBCHK, #JVAL, #MRAMP and #POSERR in dmc/roboelf.dmc are
  * the specification): motion only where the program commanded it (fault
  * 13 detail 1 and 2), the supervisor's heartbeat as a sequence (fault 14
- * detail 1), another program's connection (reported, "FOREIGN") and its
- * changes to the safety settings (fault 14, detail 3 and 4), the
- * potentiometers' absolute range (fault 16), the flicker-proof invalid
- * joystick timer (fault 3), position-tracking targets one count inside
- * FL/BL, and an encoder failure (OA) at rest named as fault 9.
+ * detail 1) and its echo in the record (2.23), another program's
+ * connection (reported, "FOREIGN") and its changes to the safety settings
+ * (fault 14, detail 3 and 4), the potentiometers' absolute range (fault
+ * 16), the flicker-proof invalid joystick timer (fault 3), position-
+ * tracking targets one count inside FL/BL, and an encoder failure (OA) at
+ * rest named as fault 9.
  *
  * Reaction times are measured in simulated time and printed ("measured:")
  * so that the figures can be compared with the formulas of the headers.
@@ -423,6 +424,133 @@ static void test_hb_wrap(void **state)
 	assert_true(wrapped);
 	assert_true(dmc_h_var(h, "state") == 1);
 	assert_int_equal(dmc_h_fault_lines(h, NULL, NULL, NULL), 0);
+}
+
+/* The echo's modulus and weight in ZAB (constants.dmc hbemod, hbemul; the
+ * harness decodes ZAB / 10000). */
+#define ECHO_MOD 10000L
+
+/*
+ * Write hbpc=@v (by hand: the harness's own heartbeat is off) and wait for
+ * the record's echo of it, in state @st, no fault: within two passes (a
+ * write just after one pass's look is seen by the next). Then 20 ms more,
+ * a supervisor's cycle.
+ */
+static void echo_follows(struct dmc_h *h, long v, int st)
+{
+	double t0 = dmc_h_now(h), mainms = dmc_h_var(h, "mainms");
+	struct dmc_h_za za;
+
+	DMC_H_CHECK(h, dmc_h_set(h, "hbpc", (double)v));
+	do {
+		dmc_h_advance(h, 1);
+		DMC_H_CHECK(h, dmc_h_za(h, &za));
+	} while (za.hb_echo != v % ECHO_MOD &&
+		 dmc_h_now(h) - t0 < 2 * mainms + 1);
+	if (za.hb_echo != v % ECHO_MOD || za.state != st || za.fcode != 0 ||
+	    za.faxis != 0)
+		fail_msg("hbpc %ld: echo %ld (want %ld) state %d fault %d axis "
+			 "%d after %.0f ms",
+			 v, za.hb_echo, v % ECHO_MOD, za.state, za.fcode,
+			 za.faxis, dmc_h_now(h) - t0);
+	dmc_h_advance(h, 20);
+}
+
+/* The record's echo, state, fault and axis now. */
+static void assert_echo(struct dmc_h *h, long echo, int st, int code)
+{
+	struct dmc_h_za za;
+
+	DMC_H_CHECK(h, dmc_h_za(h, &za));
+	if (za.hb_echo != echo || za.state != st || za.fcode != code ||
+	    za.faxis != 0)
+		fail_msg("echo %ld state %d fault %d axis %d, want echo %ld "
+			 "state %d fault %d axis 0",
+			 za.hb_echo, za.state, za.fcode, za.faxis, echo, st,
+			 code);
+}
+
+/*
+ * The record echoes the heartbeat the program accepted as the supervisor's
+ * (ZAB / hbemul = hbok mod hbemod, program 2.23): 0 before any; in the
+ * safe state every change (no sequence judged there); armed, each write in
+ * sequence within two passes, across a multiple of 10000 and across
+ * hbpcwr (999999999: the largest echo, 9999, then 0); a write out of
+ * sequence is not echoed: fault 14 detail 1, the echo stays at the last
+ * value accepted, and stays there while latched (state 2 follows no
+ * heartbeat) whatever is written next. Whatever a client writes to hbok,
+ * the echo is whole, 0..9999, and leaves state, fault and axis intact.
+ */
+static void test_hb_echo(void **state)
+{
+	static const struct {
+		double hbok;
+		long echo;
+	} odd[] = {
+	    {2147483647.0, 3647}, {-123456789.0, 6789}, {12345.75, 2345}};
+	struct dmc_h *h = *state;
+	struct dmc_h_params p;
+	long v, wrap;
+	int crossed = 0, wrapped = 0;
+
+	dmc_h_params_default(&p);
+	DMC_H_CHECK(h, dmc_h_open(h));
+	DMC_H_CHECK(h, dmc_h_start(h));
+	DMC_H_CHECK(h, dmc_h_configure(h, &p));
+	assert_true(dmc_h_var(h, "hbemod") == ECHO_MOD);
+	assert_true(dmc_h_var(h, "hbemul") == ECHO_MOD);
+	wrap = (long)dmc_h_var(h, "hbpcwr");
+	dmc_h_advance(h, 50);
+	assert_echo(h, 0, 0, 0); /* nothing written since #AUTO */
+	echo_follows(h, 123459990, 0);
+	echo_follows(h, 7, 0); /* safe: a jump is followed */
+	/* a client's write to hbok itself: the echo is made whole and not
+	 * negative, exact at the top of the range, and the fields below it
+	 * stay whole */
+	for (size_t i = 0; i < sizeof(odd) / sizeof(odd[0]); i++) {
+		DMC_H_CHECK(h, dmc_h_set(h, "hbok", odd[i].hbok));
+		dmc_h_advance(h, dmc_h_var(h, "mainms") + 1);
+		assert_echo(h, odd[i].echo, 0, 0);
+	}
+	h->hb = 123459990; /* arming writes from 123459991 on */
+	DMC_H_CHECK(h, dmc_h_arm(h));
+	h->hb_on = 0;
+	dmc_h_advance(h, 2 * dmc_h_var(h, "mainms") + 1);
+	assert_echo(h, h->hb % ECHO_MOD, 1, 0); /* arming's last write */
+	for (v = h->hb; v < 123460005;) {
+		v++;
+		crossed |= v % ECHO_MOD == 0;
+		echo_follows(h, v, 1);
+	}
+	assert_true(crossed);
+	/* back to safe (no fault), then armed again just below hbpcwr */
+	DMC_H_CHECK(h, dmc_h_set(h, "offreq", 1));
+	assert_true(dmc_h_wait_var(h, "state", 0, 50) >= 0);
+	echo_follows(h, wrap - 12, 0);
+	h->hb = wrap - 12;
+	DMC_H_CHECK(h, dmc_h_arm(h));
+	h->hb_on = 0;
+	v = h->hb;
+	assert_true(v < wrap - 3);
+	for (int i = 0; i < 12; i++) {
+		v = (v + 1) % wrap;
+		if (v == wrap - 1)
+			assert_int_equal(v % ECHO_MOD, 9999);
+		wrapped |= v == 0;
+		echo_follows(h, v, 1);
+	}
+	assert_true(wrapped);
+	/* a stray client's value: fault 14/1, the echo stays at v */
+	DMC_H_CHECK(h, dmc_h_set(h, "hbpc", (double)(v + 1000)));
+	wait_latch(h, 2 * dmc_h_var(h, "mainms") + 1);
+	assert_latched(h, 14, 0, 1, 0);
+	dmc_h_advance(h, 10);
+	assert_echo(h, v % ECHO_MOD, 2, 14);
+	for (int i = 1; i <= 5; i++) {
+		DMC_H_CHECK(h, dmc_h_set(h, "hbpc", (double)(v + i)));
+		dmc_h_advance(h, 20);
+		assert_echo(h, v % ECHO_MOD, 2, 14);
+	}
 }
 
 /* ---- another program at the controller (#FORGN) -------------------------- */
@@ -847,6 +975,8 @@ int main(void)
 	    cmocka_unit_test(test_hb_out_of_sequence),
 	    cmocka_unit_test(test_hb_stray_inside_look),
 	    cmocka_unit_test_setup_teardown(test_hb_wrap, dmc_h_fx_new,
+					    dmc_h_fx_free),
+	    cmocka_unit_test_setup_teardown(test_hb_echo, dmc_h_fx_new,
 					    dmc_h_fx_free),
 	    cmocka_unit_test(test_new_handle),
 	    cmocka_unit_test_setup_teardown(test_handle_reused, dmc_h_fx_armed,

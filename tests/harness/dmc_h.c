@@ -680,7 +680,8 @@ int dmc_h_za(struct dmc_h *h, struct dmc_h_za *za)
 	zc = rd_sl(rec + REC_AXIS0 + 2 * REC_AXIS_LEN + REC_ZA);
 	za->state = (int)(zb % 10);
 	za->fcode = (int)(zb / 10 % 100);
-	za->faxis = (int)(zb / 1000);
+	za->faxis = (int)(zb / 1000 % 10);
+	za->hb_echo = zb / 10000;
 	za->jraw = (int)(zc % 4096);
 	za->jcmd = (int)(zc / 4096 % 8) - 1;
 	za->mcmd = (int)(zc / 32768 % 8);

@@ -223,6 +223,7 @@ int dmc_h_unsol_has(const struct dmc_h *h, const char *prefix);
 struct dmc_h_za {
 	long hbdmc;
 	int state, fcode, faxis;
+	long hb_echo; /* the accepted heartbeat's echo (program 2.23) */
 	int jraw, jcmd, mcmd, mneut;
 };
 int dmc_h_za(struct dmc_h *h, struct dmc_h_za *za);

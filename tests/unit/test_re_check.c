@@ -460,6 +460,36 @@ static void test_za_decode(void **state)
 	/* the seal's fault (17, version 2.20) */
 	assert_int_equal(re_za_decode(0, 2 + 170 + 1000, 0, &z), GL_OK);
 	assert_int_equal(z.fcode, 17);
+	assert_int_equal(z.hb_echo, 0);
+	/* 2.23: the heartbeat's echo above them; every field at its largest */
+	assert_int_equal(RE_ZAB_MAX, 99993173L);
+	assert_int_equal(re_za_decode(0, 3 + 170 + 3000 + 10000L * 9999, 0, &z),
+			 GL_OK);
+	assert_int_equal(z.state, RE_DMC_SERVICE);
+	assert_int_equal(z.fcode, 17);
+	assert_int_equal(z.faxis, 3);
+	assert_int_equal(z.hb_echo, 9999);
+	assert_int_equal(re_za_decode(0, 1 + 10000L * 4321, 0, &z), GL_OK);
+	assert_int_equal(z.state, 1);
+	assert_int_equal(z.fcode, 0);
+	assert_int_equal(z.faxis, 0);
+	assert_int_equal(z.hb_echo, 4321);
+	assert_int_equal(re_za_decode(0, 2 + 40 + 2000 + 10000, 0, &z), GL_OK);
+	assert_int_equal(z.fcode, 4);
+	assert_int_equal(z.faxis, 2);
+	assert_int_equal(z.hb_echo, 1);
+	/* an echo of 10000 or a fourth axis under an echo: not the program's */
+	assert_int_equal(re_za_decode(0, 100000000L, 0, &z), GL_ERR_RANGE);
+	assert_int_equal(re_za_decode(0, 4000 + 10000L * 5, 0, &z),
+			 GL_ERR_RANGE);
+	assert_int_equal(re_za_decode(0, INT32_MAX, 0, &z), GL_ERR_RANGE);
+	/* the echo the supervisor expects for what it wrote */
+	assert_int_equal(re_hb_echo(0), 0);
+	assert_int_equal(re_hb_echo(123459999L), 9999);
+	assert_int_equal(re_hb_echo(123460000L), 0);
+	assert_int_equal(re_hb_echo(999999999L), 9999);
+	assert_int_equal(re_hb_echo(1000000000L - 9990), 10);
+	assert_int_equal(re_hb_echo(-1), -1);
 	/* Out of range fields */
 	assert_int_equal(re_za_decode(0, 4, 0, &z), GL_ERR_RANGE);
 	assert_int_equal(re_za_decode(0, 180, 0, &z), GL_ERR_RANGE);

@@ -3,7 +3,8 @@
  * fault codes as dmc/roboelf.dmc raises them (#FAULT(n,...)), as the
  * supervisor names them (enum re_dmc_fcode, pc/super/re_dmcif.h), and as
  * docs/dmc-interface.md lists them ("| n | NAME |") are the same set with
- * the same names. Sources are read from ROBOELF_TOP (default ".").
+ * the same names; ZAB's layout (the echo's weight and modulus) is the
+ * program's. Sources are read from ROBOELF_TOP (default ".").
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -188,6 +189,29 @@ static void test_version_agrees(void **state)
 	free(text);
 }
 
+/* ZAB's layout as the supervisor decodes it (RE_ZAB_*, RE_HB_ECHO_MOD) is
+ * the one dmc/roboelf.dmc publishes: its zb line and the echo's constants
+ * in dmc/constants.dmc. */
+static void test_zab_agrees(void **state)
+{
+	char *consts = slurp("dmc/constants.dmc");
+	char *prog = slurp("dmc/roboelf.dmc");
+	char want[96];
+
+	(void)state;
+	snprintf(want, sizeof(want), "\nhbemod=%ld;hbemul=%ld\n",
+		 RE_HB_ECHO_MOD, RE_ZAB_ECHO);
+	if (!strstr(consts, want))
+		fail_msg("dmc/constants.dmc has no line '%s'", want + 1);
+	snprintf(want, sizeof(want),
+		 "\nzb=state+(fcode*%ld)+(faxis*%ld)+(hbe*hbemul)\n",
+		 RE_ZAB_FCODE, RE_ZAB_FAXIS);
+	if (!strstr(prog, want))
+		fail_msg("dmc/roboelf.dmc has no line '%s'", want + 1);
+	free(consts);
+	free(prog);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -196,6 +220,7 @@ int main(void)
 	    cmocka_unit_test(test_dmc_raises_known_codes),
 	    cmocka_unit_test(test_docs_agree),
 	    cmocka_unit_test(test_version_agrees),
+	    cmocka_unit_test(test_zab_agrees),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

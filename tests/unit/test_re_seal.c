@@ -77,11 +77,11 @@ static void test_table(void **state)
 	it = item(&seal, "vers", &k);
 	assert_int_equal(k, 1);
 	assert_int_equal(it->kind, RE_SEAL_CONST);
-	assert_string_equal(it->lit, "2.22");
+	assert_string_equal(it->lit, "2.23");
 	it = item(&seal, "rampov", NULL);
 	assert_true(it->value == 1.25);
 	it = item(&seal, "vmax[0]", &k);
-	assert_int_equal(k, 26); /* after the 22 constants and 3 vmin */
+	assert_int_equal(k, 28); /* after the 24 constants and 3 vmin */
 	assert_int_equal(it->kind, RE_SEAL_PARAM);
 	assert_true(it->value == c.axes[0].vmax_cps);
 	assert_int_equal(it->axis, 0);
