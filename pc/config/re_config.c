@@ -376,13 +376,15 @@ int re_config_dump(const struct re_config *cfg, char *buf, size_t cap)
 	}
 	n = (size_t)snprintf(
 	    buf, cap,
-	    "mode %s, period %d ms, controller %s (%s, timeout %d ms), "
+	    "mode %s, period %d ms, controller %s (%s, timeout %d ms, "
+	    "record %s, UDP port %d), "
 	    "relay %s (%s, channel %d, backend %s, %d baud%s), watchdog "
 	    "%g/%g x period, controller watchdog %d ms, joystick inputs "
 	    "%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d%s, invalid timeout %d "
 	    "ms, calibration %s, log %s (%ld bytes x %d), hash %016" PRIx64,
 	    re_mode_name(cfg->mode), cfg->period_ms, cfg->controller.address,
 	    cfg->controller.model, cfg->controller.timeout_ms,
+	    re_record_name(cfg->controller.record), cfg->controller.udp_port,
 	    re_config_relay_port(cfg), re_relay_proto_name(cfg->relay.protocol),
 	    cfg->relay.channel, cfg_backend_names[cfg->relay.backend % 3],
 	    cfg->relay.baud, cfg->relay.readback ? ", read-back" : "",

@@ -35,6 +35,12 @@
  * about 100 bytes each (34 in that file: RE_CONFIG_ERR_MAX holds them). */
 #define RE_CONFIG_FILL_IN "FILL-IN"
 
+/* How the cycle gets the controller's data record (docs/link.md). */
+enum re_record {
+	RE_RECORD_POLL = 0, /* default: one "hbpc=N;QR" round trip a cycle */
+	RE_RECORD_STREAM,   /* the controller sends it (DR) to a UDP handle */
+};
+
 enum re_mode {
 	RE_MODE_CLINICAL = 0, /* default: real relay through libserialport,
 			       * real (non-loopback) controller */
@@ -48,6 +54,10 @@ struct re_config_controller {
 	int connect_timeout_ms;	   /* deadline of the TCP connect */
 	int power_output;	   /* digital output that closes the motor-
 				    * power chain (DMC pwrout), 0: none */
+	enum re_record record;	   /* how the cycle gets the record */
+	int udp_port;		   /* the controller's UDP command port,
+				    * where the record stream's handle
+				    * opens (60007 on a DMC-40x0) */
 };
 
 struct re_config_relay {
@@ -91,6 +101,9 @@ enum re_unit {
 	RE_UNIT_DEG = 0, /* a rotary axis, degrees */
 	RE_UNIT_MM,	 /* a linear axis, millimetres */
 };
+
+/* re_record_name() - "poll" or "stream". */
+const char *re_record_name(enum re_record r);
 
 /* re_unit_name() - "deg" or "mm". */
 const char *re_unit_name(enum re_unit u);

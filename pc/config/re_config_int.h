@@ -64,6 +64,7 @@ struct pctx {
 extern const char *const cfg_mode_names[];
 extern const char *const cfg_backend_names[];
 extern const char *const cfg_unit_names[];
+extern const char *const cfg_record_names[];
 extern const char *const cfg_proto_names[];
 extern const int cfg_bauds[8];
 

@@ -22,7 +22,8 @@
 #include "re_rt.h"
 
 _Static_assert(sizeof(enum re_mode) == sizeof(int) &&
-		   sizeof(enum re_relay_backend) == sizeof(int),
+		   sizeof(enum re_relay_backend) == sizeof(int) &&
+		   sizeof(enum re_record) == sizeof(int),
 	       "FT_ENUM stores an int");
 
 /* ---- messages and positions ---- */

@@ -24,6 +24,7 @@
 const char *const cfg_mode_names[] = {"clinical", "development", NULL};
 const char *const cfg_backend_names[] = {"auto", "serialport", "tty", NULL};
 const char *const cfg_unit_names[] = {"deg", "mm", NULL};
+const char *const cfg_record_names[] = {"poll", "stream", NULL};
 const char *const cfg_proto_names[] = {"devantech", "icstation", "lcus",
 				       "kmtronic", NULL};
 const int cfg_bauds[] = {1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200};
@@ -209,6 +210,8 @@ static const struct field controller_fields[] = {
 	I(struct re_config_controller, timeout_ms, 5, 10000),
 	I(struct re_config_controller, connect_timeout_ms, 100, 60000),
 	I(struct re_config_controller, power_output, 0, 8),
+	E(struct re_config_controller, record, cfg_record_names, 1),
+	I(struct re_config_controller, udp_port, 1, 65535),
 	END,
 };
 
@@ -387,6 +390,11 @@ static void axis_defaults(struct re_config_axis *a, int i)
 	a->counts_per_unit = 0; /* not known: the console shows counts */
 }
 
+const char *re_record_name(enum re_record r)
+{
+	return r == RE_RECORD_STREAM ? "stream" : "poll";
+}
+
 const char *re_unit_name(enum re_unit u)
 {
 	return u == RE_UNIT_MM ? "mm" : "deg";
@@ -424,6 +432,8 @@ void re_config_defaults(struct re_config *out)
 		 "DMC4030");
 	out->controller.timeout_ms = 100;
 	out->controller.connect_timeout_ms = 2000;
+	out->controller.record = RE_RECORD_POLL;
+	out->controller.udp_port = 60007; /* galil-notes 1.1 */
 	relay_defaults(&out->relay);
 	out->watchdog.noncritical_factor = 1.5;
 	out->watchdog.critical_factor = 2.5;

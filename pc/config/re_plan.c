@@ -111,6 +111,20 @@ void re_plan_make(const struct re_config *cfg, int mainms, struct re_plan *out)
 	    (int64_t)(2 * ms + DECEL_MS + 50) * BASE_NS_PER_MS + 2 * p_ns;
 	out->fresh_stop_ms = 2 * cfg->controller.timeout_ms;
 	out->relay_off_ms = cfg->relay.off_deadline_ms;
+	out->ctl_sample_ns = RE_PLAN_CTL_SAMPLE_NS;
+	out->stream_n0 = re_plan_stream_n0(p_ns, out->ctl_sample_ns);
+}
+
+unsigned re_plan_stream_n0(int64_t period_ns, int64_t sample_ns)
+{
+	int64_t n0;
+
+	if (period_ns <= 0 || sample_ns <= 0)
+		return RE_PLAN_STREAM_N0_MIN;
+	/* a lost record costs a quarter of a cycle, not a whole one */
+	n0 = period_ns / 4 / sample_ns;
+	return n0 < RE_PLAN_STREAM_N0_MIN ? RE_PLAN_STREAM_N0_MIN
+					  : (unsigned)n0;
 }
 
 void re_plan_super_cfg(const struct re_plan *p, const struct re_config *cfg,

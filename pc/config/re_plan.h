@@ -51,9 +51,18 @@ struct re_plan {
 	int settle_ms;		 /* wait for the program's own verdict */
 	int fresh_stop_ms;	 /* the stop over a new connection */
 	int relay_off_ms;	 /* relay off confirmed within */
+	int64_t ctl_sample_ns;	 /* one controller servo sample, ns */
+	unsigned stream_n0;	 /* samples between two streamed records
+				  * (DR n0): a quarter of the period */
 };
 
 #define RE_PLAN_SAMPLE_MS 10 /* the cycle while calibrating, ms */
+/* One servo sample of a DMC-40x0 at TM 1000, the only TM the program
+ * accepts (its seal, re_seal.c): 1000/1024 ms = 976 562.5 ns, rounded
+ * (galil-notes 1.7; docs/dmc-interface.md). galil-sim's is 1 ms: the
+ * stream's interval there is 2.4 % longer than the plan says. */
+#define RE_PLAN_CTL_SAMPLE_NS 976563
+#define RE_PLAN_STREAM_N0_MIN 2 /* the shortest DR interval (docs/link.md) */
 
 /*
  * re_plan_make() - derive the plan from @cfg (validated) and @mainms (the
@@ -62,6 +71,16 @@ struct re_plan {
  * @out: [out] the plan.
  */
 void re_plan_make(const struct re_config *cfg, int mainms, struct re_plan *out);
+
+/*
+ * re_plan_stream_n0() - the record stream's interval (DR n0) for a cycle
+ * of @period_ns and a controller sample of @sample_ns: a quarter of the
+ * period in whole samples, at least RE_PLAN_STREAM_N0_MIN (a lost record
+ * then costs a quarter of a cycle; docs/link.md). At 976 563 ns: 50 ms
+ * gives 12, 10 ms gives 2, 2 ms gives 2.
+ * Return: n0 >= 2 (also for a non-positive argument).
+ */
+unsigned re_plan_stream_n0(int64_t period_ns, int64_t sample_ns);
 
 /*
  * re_plan_super_cfg() - the supervisor's settings from the plan.

@@ -277,6 +277,13 @@ void re_app_power_off(struct app *a, int latched)
 	if (a->relay && re_relay_close(a->relay) != GL_OK)
 		rc = rc ? rc : GL_ERR_RELAY;
 	a->relay = a->real.relay = NULL;
+	/* "DR 0": the controller stops sending (a link reopened by the
+	 * fault path has no stream: nothing to close) */
+	if (a->stream && a->real.link && a->ctl_ours &&
+	    gl_link_stream_info(a->real.link, NULL, NULL) == 1)
+		gl_link_stream_close(a->real.link,
+				     a->cfg.controller.timeout_ms);
+	a->stream = 0;
 	gl_link_close(a->real.link);
 	a->real.link = NULL;
 	if (!a->powered) {

@@ -17,6 +17,7 @@
 #include "gl_link.h"
 #include "gl_route.h"
 #include "re_bind.h"
+#include "re_linkmeas.h"
 
 struct re_signals re_sig;
 
@@ -302,6 +303,40 @@ static int prepare_controller(struct app *a)
 	return 0;
 }
 
+/* The way of the record (controller.record) and the link measured, one
+ * line: in the safe state, where the program's watchdog does not run.
+ * With "stream" the controller's DR stream is opened after the take-over
+ * (its IHT=>-3 closed every UDP handle too) and before the cycle's first
+ * record, and its first records timed. */
+static int open_record(struct app *a)
+{
+	const struct re_config_controller *cc = &a->cfg.controller;
+	struct re_linkmeas m = {0};
+	gl_link *l = a->real.link;
+	char line[400];
+	int rc;
+
+	if (cc->record == RE_RECORD_STREAM) {
+		rc = re_linkmeas_stream(
+		    l, cc->address, cc->udp_port, a->plan.stream_n0,
+		    a->plan.ctl_sample_ns, &m, a->err, sizeof(a->err));
+		/* opened: closed again by the power-off, on every way out */
+		a->stream = gl_link_stream_info(l, NULL, NULL) == 1;
+		if (rc != GL_OK)
+			return re_start_fail(a, a->err);
+	}
+	rc = re_linkmeas_reply(l, RE_LINKMEAS_REPLIES, cc->timeout_ms, &m);
+	if (rc != GL_OK) {
+		snprintf(a->err, sizeof(a->err),
+			 "the controller at %s did not answer 'MG TIME': %s",
+			 cc->address, gl_strerror(rc));
+		return re_start_fail(a, a->err);
+	}
+	re_linkmeas_line(&m, line, sizeof(line));
+	re_start_progress(a, "%s", line);
+	return 0;
+}
+
 static int power_on(struct app *a)
 {
 	if (re_relay_on(a->relay) != GL_OK) {
@@ -324,6 +359,7 @@ static int init_super(struct app *a)
 	re_plan_xcheck_cfg(&a->plan, &a->cfg, a->names, &a->xcheck);
 	sc.seal = &a->seal;
 	sc.xcheck = &a->xcheck;
+	sc.stream = a->stream;
 	a->sup = re_super_new();
 	if (!a->sup || re_super_init(a->sup, &a->io, &sc, NULL, 0) != GL_OK)
 		return re_start_fail(a, "cannot set up the supervisor");
@@ -847,8 +883,8 @@ typedef int (*startup_step)(struct app *a);
 int re_start(struct app *a)
 {
 	static const startup_step steps[] = {
-	    choose_calibration, prepare_controller, init_super, power_on,
-	    enter_service,	calibrate,	    arm,
+	    choose_calibration, prepare_controller, open_record, init_super,
+	    power_on,		enter_service,	    calibrate,	 arm,
 	};
 	static const struct re_bringup b = {NULL, 1, check_stall};
 	int rc;

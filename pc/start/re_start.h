@@ -69,6 +69,7 @@ struct app {
 	struct re_calib *calrun; /* the calibration running, or NULL */
 	const struct re_calib_cfg *calcfg; /* its settings */
 	int ctl_ours; /* the controller was taken over: ours to stop */
+	int stream;   /* the record stream is open (controller.record) */
 	/* after arming: 0 "Ready" not said yet, 1 said; held_said: the
 	 * operator was told to release a joystick held at arming */
 	int ready_said, held_said;

@@ -172,15 +172,24 @@ static int subst_write(FILE *f, const char *src, const struct sys_subst *base,
 	return 0;
 }
 
+const char *sys_record(void)
+{
+	const char *v = getenv("ROBOELF_SYS_RECORD");
+
+	return v && *v ? v : NULL;
+}
+
 int sys_env_write_config(struct sys_env *e, const struct sys_subst *subst,
 			 const char *path)
 {
 	char src_path[SYS_PATH_MAX + 32], cal[SYS_PATH_MAX + 8],
 	    log[SYS_PATH_MAX + 16], ics[SYS_PATH_MAX + 16];
+	const char *rec = sys_record();
 	struct sys_subst base[] = {
 	    {"file", cal},
 	    {"path", log},
 	    {"icstation_state", ics},
+	    {rec ? "record" : NULL, rec},
 	    {NULL, NULL},
 	};
 	char *src;
@@ -630,6 +639,58 @@ static int check_armed(struct sys_case *c)
 	return 0;
 }
 
+/* galil-sim with @o's arguments and always a UDP port (--udp-port 0: the
+ * record stream's, any free one), read from its ready line. */
+static int start_sim(struct sys_case *c, const struct sys_opts *o)
+{
+	char *args[SYS_SIM_ARGS_MAX + 3];
+	int n = 0;
+
+	for (int i = 0; o->sim_args && o->sim_args[i]; i++) {
+		if (n == SYS_SIM_ARGS_MAX) {
+			seterr(c->err, "more than %d galil-sim arguments",
+			       SYS_SIM_ARGS_MAX);
+			return -1;
+		}
+		args[n++] = o->sim_args[i];
+	}
+	args[n++] = (char *)"--udp-port";
+	args[n++] = (char *)"0";
+	args[n] = NULL;
+	if (proc_sim_start_wrapped(&c->sim, o->sim_wrap, c->env->bin,
+				   c->relay_link,
+				   o->sim_wrap ? "0.0.0.0" : NULL, args,
+				   10000) < 0) {
+		seterr(c->err, "galil-sim did not start ('%s/galil-sim')",
+		       c->env->bin);
+		return -1;
+	}
+	return 0;
+}
+
+/* The case's own configuration: @o's variant, and controller.udp_port
+ * galil-sim's (unless the variant sets it). */
+static int case_config(struct sys_case *c, const struct sys_opts *o)
+{
+	struct sys_subst all[SYS_SUBST_MAX + 2];
+	char udp[16];
+	int n = 0;
+
+	for (int i = 0; o->subst && o->subst[i].key && n < SYS_SUBST_MAX; i++)
+		all[n++] = o->subst[i];
+	all[n] = (struct sys_subst){NULL, NULL};
+	snprintf(udp, sizeof(udp), "%d", c->sim.udp_port);
+	if (!has_key(all, "udp_port")) {
+		all[n++] = (struct sys_subst){"udp_port", udp};
+		all[n] = (struct sys_subst){NULL, NULL};
+	}
+	if (sys_env_write_config(c->env, all, c->cfg) < 0) {
+		seterr(c->err, "%s", c->env->err);
+		return -1;
+	}
+	return 0;
+}
+
 int sys_case_start(struct sys_case *c, struct sys_env *e,
 		   const struct sys_opts *o)
 {
@@ -643,31 +704,20 @@ int sys_case_start(struct sys_case *c, struct sys_env *e,
 	snprintf(c->relay_link, sizeof(c->relay_link), "%s/relay-%d", e->dir,
 		 c->id);
 	snprintf(c->log, sizeof(c->log), "%s/case-%d.log", e->dir, c->id);
-	snprintf(c->cfg, sizeof(c->cfg), "%s", e->cfg);
+	snprintf(c->cfg, sizeof(c->cfg), "%s/case-%d.yaml", e->dir, c->id);
 	c->bufcap = EVT_BUF;
 	c->buf = malloc(c->bufcap);
 	if (!c->buf) {
 		seterr(c->err, "out of memory");
 		return -1;
 	}
-	if (o->subst) {
-		snprintf(c->cfg, sizeof(c->cfg), "%s/case-%d.yaml", e->dir,
-			 c->id);
-		if (sys_env_write_config(e, o->subst, c->cfg) < 0) {
-			seterr(c->err, "%s", e->err);
-			goto fail;
-		}
-	}
 	snprintf(c->sim_addr, sizeof(c->sim_addr), "%s",
 		 o->sim_addr ? o->sim_addr : "127.0.0.1");
-	if (proc_sim_start_wrapped(&c->sim, o->sim_wrap, e->bin, c->relay_link,
-				   o->sim_wrap ? "0.0.0.0" : NULL, o->sim_args,
-				   10000) < 0) {
-		seterr(c->err, "galil-sim did not start ('%s/galil-sim')",
-		       e->bin);
+	if (start_sim(c, o) < 0)
 		goto fail;
-	}
 	c->sim_up = 1;
+	if (case_config(c, o) < 0)
+		goto fail;
 	c->ctl =
 	    proc_ctl_connect_at(o->ctl_addr, c->sim.ctl_port, CTL_TIMEOUT_MS);
 	if (c->ctl < 0) {

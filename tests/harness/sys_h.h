@@ -6,8 +6,10 @@
  * ONE full calibration (sys_env_calibrate()) whose file every case then
  * loads with `--calibration file`, so that a case starts in a few seconds.
  *
- * One struct sys_case per test case: a fresh galil-sim (free ports, its
- * virtual relay linked inside the temporary directory), dmc/ checked,
+ * One struct sys_case per test case: a fresh galil-sim (free ports, a UDP
+ * port for the record stream too, its virtual relay linked inside the
+ * temporary directory), the case's own configuration (the variant, and
+ * controller.udp_port galil-sim's), dmc/ checked,
  * downloaded and started with galil-load (unless no_load), and roboelf
  * started against both
  * with command-line options; the case is ready when roboelf prints
@@ -24,7 +26,10 @@
  *
  * Environment: ROBOELF_BIN (the binaries; default $BUILD/bin or build/bin),
  * ROBOELF_TOP (the repository root; default "."), ROBOELF_KEEP=1 keeps the
- * temporary directory.
+ * temporary directory, ROBOELF_SYS_RECORD=stream|poll sets
+ * controller.record in every configuration written (unset: the
+ * configuration's default; any other value is refused by roboelf's own
+ * check of the configuration, naming it).
  */
 #ifndef SYS_H_H
 #define SYS_H_H
@@ -39,6 +44,7 @@
 #define SYS_ERR_MAX   1024
 #define SYS_EVT_TEXT  160
 #define SYS_SUBST_MAX 16   /* config substitutions per variant */
+#define SYS_SIM_ARGS_MAX 40 /* extra galil-sim arguments per case */
 #define SYS_STILL_CPS 1000 /* |velocity| of an axis at rest, counts/s */
 
 /* The default timing figures of config/roboelf.yaml and dmc/constants.dmc
@@ -191,8 +197,14 @@ int sys_env_ready(struct sys_env *e);
 void sys_env_done(struct sys_env *e, int ready);
 
 /*
+ * sys_record() - ROBOELF_SYS_RECORD (controller.record for every system
+ * test), or NULL when unset or empty (the configuration's default).
+ */
+const char *sys_record(void);
+
+/*
  * sys_env_write_config() - write a copy of the test configuration with
- * @subst applied to @path.
+ * @subst applied to @path (and controller.record from sys_record()).
  * Return: 0, or -1 with e->err set (a key that is not found is an error).
  */
 int sys_env_write_config(struct sys_env *e, const struct sys_subst *subst,

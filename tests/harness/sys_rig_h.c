@@ -92,7 +92,7 @@ static int write_text(const char *path, const char *text)
 /* The short robot's configuration (travel 20000 / 20000 / 16000). OT 1000
  * samples, so that a jam trips the position error, as test_sys_basic. */
 static int write_config(const struct sys_env *e, const char *path,
-			const char *log, int power_output)
+			const char *log, int power_output, int udp_port)
 {
 	static const char axis_fmt[] =
 	    "  - {name: %s, travel_counts: %d, vmin: %d, vmax: %d,\n"
@@ -101,19 +101,21 @@ static int write_config(const struct sys_env *e, const char *path,
 	    "     encoder_failure: {time_samples: 1000}}\n";
 	static const char *const names[3] = {"A", "B", "C"};
 	static const int travel[3] = {20000, 20000, 16000};
+	const char *rec = sys_record();
 	char text[4096];
 	int n;
 
 	n = snprintf(text, sizeof(text),
 		     "mode: development\nperiod_ms: %d\n"
-		     "controller: {power_output: %d}\n"
+		     "controller: {power_output: %d, udp_port: %d%s%s}\n"
 		     "relay: {readback: true, readback_timeout_ms: %d}\n"
 		     "watchdog: {noncritical_factor: %g, critical_factor: "
 		     "%g,\n  controller_timeout_ms: %d}\n"
 		     "joystick: {invalid_timeout_ms: %d}\n"
 		     "calibration: {file: \"%s\", near_margin_counts: %d}\n"
 		     "log: {path: \"%s\"}\naxes:\n",
-		     RIG_PERIOD_MS, power_output, RIG_READBACK_MS,
+		     RIG_PERIOD_MS, power_output, udp_port,
+		     rec ? ", record: " : "", rec ? rec : "", RIG_READBACK_MS,
 		     RIG_NONCRIT_F, RIG_CRIT_F, RIG_WDTO_MS, RIG_JTO_MS, e->cal,
 		     RIG_NEAR_MARGIN, log);
 	for (int i = 0; i < 3; i++)
@@ -302,7 +304,7 @@ static int start_roboelf(struct sys_case *c, const char *calibration)
 int rig_start(struct sys_case *c, struct sys_env *e, const struct rig_opts *o)
 {
 	char pout[8], plant[SYS_PATH_MAX + 16];
-	char *extra[8];
+	char *extra[10];
 	int n = 0;
 
 	memset(c, 0, sizeof(*c));
@@ -316,8 +318,8 @@ int rig_start(struct sys_case *c, struct sys_env *e, const struct rig_opts *o)
 	snprintf(c->cfg, sizeof(c->cfg), "%s/case-%d.yaml", e->dir, c->id);
 	c->bufcap = 512 * 1024;
 	c->buf = malloc(c->bufcap);
-	if (!c->buf || write_config(e, c->cfg, c->log, o->power_output) < 0) {
-		rig_seterr(c, "cannot write '%s'", c->cfg);
+	if (!c->buf) {
+		rig_seterr(c, "out of memory");
 		return -1;
 	}
 	snprintf(plant, sizeof(plant), PLANT_FMT, e->dir);
@@ -330,6 +332,8 @@ int rig_start(struct sys_case *c, struct sys_env *e, const struct rig_opts *o)
 	}
 	if (o->no_amp_uv)
 		extra[n++] = (char *)"--no-amp-undervoltage";
+	extra[n++] = (char *)"--udp-port"; /* the record stream's */
+	extra[n++] = (char *)"0";
 	extra[n] = NULL;
 	if (proc_sim_start(&c->sim, e->bin, c->relay_link, extra,
 			   RIG_START_MS) < 0) {
@@ -337,6 +341,11 @@ int rig_start(struct sys_case *c, struct sys_env *e, const struct rig_opts *o)
 		return -1;
 	}
 	c->sim_up = 1;
+	if (write_config(e, c->cfg, c->log, o->power_output, c->sim.udp_port) <
+	    0) {
+		rig_seterr(c, "cannot write '%s'", c->cfg);
+		return -1;
+	}
 	c->ctl = proc_ctl_connect(c->sim.ctl_port, RIG_START_MS);
 	if (c->ctl < 0) {
 		rig_seterr(c, "cannot connect to the control port");

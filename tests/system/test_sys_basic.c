@@ -25,6 +25,7 @@
 
 #include "base_version.h"
 #include "proc.h"
+#include "sys_h.h"
 
 #define START_MS 10000 /* galil-sim, galil-load */
 #define READY_MS 60000 /* roboelf to "RoboELF Ready for Use" */
@@ -88,16 +89,21 @@ static int write_config(struct rig *r, int port, const char *relay,
 	    "  - {name: %s, travel_counts: %d, position_error_limit_counts:"
 	    " 800, step_counts: 1000,\n"
 	    "     encoder_failure: {time_samples: 1000}}\n";
-	char text[4096];
+	const char *rec = sys_record();
+	char text[4096], udp[32] = "";
 	int n;
 
+	/* galil-sim's UDP port (the record stream's), when it runs */
+	if (r->sim.udp_port > 0)
+		snprintf(udp, sizeof(udp), ", udp_port: %d", r->sim.udp_port);
 	n = snprintf(text, sizeof(text),
 		     "mode: development\nperiod_ms: 50\n"
-		     "controller: {address: \"127.0.0.1:%d\"}\n"
+		     "controller: {address: \"127.0.0.1:%d\"%s%s%s}\n"
 		     "relay: {port_development: \"%s\", readback: true}\n"
 		     "calibration: {file: \"%s\", near_margin_counts: 500}\n"
 		     "log: {path: \"%s\"}\naxes:\n",
-		     port, relay, calfile, r->log);
+		     port, udp, rec ? ", record: " : "", rec ? rec : "", relay,
+		     calfile, r->log);
 	n += snprintf(text + n, sizeof(text) - (size_t)n, axis_fmt, "A", 20000);
 	n += snprintf(text + n, sizeof(text) - (size_t)n, axis_fmt, "B", 20000);
 	snprintf(text + n, sizeof(text) - (size_t)n, axis_fmt, "C", 16000);
@@ -107,7 +113,8 @@ static int write_config(struct rig *r, int port, const char *relay,
 static int sim_start(struct rig *r)
 {
 	char plant[300];
-	char *extra[] = {(char *)"--plant", plant, NULL};
+	char *extra[] = {(char *)"--plant", plant, (char *)"--udp-port",
+			 (char *)"0", NULL};
 
 	path(plant, sizeof(plant), "plant.yaml");
 	path(r->relay, sizeof(r->relay), "relay");

@@ -101,7 +101,9 @@ static void start_sim2(void)
 	char link[SYS_PATH_MAX + 16];
 
 	snprintf(link, sizeof(link), "%s/relay-other", env.dir);
-	if (proc_sim_start(&sim2, env.bin, link, NULL, 10000) < 0)
+	char *extra[] = {(char *)"--udp-port", (char *)"0", NULL};
+
+	if (proc_sim_start(&sim2, env.bin, link, extra, 10000) < 0)
 		fail_msg("a second galil-sim did not start");
 }
 
@@ -228,13 +230,18 @@ static void spawn_second(struct proc *p, const char *cfg, const char *galil,
 		fail_msg("cannot start '%s': %s", bin, strerror(errno));
 }
 
-/* A configuration copy naming controller @addr and relay @port. */
-static void write_config(const char *path, const char *addr, const char *port)
+/* A configuration copy naming controller @addr (its UDP port @udp) and
+ * relay @port. */
+static void write_config(const char *path, const char *addr, int udp,
+			 const char *port)
 {
-	char qa[SYS_PATH_MAX + 4], qp[SYS_PATH_MAX + 4];
-	struct sys_subst sub[] = {
-	    {"address", qa}, {"port_development", qp}, {NULL, NULL}};
+	char qa[SYS_PATH_MAX + 4], qp[SYS_PATH_MAX + 4], qu[16];
+	struct sys_subst sub[] = {{"address", qa},
+				  {"port_development", qp},
+				  {"udp_port", qu},
+				  {NULL, NULL}};
 
+	snprintf(qu, sizeof(qu), "%d", udp);
 	snprintf(qa, sizeof(qa), "\"%s\"", addr);
 	snprintf(qp, sizeof(qp), "\"%s\"", port);
 	if (sys_env_write_config(&env, sub, path) < 0)
@@ -342,7 +349,7 @@ static void test_second_same_relay(void **state)
 	start_sim2();
 	snprintf(cfg, sizeof(cfg), "%s/same-relay.yaml", env.dir);
 	snprintf(addr, sizeof(addr), "127.0.0.1:%d", sim2.port);
-	write_config(cfg, addr, cs.sim.relay);
+	write_config(cfg, addr, sim2.udp_port, cs.sim.relay);
 	snprintf(tpl, sizeof(tpl),
 		 "roboelf: error: relay %s is already supervised by roboelf "
 		 "(pid {n}, since {t})",
@@ -371,7 +378,7 @@ static void test_second_same_controller(void **state)
 	start_sim2();
 	snprintf(cfg, sizeof(cfg), "%s/same-controller.yaml", env.dir);
 	snprintf(addr, sizeof(addr), "127.0.0.1:%d", cs.sim.port);
-	write_config(cfg, addr, sim2_relay());
+	write_config(cfg, addr, cs.sim.udp_port, sim2_relay());
 	snprintf(tpl, sizeof(tpl),
 		 "roboelf: error: controller %s is already supervised by "
 		 "roboelf (pid {n}, since {t})",
@@ -410,7 +417,7 @@ static void test_second_other_host(void **state)
 	start_sim2();
 	snprintf(cfg, sizeof(cfg), "%s/other-host.yaml", env.dir);
 	snprintf(addr, sizeof(addr), "127.0.0.1:%d", cs.sim.port);
-	write_config(cfg, addr, sim2_relay());
+	write_config(cfg, addr, cs.sim.udp_port, sim2_relay());
 	t0 = sys_sim_time(&cs);
 	w0 = proc_now_ms();
 	spawn_second(&re2, cfg, NULL, NULL, fx.lock_env2);

@@ -107,6 +107,10 @@ static const struct bad_case bad_cases[] = {
      "-0.250 V) is below 0.1 V, so an open potentiometer (0 V) would look "
      "like the axis at its end stop: make 'near_margin_counts' at most "
      "600"},
+    {"bad_record.yaml", 3, 11,
+     "'record' must be poll or stream, got 'udp'"},
+    {"bad_udp_port.yaml", 4, 13,
+     "'udp_port' must be between 1 and 65535, got 0"},
     {"bad_power_output.yaml", 3, 17,
      "'power_output' must be between 0 and 8, got 9"},
     {"bad_invalid_timeout.yaml", 3, 23,
@@ -252,6 +256,8 @@ static void test_defaults_documented(void **state)
 	assert_string_equal(c.controller.model, "DMC4030");
 	assert_int_equal(c.controller.timeout_ms, 100);
 	assert_int_equal(c.controller.connect_timeout_ms, 2000);
+	assert_int_equal(c.controller.record, RE_RECORD_POLL);
+	assert_int_equal(c.controller.udp_port, 60007);
 	assert_string_equal(c.relay.port_clinical, "");
 	assert_string_equal(c.relay.port_development, "/tmp/roboelf-relay");
 	assert_int_equal(c.relay.protocol, RE_RELAY_DEVANTECH);
@@ -446,6 +452,8 @@ static void emit(struct sbuf *b, const struct re_config *c)
 	put(b, "  timeout_ms: %d\n  connect_timeout_ms: %d\n",
 	    c->controller.timeout_ms, c->controller.connect_timeout_ms);
 	put(b, "  power_output: %d\n", c->controller.power_output);
+	put(b, "  record: %s\n  udp_port: %d\n",
+	    re_record_name(c->controller.record), c->controller.udp_port);
 	put(b, "relay:\n  port_clinical: \"%s\"\n  port_development: \"%s\"\n",
 	    c->relay.port_clinical, c->relay.port_development);
 	put(b, "  serial: \"%s\"\n", c->relay.serial);
@@ -506,6 +514,8 @@ static void changed(struct re_config *c)
 	strcpy(c->controller.model, "DMC4040");
 	c->controller.timeout_ms = 75;
 	c->controller.connect_timeout_ms = 1500;
+	c->controller.record = RE_RECORD_STREAM;
+	c->controller.udp_port = 23;
 	strcpy(c->relay.port_clinical, "/dev/serial/by-id/usb-relay");
 	strcpy(c->relay.port_development, "/tmp/other-relay");
 	strcpy(c->relay.serial, "FT4-ab.c_1:2");
@@ -1090,6 +1100,9 @@ static void test_site_template_filled(void **state)
 	assert_int_equal(c.mode, RE_MODE_CLINICAL);
 	assert_string_equal(c.controller.address, "192.0.2.10");
 	assert_int_equal(c.controller.power_output, 4);
+	/* not site keys: the defaults */
+	assert_int_equal(c.controller.record, RE_RECORD_POLL);
+	assert_int_equal(c.controller.udp_port, 60007);
 	assert_string_equal(c.relay.port_clinical, "/dev/roboelf-relay");
 	assert_string_equal(c.relay.serial, "A10KXYZ9");
 	assert_int_equal(c.relay.protocol, RE_RELAY_LCUS);

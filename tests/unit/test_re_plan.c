@@ -149,12 +149,47 @@ static void test_plan_seek_clamped(void **state)
 	assert_int_equal(p.axis[0].seek_cps, 50000);
 }
 
+/* The record stream's interval: a quarter of the period in whole samples
+ * of a DMC-40x0 at TM 1000 (976 563 ns), never below 2 (docs/link.md). */
+static void test_plan_stream_n0(void **state)
+{
+	static const struct {
+		int period_ms;
+		unsigned n0;
+	} cases[] = {
+	    {50, 12},  /* 12.5 ms / 0.9766 ms = 12.8 */
+	    {10, 2},   /* 2.5 ms: 2.56 */
+	    {2, 2},    /* 0.5 ms: 0.51, raised to the minimum */
+	    {100, 25}, /* 25 ms: 25.6 */
+	    {20, 5},   /* 5 ms: 5.12 */
+	};
+	struct re_config c;
+	struct re_plan p;
+
+	(void)state;
+	for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
+		re_config_defaults(&c);
+		c.period_ms = cases[i].period_ms;
+		re_plan_make(&c, 0, &p);
+		assert_int_equal(p.ctl_sample_ns, 976563);
+		assert_int_equal(p.stream_n0, cases[i].n0);
+	}
+	/* galil-sim's 1 ms sample: 12.5 samples at 50 ms, 2.5 at 10 ms */
+	assert_int_equal(re_plan_stream_n0(50 * MS, 1000000), 12);
+	assert_int_equal(re_plan_stream_n0(10 * MS, 1000000), 2);
+	assert_int_equal(re_plan_stream_n0(2 * MS, 1000000), 2);
+	assert_int_equal(re_plan_stream_n0(16 * MS, 1000000), 4);
+	assert_int_equal(re_plan_stream_n0(0, 1000000), 2);
+	assert_int_equal(re_plan_stream_n0(50 * MS, 0), 2);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_plan_defaults),
 	    cmocka_unit_test(test_plan_variant),
 	    cmocka_unit_test(test_plan_seek_clamped),
+	    cmocka_unit_test(test_plan_stream_n0),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -5,6 +5,11 @@
  * reference (the page is named in the item). Motor power stays off; every
  * setting a probe changes is put back.
  *
+ * The identity step also measures the link as the supervisor will use it:
+ * the command handle's reply time and the controller's record stream (DR
+ * to a UDP handle of this PC, opened and closed again): the interval is
+ * the commissioning's measure of the real controller (docs/link.md).
+ *
  * A probe FAILs when our programs or the supervisor would not work or not
  * be safe with the answer seen; it is a NOTE when the answer differs from
  * the reference (or the reference is silent) and our programs are safe
@@ -22,6 +27,8 @@
 #include "re_comm_util.h"
 #include "re_ctl.h"
 #include "re_dmcif.h"
+#include "re_linkmeas.h"
+#include "re_plan.h"
 
 #define STEP "firmware"
 
@@ -86,6 +93,109 @@ static int ask_lines(struct re_comm *c, const char *cmd, char *out, size_t cap)
 	return rc == GL_ERR_OVERFLOW ? (int)strlen(out) : rc;
 }
 
+#define DR_REF_MIN 8 /* the command reference's shortest DR interval */
+
+/* A refused "DR @n0": whether the command reference's DR_REF_MIN samples
+ * are accepted instead (opened and closed again at once), in @out. */
+static void dr_ref_try(struct re_comm *c, const struct re_plan *p, unsigned n0,
+		       char *out, size_t cap)
+{
+	int udp = c->cfg->controller.udp_port;
+	double ms = 4.0 * DR_REF_MIN * (double)p->ctl_sample_ns / 1e6;
+
+	out[0] = '\0';
+	if (n0 >= DR_REF_MIN)
+		return;
+	if (gl_link_stream_open(c->link, udp, DR_REF_MIN, p->ctl_sample_ns,
+				RE_LINKMEAS_OPEN_MS, NULL) != GL_OK) {
+		snprintf(out, cap, "; DR %d refused too", DR_REF_MIN);
+		return;
+	}
+	gl_link_stream_close(c->link, 0);
+	snprintf(out, cap,
+		 "; DR %d accepted: the stream needs period_ms >= %.0f "
+		 "(a quarter of it >= %d samples)",
+		 DR_REF_MIN, ms + 0.5, DR_REF_MIN);
+}
+
+/* The stream opened, its records timed, closed; on failure its item
+ * (FAIL with controller.record: stream, else a NOTE) and GL_ERR_AGAIN. */
+static int stream_timing(struct re_comm *c, const struct re_plan *p,
+			 struct re_linkmeas *m)
+{
+	const struct re_config_controller *cc = &c->cfg->controller;
+	char why[GL_ERRTEXT_LEN] = "", more[160] = "";
+	double rec_ms = p->stream_n0 * (double)p->ctl_sample_ns / 1e6;
+	int dl_ms = (int)(3 * RE_LINKMEAS_RECORDS * rec_ms) + 500, code = 0;
+	int rc =
+	    gl_link_stream_open(c->link, cc->udp_port, p->stream_n0,
+				p->ctl_sample_ns, RE_LINKMEAS_OPEN_MS, why);
+	enum re_comm_res res =
+	    cc->record == RE_RECORD_STREAM ? RE_COMM_FAIL : RE_COMM_NOTE;
+
+	if (rc == GL_ERR_CTRL) {
+		const char *tc = gl_link_ctrl_error(c->link, &code);
+
+		snprintf(more, sizeof(more), " (TC1 '%d %s')", code, tc);
+		dr_ref_try(c, p, p->stream_n0, more + strlen(more),
+			   sizeof(more) - strlen(more));
+	}
+	if (rc == GL_OK) {
+		rc = re_linkmeas_records(c->link, RE_LINKMEAS_RECORDS,
+					 p->ctl_sample_ns, dl_ms, m);
+		gl_link_stream_close(c->link, 0);
+		if (rc == GL_ERR_TIMEOUT)
+			snprintf(why, sizeof(why),
+				 "only %d of %d records within %d ms",
+				 m->records, RE_LINKMEAS_RECORDS, dl_ms);
+		else if (rc != GL_OK)
+			snprintf(why, sizeof(why), "%s", gl_strerror(rc));
+	}
+	if (rc == GL_OK)
+		return GL_OK;
+	re_comm_add(c, "identity", "record-stream", res,
+		    res == RE_COMM_FAIL
+			? "set controller.record: poll, or make the stream "
+			  "work: controller.udp_port, UDP between controller "
+			  "and PC, a period_ms the controller's DR accepts "
+			  "(docs/link.md)"
+			: NULL,
+		    "DR %u (every %.1f ms) to a UDP handle, port %d: %s%s; "
+		    "controller.record is %s",
+		    p->stream_n0, rec_ms, cc->udp_port,
+		    why[0] ? why : gl_strerror(rc), more,
+		    re_record_name(cc->record));
+	return GL_ERR_AGAIN;
+}
+
+/* The link measured: the reply time, the record stream's interval. */
+static int link_timing(struct re_comm *c)
+{
+	struct re_linkmeas m = {0};
+	struct re_plan p;
+	char line[400];
+	const char *reply;
+	int rc;
+
+	if (!c->link)
+		return GL_OK;
+	re_plan_make(c->cfg, 0, &p);
+	rc = re_linkmeas_reply(c->link, RE_LINKMEAS_REPLIES,
+			       c->cfg->controller.timeout_ms, &m);
+	if (rc < 0)
+		return rc;
+	rc = stream_timing(c, &p, &m);
+	re_linkmeas_line(&m, line, sizeof(line));
+	reply = strstr(line, "command reply");
+	/* no stream measured: the reply time alone ("record polled" would
+	 * say what the configuration does, not what was measured) */
+	re_comm_add(c, "identity", "link", RE_COMM_PASS, NULL, "%s",
+		    rc == GL_OK || !reply ? line : reply);
+	if (rc == GL_OK || c->cfg->controller.record != RE_RECORD_STREAM)
+		return GL_OK;
+	return GL_ERR_MISMATCH;
+}
+
 int rc_step_identity(struct re_comm *c)
 {
 	char wh[64], qz[96];
@@ -127,7 +237,7 @@ int rc_step_identity(struct re_comm *c)
 		    "WH (this connection): %s; QZ: %s; servo sample TM: "
 		    "%.0f us",
 		    wh, qz, rc == GL_OK ? tm : -1.0);
-	return GL_OK;
+	return link_timing(c);
 }
 
 /* ---- the probes ---------------------------------------------------------- */
