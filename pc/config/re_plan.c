@@ -112,7 +112,15 @@ void re_plan_make(const struct re_config *cfg, int mainms, struct re_plan *out)
 	out->fresh_stop_ms = 2 * cfg->controller.timeout_ms;
 	out->relay_off_ms = cfg->relay.off_deadline_ms;
 	out->ctl_sample_ns = RE_PLAN_CTL_SAMPLE_NS;
-	out->stream_n0 = re_plan_stream_n0(p_ns, out->ctl_sample_ns);
+	/* from the fastest cycle (the calibration's, when shorter than the
+	 * period): every cycle of every phase finds a fresh record */
+	out->stream_n0 = re_plan_stream_n0(out->sample_ns, out->ctl_sample_ns);
+	/* the program takes a heartbeat within two passes (its check, then
+	 * the pass that publishes ZA) and the stream carries it within n0
+	 * samples: the echo's age may exceed the critical limit by that */
+	out->echo_limit_ns = out->wdog.crit_ns +
+			     2LL * ms * BASE_NS_PER_MS +
+			     (int64_t)out->stream_n0 * out->ctl_sample_ns;
 }
 
 unsigned re_plan_stream_n0(int64_t period_ns, int64_t sample_ns)
@@ -152,6 +160,7 @@ void re_plan_super_cfg(const struct re_plan *p, const struct re_config *cfg,
 	out->fault_cmd_timeout_ms = cfg->controller.timeout_ms;
 	out->fresh_stop_ms = p->fresh_stop_ms;
 	out->relay_off_ms = p->relay_off_ms;
+	out->echo_limit_ns = p->echo_limit_ns;
 	out->settle_ms = p->settle_ms;
 	out->uncmd_grace_ns = p->uncmd_grace_ns;
 	out->mode_name =

@@ -53,7 +53,10 @@ struct re_plan {
 	int relay_off_ms;	 /* relay off confirmed within */
 	int64_t ctl_sample_ns;	 /* one controller servo sample, ns */
 	unsigned stream_n0;	 /* samples between two streamed records
-				  * (DR n0): a quarter of the period */
+				  * (DR n0): a quarter of the fastest
+				  * cycle (sample_ns), at least 2 */
+	int64_t echo_limit_ns;	 /* the program's heartbeat echo: fault
+				  * when older (stream design) */
 };
 
 #define RE_PLAN_SAMPLE_MS 10 /* the cycle while calibrating, ms */

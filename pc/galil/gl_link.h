@@ -24,7 +24,11 @@ typedef struct gl_link gl_link;
 #define GL_DEFAULT_PORT 23
 #define GL_ERRTEXT_LEN	128
 #define GL_LINE_MAX	80 /* controller command-line limit, bytes */
-#define GL_LINK_STREAM_READS_MAX 64 /* datagrams per gl_link_stream_read() */
+/* datagrams per gl_link_stream_read(): more than a socket's default
+ * receive buffer (208 KB) holds of 190-byte records (about 270), so that
+ * after a pause (between two phases) the newest record is reached in one
+ * call, not the oldest of a backlog */
+#define GL_LINK_STREAM_READS_MAX 1024
 
 /*
  * gl_link_open() - connect to HOST[:PORT] (default port 23).
@@ -341,8 +345,8 @@ int gl_link_stream_open(gl_link *l, int udp_port, unsigned n0_samples,
 
 /*
  * gl_link_stream_read() - read every datagram the stream socket holds
- * (without waiting; at most GL_LINK_STREAM_READS_MAX per call, the rest
- * stays for the next), judge each (gl_stream_feed()), and decode the
+ * (without waiting; at most GL_LINK_STREAM_READS_MAX per call: the whole
+ * receive buffer), judge each (gl_stream_feed()), and decode the
  * newest accepted one into @rec.
  * @now_ns: monotonic time now (base_clock), the reception time.
  * Return: 1 when @rec holds a record newer than the last call's; 0 when
@@ -376,7 +380,8 @@ int gl_link_stream_info(const gl_link *l, int *handle, unsigned *n0);
 int gl_link_stream_fd(const gl_link *l);
 
 /*
- * gl_link_stream_close() - "DR 0" on the command handle (within
+ * gl_link_stream_close() - "DR 0;IH<h>=>-1" on the command handle (the
+ * stream stopped and its UDP handle closed on the controller; within
  * @timeout_ms, 0 = default; its failure is returned but the socket is
  * closed anyway) and close the stream's socket. No stream: GL_OK.
  */

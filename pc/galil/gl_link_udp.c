@@ -233,10 +233,14 @@ int gl_link_stream_fd(const gl_link *l)
 int gl_link_stream_close(gl_link *l, int timeout_ms)
 {
 	int rc;
+	char ih[16];
 
 	if (!l || l->st_fd < 0)
 		return GL_OK;
-	rc = gl_link_command(l, "DR 0", NULL, 0, timeout_ms);
+	/* the stream stopped, then its UDP handle closed on the controller
+	 * (a UDP handle has no connection to lose: it would stay open) */
+	snprintf(ih, sizeof(ih), "DR 0;IH%c=>-1", 'A' + l->st_handle);
+	rc = gl_link_command(l, ih, NULL, 0, timeout_ms);
 	stream_drop(l);
 	return rc < 0 ? rc : GL_OK;
 }
