@@ -116,9 +116,11 @@ void re_plan_make(const struct re_config *cfg, int mainms, struct re_plan *out)
 	 * period): every cycle of every phase finds a fresh record */
 	out->stream_n0 = re_plan_stream_n0(out->sample_ns, out->ctl_sample_ns);
 	/* the program takes a heartbeat within two passes (its check, then
-	 * the pass that publishes ZA) and the stream carries it within n0
-	 * samples: the echo's age may exceed the critical limit by that */
-	out->echo_limit_ns = out->wdog.crit_ns +
+	 * the pass that publishes ZA), the stream carries it within n0
+	 * samples, and the record waits up to a period to be read: the
+	 * echo's age may exceed the critical limit by that (so a delay
+	 * trips it as it trips the round trip: past the critical limit) */
+	out->echo_limit_ns = out->wdog.crit_ns + p_ns +
 			     2LL * ms * BASE_NS_PER_MS +
 			     (int64_t)out->stream_n0 * out->ctl_sample_ns;
 }

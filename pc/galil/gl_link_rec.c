@@ -7,6 +7,7 @@
 #include <stdbool.h>
 #include <string.h>
 
+#include "base_clock.h"
 #include "gl_err.h"
 #include "gl_link_int.h"
 #include "gl_record.h"
@@ -86,5 +87,10 @@ int gl_link_record_text(gl_link *l, const char *prefix, struct gl_record *rec,
 		memcpy(text, r.text, r.text_len);
 		text[r.text_len] = '\0';
 	}
-	return gl_record_decode(r.bin, r.bin_len, l->layout, l->n_axes, rec);
+	rc = gl_record_decode(r.bin, r.bin_len, l->layout, l->n_axes, rec);
+	/* the stream never goes back behind a record read this way (e.g.
+	 * the one that saw the program armed) */
+	if (rc >= 0 && l->st_fd >= 0)
+		gl_stream_seen(&l->st, rec->sample, base_now_ns());
+	return rc;
 }

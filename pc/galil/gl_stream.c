@@ -54,6 +54,7 @@ int gl_stream_init(struct gl_stream *s, const struct gl_stream_peer *ctrl,
 	s->n0_samples = n0_samples;
 	s->horizon_ns = GL_STREAM_HORIZON_SAMPLES * sample_ns;
 	s->last_ns = now_ns;
+	s->ref_ns = now_ns;
 	return GL_OK;
 }
 
@@ -87,7 +88,7 @@ static int check_order(const struct gl_stream *s, uint16_t sample,
 	uint16_t d = (uint16_t)(sample - s->last_sample);
 
 	*delta = 0;
-	if (!s->have_last || now_ns - s->last_ns > s->horizon_ns)
+	if (!s->have_last || now_ns - s->ref_ns > s->horizon_ns)
 		return GL_STREAM_ACCEPTED;
 	if (d == 0)
 		return GL_STREAM_DUPLICATE;
@@ -106,13 +107,32 @@ static void commit(struct gl_stream *s, uint16_t sample, unsigned delta,
 
 	if (delta == 0)
 		s->stats.restarts += s->have_last ? 1 : 0;
-	else if (records > 1)
+	else if (records > 1 && !s->seen_other)
 		s->stats.lost += records - 1;
-	if (delta % n0 != 0)
+	if (delta % n0 != 0 && !s->seen_other)
 		s->stats.uneven++;
+	s->seen_other = 0;
 	s->have_last = 1;
 	s->last_sample = sample;
 	s->last_ns = now_ns;
+	s->ref_ns = now_ns;
+}
+
+int gl_stream_seen(struct gl_stream *s, uint16_t sample, int64_t now_ns)
+{
+	uint16_t d;
+
+	if (!s)
+		return GL_ERR_ARG;
+	d = (uint16_t)(sample - s->last_sample);
+	if (s->have_last && now_ns - s->ref_ns <= s->horizon_ns &&
+	    (d == 0 || d >= SERIAL_HALF))
+		return GL_OK; /* not after the last accepted */
+	s->have_last = 1;
+	s->last_sample = sample;
+	s->seen_other = 1;
+	s->ref_ns = now_ns; /* the age (last_ns) stays the stream's own */
+	return GL_OK;
 }
 
 static void count(struct gl_stream_stats *st, int verdict)

@@ -79,6 +79,9 @@ struct gl_stream {
 	int have_last;	      /* 1 once a record was accepted */
 	uint16_t last_sample; /* sample number of the last accepted */
 	int64_t last_ns;      /* when it was accepted, or init time */
+	int seen_other;	      /* last_sample came from gl_stream_seen() */
+	int64_t ref_ns;	      /* when last_sample was taken (the horizon
+			       * counts from here) */
 	struct gl_stream_stats stats;
 };
 
@@ -123,6 +126,18 @@ int gl_stream_init(struct gl_stream *s, const struct gl_stream_peer *ctrl,
 int gl_stream_feed(struct gl_stream *s, const uint8_t *dg, size_t len,
 		   const struct gl_stream_peer *from, int64_t now_ns,
 		   struct gl_record *out);
+
+/*
+ * gl_stream_seen() - a record of @sample was read by another route (a QR
+ * round trip on the command handle, e.g. the one that saw the program
+ * armed): from now on only records after it are accepted (an earlier or
+ * equal one is dropped as reordered or duplicate), so the stream never
+ * goes back behind what the caller already knows. Ignored when @sample is
+ * not after the last accepted. The samples up to the next accepted record
+ * are not counted as lost. The age is not changed.
+ * Return: GL_OK, or GL_ERR_ARG when @s is NULL.
+ */
+int gl_stream_seen(struct gl_stream *s, uint16_t sample, int64_t now_ns);
 
 /*
  * gl_stream_age_ns() - ns since the last accepted record (since init when

@@ -166,6 +166,42 @@ static void test_stream_reordered(void **state)
 	assert_int_equal(s.stats.accepted, 3);
 }
 
+/* TEST_stream_seen: a record read by another route (QR) moves the
+ * reference: records up to it are dropped, the next one is accepted
+ * without counting the gap as lost; the age stays the stream's own; a
+ * sample not after the last accepted is ignored. */
+static void test_stream_seen(void **state)
+{
+	struct gl_stream s;
+	struct gl_record out;
+
+	(void)state;
+	start(&s);
+	assert_int_equal(feed(&s, 100, T0 + 1 * MS, &out), GL_STREAM_ACCEPTED);
+	assert_int_equal(gl_stream_seen(&s, 90, T0 + 2 * MS), GL_OK);
+	assert_int_equal(s.last_sample, 100); /* not after: ignored */
+	assert_int_equal(gl_stream_seen(&s, 131, T0 + 40 * MS), GL_OK);
+	assert_int_equal(gl_stream_age_ns(&s, T0 + 40 * MS), 39 * MS);
+	assert_int_equal(feed(&s, 124, T0 + 41 * MS, &out),
+			 GL_STREAM_REORDERED);
+	assert_int_equal(feed(&s, 131, T0 + 41 * MS, &out),
+			 GL_STREAM_DUPLICATE);
+	assert_int_equal(feed(&s, 132, T0 + 42 * MS, &out), GL_STREAM_ACCEPTED);
+	assert_int_equal(out.sample, 132);
+	assert_int_equal(s.stats.lost, 0);
+	assert_int_equal(s.stats.uneven, 0);
+	assert_int_equal(feed(&s, 148, T0 + 58 * MS, &out), GL_STREAM_ACCEPTED);
+	assert_int_equal(s.stats.lost, 1); /* counted again from here */
+	/* before any record: the first one must come after the seen one */
+	start(&s);
+	assert_int_equal(gl_stream_seen(&s, 500, T0 + 1 * MS), GL_OK);
+	assert_int_equal(feed(&s, 496, T0 + 2 * MS, &out),
+			 GL_STREAM_REORDERED);
+	assert_int_equal(feed(&s, 504, T0 + 3 * MS, &out), GL_STREAM_ACCEPTED);
+	assert_int_equal(s.stats.restarts, 0);
+	assert_int_equal(gl_stream_seen(NULL, 1, T0), GL_ERR_ARG);
+}
+
 /* TEST_stream_wrap: the 16-bit sample number wraps from 65535 to 0; gaps
  * and reordering are judged across the wrap. */
 static void test_stream_wrap(void **state)
@@ -562,6 +598,7 @@ int main(void)
 	    cmocka_unit_test(test_stream_duplicate),
 	    cmocka_unit_test(test_stream_reordered),
 	    cmocka_unit_test(test_stream_wrap),
+	    cmocka_unit_test(test_stream_seen),
 	    cmocka_unit_test(test_stream_short),
 	    cmocka_unit_test(test_stream_long),
 	    cmocka_unit_test(test_stream_foreign),
