@@ -14,17 +14,35 @@
 #   netns_rig.sh setup ID              create namespace roboelf-net-ID
 #   netns_rig.sh down ID | up ID       the host's end of the data pair down/up
 #                                      (a pulled cable: no FIN, no RST)
-#   netns_rig.sh loss ID PCT           drop PCT % of the packets, each way
-#                                      (iptables statistic match)
+#   netns_rig.sh loss ID PCT [DIR]     drop PCT % of the packets (iptables
+#                                      statistic match) that DIR names: both
+#                                      (the default, each way), ctl (the frames
+#                                      the controller sends: its replies) or
+#                                      pc (the frames the PC sends: requests);
+#                                      each is dropped where it is received,
+#                                      as a cable loses it (below)
 #   netns_rig.sh delay ID MS BIN       hold every packet the controller sends
 #                                      MS ms (BIN/nfq-delay, NFQUEUE 0)
-#   netns_rig.sh rto ID MS             rto_min MS on the data route, both ends;
+#   netns_rig.sh rto ID MS [both]      rto_min MS on the data route, both ends;
 #                                      the namespace's TCP (the controller's)
 #                                      with linear retransmission timeouts
+#   netns_rig.sh rto ID MS pc          rto_min MS on the host's (the PC's)
+#                                      route only, as the package installs it;
+#                                      the namespace (the controller) left at
+#                                      the kernel's defaults: no rto_min on its
+#                                      route (200 ms), tcp_thin_linear_timeouts
+#                                      0. A real controller's TCP resends on a
+#                                      timer nobody sets (docs/link.md)
 #   netns_rig.sh clear ID              no loss, no delay, no rto_min
 #   netns_rig.sh teardown ID           remove it all
 #   netns_rig.sh addr ID               print "<data addr> <mgmt addr>" (.2)
 #   netns_rig.sh exec ID CMD...        run CMD in the namespace
+# A loss is a drop at the receiving end: the controller's frames in the
+# host's INPUT chain (-i rd<ID>h, only this rig's interface), the PC's in
+# the namespace's. A drop in the sender's own OUTPUT chain is not a lost
+# frame: the sender's TCP is told the send failed, keeps the data unsent
+# and sends it with its next segment, so its retransmission timer is never
+# exercised (measured: no retransmission in the namespace at 5 % loss).
 # Netem is not used: the development kernel has no sch_netem; iptables and
 # NFQUEUE work both there and on a stock Debian 12 kernel.
 # Exit codes: 0 done, 1 failure (message on stderr), 77 skip (check only).
@@ -94,17 +112,36 @@ clear_rules() {
 	kill_delay
 	inns iptables -F INPUT 2>/dev/null
 	inns iptables -F OUTPUT 2>/dev/null
+	host_rules_del
 	ip route del "$DNA/32" dev "$DH" 2>/dev/null
 	inns ip route del "$DHA/32" dev "$DN" 2>/dev/null
 	inns sysctl -qw net.ipv4.tcp_thin_linear_timeouts=0 2>/dev/null
 	return 0
 }
 
+# The namespace's INPUT receives the frames the PC sends, the host's INPUT
+# (on rd<ID>h) those the controller sends.
 loss() {
-	pct=$1
+	pct=$1; dir=$2
 	p=$(awk -v p="$pct" 'BEGIN { if (p + 0 <= 0 || p + 0 > 100) exit 1; printf "%.4f", p / 100 }') || die "bad loss '$pct'"
-	inns iptables -A INPUT -i "$DN" -m statistic --mode random --probability "$p" -j DROP || die "iptables"
-	inns iptables -A OUTPUT -o "$DN" -m statistic --mode random --probability "$p" -j DROP || die "iptables"
+	case $dir in both | ctl | pc) ;; *) die "bad direction '$dir' (both, ctl, pc)" ;; esac
+	if [ "$dir" != ctl ]; then
+		inns iptables -A INPUT -i "$DN" -m statistic --mode random --probability "$p" -j DROP || die "iptables"
+	fi
+	if [ "$dir" != pc ]; then
+		iptables -A INPUT -i "$DH" -m statistic --mode random --probability "$p" -j DROP || die "host iptables"
+	fi
+	return 0
+}
+
+# The host's rules of this rig's interface only.
+host_rules_del() {
+	iptables -S INPUT 2>/dev/null | grep -e "-i $DH " | sed 's/^-A //' |
+		while read -r rule; do
+			# shellcheck disable=SC2086 # one argument per word
+			iptables -D $rule 2>/dev/null
+		done
+	return 0
 }
 
 delay() {
@@ -126,14 +163,23 @@ delay() {
 }
 
 rto() {
-	ms=$1
+	ms=$1; ends=$2
+	case $ends in both | pc) ;; *) die "bad ends '$ends' (both, pc)" ;; esac
 	ip route replace "$DNA/32" dev "$DH" rto_min "${ms}ms" || die "host route"
+	if [ "$ends" = pc ]; then
+		# the controller's side as the kernel has it: whatever an
+		# earlier 'rto ID MS' left there is removed
+		inns ip route del "$DHA/32" dev "$DN" 2>/dev/null
+		inns sysctl -qw net.ipv4.tcp_thin_linear_timeouts=0 || die "namespace sysctl"
+		return 0
+	fi
 	inns ip route replace "$DHA/32" dev "$DN" rto_min "${ms}ms" || die "namespace route"
 	inns sysctl -qw net.ipv4.tcp_thin_linear_timeouts=1 || die "namespace sysctl"
 }
 
 teardown() {
 	kill_delay
+	host_rules_del
 	ip link del "$DH" 2>/dev/null
 	ip link del "$MH" 2>/dev/null
 	ip netns del "$NS" 2>/dev/null
@@ -146,9 +192,9 @@ check) check ;;
 setup) ids "$@"; setup ;;
 down) ids "$@"; ip link set "$DH" down || die "link down" ;;
 up) ids "$@"; ip link set "$DH" up || die "link up" ;;
-loss) ids "$1"; loss "${2:?pct}" ;;
+loss) ids "$1"; loss "${2:?pct}" "${3:-both}" ;;
 delay) ids "$1"; delay "${2:?ms}" "${3:?bin dir}" ;;
-rto) ids "$1"; rto "${2:?ms}" ;;
+rto) ids "$1"; rto "${2:?ms}" "${3:-both}" ;;
 clear) ids "$@"; clear_rules ;;
 teardown) ids "$@"; teardown ;;
 addr) ids "$@"; echo "$DNA $MNA" ;;
