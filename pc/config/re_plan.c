@@ -163,6 +163,7 @@ void re_plan_super_cfg(const struct re_plan *p, const struct re_config *cfg,
 	out->fresh_stop_ms = p->fresh_stop_ms;
 	out->relay_off_ms = p->relay_off_ms;
 	out->echo_limit_ns = p->echo_limit_ns;
+	out->ack_limit_ns = (int64_t)RE_PLAN_ACK_LIMIT_MS * BASE_NS_PER_MS;
 	out->settle_ms = p->settle_ms;
 	out->uncmd_grace_ns = p->uncmd_grace_ns;
 	out->mode_name =

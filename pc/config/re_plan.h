@@ -60,6 +60,13 @@ struct re_plan {
 };
 
 #define RE_PLAN_SAMPLE_MS 10 /* the cycle while calibrating, ms */
+/* The stream design: the oldest heartbeat line may wait this long for its
+ * reply. Longer than the critical limit on purpose: a real controller's
+ * TCP resends a lost reply on its own timer (200 ms at least, doubled for
+ * a second loss), and the program's echo in the record already proves the
+ * heartbeat's arrival within the critical limit; past 1 s the command
+ * connection is stalled (docs/link.md). */
+#define RE_PLAN_ACK_LIMIT_MS 1000
 /* One servo sample of a DMC-40x0 at TM 1000, the only TM the program
  * accepts (its seal, re_seal.c): 1000/1024 ms = 976 562.5 ns, rounded
  * (galil-notes 1.7; docs/dmc-interface.md). galil-sim's is 1 ms: the

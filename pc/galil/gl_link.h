@@ -29,6 +29,10 @@ typedef struct gl_link gl_link;
  * after a pause (between two phases) the newest record is reached in one
  * call, not the oldest of a backlog */
 #define GL_LINK_STREAM_READS_MAX 1024
+/* posted lines whose replies may be outstanding at once (gl_link_post()):
+ * at the shortest cycle (2 ms) 512 ms of heartbeats, past a resend of the
+ * controller's TCP (200 ms at least, 400 ms for a second one) */
+#define GL_LINK_POST_MAX 256
 
 /*
  * gl_link_open() - connect to HOST[:PORT] (default port 23).
@@ -281,11 +285,12 @@ struct gl_stream_stats;
 
 /*
  * gl_link_post() - send one command line on the command handle and return
- * without waiting for its reply; gl_link_collect() takes the reply later.
- * At most one line is outstanding. The line is checked as by
- * gl_link_command(); the send does not wait (the socket's buffer takes a
- * line of GL_LINE_MAX bytes at once unless the peer stopped reading).
- * Return: GL_OK (sent whole); GL_ERR_BUSY (a line is still outstanding:
+ * without waiting for its reply; gl_link_collect() takes the replies
+ * later, in order. Up to GL_LINK_POST_MAX lines may be outstanding. The
+ * line is checked as by gl_link_command(); the send does not wait (the
+ * socket's buffer takes a line of GL_LINE_MAX bytes at once unless the
+ * peer stopped reading).
+ * Return: GL_OK (sent whole); GL_ERR_BUSY (GL_LINK_POST_MAX outstanding:
  *         nothing sent); GL_ERR_ARG; GL_ERR_BROKEN; GL_ERR_TIMEOUT when the
  *         socket did not take the whole line at once (the link is then
  *         broken: a peer that stopped reading); GL_ERR_CLOSED, GL_ERR_SYS.
@@ -293,24 +298,27 @@ struct gl_stream_stats;
 int gl_link_post(gl_link *l, const char *cmd);
 
 /*
- * gl_link_collect() - take the reply to the posted line if it is all
- * there, without waiting (reads what the socket holds).
+ * gl_link_collect() - take the reply to the oldest outstanding posted
+ * line if it is all there, without waiting (reads what the socket holds).
+ * Call it again for the next.
  * @text: [out] optional (NULL or @cap 0): the reply's data text,
  *        NUL-terminated, as gl_link_command() gives it.
  * Return: the text's length (>= 0) when the reply is complete (the line is
  *         then no longer outstanding); GL_ERR_AGAIN (not complete yet);
  *         GL_ERR_NOENT (nothing outstanding: none posted, or another
- *         exchange took the reply, gl_link_posted()); GL_ERR_CTRL after '?'
- *         (TC1 is asked with the link's default timeout, as for a
- *         command); GL_ERR_OVERFLOW; a stream error (the link is broken).
+ *         exchange took the replies, gl_link_posted()); GL_ERR_CTRL after
+ *         '?' (when it was the last outstanding, TC1 is asked with the
+ *         link's default timeout, as for a command; else no TC1 text, and
+ *         it is counted in gl_link_post_errors()); GL_ERR_OVERFLOW; a
+ *         stream error (the link is broken).
  */
 int gl_link_collect(gl_link *l, char *text, size_t cap);
 
 /*
- * gl_link_posted() - 1 while a posted line's reply is outstanding, else 0
- * (also for NULL). Any other exchange on the command handle first waits,
- * within its own deadline, for that reply and sets it aside (a '?' in it
- * is counted in gl_link_post_errors()).
+ * gl_link_posted() - how many posted lines' replies are outstanding (0
+ * also for NULL). Any other exchange on the command handle first waits,
+ * within its own deadline, for those replies and sets them aside (a '?'
+ * in one is counted in gl_link_post_errors()).
  */
 int gl_link_posted(const gl_link *l);
 

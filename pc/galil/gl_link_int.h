@@ -50,8 +50,8 @@ struct gl_link {
 	int ctrl_code;
 	char ctrl_text[GL_ERRTEXT_LEN];
 	uint64_t tx_bytes, rx_bytes, round_trips;
-	/* the posted line (gl_link_post.c): its reply is outstanding */
-	bool posted;
+	/* the posted lines (gl_link_post.c) whose replies are outstanding */
+	int n_posted;
 	uint64_t post_errors; /* posted replies set aside that were '?' */
 	/* the record stream (gl_link_udp.c): fd -1 when none */
 	int st_fd;
@@ -142,9 +142,16 @@ int gl_link_xfer(gl_link *l, struct gl_chan *ch, const struct gl_xfer *x,
 		 int timeout_ms, struct gl_reply *r);
 
 /*
+ * gl_link_chan_drain_idle() - take the bytes that arrived on @ch since the
+ * last reply (only unsolicited ones are allowed there), without waiting.
+ * Return: GL_OK, or an error (the channel is then broken).
+ */
+int gl_link_chan_drain_idle(gl_link *l, struct gl_chan *ch);
+
+/*
  * gl_link_post_settle() - before another exchange on the command handle:
- * wait until @deadline for the posted line's reply (if one is
- * outstanding) and set it aside ('?' counted in l->post_errors).
+ * wait until @deadline for the posted lines' replies (if any are
+ * outstanding) and set them aside ('?' counted in l->post_errors).
  * Return: GL_OK, or a stream error (the channel is then broken).
  */
 int gl_link_post_settle(gl_link *l, int64_t deadline);

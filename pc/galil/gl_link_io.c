@@ -118,7 +118,7 @@ void gl_link_chan_close(struct gl_chan *ch)
  * unsolicited ones are allowed). At most GL_LINK_MSG_READS_MAX reads, so that a
  * flood cannot hold the caller; the rest is taken with the reply.
  */
-static int chan_drain_idle(gl_link *l, struct gl_chan *ch)
+int gl_link_chan_drain_idle(gl_link *l, struct gl_chan *ch)
 {
 	struct gl_reply r;
 	int i, rc;
@@ -145,12 +145,12 @@ int gl_link_xfer_begin(gl_link *l, struct gl_chan *ch, const struct gl_xfer *x,
 		return GL_ERR_BROKEN;
 	if (x->len > GL_LINE_MAX)
 		return GL_ERR_ARG;
-	if (ch == &l->cmd && l->posted) {
+	if (ch == &l->cmd && l->n_posted > 0) {
 		rc = gl_link_post_settle(l, deadline);
 		if (rc < 0)
 			return rc;
 	}
-	rc = x->seen_idle ? GL_OK : chan_drain_idle(l, ch);
+	rc = x->seen_idle ? GL_OK : gl_link_chan_drain_idle(l, ch);
 	if (rc < 0)
 		return rc;
 	rc = x->ubuf ? gl_proto_expect_upload(&ch->p, x->ubuf, x->ucap)
@@ -194,22 +194,24 @@ int gl_link_xfer_end(gl_link *l, struct gl_chan *ch, const struct gl_xfer *x,
 	return gl_link_xfer_finish(l, ch, x->seen_idle);
 }
 
-/* The posted line's reply, awaited before another exchange. */
+/* The posted lines' replies, awaited before another exchange. */
 int gl_link_post_settle(gl_link *l, int64_t deadline)
 {
 	struct gl_reply r;
 	int rc;
 
-	while ((rc = gl_proto_next(&l->cmd.p, &r)) == GL_ERR_AGAIN) {
-		rc = gl_link_chan_read(l, &l->cmd, deadline);
+	while (l->n_posted > 0) {
+		while ((rc = gl_proto_next(&l->cmd.p, &r)) == GL_ERR_AGAIN) {
+			rc = gl_link_chan_read(l, &l->cmd, deadline);
+			if (rc < 0)
+				return gl_link_chan_fail(&l->cmd, rc);
+		}
 		if (rc < 0)
 			return gl_link_chan_fail(&l->cmd, rc);
+		l->n_posted--;
+		if (r.n_err)
+			l->post_errors++;
 	}
-	if (rc < 0)
-		return gl_link_chan_fail(&l->cmd, rc);
-	l->posted = false;
-	if (r.n_err)
-		l->post_errors++;
 	return gl_link_xfer_finish(l, &l->cmd, true);
 }
 

@@ -40,7 +40,7 @@
 #define GL_PROTO_TEXT_MAX   2048 /* default reply text capacity, bytes */
 #define GL_PROTO_UNSOL_MAX  2048 /* unsolicited queue, bytes */
 #define GL_PROTO_UNSOL_LINE 256	 /* longer unsolicited lines are split */
-#define GL_PROTO_EXPECT_MAX 8	 /* replies that may be awaited at once */
+#define GL_PROTO_EXPECT_MAX 264 /* replies awaited at once (posted lines) */
 #define GL_PROTO_CMDS_MAX   64	 /* terminators per reply */
 
 /* A complete reply; pointers stay valid until the next gl_proto_next(). */

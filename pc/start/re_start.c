@@ -594,10 +594,15 @@ static int sample_cb(void *ud, const struct gl_record **rec)
 
 	if (re_sig.quit)
 		return GL_ERR_AGAIN;
-	re_super_wait(a->sup);
-	a->real.defer_log = 1; /* no file write in the cycle */
-	v = re_super_cycle(a->sup);
-	a->real.defer_log = 0;
+	/* a sample is a new record: the stream design's cycle may find none
+	 * (its watchdog ends a stream that stops) */
+	do {
+		re_super_wait(a->sup);
+		a->real.defer_log = 1; /* no file write in the cycle */
+		v = re_super_cycle(a->sup);
+		a->real.defer_log = 0;
+	} while (v != RE_FAULT && !re_super_view(a->sup)->fresh &&
+		 !re_super_view(a->sup)->latched && !re_sig.quit);
 	re_start_show_foreign(a, re_super_view(a->sup)->foreign);
 	re_start_show_events(a);
 	re_calib_progress(a->calrun, a->calcfg, &re_super_view(a->sup)->rec,

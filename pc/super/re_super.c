@@ -90,7 +90,6 @@ int re_super_init(struct re_super *s, const struct re_io *io,
 	s->t0_ns = now_ns(s);
 	s->deadline_ns = s->t0_ns + cfg->period_ns; /* no previous cycle */
 	s->last_good_ns = s->t0_ns;
-	s->post_chunk = -1;
 	re_super_stream_reset(s, s->t0_ns);
 	re_alive_reset(&s->alive);
 	re_xcheck_reset(&s->xc, s->t0_ns);
@@ -296,6 +295,7 @@ static int exchange(struct re_super *s, struct re_fault *f)
 		f->i[1] = s->pub.crit_ns / BASE_NS_PER_MS;
 		v = RE_FAULT;
 	}
+	s->pub.fresh = rc == GL_OK;
 	if (rc == GL_OK) {
 		s->pub.have_record = 1;
 		s->last_good_ns = now;
@@ -532,7 +532,7 @@ static int stream_checks(struct re_super *s, struct re_fault *f)
 {
 	int v = RE_OK;
 
-	if (s->fresh)
+	if (s->pub.fresh)
 		v = check_record(s, f);
 	if (v != RE_FAULT)
 		v = re_super_check_echo(s, f);
@@ -548,6 +548,7 @@ static int latched_cycle(struct re_super *s)
 
 	memset(&scratch, 0, sizeof(scratch));
 	s->pub.link_ok = rc == GL_OK || rc == GL_ERR_AGAIN;
+	s->pub.fresh = rc == GL_OK;
 	if (rc == GL_OK) {
 		struct re_encpot_state st[RE_SUPER_AXES];
 
@@ -586,7 +587,7 @@ static int cycle_checks(struct re_super *s)
 	v = s->pub.cfg.stream ? re_super_exchange_stream(s, &f)
 			      : exchange(s, &f);
 	warn = s->pub.link_ok && s->pub.age_last_ns > s->noncrit_ns;
-	if (s->pub.link_ok && (!s->pub.cfg.stream || s->fresh))
+	if (s->pub.link_ok && (!s->pub.cfg.stream || s->pub.fresh))
 		watch_handles(s);
 	rv = check_relay(s, &rf);
 	if (rv == RE_FAULT)

@@ -109,6 +109,10 @@ struct re_super_cfg {
 	 * (re_za.hb_echo) may be at most this old (the critical limit plus
 	 * the program's pass and the record interval), ns; 0: not checked */
 	int64_t echo_limit_ns;
+	/* stream design: the oldest posted line may wait this long for its
+	 * reply (the controller's TCP resends a lost one on its own timer;
+	 * the echo proves the heartbeat arrived), ns; 0: not checked */
+	int64_t ack_limit_ns;
 };
 
 /* Per-axis view for the status board. */
@@ -191,6 +195,8 @@ struct re_super_view {
 	/* the last record and its checks */
 	struct gl_record rec;
 	int have_record;
+	int fresh; /* rec is new this cycle (the stream design: a cycle may
+		    * find none; the round trip: every good reply) */
 	int link_ok;
 	struct re_za za;
 	int have_za;

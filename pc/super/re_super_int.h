@@ -11,6 +11,7 @@
 #define RE_LATE_BIN_US 50   /* lateness histogram resolution, us */
 #define RE_LATE_BINS   2001 /* 0 .. 100 ms, then one overflow bin */
 #define RE_SENT_RING   64   /* heartbeats remembered for the echo */
+#define RE_POST_RING   GL_LINK_POST_MAX /* posted lines outstanding */
 
 struct re_super {
 	struct re_super_view pub; /* what it publishes (re_super.h) */
@@ -72,12 +73,16 @@ struct re_super {
 	/* the stream design (re_super_stream.c): the posted line, the
 	 * times of the last fresh record and of the last reply collected,
 	 * and the heartbeats sent lately (for the program's echo) */
-	int posted;	   /* a posted line's reply is outstanding */
-	int post_chunk;	   /* its read-back chunk, -1: none */
-	int fresh;	   /* this cycle's record is new */
-	int64_t rec_ns;	   /* the last fresh record */
-	int64_t ack_ns;	   /* the last reply to a posted line */
-	int64_t post_ns;   /* when the outstanding line was posted */
+	struct {
+		int64_t ns; /* when it was posted */
+		int chunk;  /* its read-back chunk, -1: none */
+	} out[RE_POST_RING]; /* posted lines whose replies are outstanding,
+			      * oldest at out_head */
+	int out_head, n_out;
+	int chunk_out;	 /* a read-back chunk is among them */
+	uint64_t hb_skipped; /* cycles without a post (RE_POST_RING full) */
+	int64_t rec_ns;	 /* the last fresh record */
+	int64_t ack_ns;	 /* the last reply to a posted line */
 	struct {
 		long hb;
 		int64_t ns;
@@ -120,12 +125,13 @@ void re_super_stream_reset(struct re_super *s, int64_t now_ns);
 
 /*
  * re_super_exchange_stream() - the cycle's exchange in the stream design
- * (re_super_cfg.stream): collect the reply to the line posted last cycle
- * (the read-back chunk's text into s->rb_reply), post the next heartbeat
- * with the next read-back chunk when none is outstanding, read the newest
- * record of the stream (s->fresh), judge the record's and the
- * acknowledgement's ages against the critical limit and set
- * s->pub.age_last_ns for the warning. Never waits.
+ * (re_super_cfg.stream): collect the replies to lines posted in earlier
+ * cycles that are all there (a read-back chunk's text into s->rb_reply),
+ * post the next heartbeat (with the next read-back chunk when none is
+ * outstanding; none when RE_POST_RING lines are), read the newest record
+ * of the stream (s->fresh), judge the record's age against the critical
+ * limit and the oldest outstanding reply's against cfg.ack_limit_ns, and
+ * set s->pub.age_last_ns for the warning. Never waits.
  * Return: RE_OK, or RE_FAULT with @f filled (WDOG_STREAM, WDOG_ACK, COMM).
  */
 int re_super_exchange_stream(struct re_super *s, struct re_fault *f);

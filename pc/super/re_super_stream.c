@@ -2,15 +2,16 @@
  * re_super_stream.c - the cycle's exchange when the record is a stream
  * (re_super_cfg.stream; docs/link.md, "The record as a stream"): the
  * controller sends its record by itself (DR over UDP), the supervisor
- * posts its heartbeat (and a chunk of the seal's read-back) on TCP and
- * collects the reply in the next cycle. Nothing waits. Three ages, each
- * judged by the supervisor's own clock with the limits of the round trip:
- * the record's (the last fresh one), the acknowledgement's (the last
- * reply collected) and the program's echo of the heartbeat it took (the
- * heartbeats sent are remembered with their times, so the echo is judged
- * against what this supervisor sent, never against the controller's
- * copy). A lost record costs one sample; a reordered or duplicated one is
- * dropped by the reader (gl_stream). Here too: the heartbeat's text, which
+ * posts its heartbeat (and a chunk of the seal's read-back) on TCP every
+ * cycle and collects the replies when they are there: a reply the
+ * controller's TCP resends on its own timer holds no heartbeat back.
+ * Nothing waits. Judged by the supervisor's own clock: the record's age
+ * (the last fresh one) and the program's echo of the heartbeat it took
+ * (the heartbeats sent are remembered with their times, so the echo is
+ * judged against what this supervisor sent, never against the
+ * controller's copy), with the round trip's limits; the oldest reply
+ * outstanding, with a limit of its own. A lost record costs one sample; a
+ * reordered or duplicated one is dropped by the reader (gl_stream). Here too: the heartbeat's text, which
  * the round trip (re_super.c) sends as well.
  */
 #include "re_super_int.h"
@@ -76,7 +77,7 @@ void re_super_stream_reset(struct re_super *s, int64_t now_ns)
 	s->rec_ns = now_ns;
 	s->ack_ns = now_ns;
 	s->sent_n = 0;
-	s->fresh = 0;
+	s->pub.fresh = 0;
 }
 
 static int link_fault(struct re_fault *f, const char *what, int rc)
@@ -86,67 +87,85 @@ static int link_fault(struct re_fault *f, const char *what, int rc)
 	return RE_FAULT;
 }
 
-/* The reply to the line posted in an earlier cycle, if it is all there.
- * GL_ERR_NOENT: another exchange took it (a command in between): the
- * controller had answered it before that command's reply, but its text
- * is gone. */
+static int refused(struct re_super *s, struct re_fault *f)
+{
+	re_fault_set(f, RE_F_COMM, -1);
+	snprintf(f->s, sizeof(f->s),
+		 "the controller refused the heartbeat line: %s",
+		 s->pub.io.ops->ctrl_error(s->pub.io.ud, NULL));
+	return RE_FAULT;
+}
+
+/* The replies to lines posted in earlier cycles that are all there, in
+ * order. GL_ERR_NOENT: another exchange took them (a command in between):
+ * the controller had answered them before that command's reply, but their
+ * text is gone. */
 static int collect(struct re_super *s, int64_t now, struct re_fault *f)
 {
-	int rc;
+	while (s->n_out > 0) {
+		int i = s->out_head, chunk = s->out[i].chunk;
+		int rc = s->pub.io.ops->collect(
+		    s->pub.io.ud, chunk >= 0 ? s->rb_reply : s->resp,
+		    chunk >= 0 ? sizeof(s->rb_reply) : sizeof(s->resp));
 
-	if (!s->posted)
-		return RE_OK;
-	rc = s->pub.io.ops->collect(s->pub.io.ud, s->rb_reply,
-				    sizeof(s->rb_reply));
-	if (rc == GL_ERR_AGAIN)
-		return RE_OK;
-	s->posted = 0;
-	if (rc == GL_ERR_NOENT) {
+		if (rc == GL_ERR_AGAIN)
+			return RE_OK;
+		if (rc == GL_ERR_NOENT) {
+			s->n_out = s->chunk_out = 0;
+			s->ack_ns = now;
+			return RE_OK;
+		}
+		s->out_head = (i + 1) % RE_POST_RING;
+		s->n_out--;
+		if (rc == GL_ERR_CTRL)
+			return refused(s, f);
+		if (rc < 0)
+			return link_fault(f, "no reply to the heartbeat line",
+					  rc);
+		/* the reply's age: from its own line */
+		if (now - s->out[i].ns > s->pub.age_last_ns)
+			s->pub.age_last_ns = now - s->out[i].ns;
 		s->ack_ns = now;
-		return RE_OK;
+		if (chunk >= 0) {
+			s->rb_have = 1;
+			s->rb_cur = chunk;
+			s->chunk_out = 0;
+		}
 	}
-	if (rc == GL_ERR_CTRL) {
-		re_fault_set(f, RE_F_COMM, -1);
-		snprintf(f->s, sizeof(f->s),
-			 "the controller refused the heartbeat line: %s",
-			 s->pub.io.ops->ctrl_error(s->pub.io.ud, NULL));
-		return RE_FAULT;
-	}
-	if (rc < 0)
-		return link_fault(f, "no reply to the heartbeat line", rc);
-	/* the reply's age: from its own line (the last acknowledgement may
-	 * be older than the line, before a phase's first post) */
-	if (now - s->post_ns > s->pub.age_last_ns)
-		s->pub.age_last_ns = now - s->post_ns;
-	s->ack_ns = now;
-	s->rb_have = s->post_chunk >= 0;
-	s->rb_cur = s->post_chunk;
 	return RE_OK;
 }
 
-/* "hbpc=N[;MG chunk]" posted, remembered with its time. */
+/* "hbpc=N[;MG chunk]" posted (a chunk only when none is outstanding: one
+ * reply text at a time), remembered with its time. */
 static int post_next(struct re_super *s, int64_t now, struct re_fault *f)
 {
 	const char *line = s->prefix;
-	int rc;
+	int rc, chunk = -1, k;
 
+	if (s->n_out >= RE_POST_RING) {
+		s->hb_skipped++;
+		return RE_OK;
+	}
 	re_super_hb_next(s);
-	s->post_chunk = -1;
-	if (s->pub.rb_n) {
+	if (s->pub.rb_n && !s->chunk_out) {
 		size_t n = (size_t)s->prefix_len;
 
 		memcpy(s->rb_line, s->prefix, n);
 		s->rb_line[n] = ';';
 		strcpy(s->rb_line + n + 1, s->rb_chunk[s->rb_next]);
-		s->post_chunk = s->rb_next;
-		s->rb_next = (s->rb_next + 1) % s->pub.rb_n;
+		chunk = s->rb_next;
 		line = s->rb_line;
 	}
 	rc = s->pub.io.ops->post(s->pub.io.ud, line);
 	if (rc < 0)
 		return link_fault(f, "cannot send the heartbeat", rc);
-	s->posted = 1;
-	s->post_ns = now;
+	if (chunk >= 0) {
+		s->rb_next = (s->rb_next + 1) % s->pub.rb_n;
+		s->chunk_out = 1;
+	}
+	k = (s->out_head + s->n_out++) % RE_POST_RING;
+	s->out[k].ns = now;
+	s->out[k].chunk = chunk;
 	s->sent[s->sent_n % RE_SENT_RING].hb = s->pub.hbpc;
 	s->sent[s->sent_n % RE_SENT_RING].ns = now;
 	s->sent_n++;
@@ -169,16 +188,14 @@ int re_super_exchange_stream(struct re_super *s, struct re_fault *f)
 
 	s->pub.age_last_ns = 0;
 	s->rb_have = 0;
-	if (collect(s, now, f) == RE_FAULT)
-		return RE_FAULT;
-	if (!s->posted && post_next(s, now, f) == RE_FAULT)
+	if (collect(s, now, f) == RE_FAULT || post_next(s, now, f) == RE_FAULT)
 		return RE_FAULT;
 	rc = s->pub.io.ops->stream(s->pub.io.ud, &s->pub.rec, now);
 	if (rc < 0)
 		return link_fault(f, "cannot read the record stream", rc);
-	s->fresh = rc == 1;
+	s->pub.fresh = rc == 1;
 	s->pub.link_ok = 1;
-	if (s->fresh) {
+	if (s->pub.fresh) {
 		if (now - s->rec_ns > s->pub.age_last_ns)
 			s->pub.age_last_ns = now - s->rec_ns;
 		s->rec_ns = now;
@@ -188,8 +205,13 @@ int re_super_exchange_stream(struct re_super *s, struct re_fault *f)
 		s->pub.age_worst_ns = s->pub.age_last_ns;
 	if (now - s->rec_ns > crit)
 		return age_fault(f, RE_F_WDOG_STREAM, now - s->rec_ns, crit);
-	if (now - s->ack_ns > crit)
-		return age_fault(f, RE_F_WDOG_ACK, now - s->ack_ns, crit);
+	/* the oldest reply outstanding: its own limit (the echo proves
+	 * the heartbeat's arrival within the critical limit) */
+	if (s->n_out && s->pub.cfg.ack_limit_ns &&
+	    now - s->out[s->out_head].ns > s->pub.cfg.ack_limit_ns)
+		return age_fault(f, RE_F_WDOG_ACK,
+				 now - s->out[s->out_head].ns,
+				 s->pub.cfg.ack_limit_ns);
 	return RE_OK;
 }
 
@@ -213,7 +235,7 @@ int re_super_check_echo(struct re_super *s, struct re_fault *f)
 	int64_t lim = s->pub.cfg.echo_limit_ns, now, sent, oldest;
 	unsigned n;
 
-	if (!lim || !s->fresh || !s->pub.have_za || !s->sent_n)
+	if (!lim || !s->pub.fresh || !s->pub.have_za || !s->sent_n)
 		return RE_OK;
 	now = now_of(s);
 	sent = echo_sent_ns(s, s->pub.za.hb_echo);

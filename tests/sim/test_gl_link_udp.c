@@ -187,48 +187,66 @@ static void test_dr_refused(void **state)
 	(void)code;
 }
 
-/* A posted line's reply is collected later; a command waits for it. */
+/* Collect the oldest outstanding reply within REPLY_MS. */
+static int collect_one(struct fx *f, char *text, size_t cap)
+{
+	int64_t end = base_now_ms() + REPLY_MS;
+	int rc;
+
+	while ((rc = gl_link_collect(f->l, text, cap)) == GL_ERR_AGAIN &&
+	       base_now_ms() < end)
+		poll(NULL, 0, 1);
+	return rc;
+}
+
+/* Posted lines' replies are collected later, in order; up to
+ * GL_LINK_POST_MAX outstanding; a command waits for them first. */
 static void test_post_collect(void **state)
 {
 	struct fx *f = *state;
 	char text[64];
-	int64_t end = base_now_ms() + REPLY_MS;
-	int rc;
 
 	assert_int_equal(gl_link_post(f->l, "hbx=5;MG hbx"), GL_OK);
-	assert_int_equal(gl_link_posted(f->l), 1);
-	assert_int_equal(gl_link_post(f->l, "MG 1"), GL_ERR_BUSY);
-	while ((rc = gl_link_collect(f->l, text, sizeof(text))) ==
-		   GL_ERR_AGAIN &&
-	       base_now_ms() < end)
-		poll(NULL, 0, 1);
-	assert_int_equal(rc, (int)strlen(" 5.0000"));
+	assert_int_equal(gl_link_post(f->l, "hbx=6"), GL_OK);
+	assert_int_equal(gl_link_post(f->l, "MG hbx"), GL_OK);
+	assert_int_equal(gl_link_posted(f->l), 3);
+	assert_int_equal(collect_one(f, text, sizeof(text)),
+			 (int)strlen(" 5.0000"));
 	assert_string_equal(text, " 5.0000");
+	assert_int_equal(collect_one(f, text, sizeof(text)), 0);
+	assert_int_equal(collect_one(f, text, sizeof(text)),
+			 (int)strlen(" 6.0000"));
+	assert_string_equal(text, " 6.0000");
 	assert_int_equal(gl_link_posted(f->l), 0);
 	assert_int_equal(gl_link_collect(f->l, text, sizeof(text)),
 			 GL_ERR_NOENT);
-	/* posted, then a command at once: it takes the posted reply first */
-	assert_int_equal(gl_link_post(f->l, "hbx=6"), GL_OK);
+	/* the limit: one more is refused, nothing sent */
+	for (int i = 0; i < GL_LINK_POST_MAX; i++)
+		assert_int_equal(gl_link_post(f->l, "hbx=7"), GL_OK);
+	assert_int_equal(gl_link_post(f->l, "hbx=8"), GL_ERR_BUSY);
+	/* a command at once: it takes every posted reply first */
 	assert_int_equal(gl_link_command(f->l, "MG hbx", text, sizeof(text),
 					 0),
-			 (int)strlen(" 6.0000"));
+			 (int)strlen(" 7.0000"));
+	assert_string_equal(text, " 7.0000");
 	assert_int_equal(gl_link_posted(f->l), 0);
 	assert_int_equal(gl_link_collect(f->l, text, sizeof(text)),
 			 GL_ERR_NOENT);
 	assert_int_equal(gl_link_post_errors(f->l), 0);
-	/* a refused posted line set aside by a command is counted */
+	/* refused posted lines: set aside by a command, counted; collected
+	 * while others wait: GL_ERR_CTRL; the last: the controller's text */
 	assert_int_equal(gl_link_post(f->l, "XYZZY"), GL_OK);
 	assert_int_equal(gl_link_command(f->l, "MG 2", text, sizeof(text), 0),
 			 (int)strlen(" 2.0000"));
 	assert_int_equal(gl_link_post_errors(f->l), 1);
-	/* a refused posted line collected: the controller's error */
 	assert_int_equal(gl_link_post(f->l, "XYZZY"), GL_OK);
-	end = base_now_ms() + REPLY_MS;
-	while ((rc = gl_link_collect(f->l, text, sizeof(text))) ==
-		   GL_ERR_AGAIN &&
-	       base_now_ms() < end)
-		poll(NULL, 0, 1);
-	assert_int_equal(rc, GL_ERR_CTRL);
+	assert_int_equal(gl_link_post(f->l, "XYZZY"), GL_OK);
+	assert_int_equal(collect_one(f, text, sizeof(text)), GL_ERR_CTRL);
+	assert_int_equal(gl_link_post_errors(f->l), 2);
+	assert_int_equal(collect_one(f, text, sizeof(text)), GL_ERR_CTRL);
+	assert_int_equal(gl_link_post_errors(f->l), 2);
+	assert_string_equal(gl_link_ctrl_error(f->l, NULL),
+			    "Unrecognized command");
 	assert_false(gl_link_broken(f->l));
 }
 

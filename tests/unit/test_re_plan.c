@@ -157,11 +157,13 @@ static void test_plan_stream_n0(void **state)
 		int period_ms;
 		unsigned n0;
 	} cases[] = {
-	    {50, 12},  /* 12.5 ms / 0.9766 ms = 12.8 */
-	    {10, 2},   /* 2.5 ms: 2.56 */
-	    {2, 2},    /* 0.5 ms: 0.51, raised to the minimum */
-	    {100, 25}, /* 25 ms: 25.6 */
-	    {20, 5},   /* 5 ms: 5.12 */
+	    /* from the fastest cycle: the calibration's 10 ms when the
+	     * period is longer (a quarter: 2.5 ms, 2.56 samples) */
+	    {50, 2},
+	    {10, 2}, /* 2.5 ms: 2.56 */
+	    {2, 2},  /* 0.5 ms: 0.51, raised to the minimum */
+	    {100, 2},
+	    {20, 2},
 	};
 	struct re_config c;
 	struct re_plan p;
@@ -173,6 +175,10 @@ static void test_plan_stream_n0(void **state)
 		re_plan_make(&c, 0, &p);
 		assert_int_equal(p.ctl_sample_ns, 976563);
 		assert_int_equal(p.stream_n0, cases[i].n0);
+		/* critical (2.5 P) + P + two passes of 10 ms + n0 samples */
+		assert_int_equal(p.echo_limit_ns,
+				 (int64_t)(3.5 * cases[i].period_ms * MS) +
+				     20 * MS + 2 * 976563);
 	}
 	/* galil-sim's 1 ms sample: 12.5 samples at 50 ms, 2.5 at 10 ms */
 	assert_int_equal(re_plan_stream_n0(50 * MS, 1000000), 12);

@@ -56,7 +56,7 @@ struct fake {
 	int collect_rc;	   /* collect: this error once (0: none) */
 	long echo_frozen;  /* >= 0: the program echoes this, not the last */
 	long last_hb;	   /* the value of the last "hbpc=N" posted */
-	int posted;	   /* a line outstanding (the fake's view) */
+	int posted;	   /* lines outstanding (the fake's view) */
 	int n_posts, n_collects, n_busy;
 	char last_post[96];
 	int n_relay_off;
@@ -71,12 +71,12 @@ static struct fake fk;
 static int f_post(void *ud, const char *line)
 {
 	(void)ud;
-	if (fk.posted) {
+	if (fk.posted >= GL_LINK_POST_MAX) {
 		fk.n_busy++;
 		return GL_ERR_BUSY;
 	}
 	fk.n_posts++;
-	fk.posted = 1;
+	fk.posted++;
 	snprintf(fk.last_post, sizeof(fk.last_post), "%s", line);
 	fk.last_hb = strtol(line + 5, NULL, 10);
 	return GL_OK;
@@ -92,7 +92,7 @@ static int f_collect(void *ud, char *text, size_t cap)
 	if (fk.ack_stall)
 		return GL_ERR_AGAIN;
 	fk.n_collects++;
-	fk.posted = 0;
+	fk.posted--;
 	fk.collect_rc = 0;
 	if (rc)
 		return rc;
@@ -246,6 +246,7 @@ static struct re_super_cfg make_cfg(void)
 	c.mode_name = "development";
 	c.stream = 1;
 	c.echo_limit_ns = 150 * MS;
+	c.ack_limit_ns = 1000 * MS;
 	return c;
 }
 
@@ -344,21 +345,42 @@ static void test_stream_stops(void **state)
 			     72));
 }
 
-/* The heartbeat's reply never comes: no second post while one is
- * outstanding, WATCHDOG past 125 ms, though records keep coming. */
+/* The heartbeat's replies stop coming (the controller's TCP holds them
+ * back): the heartbeat is still posted every cycle and the program still
+ * takes it (its echo), so nothing trips until the oldest reply has waited
+ * longer than its own limit (1 s): WATCHDOG then. */
 static void test_stream_ack_stalls(void **state)
+{
+	(void)state;
+	assert_int_equal(run(5), RE_OK); /* post 5 (1250 ms) outstanding */
+	fk.ack_stall = 1;
+	assert_int_equal(run(20), RE_OK); /* up to 2250 ms */
+	assert_int_equal(fk.n_posts, 25);
+	assert_int_equal(fk.posted, 21);
+	assert_int_equal(fk.n_busy, 0);
+	assert_int_equal(fk.n_relay_off, 0);
+	assert_int_equal(run(1), RE_FAULT);
+	assert_int_equal(sup.pub.fault.id, RE_F_WDOG_ACK);
+	assert_int_equal(sup.pub.fault.i[0], 1050);
+	assert_int_equal(sup.pub.fault.i[1], 1000);
+	assert_int_equal(fk.n_relay_off, 1);
+}
+
+/* Replies held back, then all at once: each collected in order, the
+ * warning names the oldest's wait, nothing trips. */
+static void test_stream_replies_late(void **state)
 {
 	(void)state;
 	assert_int_equal(run(5), RE_OK);
 	fk.ack_stall = 1;
-	assert_int_equal(run(2), RE_OK);
-	assert_int_equal(fk.n_posts, 5);
-	assert_int_equal(fk.n_busy, 0);
-	assert_int_equal(run(1), RE_FAULT);
-	assert_int_equal(sup.pub.fault.id, RE_F_WDOG_ACK);
-	assert_int_equal(sup.pub.fault.i[0], 150);
-	assert_int_equal(sup.pub.fault.i[1], 125);
-	assert_int_equal(fk.n_relay_off, 1);
+	assert_int_equal(run(5), RE_OK); /* 5 more posted, none collected */
+	fk.ack_stall = 0;
+	assert_int_equal(run(1), RE_WARN); /* post 5 waited 300 ms */
+	assert_int_equal(sup.pub.age_last_ns, 300 * MS);
+	assert_int_equal(fk.posted, 1);	   /* this cycle's */
+	assert_int_equal(fk.n_collects, 10);
+	assert_int_equal(run(5), RE_OK);
+	assert_int_equal(fk.n_relay_off, 0);
 }
 
 /* The program stops taking the heartbeat (its echo frozen): WATCHDOG
@@ -426,6 +448,7 @@ int main(void)
 	    cmocka_unit_test_setup(test_stream_lost_record, setup),
 	    cmocka_unit_test_setup(test_stream_stops, setup),
 	    cmocka_unit_test_setup(test_stream_ack_stalls, setup),
+	    cmocka_unit_test_setup(test_stream_replies_late, setup),
 	    cmocka_unit_test_setup(test_stream_echo_frozen, setup),
 	    cmocka_unit_test_setup(test_stream_echo_foreign, setup),
 	    cmocka_unit_test_setup(test_stream_reply_taken, setup),
