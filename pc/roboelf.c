@@ -38,6 +38,7 @@
 #include <unistd.h>
 
 #include "gl_err.h"
+#include "gl_stream.h"
 #include "re_app.h"
 #include "re_calib.h"
 #include "re_config.h"
@@ -369,6 +370,29 @@ static void close_recorder(struct app *a)
 	a->rec = NULL;
 }
 
+/* The record stream's counters (the stream design only). */
+static void log_stream(struct app *a)
+{
+	struct gl_stream_stats st;
+
+	if (!gl_link_stream_info(a->real.link, NULL, NULL))
+		return;
+	gl_link_stream_stats(a->real.link, &st);
+	re_log_msg(&a->log, RE_LOG_INFO,
+		   "stream: datagrams=%llu records=%llu lost=%llu "
+		   "duplicates=%llu reordered=%llu foreign=%llu short=%llu "
+		   "long=%llu malformed=%llu; heartbeat lines refused=%llu",
+		   (unsigned long long)st.received,
+		   (unsigned long long)st.accepted,
+		   (unsigned long long)st.lost,
+		   (unsigned long long)st.duplicates,
+		   (unsigned long long)st.reordered,
+		   (unsigned long long)st.foreign,
+		   (unsigned long long)st.shorts, (unsigned long long)st.longs,
+		   (unsigned long long)st.malformed,
+		   (unsigned long long)gl_link_post_errors(a->real.link));
+}
+
 /* The run's end in the log: why it stopped (@key: the key that quit, -1:
  * the terminal went away, 0: a signal) and the cycle's figures. */
 static void log_stop(struct app *a, int key)
@@ -386,6 +410,7 @@ static void log_stop(struct app *a, int key)
 		   re_super_late_ms(a->sup, 50), re_super_late_ms(a->sup, 99),
 		   re_super_late_ms(a->sup, 100), ms_of_ns(v->age_worst_ns),
 		   (unsigned long long)a->con.dropped);
+	log_stream(a);
 }
 
 #define KEY_POLL_MS 100 /* the keyboard is read this often, ms */
