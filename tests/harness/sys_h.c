@@ -179,6 +179,13 @@ const char *sys_record(void)
 	return v && *v ? v : NULL;
 }
 
+enum re_fault_id sys_stall_fault(void)
+{
+	const char *r = sys_record();
+
+	return r && !strcmp(r, "stream") ? RE_F_WDOG_STREAM : RE_F_WDOG_REPLY;
+}
+
 int sys_env_write_config(struct sys_env *e, const struct sys_subst *subst,
 			 const char *path)
 {

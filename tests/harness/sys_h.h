@@ -203,6 +203,13 @@ void sys_env_done(struct sys_env *e, int ready);
 const char *sys_record(void);
 
 /*
+ * sys_stall_fault() - the fault a stalled link gives first in the design
+ * sys_record() selects: RE_F_WDOG_STREAM for "stream" (the record's age),
+ * else RE_F_WDOG_REPLY (the reply's age).
+ */
+enum re_fault_id sys_stall_fault(void);
+
+/*
  * sys_env_write_config() - write a copy of the test configuration with
  * @subst applied to @path (and controller.record from sys_record()).
  * Return: 0, or -1 with e->err set (a key that is not found is an error).

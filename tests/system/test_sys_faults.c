@@ -801,7 +801,7 @@ static void test_link_drop(void **state)
 static void test_link_stall(void **state)
 {
 	(void)state;
-	link_fault("link stalled", "link stall", RE_F_WDOG_REPLY, C() + P());
+	link_fault("link stalled", "link stall", sys_stall_fault(), C() + P());
 }
 
 static void test_link_latency(void **state)
@@ -810,7 +810,7 @@ static void test_link_latency(void **state)
 
 	(void)state;
 	snprintf(req, sizeof(req), "link delay %.0f", 2 * C());
-	link_fault("link latency", req, RE_F_WDOG_REPLY, C() + P());
+	link_fault("link latency", req, sys_stall_fault(), C() + P());
 }
 
 /* ---- relay -------------------------------------------------------------- */
@@ -969,7 +969,7 @@ static void test_power_cycle(void **state)
 	{
 		struct expect x = {
 		    .name = "controller power cycle",
-		    .ids = {RE_F_COMM, RE_F_WDOG_REPLY, RE_F_NONE},
+		    .ids = {RE_F_COMM, sys_stall_fault(), RE_F_NONE},
 		    .axis = -1,
 		    .d_relay = C() + P(),
 		    .d_motors = -1};

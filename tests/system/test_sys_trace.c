@@ -248,7 +248,7 @@ static void test_trace_link_stall(void **state)
 	fault_trace_path(&cs, path, sizeof(path));
 	wait_written(&cs, path, TRACE_WAIT_MS);
 	must_load(path, &h, &r);
-	f = check_fault_rows(&h, r, RE_F_WDOG_REPLY);
+	f = check_fault_rows(&h, r, sys_stall_fault());
 	assert_int_equal(r[f].link_ok, 0);
 	for (size_t k = 0; k < f; k++) {
 		if (!r[k].link_ok)

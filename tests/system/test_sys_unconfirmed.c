@@ -194,7 +194,7 @@ static void test_link_loss_amp_model_off(void **state)
 	    {"link drop (sockets reset, link back at once)", "link drop", 1, 1,
 	     RE_F_COMM, 2 * rig_p()},
 	    {"link drop (lasting)", "link drop", 0, 0, RE_F_COMM, 2 * rig_p()},
-	    {"link stall", "link stall", 0, 0, RE_F_WDOG_REPLY,
+	    {"link stall", "link stall", 0, 0, sys_stall_fault(),
 	     rig_c() + rig_p()},
 	};
 
