@@ -194,7 +194,6 @@ int re_super_exchange_stream(struct re_super *s, struct re_fault *f)
 	if (rc < 0)
 		return link_fault(f, "cannot read the record stream", rc);
 	s->pub.fresh = rc == 1;
-	s->pub.link_ok = 1;
 	if (s->pub.fresh) {
 		if (now - s->rec_ns > s->pub.age_last_ns)
 			s->pub.age_last_ns = now - s->rec_ns;
@@ -203,6 +202,9 @@ int re_super_exchange_stream(struct re_super *s, struct re_fault *f)
 	}
 	if (s->pub.age_last_ns > s->pub.age_worst_ns)
 		s->pub.age_worst_ns = s->pub.age_last_ns;
+	/* the link delivers in time: the record is not older than the
+	 * warning's limit (a stalled stream shows as a link down) */
+	s->pub.link_ok = now - s->rec_ns <= s->noncrit_ns;
 	if (now - s->rec_ns > crit)
 		return age_fault(f, RE_F_WDOG_STREAM, now - s->rec_ns, crit);
 	/* the oldest reply outstanding: its own limit (the echo proves
