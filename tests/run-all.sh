@@ -53,7 +53,7 @@ fi
 # its targets first (ROBOELF_TEST_TIMEOUT overrides both).
 deadline() {
 	case $1 in
-	system/* | net/* | checks/fuzz_short.sh) echo "${ROBOELF_TEST_TIMEOUT:-600}" ;;
+	system/* | net/* | checks/fuzz_short.sh | checks/stream_suite.sh) echo "${ROBOELF_TEST_TIMEOUT:-600}" ;;
 	*) echo "${ROBOELF_TEST_TIMEOUT:-180}" ;;
 	esac
 }
@@ -64,7 +64,7 @@ deadline() {
 # cycle; the rest (the network rig, the host's timing) run alone.
 few() {
 	case $1 in
-	system/* | checks/console_tmux.sh) return 0 ;;
+	system/* | checks/console_tmux.sh | checks/stream_suite.sh) return 0 ;;
 	*) return 1 ;;
 	esac
 }
