@@ -3,20 +3,30 @@
  * galil-sim, printed as a table and written as CSV. Figures, not pass/fail.
  *
  *   bench_sys --csv FILE [--seconds S] [--repeat N] [--alloc-lib SO]
- *             [--faults-bin PATH] [--only instr]
+ *             [--faults-bin PATH] [--long L] [--only instr]
  *
  *  1. full calibration time (roboelf --calibration full on the default
  *     robot);
- *  2. at supervisor periods 50, 10 and 2 ms, S seconds (default 20) of
- *     joystick use: cycles (the program heartbeat hbpc the supervisor
- *     writes every cycle, watched in the simulator), overruns and the worst
- *     reply age (roboelf's last status line), wake-up lateness p50/p99/max
- *     (roboelf's "stats:" log line at exit, when it writes one), TCP
- *     segments and bytes per cycle on roboelf's controller connections
- *     (ss -ti), CPU time per cycle (/proc/PID/schedstat), heap allocations
- *     after start-up (LD_PRELOAD counter, SIGUSR2 marks), system calls per
- *     cycle (perf stat on the raw_syscalls:sys_enter tracepoint, all
- *     threads of roboelf);
+ *  2. at supervisor periods 50, 10 and 2 ms, each in both designs of
+ *     getting the controller's record (controller.record: poll, one
+ *     "hbpc=N;QR" round trip a cycle; stream, the record sent by the
+ *     controller over UDP and the heartbeat posted on TCP: docs/link.md),
+ *     S seconds (default 20) of joystick use: cycles (the program
+ *     heartbeat hbpc the supervisor writes every cycle, watched in the
+ *     simulator), overruns and the worst reply age (roboelf's last status
+ *     line; in the stream design the worst time between two fresh
+ *     records), wake-up lateness p50/p99/max (roboelf's "stats:" log line
+ *     at exit, when it writes one), TCP segments and bytes per cycle on
+ *     roboelf's controller connections (ss -ti), UDP datagrams (the
+ *     stream's records) received per cycle (perf stat on the
+ *     sock:sock_recv_length tracepoint), CPU time per cycle
+ *     (/proc/PID/schedstat), heap allocations after start-up (LD_PRELOAD
+ *     counter, SIGUSR2 marks), system calls per cycle (perf stat on the
+ *     raw_syscalls:sys_enter tracepoint, all threads of roboelf), and
+ *     the record's interval from roboelf's start-up line;
+ *  2a. with --long L (L > 0): the stream design at 2 ms for L seconds of
+ *     joystick use (make bench: 600 under chrt -f 50), the same figures;
+ *     the target is ten minutes with no overrun and no trip;
  *  3. galil-sim's virtual-time speed (galil-sim --bench 10: 8 busy
  *     program threads, in-process sim_advance_ms());
  *  4. fault reaction times: test_sys_faults run with ROBOELF_REPEAT=N,
@@ -26,19 +36,25 @@
  *     per cycle (strace -c of this program run with --rec-loop N against
  *     --rec-loop 0), and the dump of a full 30 s ring at 10 ms (text and
  *     durable write, ms and bytes);
- *  6. user instructions per cycle: roboelf under valgrind's
- *     callgrind at 50 ms with S / 3 and S seconds of joystick use, the
- *     instructions collected in its supervisor loop, the difference over
- *     the difference of the cycles run (--only instr: this figure alone).
+ *  6. user instructions per cycle, in both designs: roboelf under
+ *     valgrind's callgrind at 50 ms with S / 3 and S seconds of joystick
+ *     use, the instructions collected in its supervisor loop, the
+ *     difference over the difference of the cycles run (--only instr:
+ *     these figures alone).
  * Beside each figure: the original system's value where it has one
  * (roboelf-software-description.txt: 50 ms loop, 75/125 ms watchdog,
- * 0.5 s invalid input, one controller command per value read).
+ * 0.5 s invalid input, one controller command per value read). The loop
+ * figures are printed as one grid, a column per period and design
+ * (item "period P ms, DESIGN"), so the two designs are read side by side;
+ * the CSV has one row per figure as for every other section.
  *
  * Environment as for the system tests (ROBOELF_BIN, ROBOELF_TOP, BUILD).
  */
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <math.h>
+#include <sched.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -60,8 +76,8 @@
 struct row {
 	char section[24];
 	char item[64];
-	char stat[32];
-	char value[48];
+	char stat[48];
+	char value[400]; /* a FAULT line whole */
 	char unit[16];
 	char original[96];
 };
@@ -102,6 +118,7 @@ struct opts {
 	const char *only; /* "instr": only the instruction count */
 	int seconds;
 	int repeat;
+	int long_s; /* the stream design at 2 ms for this long; 0: not */
 };
 
 static int parse_opts(int argc, char **argv, struct opts *o)
@@ -126,16 +143,18 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 			o->seconds = atoi(v);
 		else if (!strcmp(a, "--repeat"))
 			o->repeat = atoi(v);
+		else if (!strcmp(a, "--long"))
+			o->long_s = atoi(v);
 		else
 			goto usage;
 		i++;
 	}
-	if (o->csv && o->seconds >= 1 && o->repeat >= 0)
+	if (o->csv && o->seconds >= 1 && o->repeat >= 0 && o->long_s >= 0)
 		return 0;
 usage:
 	fprintf(stderr, "usage: bench_sys --csv FILE [--seconds S] [--repeat "
-			"N] [--alloc-lib SO] [--faults-bin PATH] [--only "
-			"instr]\n");
+			"N] [--alloc-lib SO] [--faults-bin PATH] [--long L] "
+			"[--only instr]\n");
 	return -1;
 }
 
@@ -210,15 +229,45 @@ static struct tcp_fig tcp_now(int port)
 
 /* ---- one supervised run at a period ------------------------------------- */
 
+/* The observer at normal scheduling while a run is measured: this
+ * program's polls and the tools it starts (perf, ss) then never take a CPU
+ * from roboelf and galil-sim, which inherited SCHED_FIFO at their start
+ * under chrt -f 50 (at the same priority a starting perf held a CPU for
+ * more than the 5 ms a 2 ms period allows). Return: the policy before, for
+ * observe_end(). */
+static int observe_begin(struct sched_param *old)
+{
+	struct sched_param normal = {.sched_priority = 0};
+	int pol = sched_getscheduler(0);
+
+	if (sched_getparam(0, old) < 0)
+		old->sched_priority = 0;
+	if (pol == SCHED_FIFO || pol == SCHED_RR)
+		sched_setscheduler(0, SCHED_OTHER, &normal);
+	return pol;
+}
+
+/* Back to @pol for the next case's start (its processes inherit it). */
+static void observe_end(int pol, const struct sched_param *old)
+{
+	if (pol == SCHED_FIFO || pol == SCHED_RR)
+		sched_setscheduler(0, pol, old);
+}
+
 struct loop_fig {
 	int period_ms;
-	char fault[512]; /* the FAULT line if it tripped */
-	double trip_s;	 /* when, from the start of the run; -1 */
+	const char *design; /* controller.record: "poll" or "stream" */
+	int long_s;	    /* the long run's seconds; 0: an ordinary run */
+	char link[160];	    /* the record's interval (start-up line) */
+	char link_ms[16];   /* its measured interval, "" if none */
+	char fault[512];    /* the FAULT line if it tripped */
+	double trip_s;	    /* when, from the start of the run; -1 */
 	double ready_s;
 	double seconds;
 	double cycles;
 	double cpu_us;	    /* per cycle */
 	struct tcp_fig tcp; /* per cycle */
+	double udp_in;	    /* datagrams received per cycle, -1 n/a */
 	long allocs;	    /* after start-up; -1 n/a */
 	long overruns;	    /* -1 n/a */
 	double wd_worst_ms; /* -1 n/a */
@@ -242,12 +291,49 @@ static void readback_figures(const struct proc *re, struct loop_fig *f)
 		f->rb_values = f->rb_cycles = -1;
 }
 
+/* roboelf's start-up line of the record, "roboelf: record stream: UDP
+ * handle B, every N samples (T ms); measured over 20 records M ms ..." or
+ * "roboelf: record polled (QR each cycle); ...", shortened into f->link.
+ * Return: 0, or -1 when it is missing or names the other design. */
+static int link_figure(const struct proc *re, struct loop_fig *f)
+{
+	char line[512], n0_ms[16], meas_ms[16];
+	const char *p;
+	unsigned n0;
+
+	if (proc_find_line(re, PROC_STDOUT, "roboelf: record ", line,
+			   sizeof(line)) < 0) {
+		snprintf(f->link, sizeof(f->link), "no 'roboelf: record' line");
+		return -1;
+	}
+	if (!strcmp(f->design, "poll")) {
+		snprintf(f->link, sizeof(f->link), "%s",
+			 strstr(line, "record polled") ? "QR each cycle"
+						       : "not polled");
+		return strstr(line, "record polled") ? 0 : -1;
+	}
+	p = strstr(line, "every ");
+	if (!strstr(line, "record stream: ") || !p ||
+	    sscanf(p, "every %u samples (%15[0-9.] ms)", &n0, n0_ms) != 2) {
+		snprintf(f->link, sizeof(f->link), "not a stream: %.100s",
+			 line + 9);
+		return -1;
+	}
+	p = strstr(line, "records ");
+	if (p && sscanf(p, "records %15[0-9.] ms", meas_ms) == 1)
+		snprintf(f->link_ms, sizeof(f->link_ms), "%s", meas_ms);
+	snprintf(f->link, sizeof(f->link), "DR %u (%s ms)", n0, n0_ms);
+	return 0;
+}
+
 /* ---- system calls per cycle: perf stat on the tracepoint ---------------- */
 
-/* perf stat counting @pid's system calls (all threads) into @out until
- * SIGINT; -1 when it cannot start. Counting a tracepoint costs the process
- * nothing measurable (strace's ptrace would slow every call). */
-static pid_t perf_start(pid_t pid, const char *out)
+/* perf stat counting @event (with @filter, or NULL) of @pid, all threads,
+ * into @out until SIGINT; -1 when it cannot start. Counting a tracepoint
+ * costs the process nothing measurable (strace's ptrace would slow every
+ * call). */
+static pid_t perf_start(pid_t pid, const char *out, const char *event,
+			const char *filter)
 {
 	char p[24];
 	pid_t k;
@@ -261,15 +347,20 @@ static pid_t perf_start(pid_t pid, const char *out)
 			dup2(fd, 1);
 			dup2(fd, 2);
 		}
-		execlp("perf", "perf", "stat", "-x,", "-o", out, "-e",
-		       "raw_syscalls:sys_enter", "-p", p, (char *)NULL);
+		if (filter)
+			execlp("perf", "perf", "stat", "-x,", "-o", out, "-e",
+			       event, "--filter", filter, "-p", p,
+			       (char *)NULL);
+		else
+			execlp("perf", "perf", "stat", "-x,", "-o", out, "-e",
+			       event, "-p", p, (char *)NULL);
 		_exit(127);
 	}
 	return k;
 }
 
-/* Stop @perf; the count it wrote to @out, or -1. */
-static double perf_stop(pid_t perf, const char *out)
+/* Stop @perf; the count of @event it wrote to @out, or -1. */
+static double perf_stop(pid_t perf, const char *out, const char *event)
 {
 	char line[256];
 	double n = -1;
@@ -285,7 +376,7 @@ static double perf_stop(pid_t perf, const char *out)
 		return -1;
 	f = fopen(out, "r");
 	while (f && fgets(line, sizeof(line), f))
-		if (strstr(line, "raw_syscalls:sys_enter"))
+		if (strstr(line, event))
 			n = strncmp(line, "<not counted>", 13)
 				? strtod(line, NULL)
 				: 0;
@@ -293,6 +384,13 @@ static double perf_stop(pid_t perf, const char *out)
 		fclose(f);
 	return n;
 }
+
+/* The two counts of a run: every system call, and the UDP datagrams
+ * roboelf received (the sock_recv_length tracepoint, Linux 6.3 on; a
+ * receive that found nothing is not counted). */
+#define EV_SYSCALLS "raw_syscalls:sys_enter"
+#define EV_RECV	    "sock:sock_recv_length"
+#define EV_UDP_IN   "protocol == 17 && ret > 0"
 
 static double hbpc(struct sys_case *c)
 {
@@ -407,27 +505,39 @@ static void figures(struct loop_fig *f, const struct mark *a,
 	f->tcp.segs_out = (b->tcp.segs_out - a->tcp.segs_out) / f->cycles;
 }
 
-static int loop_run(struct sys_env *e, const struct opts *o, int period,
-		    struct loop_fig *f)
+static void loop_init(struct loop_fig *f, int period, const char *design,
+		      int long_s)
 {
-	char out_env[SYS_PATH_MAX + 32], pre_env[SYS_PATH_MAX + 16],
-	    alloc_out[SYS_PATH_MAX], perf_out[SYS_PATH_MAX];
-	pid_t perf = -1;
-	double calls = -1;
-	char *env[3] = {NULL, NULL, NULL};
-	struct sys_opts so = {.period_ms = period, .re_env = env};
-	struct sys_case c;
-	struct mark a, b;
-	int rc = -1;
-
 	memset(f, 0, sizeof(*f));
 	f->period_ms = period;
+	f->design = design;
+	f->long_s = long_s;
 	f->allocs = f->overruns = -1;
 	f->trip_s = -1;
 	f->wd_worst_ms = f->late[0] = f->late[1] = f->late[2] = -1;
-	f->syscalls = -1;
-	snprintf(alloc_out, sizeof(alloc_out), "%s/alloc-%d.txt", e->dir,
-		 period);
+	f->syscalls = f->udp_in = -1;
+}
+
+/* One run of @f's period and design (loop_init()): o->seconds of joystick
+ * use, or f->long_s. Return: 0, or -1 with f->fault saying why. */
+static int loop_run(struct sys_env *e, const struct opts *o, struct loop_fig *f)
+{
+	char out_env[SYS_PATH_MAX + 32], pre_env[SYS_PATH_MAX + 16],
+	    alloc_out[SYS_PATH_MAX], perf_out[2][SYS_PATH_MAX], tag[32];
+	pid_t perf[2] = {-1, -1};
+	double calls = -1, udp = -1;
+	char *env[3] = {NULL, NULL, NULL};
+	const struct sys_subst rec[] = {{"record", f->design}, {NULL, NULL}};
+	struct sys_opts so = {
+	    .period_ms = f->period_ms, .re_env = env, .subst = rec};
+	struct sys_case c;
+	struct sched_param sp;
+	struct mark a, b;
+	int rc = -1, pol;
+
+	snprintf(tag, sizeof(tag), "%d-%s%s", f->period_ms, f->design,
+		 f->long_s ? "-long" : "");
+	snprintf(alloc_out, sizeof(alloc_out), "%s/alloc-%s.txt", e->dir, tag);
 	if (o->alloc_lib) {
 		snprintf(pre_env, sizeof(pre_env), "LD_PRELOAD=%s",
 			 o->alloc_lib);
@@ -442,18 +552,29 @@ static int loop_run(struct sys_env *e, const struct opts *o, int period,
 		return -1;
 	}
 	f->ready_s = c.ready_wall_s;
-	snprintf(perf_out, sizeof(perf_out), "%s/perf-%d.txt", e->dir, period);
+	pol = observe_begin(&sp);
+	snprintf(perf_out[0], sizeof(perf_out[0]), "%s/perf-%s.txt", e->dir,
+		 tag);
+	snprintf(perf_out[1], sizeof(perf_out[1]), "%s/perf-udp-%s.txt", e->dir,
+		 tag);
+	if (link_figure(&c.re, f) < 0) {
+		snprintf(c.err, sizeof(c.err), "not the %s design: %s",
+			 f->design, f->link);
+		goto out;
+	}
 	if (sys_ctl(&c, "watch hbpc") < 0 ||
 	    sys_wait_sim(&c, c.t_ready_ms + 1000, 5000) < 0)
 		goto out;
-	perf = perf_start(c.re.pid, perf_out);
+	perf[0] = perf_start(c.re.pid, perf_out[0], EV_SYSCALLS, NULL);
+	perf[1] = perf_start(c.re.pid, perf_out[1], EV_RECV, EV_UDP_IN);
 	if (take_mark(&c, o->alloc_lib != NULL, &a) < 0)
 		goto out;
-	f->trip_s = drive(&c, o->seconds);
+	f->trip_s = drive(&c, f->long_s ? f->long_s : o->seconds);
 	if (f->trip_s < 0 || take_mark(&c, o->alloc_lib != NULL, &b) < 0)
 		goto out;
-	calls = perf_stop(perf, perf_out);
-	perf = -1;
+	calls = perf_stop(perf[0], perf_out[0], EV_SYSCALLS);
+	udp = perf_stop(perf[1], perf_out[1], EV_RECV);
+	perf[0] = perf[1] = -1;
 	if (f->trip_s > 0) {
 		int i = sys_events(&c) < 0
 			    ? -1
@@ -466,6 +587,7 @@ static int loop_run(struct sys_env *e, const struct opts *o, int period,
 	figures(f, &a, &b);
 	/* the count spans the two marks and two hbpc reads: good to 1 % */
 	f->syscalls = calls >= 0 && f->cycles > 0 ? calls / f->cycles : -1;
+	f->udp_in = udp >= 0 && f->cycles > 0 ? udp / f->cycles : -1;
 	proc_find_line(&c.re, PROC_STDOUT, "FAULT ", f->fault,
 		       sizeof(f->fault));
 	readback_figures(&c.re, f);
@@ -477,8 +599,10 @@ static int loop_run(struct sys_env *e, const struct opts *o, int period,
 		f->allocs = alloc_figure(alloc_out);
 	rc = 0;
 out:
-	if (perf > 0)
-		perf_stop(perf, perf_out);
+	for (int k = 0; k < 2; k++)
+		if (perf[k] > 0)
+			perf_stop(perf[k], perf_out[k], EV_RECV);
+	observe_end(pol, &sp);
 	if (rc < 0)
 		snprintf(f->fault, sizeof(f->fault), "run failed: %.400s",
 			 c.err);
@@ -495,14 +619,16 @@ static void fmt_or_na(char *buf, size_t cap, double v, int decimals)
 		snprintf(buf, cap, "%.*f", decimals, v);
 }
 
-static void add_loop_cycle(const struct loop_fig *f, const char *item, int is50)
+/* Lateness, overruns and the worst reply age: from roboelf's exit, over
+ * the whole run (after a trip too). */
+static void add_loop_timing(const struct loop_fig *f, const char *item,
+			    int is50)
 {
+	static const char *const st[] = {"lateness p50", "lateness p99",
+					 "lateness max"};
 	char v[48];
 
 	for (int k = 0; k < 3; k++) {
-		static const char *const st[] = {"lateness p50", "lateness p99",
-						 "lateness max"};
-
 		fmt_or_na(v, sizeof(v), f->late[k], 3);
 		add("loop", item, st[k], "ms", "", "%s%s", v,
 		    f->late[k] < 0 ? " (not reported by roboelf)" : "");
@@ -511,16 +637,25 @@ static void add_loop_cycle(const struct loop_fig *f, const char *item, int is50)
 	fmt_or_na(v, sizeof(v), f->wd_worst_ms, 1);
 	add("loop", item, "worst reply age", "ms",
 	    is50 ? "limits 75 / 125 ms" : "", "%s", v);
+}
+
+static void add_loop_cycle(const struct loop_fig *f, const char *item, int is50)
+{
+	char v[48];
+
 	if (f->tcp.ok) {
-		add("loop", item, "requests per cycle", "",
+		add("loop", item, "requests per cycle (TCP)", "",
 		    is50 ? "one command per value read" : "", "%.2f",
 		    f->tcp.segs_out);
-		add("loop", item, "bytes out / in per cycle", "B", "",
+		add("loop", item, "bytes out / in per cycle (TCP)", "B", "",
 		    "%.1f / %.1f", f->tcp.bytes_out, f->tcp.bytes_in);
 	} else {
-		add("loop", item, "requests per cycle", "", "",
+		add("loop", item, "requests per cycle (TCP)", "", "",
 		    "n/a (ss not available)");
 	}
+	fmt_or_na(v, sizeof(v), f->udp_in, 2);
+	add("loop", item, "records per cycle (UDP datagrams in)", "", "",
+	    "%s%s", v, f->udp_in < 0 ? " (perf not available)" : "");
 	fmt_or_na(v, sizeof(v), f->cpu_us, 1);
 	add("loop", item, "supervisor CPU per cycle", "us", "", "%s", v);
 	fmt_or_na(v, sizeof(v), f->syscalls, 2);
@@ -530,30 +665,48 @@ static void add_loop_cycle(const struct loop_fig *f, const char *item, int is50)
 	add("loop", item, "heap allocations after start-up", "", "", "%s", v);
 }
 
+/* "period P ms, DESIGN" (and ", L s" for the long run): the grid's
+ * column. */
+static void loop_item(const struct loop_fig *f, char *buf, size_t cap)
+{
+	if (f->long_s)
+		snprintf(buf, cap, "period %d ms, %s, %d s", f->period_ms,
+			 f->design, f->long_s);
+	else
+		snprintf(buf, cap, "period %d ms, %s", f->period_ms, f->design);
+}
+
 static void add_loop(const struct loop_fig *f)
 {
-	char item[32];
-	int is50 = f->period_ms == 50;
+	char item[64];
+	int is50 = f->period_ms == 50, pol = sched_getscheduler(0);
+	const char *how = pol == SCHED_FIFO ? "SCHED_FIFO" : "normal";
 
-	snprintf(item, sizeof(item), "period %d ms", f->period_ms);
+	loop_item(f, item, sizeof(item));
 	add("loop", item, "start-up with --calibration file", "s", "", "%.2f",
 	    f->ready_s);
+	add("loop", item, "record (start-up line)", "", "", "%s", f->link);
+	add("loop", item, "record interval, 20 at start-up", "ms", "", "%s",
+	    f->link_ms[0] ? f->link_ms : "n/a (polled)");
+	if (f->long_s)
+		add("loop", item, "galil-sim's scheduling", "", "", "%s", how);
 	if (f->fault[0]) {
 		add("loop", item, "tripped", "", is50 ? "50 ms loop" : "",
-		    "%.1f s after Ready: %s", f->trip_s, f->fault);
-		add("loop", item, "overruns before the trip", "", "", "%ld",
-		    f->overruns);
-		add("loop", item, "worst reply age", "ms", "", "%.1f",
-		    f->wd_worst_ms);
+		    "%.1f s after Ready", f->trip_s);
+		add("loop", item, "FAULT line", "", "", "%s", f->fault);
+		add_loop_timing(f, item, is50);
 		return;
 	}
 	add("loop", item, "tripped", "", is50 ? "50 ms loop" : "", "no");
 	add("loop", item, "cycles measured", "", "", "%.0f in %.1f s",
 	    f->cycles, f->seconds);
-	if (f->rb_cycles > 0)
+	if (f->rb_cycles > 0) {
 		add("loop", item, "seal read back: all values every", "ms",
-		    "none", "%d (%d values, a chunk a cycle, %d cycles)",
-		    f->rb_cycles * f->period_ms, f->rb_values, f->rb_cycles);
+		    "none", "%d", f->rb_cycles * f->period_ms);
+		add("loop", item, "seal read back: values / cycles", "", "",
+		    "%d / %d", f->rb_values, f->rb_cycles);
+	}
+	add_loop_timing(f, item, is50);
 	add_loop_cycle(f, item, is50);
 }
 
@@ -581,17 +734,23 @@ struct instr_fig {
 	char out[SYS_PATH_MAX + 32];
 };
 
-/* The absolute path of valgrind on PATH into @buf, or -1. */
+/* The absolute path of valgrind on PATH into @buf (cap >= PATH_MAX), or
+ * -1. Its real path: Debian's valgrind is a script that runs "$0.bin",
+ * which make bench's PATH of symbolic links (tools/cmdtable.sh) lacks. */
 static int find_valgrind(char *buf, size_t cap)
 {
 	FILE *f = popen("command -v valgrind 2>/dev/null", "r");
-	int ok = f && fgets(buf, (int)cap, f) && buf[0] == '/';
+	char found[PATH_MAX];
+	int ok = f && fgets(found, (int)sizeof(found), f) && found[0] == '/';
 
 	if (f)
 		pclose(f);
-	if (ok)
-		buf[strcspn(buf, "\n")] = '\0';
-	return ok ? 0 : -1;
+	if (!ok)
+		return -1;
+	found[strcspn(found, "\n")] = '\0';
+	if (cap < PATH_MAX || !realpath(found, buf))
+		return -1;
+	return 0;
 }
 
 /* Name compression of callgrind's output: "(id) name" defines @id's name,
@@ -654,9 +813,11 @@ static int cg_read(const char *path, struct instr_fig *f)
 	return 0;
 }
 
-static void instr_run(struct sys_env *e, int secs, struct instr_fig *f)
+static void instr_run(struct sys_env *e, int secs, const char *design,
+		      struct instr_fig *f)
 {
-	char vg[SYS_PATH_MAX], outopt[SYS_PATH_MAX + 64];
+	const struct sys_subst rec[] = {{"record", design}, {NULL, NULL}};
+	char vg[PATH_MAX], outopt[SYS_PATH_MAX + 64];
 	char *wrap[] = {vg,
 			(char *)"--tool=callgrind",
 			(char *)"--collect-atstart=no",
@@ -664,8 +825,10 @@ static void instr_run(struct sys_env *e, int secs, struct instr_fig *f)
 			(char *)"--toggle-collect=run.*",
 			outopt,
 			NULL};
-	struct sys_opts so = {
-	    .period_ms = 50, .re_wrap = wrap, .ready_timeout_ms = 120000};
+	struct sys_opts so = {.period_ms = 50,
+			      .re_wrap = wrap,
+			      .ready_timeout_ms = 120000,
+			      .subst = rec};
 	struct sys_case c;
 	double t;
 
@@ -675,8 +838,8 @@ static void instr_run(struct sys_env *e, int secs, struct instr_fig *f)
 		snprintf(f->why, sizeof(f->why), "valgrind not installed");
 		return;
 	}
-	snprintf(f->out, sizeof(f->out), "%s/callgrind-50-%ds.out", e->dir,
-		 secs);
+	snprintf(f->out, sizeof(f->out), "%s/callgrind-50-%s-%ds.out", e->dir,
+		 design, secs);
 	snprintf(outopt, sizeof(outopt), "--callgrind-out-file=%s", f->out);
 	if (sys_case_start(&c, e, &so) < 0) {
 		snprintf(f->why, sizeof(f->why), "did not start: %.200s",
@@ -697,37 +860,39 @@ static void instr_run(struct sys_env *e, int secs, struct instr_fig *f)
 			 f->out);
 }
 
-static void instr(struct sys_env *e, const struct opts *o)
+/* The instructions per cycle of @design ("poll", "stream") at 50 ms,
+ * item "period 50 ms, DESIGN" like the loop figures. */
+static void instr(struct sys_env *e, const struct opts *o, const char *design)
 {
-	const char *item = "period 50 ms: callgrind Ir in run() / cycles";
+	int short_s = o->seconds / 3 > 2 ? o->seconds / 3 : 2;
 	struct instr_fig a, b;
 	const char *why;
+	char item[64];
 
+	snprintf(item, sizeof(item), "period 50 ms, %s", design);
 	printf("bench: %d and %d s of joystick use at 50 ms under callgrind "
-	       "...\n",
-	       o->seconds / 3 > 2 ? o->seconds / 3 : 2, o->seconds);
+	       "(%s) ...\n",
+	       short_s, o->seconds, design);
 	fflush(stdout);
-	instr_run(e, o->seconds / 3 > 2 ? o->seconds / 3 : 2, &a);
-	instr_run(e, o->seconds, &b);
+	instr_run(e, short_s, design, &a);
+	instr_run(e, o->seconds, design, &b);
 	why = a.why[0] ? a.why : b.why;
 	if (!why[0] && b.cycles <= a.cycles)
 		why = "no more cycles in the longer run";
 	if (why[0]) {
-		add("loop", item, "user instructions per cycle", "", "",
-		    "n/a (%.40s)", why);
+		add("loop", item, "user instructions per cycle, run()", "", "",
+		    "n/a (%.200s)", why);
 		return;
 	}
-	add("loop", item, "user instructions per cycle", "", "5 k", "%.0f",
-	    (b.ir - a.ir) / (double)(b.cycles - a.cycles));
-	add("loop", item, "instructions / cycles, 2 runs", "", "",
+	add("loop", item, "user instructions per cycle, run()", "", "5 k",
+	    "%.0f", (b.ir - a.ir) / (double)(b.cycles - a.cycles));
+	add("loop", item, "user instructions per cycle, cycle alone", "", "5 k",
+	    "%.0f", (b.cyc_ir - a.cyc_ir) / (double)(b.cycles - a.cycles));
+	add("loop", item, "callgrind Ir / cycles, 2 runs", "", "",
 	    "%.0f/%ld, %.0f/%ld", a.ir, a.cycles, b.ir, b.cycles);
-	add("loop",
-	    "period 50 ms: the cycle alone (re_super_wait + re_super_cycle)",
-	    "user instructions per cycle", "", "5 k", "%.0f",
-	    (b.cyc_ir - a.cyc_ir) / (double)(b.cycles - a.cycles));
-	printf("bench: the cycle's instructions by function: "
+	printf("bench: the cycle's instructions by function (%s): "
 	       "callgrind_annotate --inclusive=yes %s\n",
-	       b.out);
+	       design, b.out);
 }
 
 /* ---- galil-sim's virtual-time speed ------------------------------------- */
@@ -934,14 +1099,99 @@ static int write_csv(const char *path)
 	return fclose(f);
 }
 
+/* A loop figure of one period and design (item "period ..."): printed in
+ * the grid, not in the table. */
+static int in_grid(const struct row *r)
+{
+	return !strcmp(r->section, "loop") && !strncmp(r->item, "period ", 7);
+}
+
+#define GRID_COLS 6  /* columns of one grid */
+#define GRID_W	  18 /* a cell's width; longer values are listed below */
+
+/* The row of @item and @stat, or NULL. */
+static const struct row *find_row(const char *item, const char *stat)
+{
+	for (int i = 0; i < n_rows; i++)
+		if (in_grid(&rows[i]) && !strcmp(rows[i].item, item) &&
+		    !strcmp(rows[i].stat, stat))
+			return &rows[i];
+	return NULL;
+}
+
+/* The grid's lines for @ncol columns @col: one line per statistic (in the
+ * order they were added), one cell per column, then the original
+ * system's value; the values too long for a cell in full after it. */
+static void print_grid(const char *const *col, int ncol)
+{
+	char label[72];
+	int w[GRID_COLS];
+
+	printf("\n%-40s", "loop");
+	for (int k = 0; k < ncol; k++) {
+		w[k] = (int)strlen(col[k] + 7);
+		w[k] = w[k] > GRID_W ? w[k] : GRID_W;
+		printf(" %-*s", w[k], col[k] + 7);
+	}
+	printf(" original design\n");
+	for (int i = 0; i < n_rows; i++) {
+		const char *orig = "";
+		int first = 1, here = 0;
+
+		for (int j = 0; j < i && first; j++)
+			first = !in_grid(&rows[j]) ||
+				strcmp(rows[j].stat, rows[i].stat);
+		for (int k = 0; k < ncol && first; k++)
+			here |= find_row(col[k], rows[i].stat) != NULL;
+		if (!in_grid(&rows[i]) || !here)
+			continue;
+		snprintf(label, sizeof(label),
+			 rows[i].unit[0] ? "%s (%s)" : "%s", rows[i].stat,
+			 rows[i].unit);
+		printf("%-40.40s", label);
+		for (int k = 0; k < ncol; k++) {
+			const struct row *r = find_row(col[k], rows[i].stat);
+
+			printf(" %-*.*s", w[k], GRID_W, r ? r->value : "-");
+			if (r && r->original[0] && !orig[0])
+				orig = r->original;
+		}
+		printf(" %s\n", orig);
+	}
+	for (int k = 0; k < ncol; k++)
+		for (int i = 0; i < n_rows; i++)
+			if (in_grid(&rows[i]) &&
+			    !strcmp(rows[i].item, col[k]) &&
+			    strlen(rows[i].value) > GRID_W)
+				printf("  %s: %s: %s\n", rows[i].item,
+				       rows[i].stat, rows[i].value);
+}
+
+/* Every figure: the loops as grids (periods and designs side by side),
+ * the rest as a table. */
 static void print_table(void)
 {
-	printf("\n%-10s %-44s %-32s %-22s %-6s %s\n", "section", "item",
+	const char *col[MAX_ROWS];
+	int ncol = 0;
+
+	for (int i = 0; i < n_rows; i++) {
+		int k = 0;
+
+		while (k < ncol && strcmp(col[k], rows[i].item))
+			k++;
+		if (in_grid(&rows[i]) && k == ncol)
+			col[ncol++] = rows[i].item;
+	}
+	for (int k = 0; k < ncol; k += GRID_COLS)
+		print_grid(col + k,
+			   ncol - k < GRID_COLS ? ncol - k : GRID_COLS);
+	printf("\n%-10s %-44s %-36s %-22s %-6s %s\n", "section", "item",
 	       "statistic", "value", "unit", "original design");
 	for (int i = 0; i < n_rows; i++)
-		printf("%-10s %-44.44s %-32.32s %-22s %-6s %s\n",
-		       rows[i].section, rows[i].item, rows[i].stat,
-		       rows[i].value, rows[i].unit, rows[i].original);
+		if (!in_grid(&rows[i]))
+			printf("%-10s %-44.44s %-36.36s %-22s %-6s %s\n",
+			       rows[i].section, rows[i].item, rows[i].stat,
+			       rows[i].value, rows[i].unit, rows[i].original);
 }
 
 /* ---- calibration against its physical bounds ----------------- */
@@ -1116,9 +1366,27 @@ static void recorder_cost(const char *self)
 	re_rec_free(&rb_rec);
 }
 
+/* One loop run and its rows; a trip or a failure is said at once. */
+static void loop_one(struct sys_env *e, const struct opts *o, int period,
+		     const char *design, int long_s)
+{
+	struct loop_fig f;
+
+	loop_init(&f, period, design, long_s);
+	printf("bench: %d s of joystick use at a %d ms period, %s ...\n",
+	       long_s ? long_s : o->seconds, period, design);
+	fflush(stdout);
+	loop_run(e, o, &f);
+	if (f.fault[0])
+		printf("bench: period %d ms, %s: %s\n", period, design,
+		       f.fault);
+	add_loop(&f);
+}
+
 int main(int argc, char **argv)
 {
 	static const int periods[] = {50, 10, 2};
+	static const char *const designs[] = {"poll", "stream"};
 	static struct sys_env env;
 	struct opts o;
 
@@ -1145,17 +1413,14 @@ int main(int argc, char **argv)
 		    "s", "", "%.1f", env.calib_s);
 		calib_bounds(&env);
 	}
-	instr(&env, &o);
 	for (size_t i = 0; !o.only && i < sizeof(periods) / sizeof(periods[0]);
-	     i++) {
-		struct loop_fig f;
-
-		printf("bench: %d s of joystick use at a %d ms period ...\n",
-		       o.seconds, periods[i]);
-		fflush(stdout);
-		loop_run(&env, &o, periods[i], &f);
-		add_loop(&f);
-	}
+	     i++)
+		for (size_t d = 0; d < 2; d++)
+			loop_one(&env, &o, periods[i], designs[d], 0);
+	for (size_t d = 0; d < 2; d++)
+		instr(&env, &o, designs[d]);
+	if (!o.only && o.long_s > 0)
+		loop_one(&env, &o, 2, "stream", o.long_s);
 	if (!o.only) {
 		sim_speed(&env);
 		recorder_cost(argv[0]);
