@@ -31,6 +31,8 @@
 #include "gl_stream.h"
 
 #define GL_LINK_MSG_READS_MAX 8 /* recv() calls per gl_link_message() */
+#define GL_LINK_DGRAM_BATCH  32  /* stream datagrams a recvmmsg() */
+#define GL_LINK_DGRAM_MAX    512 /* the largest record is 190 bytes */
 
 /* One TCP connection to the controller and the parser of its bytes. */
 struct gl_chan {
@@ -57,6 +59,9 @@ struct gl_link {
 	int st_fd;
 	int st_handle; /* 0..7 = A..H */
 	struct gl_stream st;
+	/* a batch of datagrams (recvmmsg()), here rather than on the
+	 * cycle's stack */
+	uint8_t st_buf[GL_LINK_DGRAM_BATCH][GL_LINK_DGRAM_MAX];
 };
 
 /* What one exchange sends and awaits. */

@@ -7,6 +7,7 @@
  * kernel drops datagrams from anyone else; gl_stream checks the sender
  * again and judges every record by its own sample number.
  */
+#define _GNU_SOURCE /* recvmmsg() */
 #include <errno.h>
 #include <fcntl.h>
 #include <netinet/in.h>
@@ -14,6 +15,7 @@
 #include <stdio.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/uio.h>
 #include <unistd.h>
 
 #include "base_clock.h"
@@ -22,6 +24,7 @@
 
 #define WH_RESEND_MS 20 /* UDP may lose WH or its answer: ask again */
 #define DGRAM_MAX    512 /* the largest record is 190 bytes */
+#define DGRAM_BATCH  GL_LINK_DGRAM_BATCH
 
 /* The controller's address with @port. */
 static void udp_peer(const gl_link *l, int port, struct sockaddr_storage *ss)
@@ -172,27 +175,43 @@ int gl_link_stream_open(gl_link *l, int udp_port, unsigned n0_samples,
 
 int gl_link_stream_read(gl_link *l, struct gl_record *rec, int64_t now_ns)
 {
-	uint8_t b[DGRAM_MAX];
-	struct gl_stream_peer from = {{0}, 0};
-	int fresh = 0;
+	uint8_t(*b)[GL_LINK_DGRAM_MAX];
+	struct mmsghdr m[DGRAM_BATCH];
+	struct iovec v[DGRAM_BATCH];
+	struct gl_stream_peer from;
+	int fresh = 0, n;
 
 	if (!l || !rec || l->st_fd < 0)
 		return GL_ERR_ARG;
+	b = l->st_buf;
 	from = l->st.ctrl; /* connected: only the controller's get here */
-	for (int i = 0; i < GL_LINK_STREAM_READS_MAX; i++) {
-		ssize_t n = recv(l->st_fd, b, sizeof(b), MSG_DONTWAIT);
-
+	/* a batch a system call: at 50 ms a cycle finds about 25 */
+	for (int got = 0; got < GL_LINK_STREAM_READS_MAX; got += n) {
+		memset(m, 0, sizeof(m));
+		for (int i = 0; i < DGRAM_BATCH; i++) {
+			v[i].iov_base = b[i];
+			v[i].iov_len = GL_LINK_DGRAM_MAX;
+			m[i].msg_hdr.msg_iov = &v[i];
+			m[i].msg_hdr.msg_iovlen = 1;
+		}
+		n = recvmmsg(l->st_fd, m, DGRAM_BATCH, MSG_DONTWAIT, NULL);
 		if (n < 0) {
 			if (errno == EAGAIN || errno == EWOULDBLOCK)
 				break;
-			if (errno == EINTR || errno == ECONNREFUSED)
-				continue; /* an ICMP error: the stream judges */
+			if (errno == EINTR || errno == ECONNREFUSED) {
+				n = 0; /* an ICMP error: the stream judges */
+				continue;
+			}
 			return GL_ERR_SYS;
 		}
-		l->rx_bytes += (uint64_t)n;
-		if (gl_stream_feed(&l->st, b, (size_t)n, &from, now_ns, rec) ==
-		    GL_STREAM_ACCEPTED)
-			fresh = 1;
+		for (int i = 0; i < n; i++) {
+			l->rx_bytes += m[i].msg_len;
+			if (gl_stream_feed(&l->st, b[i], m[i].msg_len, &from,
+					   now_ns, rec) == GL_STREAM_ACCEPTED)
+				fresh = 1;
+		}
+		if (n < DGRAM_BATCH)
+			break;
 	}
 	return fresh;
 }
