@@ -14,15 +14,22 @@
 #   netns_rig.sh setup ID              create namespace roboelf-net-ID
 #   netns_rig.sh down ID | up ID       the host's end of the data pair down/up
 #                                      (a pulled cable: no FIN, no RST)
-#   netns_rig.sh loss ID PCT [DIR]     drop PCT % of the packets (iptables
+#   netns_rig.sh loss ID PCT [DIR] [PROTO]
+#                                      drop PCT % of the packets (iptables
 #                                      statistic match) that DIR names: both
 #                                      (the default, each way), ctl (the frames
 #                                      the controller sends: its replies) or
 #                                      pc (the frames the PC sends: requests);
 #                                      each is dropped where it is received,
-#                                      as a cable loses it (below)
-#   netns_rig.sh delay ID MS BIN       hold every packet the controller sends
-#                                      MS ms (BIN/nfq-delay, NFQUEUE 0)
+#                                      as a cable loses it (below). PROTO: tcp
+#                                      (the command port: requests, replies,
+#                                      the heartbeat), udp (the record stream,
+#                                      DR) or all (the default); PROTO needs
+#                                      DIR before it
+#   netns_rig.sh delay ID MS BIN [PROTO]
+#                                      hold every packet of PROTO (tcp, udp,
+#                                      all: the default) that the controller
+#                                      sends MS ms (BIN/nfq-delay, NFQUEUE 0)
 #   netns_rig.sh rto ID MS [both]      rto_min MS on the data route, both ends;
 #                                      the namespace's TCP (the controller's)
 #                                      with linear retransmission timeouts
@@ -119,17 +126,29 @@ clear_rules() {
 	return 0
 }
 
+# PROTO as iptables words in $PM: none for all, "-p tcp" or "-p udp".
+proto() {
+	case $1 in
+	all) PM= ;;
+	tcp | udp) PM="-p $1" ;;
+	*) die "bad protocol '$1' (tcp, udp, all)" ;;
+	esac
+}
+
 # The namespace's INPUT receives the frames the PC sends, the host's INPUT
 # (on rd<ID>h) those the controller sends.
 loss() {
 	pct=$1; dir=$2
 	p=$(awk -v p="$pct" 'BEGIN { if (p + 0 <= 0 || p + 0 > 100) exit 1; printf "%.4f", p / 100 }') || die "bad loss '$pct'"
 	case $dir in both | ctl | pc) ;; *) die "bad direction '$dir' (both, ctl, pc)" ;; esac
+	proto "$3"
 	if [ "$dir" != ctl ]; then
-		inns iptables -A INPUT -i "$DN" -m statistic --mode random --probability "$p" -j DROP || die "iptables"
+		# shellcheck disable=SC2086 # $PM: zero or two words
+		inns iptables -A INPUT -i "$DN" $PM -m statistic --mode random --probability "$p" -j DROP || die "iptables"
 	fi
 	if [ "$dir" != pc ]; then
-		iptables -A INPUT -i "$DH" -m statistic --mode random --probability "$p" -j DROP || die "host iptables"
+		# shellcheck disable=SC2086
+		iptables -A INPUT -i "$DH" $PM -m statistic --mode random --probability "$p" -j DROP || die "host iptables"
 	fi
 	return 0
 }
@@ -146,6 +165,7 @@ host_rules_del() {
 
 delay() {
 	ms=$1; bin=$2
+	proto "$3"
 	[ -x "$bin/nfq-delay" ] || die "no '$bin/nfq-delay' (libnetfilter-queue-dev missing at build time?)"
 	kill_delay
 	fifo=$(mktemp -u /tmp/roboelf-nfq.XXXXXX); mkfifo "$fifo" || die "mkfifo"
@@ -159,7 +179,8 @@ delay() {
 		rm -f "$fifo"; kill_delay; die "nfq-delay did not start: $line"
 	fi
 	rm -f "$fifo"
-	inns iptables -A OUTPUT -o "$DN" -j NFQUEUE --queue-num 0 || { kill_delay; die "iptables NFQUEUE"; }
+	# shellcheck disable=SC2086
+	inns iptables -A OUTPUT -o "$DN" $PM -j NFQUEUE --queue-num 0 || { kill_delay; die "iptables NFQUEUE"; }
 }
 
 rto() {
@@ -192,8 +213,8 @@ check) check ;;
 setup) ids "$@"; setup ;;
 down) ids "$@"; ip link set "$DH" down || die "link down" ;;
 up) ids "$@"; ip link set "$DH" up || die "link up" ;;
-loss) ids "$1"; loss "${2:?pct}" "${3:-both}" ;;
-delay) ids "$1"; delay "${2:?ms}" "${3:?bin dir}" ;;
+loss) ids "$1"; loss "${2:?pct}" "${3:-both}" "${4:-all}" ;;
+delay) ids "$1"; delay "${2:?ms}" "${3:?bin dir}" "${4:-all}" ;;
 rto) ids "$1"; rto "${2:?ms}" "${3:-both}" ;;
 clear) ids "$@"; clear_rules ;;
 teardown) ids "$@"; teardown ;;

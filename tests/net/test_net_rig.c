@@ -9,7 +9,10 @@
  * RTO_MIN_MS on its route. The controller's side is, per case, either tuned
  * the same way (a controller whose TCP resends as fast as the PC's) or left
  * at the kernel's defaults (rto_min 200 ms: a real controller's timer is
- * nobody's to set); the loss and delay cases are a table (struct link_case).
+ * nobody's to set); the loss and delay cases are a table (struct link_case),
+ * each row in one of the two designs of controller.record: the round trip
+ * per cycle (poll) or the record streamed over UDP with the heartbeat posted
+ * on TCP (stream), its loss or delay on one protocol or on both.
  * Each case asserts the outcome that docs/safety.md ("Network cases")
  * states: no trip, warnings only, or a WATCHDOG fault with the relay off and
  * every motor off within the deadline, measured on galil-sim's event log
@@ -38,6 +41,7 @@
 #include <cmocka.h>
 
 #include "proc.h"
+#include "re_fault.h"
 #include "sys_h.h"
 
 #define SKIP_EXIT     77
@@ -180,7 +184,9 @@ static void record(const char *name, const char *expected,
 	fclose(f);
 }
 
-/* The log's "watchdog: reply after" warnings so far. */
+/* The log's watchdog warnings so far ("watchdog: reply after ..." or, in
+ * the stream design, "watchdog: a record or the heartbeat's reply came
+ * after ..."). */
 static long count_warnings(struct sys_case *c)
 {
 	char line[2048];
@@ -188,7 +194,8 @@ static long count_warnings(struct sys_case *c)
 	FILE *f = fopen(c->log, "r");
 
 	while (f && fgets(line, sizeof(line), f))
-		n += strstr(line, "watchdog: reply after") != NULL;
+		n += strstr(line, "watchdog: ") &&
+		     strstr(line, "(non-critical limit ");
 	if (f)
 		fclose(f);
 	return n;
@@ -210,26 +217,70 @@ static double wait_motors_off(struct sys_case *c, double after, int ms)
 	}
 }
 
+/* The link's WATCHDOG faults: the round trip's reply age, and the stream
+ * design's record, acknowledgement and echo ages (docs/link.md). */
+static const enum re_fault_id link_wdogs[] = {RE_F_WDOG_REPLY, RE_F_WDOG_STREAM,
+					      RE_F_WDOG_ACK, RE_F_WDOG_ECHO,
+					      RE_F_NONE};
+
+/* Which of link_wdogs @line is: the class and the recovery (which the
+ * four share), and the text of its template up to the first figure.
+ * Return: the id, or RE_F_NONE. */
+static enum re_fault_id link_fault_id(const char *line)
+{
+	for (int i = 0; link_wdogs[i] != RE_F_NONE; i++) {
+		const enum re_fault_id one[] = {link_wdogs[i], RE_F_NONE};
+		const char *what = NULL, *brace;
+		char head[128];
+
+		if (sys_fault_match(line, -1, one) == RE_F_NONE ||
+		    re_fault_template(link_wdogs[i], &what, NULL) != 0 || !what)
+			continue;
+		brace = strchr(what, '{');
+		snprintf(head, sizeof(head), "%.*s",
+			 (int)(brace ? brace - what : (long)strlen(what)),
+			 what);
+		if (head[0] && strstr(line, head))
+			return link_wdogs[i];
+	}
+	return RE_F_NONE;
+}
+
+/* The age and the limit a link WATCHDOG FAULT line names ("... for A ms
+ * (limit L ms"): 0, or -1 when the line has no such figures. */
+static int fault_age(const char *line, double *age_ms, double *limit_ms)
+{
+	const char *p = strstr(line, " ms (limit ");
+
+	if (!p)
+		return -1;
+	while (p > line && (p[-1] == '.' || (p[-1] >= '0' && p[-1] <= '9')))
+		p--;
+	return sscanf(p, "%lf ms (limit %lf ms", age_ms, limit_ms) == 2 ? 0
+									: -1;
+}
+
 /*
- * A WATCHDOG trip within @wait_ms (real time): the FAULT line names the
- * reply age (RE_F_WDOG_REPLY), the relay goes off within @d_relay and every
- * motor within @d_motors of @t_inj (a negative deadline: not asserted, only
- * measured), the robot is safe and stays so.
+ * A WATCHDOG trip within @wait_ms (real time): the FAULT line is @want
+ * (RE_F_NONE: any of link_wdogs) and names an age past its limit by at
+ * most a period, the relay goes off within @d_relay and every motor within
+ * @d_motors of @t_inj (a negative deadline: not asserted, only measured),
+ * the robot is safe and stays so.
  */
 static void expect_trip(struct sys_case *c, const char *name, double t_inj,
 			double d_relay, double d_motors, int wait_ms,
-			struct outcome *o)
+			enum re_fault_id want, struct outcome *o)
 {
-	static const enum re_fault_id ids[] = {RE_F_WDOG_REPLY, RE_F_NONE};
-	double t;
+	enum re_fault_id got;
+	double t, lim = -1;
 
 	if (sys_wait_fault(c, wait_ms, o->line, sizeof(o->line)) < 0)
 		fail_msg("%s: %s", name, c->err);
-	if (sys_fault_match(o->line, -1, ids) != RE_F_WDOG_REPLY)
-		fail_msg("%s: not the reply-age WATCHDOG fault: %s", name,
+	got = link_fault_id(o->line);
+	if (got == RE_F_NONE || (want != RE_F_NONE && got != want))
+		fail_msg("%s: not the expected link WATCHDOG fault: %s", name,
 			 o->line);
-	if (sscanf(strstr(o->line, "no reply from the controller for "),
-		   "no reply from the controller for %lf ms", &o->age_ms) != 1)
+	if (fault_age(o->line, &o->age_ms, &lim) < 0)
 		o->age_ms = -1;
 	if (sys_wait_event(c, "relay off", t_inj, 3000, &t) < 0)
 		fail_msg("%s: %s", name, c->err);
@@ -248,33 +299,66 @@ static void expect_trip(struct sys_case *c, const char *name, double t_inj,
 	if (d_motors >= 0 && o->motors_ms > d_motors + SLACK_MS)
 		fail_msg("%s: motors off after %.0f ms, deadline %.0f ms (+%d)",
 			 name, o->motors_ms, d_motors, SLACK_MS);
-	if (o->age_ms < 0 || o->age_ms > C() + P() + SLACK_MS)
-		fail_msg("%s: reply age %.0f ms in the FAULT line, limit "
-			 "C + P = %.0f ms",
-			 name, o->age_ms, C() + P());
+	/* the echo's limit is its own (re_plan); the other ages' is C */
+	if (got != RE_F_WDOG_ECHO && lim != C())
+		fail_msg("%s: limit %.0f ms in the FAULT line, not C = %.0f ms",
+			 name, lim, C());
+	if (o->age_ms < 0 || o->age_ms > lim + P() + SLACK_MS)
+		fail_msg("%s: age %.0f ms in the FAULT line, limit %.0f ms + P "
+			 "= %.0f ms",
+			 name, o->age_ms, lim, lim + P());
+}
+
+/* An unexpected trip of a no-trip case: measured like an expected one
+ * (the relay's and the motors' times from @t0, the safe state held), so
+ * that the failure names the fault and says whether the robot was safe. */
+static void unexpected_trip(struct sys_case *c, const char *name, double t0,
+			    const char *expected, struct outcome *o)
+{
+	double t;
+
+	if (sys_wait_event(c, "relay off", t0, 3000, &t) == 0)
+		o->relay_ms = t - t0;
+	t = wait_motors_off(c, t0, 3000);
+	if (t >= 0)
+		o->motors_ms = t - t0;
+	if (fault_age(o->line, &o->age_ms, &t) < 0)
+		o->age_ms = -1;
+	o->warnings = count_warnings(c);
+	record(name, expected, o);
+	if (strstr(o->line, "this supervisor did not run"))
+		fail_msg("%s: inconclusive: the PC stalled (machine "
+			 "overloaded), not the link: %s",
+			 name, o->line);
+	fail_msg("%s: tripped (%s; relay off %.0f ms, motors off %.0f ms "
+		 "after the rule): %s",
+		 name,
+		 o->relay_ms >= 0 && o->motors_ms >= 0 &&
+			 sys_check_safe(c, 0, HOLD_MS) == 0
+		     ? "safe state reached and held"
+		     : "NOT SAFE",
+		 o->relay_ms, o->motors_ms, o->line);
 }
 
 /* No trip for @secs of simulated time from @t0: no FAULT line, still
- * armed (relay on, every motor on). */
+ * armed (relay on, every motor on). A trip ends the wait at once and is
+ * measured (unexpected_trip()). */
 static void expect_no_trip(struct sys_case *c, const char *name, double t0,
 			   double secs, const char *expected, long max_warn)
 {
 	struct outcome o = {.relay_ms = -1, .motors_ms = -1, .age_ms = -1};
 	char st[2048];
 
-	if (sys_wait_sim(c, t0 + secs * 1000, (int)(secs * 1000) + 5000) < 0)
+	if (sys_wait_fault(c, (int)(secs * 1000), o.line, sizeof(o.line)) == 0)
+		unexpected_trip(c, name, t0, expected, &o);
+	if (sys_wait_sim(c, t0 + secs * 1000, 5000) < 0)
 		fail_msg("%s: %s", name, c->err);
 	proc_pump(&c->re, 0);
 	proc_find_line(&c->re, PROC_STDOUT, "FAULT ", o.line, sizeof(o.line));
+	if (o.line[0])
+		unexpected_trip(c, name, t0, expected, &o);
 	o.warnings = count_warnings(c);
 	record(name, expected, &o);
-	if (o.line[0] && strstr(o.line, "this supervisor did not run"))
-		fail_msg(
-		    "%s: inconclusive: the PC stalled (machine overloaded), "
-		    "not the link: %s",
-		    name, o.line);
-	if (o.line[0])
-		fail_msg("%s: tripped within %.0f s: %s", name, secs, o.line);
 	if (sys_state(c, st, sizeof(st)) < 0)
 		fail_msg("%s: %s", name, c->err);
 	if (!strstr(st, " relay=on ") || !strstr(st, " A.mo=0 ") ||
@@ -312,19 +396,33 @@ enum rto_ends {
 	RTO_NONE,
 };
 
-/* A case on the rig with rto_min on the @ends of the route. */
+/* How the cycle gets the controller's record (controller.record). */
+enum design {
+	POLL,	/* one round trip per cycle, "hbpc=N;QR" */
+	STREAM, /* the record streamed (DR over UDP), the heartbeat posted */
+};
+
+/* A case on the rig in @design with rto_min on the @ends of the route.
+ * The design is written into the case's configuration, so a case never
+ * depends on ROBOELF_SYS_RECORD. */
 static void start_rto(struct sys_case *c, const char *calibration,
-		      enum rto_ends ends)
+		      enum rto_ends ends, enum design design)
 {
 	/* the script exec's ip, which exec's galil-sim: the pid is its */
 	char *wrap[] = {(char *)"/bin/bash", rig_sh, (char *)"exec", rig_id,
 			NULL};
+	const struct sys_subst subst[] = {
+	    {"record", design == STREAM ? "stream" : "poll"}, {NULL, NULL}};
 	struct sys_opts o = {.sim_wrap = wrap,
 			     .sim_addr = data_addr,
 			     .ctl_addr = mgmt_addr,
+			     .subst = subst,
 			     .calibration = calibration,
 			     .no_ready = calibration != NULL};
 
+	/* a case that failed left its processes: they would run on (and
+	 * hold their relay's lock) beside the next case */
+	sys_case_stop(c);
 	if (!env_ok || !rig_ok)
 		fail_msg("no environment (calibration or rig failed)");
 	if (rig("clear %s", rig_id) || rig("up %s", rig_id) ||
@@ -341,7 +439,7 @@ static void start_rto(struct sys_case *c, const char *calibration,
 
 static void start(struct sys_case *c, const char *calibration)
 {
-	start_rto(c, calibration, RTO_BOTH);
+	start_rto(c, calibration, RTO_BOTH, POLL);
 }
 
 static void stop(struct sys_case *c)
@@ -378,7 +476,7 @@ static void test_pull_armed(void **state)
 	jog(&cs);
 	t = pull_cable(&cs);
 	expect_trip(&cs, "cable pull, armed", t, C() + P(), W_stop(),
-		    FAULT_WAIT_MS, &o);
+		    FAULT_WAIT_MS, RE_F_WDOG_REPLY, &o);
 	quit_latched(&cs, "cable pull, armed");
 	stop(&cs);
 }
@@ -395,7 +493,7 @@ static void test_pull_calibrating(void **state)
 		fail_msg("no calibration motion: %s", cs.err);
 	t = pull_cable(&cs);
 	expect_trip(&cs, "cable pull, calibrating", t, C() + P(), W_stop(),
-		    FAULT_WAIT_MS, &o);
+		    FAULT_WAIT_MS, RE_F_WDOG_REPLY, &o);
 	quit_latched(&cs, "cable pull, calibrating");
 	stop(&cs);
 }
@@ -440,7 +538,7 @@ static void test_pull_back_200ms(void **state)
 	if (sys_wait_sim(&cs, t + 200, 3000) < 0 || link_set(1) < 0)
 		fail_msg("cable back: %s", cs.err);
 	expect_trip(&cs, "cable back after 200 ms", t, C() + P(), W_stop(),
-		    FAULT_WAIT_MS, &o);
+		    FAULT_WAIT_MS, RE_F_WDOG_REPLY, &o);
 	if (sys_check_safe(&cs, 0, 1000) < 0 || sys_events(&cs) < 0)
 		fail_msg("cable back after 200 ms: %s", cs.err);
 	for (int a = 0; a < 3; a++) {
@@ -463,23 +561,31 @@ static void test_pull_back_200ms(void **state)
 /* What a case asserts (docs/safety.md, "Network cases"). */
 enum expect {
 	NO_TRIP, /* held @secs: no FAULT line, still armed */
-	TRIP,	 /* the reply-age WATCHDOG fault, relay and motors off */
+	TRIP,	 /* a link WATCHDOG fault, relay and motors off */
 };
 
 /*
- * One loss or delay case. The round trip per cycle is the design every row
- * measures today; a record stream on UDP (docs/link.md, option C) is to be
- * one more column here, with the same rows.
+ * One loss or delay case: the same injections for both designs of
+ * controller.record, so that the rows compare them.
  */
 struct link_case {
 	const char *name;   /* the measurement's name (output, CSV) */
+	enum design design; /* how the cycle gets the record */
 	int loss_pct;	    /* random loss, 0 none */
 	const char *dir;    /* the loss's frames (netns_rig.sh loss): "both"
 			       ways, "ctl" (the controller's replies), "pc"
 			       (the PC's requests) */
-	int delay_ms;	    /* on every frame the controller sends, 0 none */
+	const char *proto;  /* the loss's or the delay's protocol: "tcp" (the
+			       command port), "udp" (the record stream) or
+			       "all" */
+	int delay_ms;	    /* on the frames of @proto the controller sends,
+			       0 none */
 	enum rto_ends rto;  /* which ends resend fast */
 	enum expect expect; /* the outcome asserted */
+	/* TRIP: the fault's class; RE_F_NONE: any of link_wdogs (a loss in
+	 * the stream design may meet the record's, the acknowledgement's or
+	 * the echo's limit first). The round trip's is always WDOG_REPLY. */
+	enum re_fault_id fault;
 	/* NO_TRIP: the time held; TRIP on loss (at a random time): the
 	 * longest wait for the fault; a trip on delay must come within the
 	 * deadline C + P + the delay */
@@ -488,46 +594,84 @@ struct link_case {
 };
 
 /* Loss: a trip comes at a random time, so there is no deadline from the
- * injection; the reply age and the controller's stop are asserted. */
-static void loss_trip(const struct link_case *k, double t)
+ * injection; the age in the FAULT line and the controller's stop are
+ * asserted. */
+static void loss_trip(const struct link_case *k, enum re_fault_id want,
+		      double t)
 {
 	struct outcome o = {0};
 
-	expect_trip(&cs, k->name, t, -1, -1, (int)(k->secs * 1000) + 5000, &o);
+	expect_trip(&cs, k->name, t, -1, -1, (int)(k->secs * 1000) + 5000, want,
+		    &o);
 	if (o.motors_ms > o.relay_ms + W_stop() + SLACK_MS)
 		fail_msg("%s: motors off %.0f ms after the relay", k->name,
 			 o.motors_ms - o.relay_ms);
 }
 
-/* The start-up line about the route: the installed rto_min, or (none set)
- * the warning a development start gives. */
-static void expect_route_line(const struct link_case *k)
+/* The start-up lines: about the route (the installed rto_min, or, none
+ * set, the warning a development start gives) and about the record (the
+ * stream opened and measured through the rig's cable, or polled). */
+static void expect_start_lines(const struct link_case *k)
 {
-	const char *want = k->rto == RTO_NONE
-			       ? "roboelf: warning: the route to the "
-				 "controller '10.231."
-			       : "roboelf: route to the controller: rto_min 5 "
-				 "ms (limit 25 ms)";
+	const char *want[] = {
+	    k->rto == RTO_NONE
+		? "roboelf: warning: the route to the controller '10.231."
+		: "roboelf: route to the controller: rto_min 5 ms (limit 25 "
+		  "ms)",
+	    k->design == STREAM ? "roboelf: record stream: UDP handle "
+				: "roboelf: record polled (QR each cycle)",
+	};
 
-	if (proc_find_line(&cs.re, PROC_STDOUT, want, NULL, 0) != 0)
-		fail_msg("%s: no start-up line '%s'", k->name, want);
+	for (size_t i = 0; i < sizeof(want) / sizeof(want[0]); i++)
+		if (proc_find_line(&cs.re, PROC_STDOUT, want[i], NULL, 0) != 0)
+			fail_msg("%s: no start-up line '%s'", k->name, want[i]);
+}
+
+/* The stream design: roboelf's run ended (SIGTERM, when a no-trip case
+ * left it armed), the record stream's counters that its log ends with,
+ * printed beside the measurement: the datagrams the loss took. */
+static void stream_counters(struct sys_case *c, const struct link_case *k)
+{
+	char line[1024];
+	int status;
+
+	if (k->design != STREAM)
+		return;
+	if (k->expect == NO_TRIP) {
+		proc_signal(&c->re, SIGTERM);
+		if (proc_wait_exit(&c->re, EXIT_WAIT_MS, &status) < 0)
+			fail_msg("%s: roboelf did not exit within %d ms of "
+				 "SIGTERM",
+				 k->name, EXIT_WAIT_MS);
+	}
+	if (sys_log_find(c, "stream: datagrams=", NULL, line, sizeof(line)) ==
+	    0)
+		print_message("[ MEASURE  ] %s: %s\n", k->name,
+			      strstr(line, "stream: datagrams="));
+	else
+		print_message("[ MEASURE  ] %s: no stream counters in the "
+			      "log\n",
+			      k->name);
 }
 
 /* Run the case that cmocka passes as the initial state. */
 static void run_case(void **state)
 {
 	const struct link_case *k = *state;
-	char arg[SYS_PATH_MAX + 32];
+	enum re_fault_id want = k->design == POLL ? RE_F_WDOG_REPLY : k->fault;
+	char arg[SYS_PATH_MAX + 48];
 	struct outcome o = {0};
 	double t;
 
-	start_rto(&cs, NULL, k->rto);
-	expect_route_line(k);
+	start_rto(&cs, NULL, k->rto, k->design);
+	expect_start_lines(k);
 	if (k->delay_ms) {
-		snprintf(arg, sizeof(arg), "%d %s", k->delay_ms, env.bin);
+		snprintf(arg, sizeof(arg), "%d %s %s", k->delay_ms, env.bin,
+			 k->proto);
 		t = rig_after(&cs, "delay", arg);
 	} else {
-		snprintf(arg, sizeof(arg), "%d %s", k->loss_pct, k->dir);
+		snprintf(arg, sizeof(arg), "%d %s %s", k->loss_pct, k->dir,
+			 k->proto);
 		t = rig_after(&cs, "loss", arg);
 	}
 	if (k->expect == NO_TRIP) {
@@ -537,11 +681,13 @@ static void run_case(void **state)
 	} else {
 		if (k->delay_ms)
 			expect_trip(&cs, k->name, t, C() + P() + k->delay_ms,
-				    W_stop() + k->delay_ms, FAULT_WAIT_MS, &o);
+				    W_stop() + k->delay_ms, FAULT_WAIT_MS, want,
+				    &o);
 		else
-			loss_trip(k, t);
+			loss_trip(k, want, t);
 		quit_latched(&cs, k->name);
 	}
+	stream_counters(&cs, k);
 	stop(&cs);
 }
 
@@ -611,6 +757,73 @@ static void test_ctl_untuned_delay_150(void **state)
 {
 	run_case(state);
 }
+static void test_stream_loss_1_udp(void **state)
+{
+	run_case(state);
+}
+static void test_stream_loss_1_tcp(void **state)
+{
+	run_case(state);
+}
+static void test_stream_loss_1_both(void **state)
+{
+	run_case(state);
+}
+static void test_stream_loss_5_udp(void **state)
+{
+	run_case(state);
+}
+static void test_stream_loss_5_tcp(void **state)
+{
+	run_case(state);
+}
+static void test_stream_loss_5_both(void **state)
+{
+	run_case(state);
+}
+static void test_stream_loss_30_udp(void **state)
+{
+	run_case(state);
+}
+static void test_stream_loss_30_tcp(void **state)
+{
+	run_case(state);
+}
+static void test_stream_loss_30_both(void **state)
+{
+	run_case(state);
+}
+static void test_stream_delay_40_udp(void **state)
+{
+	run_case(state);
+}
+static void test_stream_delay_40_tcp(void **state)
+{
+	run_case(state);
+}
+static void test_stream_delay_80_udp(void **state)
+{
+	run_case(state);
+}
+static void test_stream_delay_80_tcp(void **state)
+{
+	run_case(state);
+}
+static void test_stream_delay_150_udp(void **state)
+{
+	run_case(state);
+}
+static void test_stream_delay_150_tcp(void **state)
+{
+	run_case(state);
+}
+
+/* Rows: a loss of @pct % of @dir's frames of @proto, a delay of @ms ms of
+ * the frames of @proto the controller sends. */
+#define LOSS(d, pct, dir_, proto_)                                             \
+	.design = d, .loss_pct = pct, .dir = dir_, .proto = proto_
+#define DELAY(d, ms, proto_) .design = d, .delay_ms = ms, .proto = proto_
+#define ROW(f)		     #f, f
 
 /* The cases: the function, then the row it runs. Outcomes as measured
  * (docs/link.md, "Measurements"; docs/safety.md, "Network cases"). */
@@ -619,41 +832,111 @@ static struct {
 	CMUnitTestFunction fn;
 	struct link_case k;
 } cases[] = {
-#define ROW(f) #f, f
-    /* both ends resend fast (rto_min 5 ms, linear timeouts) */
-    {ROW(test_delay_40), {"delay 40 ms", 0, 0, 40, RTO_BOTH, NO_TRIP, 10, 0}},
-    {ROW(test_delay_80), {"delay 80 ms", 0, 0, 80, RTO_BOTH, TRIP, 0, 0}},
-    {ROW(test_delay_150), {"delay 150 ms", 0, 0, 150, RTO_BOTH, TRIP, 0, 1}},
+    /* the round trip, both ends resend fast (rto_min 5 ms, linear
+     * timeouts) */
+    {ROW(test_delay_40),
+     {"delay 40 ms", DELAY(POLL, 40, "all"), .rto = RTO_BOTH, .expect = NO_TRIP,
+      .secs = 10}},
+    {ROW(test_delay_80),
+     {"delay 80 ms", DELAY(POLL, 80, "all"), .rto = RTO_BOTH, .expect = TRIP}},
+    {ROW(test_delay_150),
+     {"delay 150 ms", DELAY(POLL, 150, "all"), .rto = RTO_BOTH, .expect = TRIP,
+      .in_check = 1}},
     {ROW(test_loss_5_short),
-     {"loss 5 % (10 s)", 5, "both", 0, RTO_BOTH, NO_TRIP, 10, 0}},
-    {ROW(test_loss_30), {"loss 30 %", 30, "both", 0, RTO_BOTH, TRIP, 3, 1}},
+     {"loss 5 % (10 s)", LOSS(POLL, 5, "both", "all"), .rto = RTO_BOTH,
+      .expect = NO_TRIP, .secs = 10}},
+    {ROW(test_loss_30),
+     {"loss 30 %", LOSS(POLL, 30, "both", "all"), .rto = RTO_BOTH,
+      .expect = TRIP, .secs = 3, .in_check = 1}},
     {ROW(test_loss_1_60s),
-     {"loss 1 % (60 s)", 1, "both", 0, RTO_BOTH, NO_TRIP, 60, 0}},
+     {"loss 1 % (60 s)", LOSS(POLL, 1, "both", "all"), .rto = RTO_BOTH,
+      .expect = NO_TRIP, .secs = 60}},
     {ROW(test_loss_5_60s),
-     {"loss 5 % (60 s)", 5, "both", 0, RTO_BOTH, NO_TRIP, 60, 0}},
-    /* neither end: the state before docs/link.md */
+     {"loss 5 % (60 s)", LOSS(POLL, 5, "both", "all"), .rto = RTO_BOTH,
+      .expect = NO_TRIP, .secs = 60}},
+    /* the round trip, neither end: the state before docs/link.md */
     {ROW(test_loss_5_no_rto),
-     {"loss 5 %, no rto_min", 5, "both", 0, RTO_NONE, TRIP, 3, 0}},
-    /* the PC as installed, the controller's TCP at the kernel's defaults */
+     {"loss 5 %, no rto_min", LOSS(POLL, 5, "both", "all"), .rto = RTO_NONE,
+      .expect = TRIP, .secs = 3}},
+    /* the round trip, the PC as installed, the controller's TCP at the
+     * kernel's defaults */
     {ROW(test_ctl_untuned_loss_1),
-     {"ctl untuned, loss 1 %", 1, "both", 0, RTO_PC, TRIP, 60, 0}},
+     {"ctl untuned, loss 1 %", LOSS(POLL, 1, "both", "all"), .rto = RTO_PC,
+      .expect = TRIP, .secs = 60}},
     {ROW(test_ctl_untuned_loss_5),
-     {"ctl untuned, loss 5 %", 5, "both", 0, RTO_PC, TRIP, 20, 1}},
+     {"ctl untuned, loss 5 %", LOSS(POLL, 5, "both", "all"), .rto = RTO_PC,
+      .expect = TRIP, .secs = 20, .in_check = 1}},
     {ROW(test_ctl_untuned_loss_30),
-     {"ctl untuned, loss 30 %", 30, "both", 0, RTO_PC, TRIP, 3, 1}},
+     {"ctl untuned, loss 30 %", LOSS(POLL, 30, "both", "all"), .rto = RTO_PC,
+      .expect = TRIP, .secs = 3, .in_check = 1}},
     {ROW(test_ctl_untuned_loss_5_replies),
-     {"ctl untuned, loss 5 % of replies", 5, "ctl", 0, RTO_PC, TRIP, 20, 0}},
+     {"ctl untuned, loss 5 % of replies", LOSS(POLL, 5, "ctl", "all"),
+      .rto = RTO_PC, .expect = TRIP, .secs = 20}},
     {ROW(test_ctl_untuned_loss_5_requests),
-     {"ctl untuned, loss 5 % of requests (30 s)", 5, "pc", 0, RTO_PC, NO_TRIP,
-      30, 0}},
+     {"ctl untuned, loss 5 % of requests (30 s)", LOSS(POLL, 5, "pc", "all"),
+      .rto = RTO_PC, .expect = NO_TRIP, .secs = 30}},
     {ROW(test_ctl_untuned_delay_40),
-     {"ctl untuned, delay 40 ms", 0, 0, 40, RTO_PC, NO_TRIP, 10, 0}},
+     {"ctl untuned, delay 40 ms", DELAY(POLL, 40, "all"), .rto = RTO_PC,
+      .expect = NO_TRIP, .secs = 10}},
     {ROW(test_ctl_untuned_delay_80),
-     {"ctl untuned, delay 80 ms", 0, 0, 80, RTO_PC, TRIP, 0, 0}},
+     {"ctl untuned, delay 80 ms", DELAY(POLL, 80, "all"), .rto = RTO_PC,
+      .expect = TRIP}},
     {ROW(test_ctl_untuned_delay_150),
-     {"ctl untuned, delay 150 ms", 0, 0, 150, RTO_PC, TRIP, 0, 1}},
-#undef ROW
+     {"ctl untuned, delay 150 ms", DELAY(POLL, 150, "all"), .rto = RTO_PC,
+      .expect = TRIP, .in_check = 1}},
+    /* the record as a stream, the controller's TCP at the kernel's
+     * defaults: a lost or late record costs one sample of the stream; the
+     * heartbeat's reply, resent after the controller's 200 ms, is not
+     * waited for (docs/link.md, "The record as a stream") */
+    {ROW(test_stream_loss_1_udp),
+     {"stream, loss 1 % of the stream (60 s)", LOSS(STREAM, 1, "both", "udp"),
+      .rto = RTO_PC, .expect = NO_TRIP, .secs = 60}},
+    {ROW(test_stream_loss_1_tcp),
+     {"stream, loss 1 % on TCP (60 s)", LOSS(STREAM, 1, "both", "tcp"),
+      .rto = RTO_PC, .expect = NO_TRIP, .secs = 60}},
+    {ROW(test_stream_loss_1_both),
+     {"stream, loss 1 % of both (60 s)", LOSS(STREAM, 1, "both", "all"),
+      .rto = RTO_PC, .expect = NO_TRIP, .secs = 60}},
+    {ROW(test_stream_loss_5_udp),
+     {"stream, loss 5 % of the stream (20 s)", LOSS(STREAM, 5, "both", "udp"),
+      .rto = RTO_PC, .expect = NO_TRIP, .secs = 20, .in_check = 1}},
+    {ROW(test_stream_loss_5_tcp),
+     {"stream, loss 5 % on TCP (20 s)", LOSS(STREAM, 5, "both", "tcp"),
+      .rto = RTO_PC, .expect = NO_TRIP, .secs = 20, .in_check = 1}},
+    {ROW(test_stream_loss_5_both),
+     {"stream, loss 5 % of both (20 s)", LOSS(STREAM, 5, "both", "all"),
+      .rto = RTO_PC, .expect = NO_TRIP, .secs = 20}},
+    {ROW(test_stream_loss_30_udp),
+     {"stream, loss 30 % of the stream (20 s)", LOSS(STREAM, 30, "both", "udp"),
+      .rto = RTO_PC, .expect = NO_TRIP, .secs = 20}},
+    {ROW(test_stream_loss_30_tcp),
+     {"stream, loss 30 % on TCP", LOSS(STREAM, 30, "both", "tcp"),
+      .rto = RTO_PC, .expect = TRIP, .fault = RE_F_NONE, .secs = 20}},
+    {ROW(test_stream_loss_30_both),
+     {"stream, loss 30 % of both", LOSS(STREAM, 30, "both", "all"),
+      .rto = RTO_PC, .expect = TRIP, .fault = RE_F_NONE, .secs = 20}},
+    {ROW(test_stream_delay_40_udp),
+     {"stream, delay 40 ms of the stream", DELAY(STREAM, 40, "udp"),
+      .rto = RTO_PC, .expect = NO_TRIP, .secs = 10}},
+    {ROW(test_stream_delay_40_tcp),
+     {"stream, delay 40 ms on TCP", DELAY(STREAM, 40, "tcp"), .rto = RTO_PC,
+      .expect = NO_TRIP, .secs = 10}},
+    {ROW(test_stream_delay_80_udp),
+     {"stream, delay 80 ms of the stream", DELAY(STREAM, 80, "udp"),
+      .rto = RTO_PC, .expect = NO_TRIP, .secs = 10}},
+    {ROW(test_stream_delay_80_tcp),
+     {"stream, delay 80 ms on TCP", DELAY(STREAM, 80, "tcp"), .rto = RTO_PC,
+      .expect = NO_TRIP, .secs = 10}},
+    {ROW(test_stream_delay_150_udp),
+     {"stream, delay 150 ms of the stream", DELAY(STREAM, 150, "udp"),
+      .rto = RTO_PC, .expect = TRIP, .fault = RE_F_WDOG_ECHO, .in_check = 1}},
+    {ROW(test_stream_delay_150_tcp),
+     {"stream, delay 150 ms on TCP", DELAY(STREAM, 150, "tcp"), .rto = RTO_PC,
+      .expect = NO_TRIP, .secs = 10}},
 };
+#undef ROW
+#undef DELAY
+#undef LOSS
 
 /* ---- fixtures ----------------------------------------------------------- */
 
