@@ -375,9 +375,12 @@ static void log_stream(struct app *a)
 {
 	struct gl_stream_stats st;
 
-	if (!gl_link_stream_info(a->real.link, NULL, NULL))
+	if (gl_link_stream_info(a->real.link, NULL, NULL))
+		gl_link_stream_stats(a->real.link, &st);
+	else if (a->real.have_stream_was)
+		st = a->real.stream_was; /* the link the stop replaced */
+	else
 		return;
-	gl_link_stream_stats(a->real.link, &st);
 	re_log_msg(&a->log, RE_LOG_INFO,
 		   "stream: datagrams=%llu records=%llu lost=%llu "
 		   "duplicates=%llu reordered=%llu foreign=%llu short=%llu "

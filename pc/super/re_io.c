@@ -324,6 +324,12 @@ static int real_stop_fresh(void *ud, const char *cmd, char *resp, size_t cap,
 	}
 	gl_link_set_timeout(l, r->cmd_timeout_ms > 0 ? r->cmd_timeout_ms
 						     : deadline_ms);
+	/* the record stream was the old link's: its counters are kept for
+	 * the end of the run (the new connection has no stream) */
+	if (gl_link_stream_info(r->link, NULL, NULL)) {
+		gl_link_stream_stats(r->link, &r->stream_was);
+		r->have_stream_was = 1;
+	}
 	gl_link_close(r->link);
 	r->link = l;
 	look_forget(r); /* of the old link's descriptors */

@@ -16,6 +16,7 @@
 
 #include "gl_link.h"
 #include "gl_record.h"
+#include "gl_stream.h"
 #include "re_log.h"
 
 #include <time.h>
@@ -137,6 +138,10 @@ struct re_io_real {
 	struct re_log *log;
 	const char *address; /* the controller, for stop_fresh; NULL: none */
 	int cmd_timeout_ms;  /* the command link's default reply deadline */
+	/* the record stream's counters of a link the stop over a new
+	 * connection replaced (have_stream_was: 1 when kept) */
+	struct gl_stream_stats stream_was;
+	int have_stream_was;
 	/* CLOCK_MONOTONIC ns at the start and the end of the last record or
 	 * command: a moment this process is known to have run (roboelf's
 	 * SIGCONT handler reads it to measure a stop) */
