@@ -50,7 +50,7 @@ static const struct re_fault_msg re_fault_table[] = {
 	 "press the E-stop and keep it pressed, check the controller's Ethernet cable and power, then restart roboelf"},
 	{RE_F_WDOG_ECHO, RE_FC_WATCHDOG,
 	 "the controller program has not taken the supervisor's heartbeat for {i0} ms (limit {i1} ms; its record echoes {i2})",
-	 "press the E-stop and keep it pressed, check the controller's Ethernet cable and the network between it and this PC (loss or delay), then restart roboelf; if it happens again on a sound link, reload the controller program with galil-load"},
+	 "press the E-stop and keep it pressed, check the network to the controller (cable, loss, delay), then restart roboelf; if it happens again on a sound link, reload the controller program with galil-load"},
 	{RE_F_WDOG_HEARTBEAT, RE_FC_WATCHDOG,
 	 "the controller program's heartbeat stopped at {i0} for {i1} ms (limit {i2} ms)",
 	 "press the E-stop and keep it pressed, restart roboelf; if it happens again, reload the controller program with galil-load"},
