@@ -164,6 +164,12 @@ int gl_link_stream_open(gl_link *l, int udp_port, unsigned n0_samples,
 		gl_link_err_put(err, "'%s' refused: %s%s%s", dr,
 				gl_strerror(rc), rc == GL_ERR_CTRL ? ": " : "",
 				rc == GL_ERR_CTRL ? l->ctrl_text : "");
+		/* the handle WH opened stays open on the controller else
+		 * (best effort: the refusal is what is reported) */
+		if (rc == GL_ERR_CTRL) {
+			snprintf(dr, sizeof(dr), "IH%c=>-1", 'A' + h);
+			gl_link_command(l, dr, NULL, 0, 0);
+		}
 		stream_drop(l);
 		return rc;
 	}

@@ -70,9 +70,9 @@ struct re_super {
 	char rb_chunk[RE_SEAL_MAX][64];
 	char rb_line[96];
 	char rb_reply[512];
-	/* the stream design (re_super_stream.c): the posted line, the
-	 * times of the last fresh record and of the last reply collected,
-	 * and the heartbeats sent lately (for the program's echo) */
+	/* the stream design (re_super_stream.c): the posted lines, the
+	 * time of the last fresh record, and the heartbeats sent lately (for
+	 * the program's echo) */
 	struct {
 		int64_t ns; /* when it was posted */
 		int chunk;  /* its read-back chunk, -1: none */
@@ -80,9 +80,7 @@ struct re_super {
 			      * oldest at out_head */
 	int out_head, n_out;
 	int chunk_out;	 /* a read-back chunk is among them */
-	uint64_t hb_skipped; /* cycles without a post (RE_POST_RING full) */
 	int64_t rec_ns;	 /* the last fresh record */
-	int64_t ack_ns;	 /* the last reply to a posted line */
 	struct {
 		long hb;
 		int64_t ns;
@@ -118,8 +116,8 @@ void re_super_hb_next(struct re_super *s);
 
 /*
  * re_super_stream_reset() - a phase starts (re_super_start, init): the
- * record's and the acknowledgement's ages count from @now_ns, the
- * heartbeats sent are forgotten (a posted line stays outstanding).
+ * record's age counts from @now_ns, the heartbeats sent are forgotten
+ * (posted lines stay outstanding).
  */
 void re_super_stream_reset(struct re_super *s, int64_t now_ns);
 
@@ -129,7 +127,7 @@ void re_super_stream_reset(struct re_super *s, int64_t now_ns);
  * cycles that are all there (a read-back chunk's text into s->rb_reply),
  * post the next heartbeat (with the next read-back chunk when none is
  * outstanding; none when RE_POST_RING lines are), read the newest record
- * of the stream (s->fresh), judge the record's age against the critical
+ * of the stream (s->pub.fresh), judge the record's age against the critical
  * limit and the oldest outstanding reply's against cfg.ack_limit_ns, and
  * set s->pub.age_last_ns for the warning. Never waits.
  * Return: RE_OK, or RE_FAULT with @f filled (WDOG_STREAM, WDOG_ACK, COMM).

@@ -75,7 +75,6 @@ void re_super_hb_next(struct re_super *s)
 void re_super_stream_reset(struct re_super *s, int64_t now_ns)
 {
 	s->rec_ns = now_ns;
-	s->ack_ns = now_ns;
 	s->sent_n = 0;
 	s->pub.fresh = 0;
 }
@@ -112,7 +111,6 @@ static int collect(struct re_super *s, int64_t now, struct re_fault *f)
 			return RE_OK;
 		if (rc == GL_ERR_NOENT) {
 			s->n_out = s->chunk_out = 0;
-			s->ack_ns = now;
 			return RE_OK;
 		}
 		s->out_head = (i + 1) % RE_POST_RING;
@@ -125,7 +123,6 @@ static int collect(struct re_super *s, int64_t now, struct re_fault *f)
 		/* the reply's age: from its own line */
 		if (now - s->out[i].ns > s->pub.age_last_ns)
 			s->pub.age_last_ns = now - s->out[i].ns;
-		s->ack_ns = now;
 		if (chunk >= 0) {
 			s->rb_have = 1;
 			s->rb_cur = chunk;
@@ -142,10 +139,8 @@ static int post_next(struct re_super *s, int64_t now, struct re_fault *f)
 	const char *line = s->prefix;
 	int rc, chunk = -1, k;
 
-	if (s->n_out >= RE_POST_RING) {
-		s->hb_skipped++;
-		return RE_OK;
-	}
+	if (s->n_out >= RE_POST_RING)
+		return RE_OK; /* the heartbeat stops: the echo ages */
 	re_super_hb_next(s);
 	if (s->pub.rb_n && !s->chunk_out) {
 		size_t n = (size_t)s->prefix_len;
