@@ -94,9 +94,16 @@ cmdof() {
 exec1() {
 	name=$1; log=$(logof "$name")
 	start=$(date +%s)
+	# Each program its own lock directory (re_lock.h): programs run side
+	# by side, and a relay's pty number freed by one (galil-sim's
+	# "relayfault unplug" closes it while that roboelf still holds the
+	# relay's lock, as it must) is handed to another's galil-sim at once.
+	locks=$(mktemp -d "${TMPDIR:-/tmp}/roboelf-locks.XXXXXX") || locks=
 	# shellcheck disable=SC2046 # the command's words
-	timeout --kill-after=10 "$(deadline "$name")" $(cmdof "$name") >"$log" 2>&1
+	ROBOELF_LOCK_DIR=${ROBOELF_LOCK_DIR:-$locks} \
+		timeout --kill-after=10 "$(deadline "$name")" $(cmdof "$name") >"$log" 2>&1
 	rc=$?
+	[ -n "$locks" ] && rm -rf "$locks"
 	res=ok
 	if [ "$rc" -eq 77 ]; then
 		res="SKIPPED ($(grep -m1 '^SKIP' "$log"))"
