@@ -383,13 +383,15 @@ static void log_stream(struct app *a)
 		return;
 	re_log_msg(&a->log, RE_LOG_INFO,
 		   "stream: datagrams=%llu records=%llu lost=%llu "
-		   "duplicates=%llu reordered=%llu foreign=%llu short=%llu "
-		   "long=%llu malformed=%llu; heartbeat lines refused=%llu",
+		   "duplicates=%llu reordered=%llu superseded=%llu "
+		   "foreign=%llu short=%llu long=%llu malformed=%llu; "
+		   "heartbeat lines refused=%llu",
 		   (unsigned long long)st.received,
 		   (unsigned long long)st.accepted,
 		   (unsigned long long)st.lost,
 		   (unsigned long long)st.duplicates,
 		   (unsigned long long)st.reordered,
+		   (unsigned long long)st.superseded,
 		   (unsigned long long)st.foreign,
 		   (unsigned long long)st.shorts, (unsigned long long)st.longs,
 		   (unsigned long long)st.malformed,

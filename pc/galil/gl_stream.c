@@ -10,6 +10,12 @@
  * and lets the stream start afresh after such a silence instead of
  * dropping every record as "reordered" until the number catches up.
  *
+ * A record read by another route (gl_stream_seen()) becomes the reference
+ * while the stream's own last accepted record is kept beside it, so that a
+ * record dropped for being behind tells which it is behind: behind the
+ * stream's own (reordered on the stream) or only behind the other route's
+ * (superseded: the QR round trip was simply faster than the stream).
+ *
  * The header is checked here only for its general form (bit 7, the axis
  * bits, the announced length) so that the length can be judged against
  * what the header announces; the layout's own rules are gl_record's, whose
@@ -80,7 +86,26 @@ static int check_frame(const struct gl_stream *s, const uint8_t *dg, size_t len,
 	return GL_STREAM_ACCEPTED;
 }
 
-/* The sample number against the last accepted; @delta: [out] the samples
+/* A number not after the reference when the reference is a record read
+ * by another route: the stream's own last accepted, if one is within the
+ * horizon, decides between DUPLICATE, REORDERED (the stream delivered it
+ * late) and SUPERSEDED (made between the two: late only against the
+ * record read over TCP). */
+static int check_behind(const struct gl_stream *s, uint16_t sample,
+			int64_t now_ns)
+{
+	uint16_t d = (uint16_t)(sample - s->own_sample);
+
+	if (!s->have_own || now_ns - s->last_ns > s->horizon_ns)
+		return GL_STREAM_SUPERSEDED;
+	if (d == 0)
+		return GL_STREAM_DUPLICATE;
+	if (d >= SERIAL_HALF)
+		return GL_STREAM_REORDERED;
+	return GL_STREAM_SUPERSEDED;
+}
+
+/* The sample number against the reference; @delta: [out] the samples
  * since it, 0 for a restart (first record, or past the horizon). */
 static int check_order(const struct gl_stream *s, uint16_t sample,
 		       int64_t now_ns, unsigned *delta)
@@ -90,10 +115,11 @@ static int check_order(const struct gl_stream *s, uint16_t sample,
 	*delta = 0;
 	if (!s->have_last || now_ns - s->ref_ns > s->horizon_ns)
 		return GL_STREAM_ACCEPTED;
-	if (d == 0)
-		return GL_STREAM_DUPLICATE;
-	if (d >= SERIAL_HALF)
-		return GL_STREAM_REORDERED;
+	if (d == 0 || d >= SERIAL_HALF) {
+		if (s->seen_other)
+			return check_behind(s, sample, now_ns);
+		return d == 0 ? GL_STREAM_DUPLICATE : GL_STREAM_REORDERED;
+	}
 	*delta = d;
 	return GL_STREAM_ACCEPTED;
 }
@@ -116,6 +142,8 @@ static void commit(struct gl_stream *s, uint16_t sample, unsigned delta,
 	s->last_sample = sample;
 	s->last_ns = now_ns;
 	s->ref_ns = now_ns;
+	s->have_own = 1;
+	s->own_sample = sample;
 }
 
 int gl_stream_seen(struct gl_stream *s, uint16_t sample, int64_t now_ns)
@@ -142,6 +170,7 @@ static void count(struct gl_stream_stats *st, int verdict)
 	case GL_STREAM_ACCEPTED: st->accepted++; break;
 	case GL_STREAM_DUPLICATE: st->duplicates++; break;
 	case GL_STREAM_REORDERED: st->reordered++; break;
+	case GL_STREAM_SUPERSEDED: st->superseded++; break;
 	case GL_STREAM_SHORT: st->shorts++; break;
 	case GL_STREAM_LONG: st->longs++; break;
 	case GL_STREAM_FOREIGN: st->foreign++; break;
@@ -228,6 +257,7 @@ const char *gl_stream_verdict_name(int verdict)
 	case GL_STREAM_LONG: return "long";
 	case GL_STREAM_FOREIGN: return "foreign";
 	case GL_STREAM_MALFORMED: return "malformed";
+	case GL_STREAM_SUPERSEDED: return "superseded";
 	}
 	return "unknown";
 }

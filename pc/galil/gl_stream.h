@@ -9,7 +9,9 @@
  * layout expects, its length is the one announced, and its sample number
  * (16 bits, bytes 4-5: galil-notes.md 2.2) is after the last accepted one.
  * A lost record costs one sample: the gap is counted, nothing waits for it.
- * A duplicate or a late (reordered) record is dropped, never decoded.
+ * A duplicate, a late (reordered) record, and a record superseded by one
+ * the caller read by another route (gl_stream_seen()) are dropped, never
+ * decoded.
  *
  * Staleness is the caller's: gl_stream_age_ns() is the time since the last
  * accepted record, to be judged with the deadlines the cycle already uses
@@ -35,13 +37,16 @@ struct sockaddr;
 
 /* What gl_stream_feed() did with a datagram (>= 0; errors are < 0). */
 enum gl_stream_verdict {
-	GL_STREAM_ACCEPTED = 0,	 /* decoded into the caller's record */
-	GL_STREAM_DUPLICATE = 1, /* same sample number as the last accepted */
-	GL_STREAM_REORDERED = 2, /* sample number before the last accepted */
-	GL_STREAM_SHORT = 3,	 /* fewer bytes than the header announces */
-	GL_STREAM_LONG = 4,	 /* more bytes than the header announces */
-	GL_STREAM_FOREIGN = 5,	 /* not from the controller's address+port */
-	GL_STREAM_MALFORMED = 6, /* the header is not the layout's record */
+	GL_STREAM_ACCEPTED = 0,	  /* decoded into the caller's record */
+	GL_STREAM_DUPLICATE = 1,  /* same sample number as the last accepted */
+	GL_STREAM_REORDERED = 2,  /* sample number before the last accepted */
+	GL_STREAM_SHORT = 3,	  /* fewer bytes than the header announces */
+	GL_STREAM_LONG = 4,	  /* more bytes than the header announces */
+	GL_STREAM_FOREIGN = 5,	  /* not from the controller's address+port */
+	GL_STREAM_MALFORMED = 6,  /* the header is not the layout's record */
+	GL_STREAM_SUPERSEDED = 7, /* at or before a record read by another
+				   * route (gl_stream_seen()), after the
+				   * last accepted */
 };
 
 /* A UDP sender: IPv6 address, or IPv4 as ::ffff:a.b.c.d; port in host
@@ -59,6 +64,7 @@ struct gl_stream_stats {
 	uint64_t lost; /* records missing between accepted ones */
 	uint64_t duplicates;
 	uint64_t reordered;
+	uint64_t superseded;
 	uint64_t shorts;
 	uint64_t longs;
 	uint64_t foreign;
@@ -76,12 +82,15 @@ struct gl_stream {
 	size_t rec_bytes;     /* gl_record_size(layout, n_axes) */
 	unsigned n0_samples;  /* samples between two records (DR n0) */
 	int64_t horizon_ns;   /* GL_STREAM_HORIZON_SAMPLES samples */
-	int have_last;	      /* 1 once a record was accepted */
-	uint16_t last_sample; /* sample number of the last accepted */
+	int have_last;	      /* 1 once a record was accepted or seen */
+	uint16_t last_sample; /* sample number of the last accepted, or of
+			       * the record seen after it */
 	int64_t last_ns;      /* when it was accepted, or init time */
 	int seen_other;	      /* last_sample came from gl_stream_seen() */
 	int64_t ref_ns;	      /* when last_sample was taken (the horizon
 			       * counts from here) */
+	int have_own;	      /* 1 once a record of the stream was accepted */
+	uint16_t own_sample;  /* sample number of the last accepted */
 	struct gl_stream_stats stats;
 };
 
@@ -116,9 +125,15 @@ int gl_stream_init(struct gl_stream *s, const struct gl_stream_peer *ctrl,
  * The checks, in order: sender (FOREIGN), at least the 4 header bytes
  * (SHORT), header bit 7, axis bits and announced length of the layout's
  * record (MALFORMED), @len against the announced length (SHORT, LONG), the
- * sample number against the last accepted (DUPLICATE, REORDERED), the full
- * decode (MALFORMED). The first record, and the first after a silence
- * longer than the horizon, is accepted whatever its number (a restart).
+ * sample number (below), the full decode (MALFORMED). The first record,
+ * and the first after a silence longer than the horizon, is accepted
+ * whatever its number (a restart). The sample number x is judged against
+ * the last accepted record A and the newest record S read by another
+ * route since A (gl_stream_seen()): x after A and after S: accepted; x
+ * equal to A: DUPLICATE; x before A: REORDERED (the stream itself
+ * delivered it late); x after A and at or before S: SUPERSEDED (made no
+ * later than a record the caller already has; nothing was reordered).
+ * With no A within the horizon, every x at or before S is SUPERSEDED.
  * An accepted record n samples after the last adds round(n / n0) - 1 to
  * the lost count.
  * Return: an enum gl_stream_verdict (>= 0), or GL_ERR_ARG.
@@ -130,11 +145,13 @@ int gl_stream_feed(struct gl_stream *s, const uint8_t *dg, size_t len,
 /*
  * gl_stream_seen() - a record of @sample was read by another route (a QR
  * round trip on the command handle, e.g. the one that saw the program
- * armed): from now on only records after it are accepted (an earlier or
- * equal one is dropped as reordered or duplicate), so the stream never
- * goes back behind what the caller already knows. Ignored when @sample is
- * not after the last accepted. The samples up to the next accepted record
- * are not counted as lost. The age is not changed.
+ * armed): from now on only records after it are accepted, so the stream
+ * never goes back behind what the caller already knows; a record at or
+ * before it but after the last accepted is dropped as SUPERSEDED, one at
+ * or before the last accepted still as DUPLICATE or REORDERED
+ * (gl_stream_feed()). Ignored when @sample is not after the last accepted
+ * or the last seen. The samples up to the next accepted record are not
+ * counted as lost. The age is not changed.
  * Return: GL_OK, or GL_ERR_ARG when @s is NULL.
  */
 int gl_stream_seen(struct gl_stream *s, uint16_t sample, int64_t now_ns);
@@ -167,7 +184,8 @@ int gl_stream_peer_from_sockaddr(const struct sockaddr *sa, size_t len,
 
 /*
  * gl_stream_verdict_name() - a short lower-case word for a verdict
- * ("accepted", "duplicate", ...), for status lines and the bench.
+ * ("accepted", "duplicate", "superseded", ...), for status lines and the
+ * bench.
  * Return: a static string, never NULL ("unknown" for other values).
  */
 const char *gl_stream_verdict_name(int verdict);

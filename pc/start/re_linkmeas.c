@@ -13,6 +13,7 @@
 #include "base_clock.h"
 #include "gl_err.h"
 #include "gl_record.h"
+#include "gl_stream.h"
 
 static int cmp_i64(const void *a, const void *b)
 {
@@ -123,27 +124,34 @@ int re_linkmeas_reply(gl_link *l, int n, int timeout_ms, struct re_linkmeas *m)
 	return GL_OK;
 }
 
-int re_linkmeas_intervals(const int64_t *t_ns, const uint16_t *sample, int n,
-			  struct re_linkmeas *m)
+int re_linkmeas_intervals(const int64_t *t_ns, const uint16_t *sample,
+			  const int *count, int n, struct re_linkmeas *m)
 {
 	int64_t d, min, max;
+	int recs = 1, k;
 
 	if (!t_ns || !sample || !m || n < 2)
 		return GL_ERR_ARG;
+	for (int i = 1; i < n; i++)
+		if (count && count[i] < 1)
+			return GL_ERR_ARG;
 	min = max = t_ns[1] - t_ns[0];
-	for (int i = 2; i < n; i++) {
+	for (int i = 1; i < n; i++) {
+		k = count ? count[i] : 1;
 		d = t_ns[i] - t_ns[i - 1];
-		min = d < min ? d : min;
+		/* records read together arrived together, as seen here */
+		min = k > 1 ? 0 : (d < min ? d : min);
 		max = d > max ? d : max;
+		recs += k;
 	}
-	m->records = n;
-	m->mean_ms = (double)(t_ns[n - 1] - t_ns[0]) / (n - 1) / 1e6;
+	m->records = recs;
+	m->mean_ms = (double)(t_ns[n - 1] - t_ns[0]) / (recs - 1) / 1e6;
 	m->min_ms = (double)min / 1e6;
 	m->max_ms = (double)max / 1e6;
 	/* the 16-bit number wraps every 65 536 samples: the span modulo
 	 * 2^16 is right for any span shorter than that */
 	m->step_samples =
-	    (double)(uint16_t)(sample[n - 1] - sample[0]) / (n - 1);
+	    (double)(uint16_t)(sample[n - 1] - sample[0]) / (recs - 1);
 	return GL_OK;
 }
 
@@ -163,15 +171,26 @@ static int wait_readable(int fd, int64_t end_ns)
 	return rc > 0;
 }
 
+/* The records the stream's reader accepted so far. */
+static uint64_t accepted(const gl_link *l)
+{
+	struct gl_stream_stats st;
+
+	gl_link_stream_stats(l, &st);
+	return st.accepted;
+}
+
 int re_linkmeas_records(gl_link *l, int n, int64_t sample_ns, int deadline_ms,
 			struct re_linkmeas *m)
 {
 	int64_t t[RE_LINKMEAS_MAX], now;
 	int64_t end = base_now_ns() + (int64_t)deadline_ms * 1000000;
 	uint16_t s[RE_LINKMEAS_MAX];
+	int c[RE_LINKMEAS_MAX];
 	struct gl_record rec;
+	uint64_t before;
 	unsigned n0 = 0;
-	int handle = 0, k = 0, rc;
+	int handle = 0, k = 0, got = 0, rc;
 
 	if (!l || !m || n < 2 || n > RE_LINKMEAS_MAX ||
 	    gl_link_stream_info(l, &handle, &n0) != 1)
@@ -180,7 +199,10 @@ int re_linkmeas_records(gl_link *l, int n, int64_t sample_ns, int deadline_ms,
 	m->handle = handle;
 	m->n0 = n0;
 	m->n0_ms = (double)n0 * (double)sample_ns / 1e6;
-	while (k < n && base_now_ns() < end) {
+	before = accepted(l);
+	/* a read takes every record waiting: the ones a late wake-up finds
+	 * together count each (the first read's newest only: it starts) */
+	while (got < n && base_now_ns() < end) {
 		rc = wait_readable(gl_link_stream_fd(l), end);
 		if (rc < 0)
 			return rc;
@@ -189,15 +211,18 @@ int re_linkmeas_records(gl_link *l, int n, int64_t sample_ns, int deadline_ms,
 		if (rc < 0)
 			return rc;
 		if (rc == 1) {
+			c[k] = (int)(accepted(l) - before);
+			before += (uint64_t)c[k];
+			got += k ? c[k] : 1;
 			t[k] = now;
 			s[k++] = rec.sample;
 		}
 	}
-	if (k < n) {
-		m->records = k;
+	if (got < n) {
+		m->records = got;
 		return GL_ERR_TIMEOUT;
 	}
-	return re_linkmeas_intervals(t, s, n, m);
+	return re_linkmeas_intervals(t, s, c, k, m);
 }
 
 /* A duration in ms: one decimal, two under 0.1 ms (a loopback's reply

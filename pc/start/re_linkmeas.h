@@ -30,7 +30,8 @@ struct re_linkmeas {
 	/* the stream (@records 0: not measured): its handle (0..7 = A..H),
 	 * interval asked (@n0 samples, @n0_ms at the plan's sample time),
 	 * and over @records records the intervals of arrival (mean, min,
-	 * max) and the mean step of the sample number (samples) */
+	 * max; records read together are 0 apart) and the mean step of the
+	 * sample number (samples) */
 	int records;
 	int handle;
 	unsigned n0;
@@ -72,11 +73,14 @@ int re_linkmeas_stream(gl_link *l, const char *addr, int udp_port, unsigned n0,
 int re_linkmeas_reply(gl_link *l, int n, int timeout_ms, struct re_linkmeas *m);
 
 /*
- * re_linkmeas_records() - read @n (2..RE_LINKMEAS_MAX) records from @l's
- * open stream (gl_link_stream_read(), waiting on its socket with poll()),
- * all within @deadline_ms, and set @m's stream fields from their times of
- * arrival and sample numbers; @sample_ns (the plan's controller sample)
- * gives n0_ms.
+ * re_linkmeas_records() - read at least @n (2..RE_LINKMEAS_MAX) records
+ * from @l's open stream (gl_link_stream_read(), waiting on its socket with
+ * poll()), all within @deadline_ms, and set @m's stream fields from their
+ * times of arrival and sample numbers; @sample_ns (the plan's controller
+ * sample) gives n0_ms. A read takes every record waiting: each counts
+ * (the reader's accepted count says how many), at the time of that read,
+ * so that a late wake-up makes neither a longer interval nor a record
+ * that looks lost; the first read counts its newest record only.
  * Return: GL_OK; GL_ERR_ARG (no stream open, @n out of range);
  *         GL_ERR_TIMEOUT (fewer than @n records by the deadline:
  *         @m->records says how many came); GL_ERR_SYS.
@@ -85,13 +89,17 @@ int re_linkmeas_records(gl_link *l, int n, int64_t sample_ns, int deadline_ms,
 			struct re_linkmeas *m);
 
 /*
- * re_linkmeas_intervals() - the stream fields of @m from @n (>= 2) times
- * of arrival @t_ns and the records' 16-bit sample numbers @sample (in
- * order of arrival; the number wraps: serial arithmetic). Pure.
- * Return: GL_OK; GL_ERR_ARG (@n < 2).
+ * re_linkmeas_intervals() - the stream fields of @m from @n (>= 2) reads:
+ * their times @t_ns, the 16-bit sample number of the newest record each
+ * took @sample (in order of arrival; the number wraps: serial arithmetic)
+ * and how many records each took @count (>= 1; @count[0] is not used: the
+ * first read's newest starts; NULL: one each). @m->records is 1 + the sum
+ * of @count[1..n-1]; the mean interval and the step of the sample number
+ * are per record; the minimum is 0 when a read took more than one. Pure.
+ * Return: GL_OK; GL_ERR_ARG (NULL, @n < 2, a @count below 1).
  */
-int re_linkmeas_intervals(const int64_t *t_ns, const uint16_t *sample, int n,
-			  struct re_linkmeas *m);
+int re_linkmeas_intervals(const int64_t *t_ns, const uint16_t *sample,
+			  const int *count, int n, struct re_linkmeas *m);
 
 /*
  * re_linkmeas_median_ms() - the median of @n (>= 1) durations in ns, in

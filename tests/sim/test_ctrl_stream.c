@@ -4,7 +4,8 @@
  * samples, TC 6; a handle that is not UDP, TC 133), _DR0/_DR1, one record
  * every n0 samples (the QR bytes, checked by their sample number), the
  * pause during a download, UDP handles (_IHh2, TH, the record's handle
- * bytes) and IH=>-1 closing them, and the stream stopping with its handle.
+ * bytes) and IH=>-1 closing them, the stream stopping with its handle,
+ * and the events of DR starting and stopping the stream.
  * Expectations: galil-notes.md 1.1 and 2.6, real-controller-facts.md (DR),
  * docs/galil-sim.md "The record stream".
  */
@@ -217,6 +218,56 @@ static void test_udp_handles(void **state)
 	assert_int_equal(tp_mg(p, "_DR0"), 0);
 }
 
+/* The event of the last statement: exactly @want, and only it since
+ * @before events. */
+static void last_event(const struct tplant *p, int before, const char *want)
+{
+	assert_int_equal(p->nevents, before + 1);
+	assert_string_equal(p->events[p->nevents - 1], want);
+}
+
+/* Each DR that takes effect is an event naming the stream's handle, its
+ * interval and who sent it; each stop (DR 0, its handle closed, a power
+ * cycle) names why and the records made since the DR that started it; a
+ * refused DR and a DR 0 with nothing running are silent. */
+static void test_dr_events(void **state)
+{
+	struct tplant *p = *state;
+	uint8_t rec[GL_REC_MAX_BYTES];
+	int n = p->nevents;
+
+	exchange(p, TCP_A, "DR 5,1\r", ":");
+	last_event(p, n, "handle B: data record every 5 samples (handle A)");
+	tp_step(p, 25);
+	exchange(p, TCP_A, "DR 0\r", ":");
+	last_event(p, n + 1,
+		   "handle B: data record stopped: DR 0 (handle A); records "
+		   "made: 5");
+	n = p->nevents;
+	exchange(p, TCP_A, "DR 0,1\r", ":");
+	refused(p, "DR 1,1\r", " 6 Number out of range\r\n:");
+	assert_int_equal(p->nevents, n);
+	exchange(p, UDP_B, "DR 2,1\r", ":"); /* from the UDP handle itself */
+	last_event(p, n, "handle B: data record every 2 samples (handle B)");
+	tp_step(p, 7);
+	exchange(p, TCP_A, "DR 4,1\r", ":"); /* a new interval, a new count */
+	last_event(p, n + 1,
+		   "handle B: data record every 4 samples (handle A)");
+	tp_step(p, 8);
+	while (ctrl_stream_take(p->c, NULL, rec, sizeof(rec)))
+		;
+	ctrl_handle_close(p->c, UDP_B);
+	last_event(p, n + 2,
+		   "handle B: data record stopped: handle closed; records "
+		   "made: 2");
+	ctrl_handle_open_udp(p->c, UDP_B);
+	exchange(p, TCP_A, "DR 3,1\r", ":");
+	tp_step(p, 3);
+	ctrl_power_cycle(p->c);
+	assert_true(tp_has_event(p, "handle B: data record stopped: power "
+				    "cycle; records made: 1"));
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -224,6 +275,7 @@ int main(void)
 	    cmocka_unit_test_setup_teardown(test_interval, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_pause, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_udp_handles, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_dr_events, setup, teardown),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -4,10 +4,11 @@
  * sockets ($ROBOELF_BIN/galil-sim --udp-port 0): gl_link_stream_open()
  * finds the UDP handle with WH and starts DR; records arrive n0 samples
  * apart and are read without waiting; a stalled stream makes no record
- * and ages; DR refused (n1 of a TCP handle is impossible here, so an
- * interval the controller refuses) is reported with its text; a posted
- * line is collected later, and another command waits for it first;
- * gl_link_stream_close() stops the stream (DR 0).
+ * and ages; a QR over TCP while the stream is late makes the records on
+ * their way superseded, not reordered; DR refused (n1 of a TCP handle is
+ * impossible here, so an interval the controller refuses) is reported
+ * with its text; a posted line is collected later, and another command
+ * waits for it first; gl_link_stream_close() stops the stream (DR 0).
  *
  * Every wait polls with a deadline.
  */
@@ -165,6 +166,45 @@ static void test_stall_ages(void **state)
 	assert_int_equal(next_record(f, &rec, REPLY_MS), 1);
 }
 
+/* A QR round trip over TCP while the stream is 300 ms late: the records
+ * made after the last one read (A) up to the QR's sample S, still on their
+ * way, are superseded, exactly (S - A) / n0 of them; none is counted as
+ * reordered, duplicate or lost, and the first record after S is accepted. */
+static void test_qr_supersedes(void **state)
+{
+	struct fx *f = *state;
+	struct gl_stream_stats st0, st1;
+	struct gl_record rec, qr;
+	uint16_t a;
+	int64_t end;
+
+	assert_int_equal(gl_link_stream_open(f->l, f->sim.udp_port, 2,
+					     SAMPLE_NS, 0, NULL),
+			 GL_OK);
+	assert_string_equal(ctl(f, "link delay 300 stream"), "ok");
+	/* past the records sent before the delay: one that arrives 250 ms
+	 * after it was made at least 300 ms before */
+	end = base_now_ms() + 250;
+	do
+		assert_int_equal(next_record(f, &rec, REPLY_MS), 1);
+	while (base_now_ms() < end);
+	a = rec.sample; /* the newest accepted: nothing else was fed */
+	gl_link_stream_stats(f->l, &st0);
+	assert_int_equal(gl_link_record(f->l, NULL, &qr, 0), GL_OK);
+	/* the records up to the QR's come first and are all dropped */
+	assert_int_equal(next_record(f, &rec, REPLY_MS), 1);
+	assert_in_range((uint16_t)(rec.sample - qr.sample), 1, 32767);
+	gl_link_stream_stats(f->l, &st1);
+	/* 300 ms behind, less a simulated clock lagging the wall's */
+	assert_true((uint16_t)(qr.sample - a) >= 200);
+	assert_int_equal(st1.superseded - st0.superseded,
+			 (uint16_t)(qr.sample - a) / 2);
+	assert_int_equal(st1.reordered, 0);
+	assert_int_equal(st1.duplicates, 0);
+	assert_int_equal(st1.lost, 0);
+	assert_true(st1.accepted > st0.accepted);
+}
+
 /* An interval the controller refuses: its own words come back. */
 static void test_dr_refused(void **state)
 {
@@ -257,6 +297,8 @@ int main(void)
 					    teardown),
 	    cmocka_unit_test_setup_teardown(test_stall_ages, setup, teardown),
 	    cmocka_unit_test_setup_teardown(test_dr_refused, setup, teardown),
+	    cmocka_unit_test_setup_teardown(test_qr_supersedes, setup,
+					    teardown),
 	    cmocka_unit_test_setup_teardown(test_post_collect, setup,
 					    teardown),
 	};

@@ -14,8 +14,15 @@
  *     for 3 s, still armed;
  * each FAULT checked against galil-sim's event log (sys_truth). Each case
  * prints one "[ ROW      ]" line: what | relay off ms | FAULT line.
+ * And the facts roboelf prints about the stream, against galil-sim's
+ * events: the start-up's "record stream: UDP handle X, every N samples
+ * ...; measured over M records I ms (lo-hi)" line against the DR that
+ * galil-sim executed, and the end-of-run "stream:" counters (after a quit)
+ * against the records galil-sim made.
  */
+#include <math.h>
 #include <setjmp.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -26,6 +33,7 @@
 
 #include <cmocka.h>
 
+#include "re_linkmeas.h"
 #include "sys_h.h"
 #include "sys_truth.h"
 
@@ -33,6 +41,13 @@
 #define HOLD_MS	      300 /* no motion over this after the safe state */
 #define FAULT_WAIT_MS 5000
 #define QUIET_MS      3000 /* no fault over this under a tolerable delay */
+#define EXIT_MS	      5000 /* SIGTERM to roboelf's exit */
+#define EVENT_MS      3000 /* an event galil-sim logs, its deadline */
+#define SIM_SAMPLE_MS 1.0  /* galil-sim's servo sample (its default) */
+#define PRINT_MS      0.05 /* half the last printed digit of "%.1f" */
+/* roboelf's nominal interval is n0 samples of a DMC-4030 at TM 1000
+ * (1000/1024 ms: docs/link.md), 2.4 % shorter than galil-sim's 1 ms */
+#define DMC_SHORT     (1.0 - 1000.0 / 1024.0)
 
 static struct sys_env env;
 static int env_ok;
@@ -167,6 +182,223 @@ static void test_delay_tolerated(void **state)
 		      QUIET_MS);
 }
 
+/* What roboelf's start-up line says about the stream. */
+struct meas_line {
+	char handle;
+	unsigned n0;
+	double nominal_ms, mean_ms, lo_ms, hi_ms, reply_ms, reply_max_ms;
+	int records;
+};
+
+/* Parse the whole line, or fail: a clause between "(lo-hi)" and "; command
+ * reply" (", a record every X samples by their numbers (not N: ...)") is
+ * the records' own sample numbers disagreeing with N, and fails too. */
+static void parse_meas(const char *line, struct meas_line *m)
+{
+	int end = -1;
+
+	if (sscanf(line,
+		   "roboelf: record stream: UDP handle %c, every %u samples "
+		   "(%lf ms); measured over %d records %lf ms (%lf-%lf); "
+		   "command reply %lf ms (max %lf)%n",
+		   &m->handle, &m->n0, &m->nominal_ms, &m->records, &m->mean_ms,
+		   &m->lo_ms, &m->hi_ms, &m->reply_ms, &m->reply_max_ms,
+		   &end) != 9 ||
+	    end != (int)strlen(line))
+		fail_msg("not the measurement line of a whole stream: '%s'",
+			 line);
+}
+
+/* The one "handle X: data record every N samples (handle Y)" event of the
+ * case (roboelf's DR): X, N and Y. */
+static void dr_event(struct sys_case *c, char *handle, unsigned *n0, char *who)
+{
+	int found = 0, end;
+
+	if (sys_events(c) < 0)
+		fail_msg("%s", c->err);
+	for (size_t i = 0; i < c->nev; i++) {
+		end = -1;
+		if (!strstr(c->ev[i].text, ": data record every "))
+			continue;
+		if (sscanf(c->ev[i].text,
+			   "handle %c: data record every %u samples (handle "
+			   "%c)%n",
+			   handle, n0, who, &end) != 3 ||
+		    end != (int)strlen(c->ev[i].text))
+			fail_msg("galil-sim's DR event is not as documented: "
+				 "'%s'",
+				 c->ev[i].text);
+		found++;
+	}
+	if (found != 1)
+		fail_msg("%d DR events in galil-sim's log, want 1", found);
+}
+
+/* An event "@prefix... (UDP)": a UDP peer took that handle. */
+static int udp_opened(const struct sys_case *c, const char *prefix)
+{
+	size_t n;
+
+	for (size_t i = 0; i < c->nev; i++) {
+		n = strlen(c->ev[i].text);
+		if (!strncmp(c->ev[i].text, prefix, strlen(prefix)) && n > 6 &&
+		    !strcmp(c->ev[i].text + n - 6, " (UDP)"))
+			return 1;
+	}
+	return 0;
+}
+
+/* The start-up's measurement line, against the DR galil-sim executed:
+ * the same UDP handle and n0, and an interval of n0 of galil-sim's 1 ms
+ * samples. The mean is taken over the times of arrival of M records, each
+ * made by galil-sim at an exact multiple of n0 samples (its timer keeps
+ * its clock on the wall clock, catching up after a late wake-up) and
+ * delivered after it by 0 to SLACK_MS of scheduling on this busy box: the
+ * mean's error is at most SLACK_MS / (M - 1), plus the printed rounding.
+ * The records' own sample numbers agree with n0 exactly (parse_meas()). */
+static void check_meas(struct sys_case *c, const struct meas_line *m)
+{
+	char handle, who, udp[64];
+	unsigned n0;
+	double want = 0, tol_ms;
+
+	dr_event(c, &handle, &n0, &who);
+	if (m->handle != handle || m->n0 != n0)
+		fail_msg("roboelf says UDP handle %c every %u samples; "
+			 "galil-sim ran DR %u to handle %c",
+			 m->handle, m->n0, n0, handle);
+	snprintf(udp, sizeof(udp), "handle %c opened from ", handle);
+	if (!udp_opened(c, udp))
+		fail_msg("no '%s... (UDP)' event: handle %c is not a UDP "
+			 "handle",
+			 udp, handle);
+	/* more when the last read found several records waiting */
+	if (m->records < RE_LINKMEAS_RECORDS || m->records > RE_LINKMEAS_MAX)
+		fail_msg("measured over %d records, want %d..%d", m->records,
+			 RE_LINKMEAS_RECORDS, RE_LINKMEAS_MAX);
+	want = n0 * SIM_SAMPLE_MS;
+	if (fabs(m->nominal_ms - want) > want * DMC_SHORT + PRINT_MS)
+		fail_msg("nominal %.1f ms for %u samples (galil-sim: %.1f)",
+			 m->nominal_ms, n0, want);
+	tol_ms = (double)SLACK_MS / (m->records - 1) + PRINT_MS;
+	if (fabs(m->mean_ms - want) > tol_ms)
+		fail_msg("measured %.1f ms a record; galil-sim sent one every "
+			 "%.1f ms (tolerance %.2f ms)",
+			 m->mean_ms, want, tol_ms);
+	if (m->lo_ms > m->mean_ms + PRINT_MS ||
+	    m->hi_ms < m->mean_ms - PRINT_MS ||
+	    m->reply_ms > m->reply_max_ms + PRINT_MS)
+		fail_msg("a mean outside its min-max, or a median above its "
+			 "max: %.2f (%.2f-%.2f), reply %.2f (max %.2f)",
+			 m->mean_ms, m->lo_ms, m->hi_ms, m->reply_ms,
+			 m->reply_max_ms);
+	print_message("[ ROW      ] start-up line | handle %c, %u samples, "
+		      "%.1f ms over %d (tolerance %.2f) | galil-sim: DR %u,%d "
+		      "from handle %c\n",
+		      m->handle, m->n0, m->mean_ms, m->records, tol_ms, n0,
+		      handle - 'A', who);
+}
+
+/* The counters of the end-of-run "stream:" log line. */
+struct stream_counts {
+	unsigned long long dgrams, records, lost, dup, reord, supers, foreign,
+	    shorts, longs, malformed, refused;
+};
+
+static void parse_counts(const char *line, struct stream_counts *k)
+{
+	const char *p = strstr(line, "stream: datagrams=");
+	int end = -1;
+
+	if (!p ||
+	    sscanf(p,
+		   "stream: datagrams=%llu records=%llu lost=%llu "
+		   "duplicates=%llu reordered=%llu superseded=%llu "
+		   "foreign=%llu short=%llu long=%llu malformed=%llu; "
+		   "heartbeat lines refused=%llu%n",
+		   &k->dgrams, &k->records, &k->lost, &k->dup, &k->reord,
+		   &k->supers, &k->foreign, &k->shorts, &k->longs,
+		   &k->malformed, &k->refused, &end) != 11 ||
+	    end != (int)strlen(p))
+		fail_msg("not the stream counters line: '%s'", line);
+}
+
+/* After a quit: the "stream:" counters against the records galil-sim made
+ * from roboelf's DR to its DR 0 (the stop event's count). On loopback with
+ * no fault galil-sim sends each record once, in order, one a datagram:
+ * nothing duplicated, reordered, foreign, short, long or malformed; every
+ * datagram counts in exactly one verdict; a record received or counted lost
+ * was made (datagrams + lost <= made). How many of the made ones were still
+ * on their way when roboelf stopped reading is not known to galil-sim: not
+ * checked, printed. */
+static void check_counts(struct sys_case *c, char handle, char who)
+{
+	char line[1024], prefix[96];
+	struct stream_counts k;
+	unsigned long long made;
+	double t;
+	int i, end = -1;
+
+	if (sys_log_find(c, "stream: datagrams=", NULL, line, sizeof(line)) < 0)
+		fail_msg("no stream counters in the log");
+	parse_counts(line, &k);
+	snprintf(prefix, sizeof(prefix),
+		 "handle %c: data record stopped: DR 0 (handle %c); records "
+		 "made: ",
+		 handle, who);
+	if (sys_wait_event(c, prefix, 0, EVENT_MS, &t) < 0)
+		fail_msg("no '%s' event: %s", prefix, c->err);
+	i = sys_event_find(c, prefix, 0);
+	if (sscanf(c->ev[i].text + strlen(prefix), "%llu%n", &made, &end) !=
+		1 ||
+	    end != (int)strlen(c->ev[i].text + strlen(prefix)))
+		fail_msg("galil-sim's stop event: '%s'", c->ev[i].text);
+	if (k.dgrams != k.records + k.dup + k.reord + k.supers + k.foreign +
+			    k.shorts + k.longs + k.malformed)
+		fail_msg("datagrams=%llu is not the sum of the verdicts: %s",
+			 k.dgrams, line);
+	if (k.dup || k.reord || k.foreign || k.shorts || k.longs || k.malformed)
+		fail_msg("a verdict galil-sim cannot cause on loopback: %s",
+			 line);
+	if (k.records == 0 || k.dgrams + k.lost > made)
+		fail_msg("%llu datagrams and %llu lost, but galil-sim made "
+			 "%llu records: %s",
+			 k.dgrams, k.lost, made, line);
+	print_message("[ ROW      ] end-of-run counters | datagrams %llu "
+		      "(records %llu, superseded %llu) lost %llu | galil-sim "
+		      "made %llu, %llu not read by the end\n",
+		      k.dgrams, k.records, k.supers, k.lost, made,
+		      made - k.dgrams - k.lost);
+}
+
+/* The start-up's measurement line and, after a quit, the end-of-run
+ * counters, each against galil-sim's events. */
+static void test_printed_facts(void **state)
+{
+	struct meas_line m;
+	char line[512], handle, who;
+	unsigned n0;
+	int status;
+
+	(void)state;
+	start_armed(&cs, 0);
+	if (proc_find_line(&cs.re, PROC_STDOUT, "roboelf: record stream: ",
+			   line, sizeof(line)) < 0)
+		fail_msg("no 'record stream' line");
+	parse_meas(line, &m);
+	check_meas(&cs, &m);
+	if (proc_signal(&cs.re, SIGTERM) < 0 ||
+	    proc_wait_exit(&cs.re, EXIT_MS, &status) < 0)
+		fail_msg("roboelf did not exit within %d ms of SIGTERM",
+			 EXIT_MS);
+	if (proc_exit_code(&cs.re) != 0)
+		fail_msg("roboelf exited %d after SIGTERM, want 0",
+			 proc_exit_code(&cs.re));
+	dr_event(&cs, &handle, &n0, &who);
+	check_counts(&cs, handle, who);
+}
+
 static int case_teardown(void **state)
 {
 	(void)state;
@@ -196,6 +428,7 @@ int main(void)
 	    cmocka_unit_test_teardown(test_stream_stalled, case_teardown),
 	    cmocka_unit_test_teardown(test_tcp_stalled, case_teardown),
 	    cmocka_unit_test_teardown(test_delay_tolerated, case_teardown),
+	    cmocka_unit_test_teardown(test_printed_facts, case_teardown),
 	};
 
 	return cmocka_run_group_tests(tests, group_setup, group_teardown);

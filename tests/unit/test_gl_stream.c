@@ -1,7 +1,8 @@
 /*
  * test_gl_stream.c - the DR stream reader on datagrams built with
  * gl_record_encode() (the decoder itself is checked against the published
- * offsets in test_gl_record.c): gaps, duplicates, reordering, the 16-bit
+ * offsets in test_gl_record.c): gaps, duplicates, reordering, records
+ * superseded by one read over another route (gl_stream_seen()), the 16-bit
  * sample number's wrap, short, long, foreign and malformed datagrams, the
  * horizon, the age and the counters.
  *
@@ -167,9 +168,10 @@ static void test_stream_reordered(void **state)
 }
 
 /* TEST_stream_seen: a record read by another route (QR) moves the
- * reference: records up to it are dropped, the next one is accepted
- * without counting the gap as lost; the age stays the stream's own; a
- * sample not after the last accepted is ignored. */
+ * reference: records after the last accepted and up to it are dropped as
+ * superseded, the next one is accepted without counting the gap as lost;
+ * the age stays the stream's own; a sample not after the last accepted is
+ * ignored. */
 static void test_stream_seen(void **state)
 {
 	struct gl_stream s;
@@ -182,24 +184,114 @@ static void test_stream_seen(void **state)
 	assert_int_equal(s.last_sample, 100); /* not after: ignored */
 	assert_int_equal(gl_stream_seen(&s, 131, T0 + 40 * MS), GL_OK);
 	assert_int_equal(gl_stream_age_ns(&s, T0 + 40 * MS), 39 * MS);
+	assert_int_equal(gl_stream_seen(&s, 120, T0 + 40 * MS), GL_OK);
+	assert_int_equal(s.last_sample, 131); /* not after the seen one */
 	assert_int_equal(feed(&s, 124, T0 + 41 * MS, &out),
-			 GL_STREAM_REORDERED);
+			 GL_STREAM_SUPERSEDED);
 	assert_int_equal(feed(&s, 131, T0 + 41 * MS, &out),
-			 GL_STREAM_DUPLICATE);
+			 GL_STREAM_SUPERSEDED);
 	assert_int_equal(feed(&s, 132, T0 + 42 * MS, &out), GL_STREAM_ACCEPTED);
 	assert_int_equal(out.sample, 132);
 	assert_int_equal(s.stats.lost, 0);
 	assert_int_equal(s.stats.uneven, 0);
+	assert_int_equal(s.stats.superseded, 2);
+	assert_int_equal(s.stats.reordered, 0);
+	assert_int_equal(s.stats.duplicates, 0);
 	assert_int_equal(feed(&s, 148, T0 + 58 * MS, &out), GL_STREAM_ACCEPTED);
 	assert_int_equal(s.stats.lost, 1); /* counted again from here */
-	/* before any record: the first one must come after the seen one */
+	/* before any record: the first one must come after the seen one,
+	 * and the ones before it were superseded, not reordered */
 	start(&s);
 	assert_int_equal(gl_stream_seen(&s, 500, T0 + 1 * MS), GL_OK);
 	assert_int_equal(feed(&s, 496, T0 + 2 * MS, &out),
-			 GL_STREAM_REORDERED);
+			 GL_STREAM_SUPERSEDED);
+	assert_int_equal(feed(&s, 500, T0 + 2 * MS, &out),
+			 GL_STREAM_SUPERSEDED);
 	assert_int_equal(feed(&s, 504, T0 + 3 * MS, &out), GL_STREAM_ACCEPTED);
 	assert_int_equal(s.stats.restarts, 0);
+	assert_int_equal(s.stats.superseded, 2);
+	assert_int_equal(s.stats.reordered, 0);
 	assert_int_equal(gl_stream_seen(NULL, 1, T0), GL_ERR_ARG);
+}
+
+/* TEST_stream_superseded: a stream 24 samples behind (n0 = 8) and a QR
+ * that read sample 164 while the stream's last accepted was 140: the
+ * stream's 148, 156 and 164, already in flight, are superseded (not
+ * reordered, not lost, not duplicates); a record at or before 140 that
+ * comes now is still the stream's own fault (duplicate, reordered); once
+ * 172 is accepted, a late 164 is reordered on the stream. */
+static void test_stream_superseded(void **state)
+{
+	struct gl_stream s;
+	struct gl_record out;
+	uint16_t last = 0;
+
+	(void)state;
+	start(&s);
+	for (int k = 0; k < 6; k++) /* 100, 108, ... 140 */
+		assert_int_equal(feed(&s, (uint16_t)(100 + 8 * k),
+				      T0 + (24 + 8 * k) * MS, &out),
+				 GL_STREAM_ACCEPTED);
+	assert_int_equal(gl_stream_seen(&s, 164, T0 + 65 * MS), GL_OK);
+	memset(&out, 0x5A, sizeof(out));
+	assert_int_equal(feed(&s, 148, T0 + 72 * MS, &out),
+			 GL_STREAM_SUPERSEDED);
+	assert_int_equal(feed(&s, 140, T0 + 73 * MS, &out),
+			 GL_STREAM_DUPLICATE);
+	assert_int_equal(feed(&s, 132, T0 + 74 * MS, &out),
+			 GL_STREAM_REORDERED);
+	assert_int_equal(feed(&s, 156, T0 + 80 * MS, &out),
+			 GL_STREAM_SUPERSEDED);
+	assert_int_equal(feed(&s, 164, T0 + 88 * MS, &out),
+			 GL_STREAM_SUPERSEDED);
+	assert_untouched(&out);
+	assert_int_equal(gl_stream_last_sample(&s, &last), 1);
+	assert_int_equal(last, 164); /* the reference, from the QR */
+	assert_int_equal(gl_stream_age_ns(&s, T0 + 88 * MS), 24 * MS);
+	assert_int_equal(feed(&s, 172, T0 + 96 * MS, &out), GL_STREAM_ACCEPTED);
+	assert_int_equal(out.sample, 172);
+	/* from here the stream's own 172 is the reference: late is late */
+	assert_int_equal(feed(&s, 164, T0 + 97 * MS, &out),
+			 GL_STREAM_REORDERED);
+	assert_int_equal(feed(&s, 172, T0 + 98 * MS, &out),
+			 GL_STREAM_DUPLICATE);
+	assert_int_equal(feed(&s, 180, T0 + 104 * MS, &out),
+			 GL_STREAM_ACCEPTED);
+	assert_int_equal(s.stats.received, 15);
+	assert_int_equal(s.stats.accepted, 8);
+	assert_int_equal(s.stats.superseded, 3);
+	assert_int_equal(s.stats.reordered, 2);
+	assert_int_equal(s.stats.duplicates, 2);
+	assert_int_equal(s.stats.lost, 0);
+	assert_int_equal(s.stats.uneven, 0);
+}
+
+/* TEST_stream_superseded_horizon: the stream's own last record more than
+ * the horizon old no longer tells a late record from a superseded one:
+ * behind a record seen since, every number is superseded. */
+static void test_stream_superseded_horizon(void **state)
+{
+	struct gl_stream s;
+	struct gl_record out;
+	const int64_t h = GL_STREAM_HORIZON_SAMPLES * MS;
+
+	(void)state;
+	start(&s);
+	assert_int_equal(feed(&s, 1000, T0, &out), GL_STREAM_ACCEPTED);
+	assert_int_equal(gl_stream_seen(&s, 2000, T0 + h), GL_OK);
+	/* within the horizon of the accepted 1000: its own verdicts */
+	assert_int_equal(feed(&s, 1000, T0 + h, &out), GL_STREAM_DUPLICATE);
+	assert_int_equal(feed(&s, 992, T0 + h, &out), GL_STREAM_REORDERED);
+	/* past it (but within the seen one's): superseded */
+	assert_int_equal(feed(&s, 1000, T0 + h + 1, &out),
+			 GL_STREAM_SUPERSEDED);
+	assert_int_equal(feed(&s, 992, T0 + h + 1, &out), GL_STREAM_SUPERSEDED);
+	assert_int_equal(feed(&s, 2008, T0 + h + 2, &out), GL_STREAM_ACCEPTED);
+	assert_int_equal(s.stats.superseded, 2);
+	assert_int_equal(s.stats.reordered, 1);
+	assert_int_equal(s.stats.duplicates, 1);
+	assert_int_equal(s.stats.restarts, 0);
+	assert_int_equal(s.stats.lost, 0);
 }
 
 /* TEST_stream_wrap: the 16-bit sample number wraps from 65535 to 0; gaps
@@ -587,7 +679,9 @@ static void test_stream_verdict_name(void **state)
 			    "foreign");
 	assert_string_equal(gl_stream_verdict_name(GL_STREAM_MALFORMED),
 			    "malformed");
-	assert_string_equal(gl_stream_verdict_name(7), "unknown");
+	assert_string_equal(gl_stream_verdict_name(GL_STREAM_SUPERSEDED),
+			    "superseded");
+	assert_string_equal(gl_stream_verdict_name(8), "unknown");
 	assert_string_equal(gl_stream_verdict_name(GL_ERR_ARG), "unknown");
 }
 
@@ -599,6 +693,8 @@ int main(void)
 	    cmocka_unit_test(test_stream_reordered),
 	    cmocka_unit_test(test_stream_wrap),
 	    cmocka_unit_test(test_stream_seen),
+	    cmocka_unit_test(test_stream_superseded),
+	    cmocka_unit_test(test_stream_superseded_horizon),
 	    cmocka_unit_test(test_stream_short),
 	    cmocka_unit_test(test_stream_long),
 	    cmocka_unit_test(test_stream_foreign),

@@ -42,15 +42,47 @@ static void test_intervals_exact(void **state)
 		t[i] = t[i - 1] + (i % 2 ? 11500000 : 12000000);
 		s[i] = (uint16_t)(s[i - 1] + 12);
 	}
-	assert_int_equal(re_linkmeas_intervals(t, s, 20, &m), GL_OK);
+	assert_int_equal(re_linkmeas_intervals(t, s, NULL, 20, &m), GL_OK);
 	assert_int_equal(m.records, 20);
 	assert_true(m.mean_ms > 223.0 / 19 - 1e-9 &&
 		    m.mean_ms < 223.0 / 19 + 1e-9);
 	assert_true(m.min_ms > 11.4999 && m.min_ms < 11.5001);
 	assert_true(m.max_ms > 11.9999 && m.max_ms < 12.0001);
 	assert_true(m.step_samples > 11.9999 && m.step_samples < 12.0001);
-	assert_int_equal(re_linkmeas_intervals(t, s, 1, &m), GL_ERR_ARG);
-	assert_int_equal(re_linkmeas_intervals(NULL, s, 20, &m), GL_ERR_ARG);
+	assert_int_equal(re_linkmeas_intervals(t, s, NULL, 1, &m), GL_ERR_ARG);
+	assert_int_equal(re_linkmeas_intervals(NULL, s, NULL, 20, &m),
+			 GL_ERR_ARG);
+}
+
+/* Reads that took several records each (late wake-ups): 6 reads of a
+ * record every 2 samples (2 ms); the first read's 4 count as its newest
+ * only, the third took 3 records, the sixth 2: 1 + 1 + 3 + 1 + 1 + 2 = 9
+ * records over 16 ms (2 ms each), nothing lost by their numbers (16
+ * samples over 8 intervals), the minimum 0. */
+static void test_intervals_batches(void **state)
+{
+	const int64_t t[6] = {100 * MS, 102 * MS, 108 * MS,
+			      110 * MS, 112 * MS, 116 * MS};
+	const uint16_t s[6] = {40, 42, 48, 50, 52, 56};
+	const int c[6] = {4, 1, 3, 1, 1, 2};
+	const int bad[6] = {1, 1, 0, 1, 1, 1};
+	struct re_linkmeas m = {0};
+
+	(void)state;
+	assert_int_equal(re_linkmeas_intervals(t, s, c, 6, &m), GL_OK);
+	assert_int_equal(m.records, 9);
+	assert_true(m.mean_ms > 1.9999 && m.mean_ms < 2.0001);
+	assert_true(m.min_ms == 0);
+	assert_true(m.max_ms > 5.9999 && m.max_ms < 6.0001);
+	assert_true(m.step_samples > 1.9999 && m.step_samples < 2.0001);
+	/* read one by one, the same records said one was lost: 16 samples
+	 * over 5 intervals, 3.2 ms each */
+	assert_int_equal(re_linkmeas_intervals(t, s, NULL, 6, &m), GL_OK);
+	assert_int_equal(m.records, 6);
+	assert_true(m.step_samples > 3.1999 && m.step_samples < 3.2001);
+	m.records = 77;
+	assert_int_equal(re_linkmeas_intervals(t, s, bad, 6, &m), GL_ERR_ARG);
+	assert_int_equal(m.records, 77);
 }
 
 static void test_median(void **state)
@@ -141,6 +173,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_intervals_exact),
+	    cmocka_unit_test(test_intervals_batches),
 	    cmocka_unit_test(test_median),
 	    cmocka_unit_test(test_line_stream),
 	    cmocka_unit_test(test_line_poll),

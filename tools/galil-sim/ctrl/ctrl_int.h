@@ -303,6 +303,7 @@ struct ctrl_stream {
 	int head, count;
 	struct ctrl_stream_rec q[CTRL_DR_QUEUE];
 	uint64_t lost; /* records dropped because the queue was full */
+	uint64_t made; /* records queued since the DR that started it */
 };
 
 /* ---- what BN / BP / BV keep over a power cycle ----------------------- */

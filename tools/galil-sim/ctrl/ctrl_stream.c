@@ -9,11 +9,14 @@
  * not an open UDP session: TC 133 ("Handle must be UDP", galil-notes 2.6,
  * INFERRED for recent firmware).
  */
+#include <stdio.h>
 #include <string.h>
 
 #include "ctrl_stream.h"
 #include "ctrl_args.h"
+#include "ctrl_out.h"
 #include "ctrl_rec.h"
+#include "ctrl_thread.h"
 #include "gl_record.h"
 
 _Static_assert(CTRL_REC_MAX >= GL_REC_MAX_BYTES, "record queue too small");
@@ -21,6 +24,45 @@ _Static_assert(CTRL_REC_MAX >= GL_REC_MAX_BYTES, "record queue too small");
 static int is_int_in(double v, int lo, int hi)
 {
 	return v == (int)v && v >= lo && v <= hi;
+}
+
+/* A running stream stops, with its event: the handle it went to, why, and
+ * how many records were made since the DR that started it (the test's
+ * truth beside the reader's counters). */
+static void stop(struct ctrl *c, const char *why)
+{
+	struct ctrl_stream *d = &c->dr;
+
+	if (d->n <= 0)
+		return;
+	ctrl_event(c, "handle %c: data record stopped: %s; records made: %llu",
+		   'A' + d->h, why, (unsigned long long)d->made);
+	d->n = 0;
+}
+
+/* DR 0 from @x stops a running stream. */
+static void stop_by(struct ctrl_xc *x)
+{
+	char who[CTRL_WHO_LEN], why[CTRL_WHO_LEN + 8];
+
+	ctrl_xc_who(x, who, sizeof(who));
+	snprintf(why, sizeof(why), "DR 0 (%s)", who);
+	stop(x->c, why);
+}
+
+/* DR n0,h took effect: the interval starts again, and the count. */
+static void start(struct ctrl_xc *x, int n0, int h)
+{
+	struct ctrl_stream *d = &x->c->dr;
+	char who[CTRL_WHO_LEN];
+
+	ctrl_xc_who(x, who, sizeof(who));
+	d->n = n0;
+	d->h = h;
+	d->left = n0;
+	d->made = 0;
+	ctrl_event(x->c, "handle %c: data record every %d samples (%s)",
+		   'A' + h, n0, who);
 }
 
 int ctrl_stream_cmd(struct ctrl_xc *x, const char *a)
@@ -39,7 +81,7 @@ int ctrl_stream_cmd(struct ctrl_xc *x, const char *a)
 	if (v[0] != 0 && !is_int_in(v[0], CTRL_DR_MIN, CTRL_DR_MAX))
 		return 6;
 	if (v[0] == 0 && !(got & 2)) {
-		c->dr.n = 0;
+		stop_by(x);
 		return 0;
 	}
 	if (!(got & 2) && c->cf == CTRL_SERIAL)
@@ -49,9 +91,12 @@ int ctrl_stream_cmd(struct ctrl_xc *x, const char *a)
 	h = (int)v[1];
 	if (v[0] != 0 && (!c->h[h].open || !c->h[h].udp))
 		return 133;
-	c->dr.n = (int)v[0];
-	c->dr.h = h;
-	c->dr.left = c->dr.n;
+	if (v[0] == 0) {
+		stop_by(x);
+		c->dr.h = h; /* _DR1 reads it back */
+		return 0;
+	}
+	start(x, (int)v[0], h);
 	return 0;
 }
 
@@ -82,6 +127,7 @@ static void queue_record(struct ctrl *c)
 	r->len = (uint16_t)n;
 	r->handle = d->h;
 	d->count++;
+	d->made++;
 }
 
 void ctrl_stream_sample(struct ctrl *c)
@@ -105,7 +151,7 @@ void ctrl_stream_handle_closed(struct ctrl *c, int h)
 	struct ctrl_stream *d = &c->dr;
 
 	if (d->n > 0 && d->h == h)
-		d->n = 0;
+		stop(c, "handle closed");
 	while (d->count && d->q[d->head].handle == h) {
 		d->head = (d->head + 1) % CTRL_DR_QUEUE;
 		d->count--;
@@ -114,7 +160,7 @@ void ctrl_stream_handle_closed(struct ctrl *c, int h)
 
 void ctrl_stream_reset(struct ctrl *c)
 {
-	c->dr.n = 0;
+	stop(c, "power cycle");
 	c->dr.h = 0;
 	c->dr.left = 0;
 	c->dr.head = c->dr.count = 0;

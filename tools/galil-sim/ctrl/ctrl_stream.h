@@ -16,7 +16,10 @@
 /*
  * ctrl_stream_cmd() - DR n0,n1: n0 = 0 stops the stream, else
  * CTRL_DR_MIN..CTRL_DR_MAX samples between records; n1 = handle 0..7 (A..H),
- * which must be an open UDP handle (absent: the CF handle).
+ * which must be an open UDP handle (absent: the CF handle). Events: "handle
+ * C: data record every 2 samples (handle A)" when it takes effect, "handle
+ * C: data record stopped: DR 0 (handle A); records made: N" when DR 0
+ * stops a running stream (N since the DR that started it).
  * Return: 0, TC 6 (n0 or n1 out of range), TC 50 (no argument), TC 133
  * (n1 is not an open UDP handle), or the expression's TC.
  */
@@ -26,11 +29,14 @@ int ctrl_stream_cmd(struct ctrl_xc *x, const char *a);
  * queue a record when one is due. */
 void ctrl_stream_sample(struct ctrl *c);
 
-/* ctrl_stream_handle_closed() - handle @h closed: a stream to it stops and
+/* ctrl_stream_handle_closed() - handle @h closed: a stream to it stops
+ * (event "... data record stopped: handle closed; records made: N") and
  * its queued records are dropped. */
 void ctrl_stream_handle_closed(struct ctrl *c, int h);
 
-/* ctrl_stream_reset() - power cycle: the stream off, the queue empty. */
+/* ctrl_stream_reset() - power cycle: the stream off (event "... data
+ * record stopped: power cycle; records made: N" if it ran), the queue
+ * empty. */
 void ctrl_stream_reset(struct ctrl *c);
 
 #endif /* SIM_CTRL_STREAM_H */
