@@ -8,6 +8,6 @@
 #define BASE_VERSION_H
 
 #define ROBOELF_VERSION	    "1.4.0"
-#define ROBOELF_DMC_VERSION "2.23"
+#define ROBOELF_DMC_VERSION "2.24"
 
 #endif /* BASE_VERSION_H */

@@ -3,7 +3,8 @@
  * #GUARD, #FORGN, #HBCHK, #JVAL, #MRAMP and #POSERR in dmc/roboelf.dmc are
  * the specification): motion only where the program commanded it (fault
  * 13 detail 1 and 2), the supervisor's heartbeat as a sequence (fault 14
- * detail 1) and its echo in the record (2.23), another program's
+ * detail 1; a fraction or a value outside 0..hbpcwr-1 too, 2.24) and
+ * its echo in the record (2.23), another program's
  * connection (reported, "FOREIGN") and its changes to the safety settings
  * (fault 14, detail 3 and 4), the potentiometers' absolute range (fault
  * 16), the flicker-proof invalid joystick timer (fault 3), position-
@@ -553,6 +554,112 @@ static void test_hb_echo(void **state)
 	}
 }
 
+/* Heartbeats the supervisor never writes (it writes whole numbers in
+ * 0..hbpcwr-1, one more each cycle): written as the last value accepted
+ * + step - wraps * hbpcwr. hbmaxd is 5 (dmc_h_params_default). */
+struct hbodd {
+	const char *what;
+	double step;
+	int wraps;
+};
+
+static const struct hbodd hbodd[] = {
+    {"half a step", 0.5, 0},
+    {"0.0001 of a step", 0.0001, 0},
+    {"one and a half steps", 1.5, 0},
+    {"hbmaxd - 0.5 steps", 4.5, 0},
+    {"a step of 1 to below 0", 1, 1},
+    {"a step of 1 that the wrap leaves below 1", 1, 2},
+};
+
+/*
+ * Armed, a whole step is in sequence and echoed; then another client
+ * writes a value the supervisor never writes: a fraction of a step (a
+ * DMC number keeps 4 decimals, so hbold + 0.0001 is a new value), or a
+ * whole step to a value below 0. It is out of sequence (program 2.24):
+ * fault 14, axis 0, detail 1 within two passes (a write just after one
+ * look is seen by the next); hbok and the echo stay at the whole value.
+ */
+static void test_hb_not_whole(void **state)
+{
+	(void)state;
+	for (size_t k = 0; k < sizeof(hbodd) / sizeof(hbodd[0]); k++) {
+		static struct dmc_h h;
+		const struct hbodd *c = &hbodd[k];
+		char line[48];
+		double mainms, wrap, t;
+		long v;
+
+		if (dmc_h_setup(&h) < 0)
+			fail_msg("%s: set-up: %s", c->what, h.err);
+		assert_true(dmc_h_var(&h, "hbmaxd") == 5);
+		h.hb_on = 0;
+		mainms = dmc_h_var(&h, "mainms");
+		wrap = dmc_h_var(&h, "hbpcwr");
+		v = h.hb + 1;
+		echo_follows(&h, v, 1); /* a whole step: in sequence */
+		snprintf(line, sizeof(line), "hbpc=%.4f",
+			 ((double)v + c->step) - (c->wraps * wrap));
+		DMC_H_CHECK(&h, dmc_h_cmd(&h, line, NULL, 0));
+		t = dmc_h_wait_var(&h, "state", 2, 2 * mainms + 1);
+		if (t < 0)
+			fail_msg("%s ('%s' after hbpc=%ld): no fault within "
+				 "%.0f ms (state %g, hbok %.4f)",
+				 c->what, line, v, 2 * mainms + 1,
+				 dmc_h_var(&h, "state"), dmc_h_var(&h, "hbok"));
+		print_message("measured: '%s' after hbpc=%ld (%s) -> fault 14 "
+			      "in %.0f ms\n",
+			      line, v, c->what, t);
+		assert_latched(&h, 14, 0, 1, 0);
+		assert_true(dmc_h_var(&h, "hbok") == (double)v);
+		assert_echo(&h, v % ECHO_MOD, 2, 14);
+		dmc_h_close(&h);
+	}
+}
+
+/*
+ * In the safe state (#HBSEEN: no sequence judged) every whole change is
+ * followed, but not a value the supervisor never writes (program 2.24,
+ * the fail-safe reading: no sign of its life): a fraction, a value below
+ * 0 or at hbpcwr. hbold, hbok, the echo and hbt (the date a request is
+ * judged by) stay at the last whole write; the next whole one is
+ * followed again.
+ */
+static void test_hb_safe_not_whole(void **state)
+{
+	static const char *const odd[] = {"hbpc=1000.5", "hbpc=1000.0001",
+					  "hbpc=999.9999", "hbpc=-7",
+					  "hbpc=1000000000"};
+	struct dmc_h *h = *state;
+	struct dmc_h_params p;
+	double hbt, mainms;
+
+	dmc_h_params_default(&p);
+	DMC_H_CHECK(h, dmc_h_open(h));
+	DMC_H_CHECK(h, dmc_h_start(h));
+	DMC_H_CHECK(h, dmc_h_configure(h, &p));
+	assert_true(dmc_h_var(h, "hbpcwr") == 1000000000);
+	h->hb_on = 0;
+	mainms = dmc_h_var(h, "mainms");
+	echo_follows(h, 1000, 0);
+	hbt = dmc_h_var(h, "hbt");
+	for (size_t i = 0; i < sizeof(odd) / sizeof(odd[0]); i++) {
+		DMC_H_CHECK(h, dmc_h_cmd(h, odd[i], NULL, 0));
+		dmc_h_advance(h, 2 * mainms + 1);
+		if (dmc_h_var(h, "hbold") != 1000 ||
+		    dmc_h_var(h, "hbok") != 1000 || dmc_h_var(h, "hbt") != hbt)
+			fail_msg("'%s' in the safe state was followed: hbold "
+				 "%.4f hbok %.4f hbt %.0f (was %.0f)",
+				 odd[i], dmc_h_var(h, "hbold"),
+				 dmc_h_var(h, "hbok"), dmc_h_var(h, "hbt"),
+				 hbt);
+		assert_echo(h, 1000, 0, 0);
+	}
+	echo_follows(h, 1001, 0);
+	assert_true(dmc_h_var(h, "hbold") == 1001);
+	assert_true(dmc_h_var(h, "hbt") > hbt);
+}
+
 /* ---- another program at the controller (#FORGN) -------------------------- */
 
 /* The number of received lines that start with @prefix. */
@@ -978,6 +1085,9 @@ int main(void)
 					    dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_hb_echo, dmc_h_fx_new,
 					    dmc_h_fx_free),
+	    cmocka_unit_test(test_hb_not_whole),
+	    cmocka_unit_test_setup_teardown(test_hb_safe_not_whole,
+					    dmc_h_fx_new, dmc_h_fx_free),
 	    cmocka_unit_test(test_new_handle),
 	    cmocka_unit_test_setup_teardown(test_handle_reused, dmc_h_fx_armed,
 					    dmc_h_fx_free),

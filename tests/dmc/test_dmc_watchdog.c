@@ -2,7 +2,9 @@
  * test_dmc_watchdog.c - the controller side of the PC watchdog and the
  * program heartbeat: if hbpc does not change within
  * wdto while armed, every axis is stopped and switched off and fault 2
- * WATCHDOG is latched; thread 1 backs thread 0 up; pcflt latches 12.
+ * WATCHDOG is latched; thread 1 backs thread 0 up; pcflt latches 12. A
+ * stale tool's fractional hbpc (never the supervisor's, 2.24) gives a
+ * request no fresh date and keeps no probe watchdog (#PRWD) alive.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -67,6 +69,8 @@ struct reqcase {
 	double want;	 /* the state it asks for */
 	int stale;	 /* 0: request 20 ms after the last heartbeat
 			    change, 1: wdto after it */
+	int frac;	 /* 1: a stale tool's "hbpc=<last>.5" on the
+			    request's line (program 2.24) */
 };
 
 /*
@@ -74,15 +78,16 @@ struct reqcase {
  * after both): the program judges the request by that last change, not by
  * the request's own time (#GOON). A request wdto after the change latches
  * fault 2 with no motor ever on; one 20 ms after it goes on, and every
- * motor is off again within wdto + mainms (+1 sample) of the change.
+ * motor is off again within wdto + mainms (+1 sample) of the change. A
+ * stale tool's fractional heartbeat on the late request's line
+ * ("hbpc=n.5;armreq=1") is not the supervisor's and gives the request no
+ * fresh date (#HBSEEN, 2.24): refused the same, no motor ever on.
  */
 static void test_request_after_death(void **state)
 {
 	static const struct reqcase cases[] = {
-	    {"svcreq", 3, 0},
-	    {"armreq", 1, 0},
-	    {"svcreq", 3, 1},
-	    {"armreq", 1, 1},
+	    {"svcreq", 3, 0, 0}, {"armreq", 1, 0, 0}, {"svcreq", 3, 1, 0},
+	    {"armreq", 1, 1, 0}, {"svcreq", 3, 1, 1}, {"armreq", 1, 1, 1},
 	};
 
 	(void)state;
@@ -91,6 +96,7 @@ static void test_request_after_death(void **state)
 		const struct reqcase *c = &cases[k];
 		struct dmc_h_params p;
 		double wdto, mainms, t_last, t_on = -1, t, delay;
+		char line[48];
 		int on = 0;
 
 		dmc_h_params_default(&p);
@@ -104,7 +110,13 @@ static void test_request_after_death(void **state)
 		t_last = dmc_h_now(&h);
 		delay = c->stale ? wdto : 20;
 		dmc_h_advance(&h, delay);
-		DMC_H_CHECK(&h, dmc_h_set(&h, c->req, 1));
+		if (c->frac) {
+			snprintf(line, sizeof(line), "hbpc=%ld.5;%s=1", h.hb,
+				 c->req);
+			DMC_H_CHECK(&h, dmc_h_cmd(&h, line, NULL, 0));
+		} else {
+			DMC_H_CHECK(&h, dmc_h_set(&h, c->req, 1));
+		}
 		while ((t = dmc_h_now(&h) - t_last) < delay + wdto &&
 		       dmc_h_var(&h, "state") != 2) {
 			dmc_h_advance(&h, 1);
@@ -117,9 +129,10 @@ static void test_request_after_death(void **state)
 		}
 		(void)dmc_h_wait_motor_off(&h, 7, 3 * mainms);
 		t = dmc_h_now(&h) - t_last;
-		print_message("measured: %s %.0f ms after the last heartbeat: "
-			      "motors %s, fault %g at %.0f ms\n",
-			      c->req, delay, on ? "went on" : "never on",
+		print_message("measured: %s%s %.0f ms after the last "
+			      "heartbeat: motors %s, fault %g at %.0f ms\n",
+			      c->req, c->frac ? " with hbpc=<last>.5" : "",
+			      delay, on ? "went on" : "never on",
 			      dmc_h_var(&h, "fcode"), t);
 		assert_true(dmc_h_var(&h, "state") == 2);
 		assert_true(dmc_h_var(&h, "fcode") == 2);
@@ -306,6 +319,52 @@ static void test_probe_watchdog(void **state)
 	}
 }
 
+/*
+ * Under #PRWD, after the probe's last write, a stale tool writes
+ * fractional heartbeats every 10 ms (last + 0.5, last + 0.0001 in turn):
+ * not the probe's (it writes whole values, 2.24), so they feed no
+ * watchdog: axis A's motor is off within wdto + mainms (+1) of the
+ * probe's last write, with "PROBE WATCHDOG".
+ */
+static void test_probe_watchdog_fraction(void **state)
+{
+	static struct dmc_h h;
+	double wdto, mainms, t_last, t;
+	char line[48];
+
+	(void)state;
+	DMC_H_CHECK(&h, dmc_h_open(&h));
+	DMC_H_CHECK(&h, dmc_h_cmd(&h, "XQ #PRWD,0", NULL, 0));
+	dmc_h_advance(&h, 30);
+	wdto = dmc_h_var(&h, "wdto");
+	mainms = dmc_h_var(&h, "mainms");
+	DMC_H_CHECK(&h, dmc_h_cmd(&h, "SH A", NULL, 0));
+	DMC_H_CHECK(&h, dmc_h_set(&h, "hbpc", (double)++h.hb));
+	t_last = dmc_h_now(&h);
+	for (int k = 1; !dmc_h_axis(&h, 0).motor_off &&
+			dmc_h_now(&h) - t_last < wdto + mainms + 50;
+	     k++) {
+		dmc_h_advance(&h, 1);
+		if (k % 10)
+			continue;
+		snprintf(line, sizeof(line), "hbpc=%ld.%s", h.hb,
+			 k % 20 ? "5" : "0001");
+		DMC_H_CHECK(&h, dmc_h_cmd(&h, line, NULL, 0));
+	}
+	t = dmc_h_now(&h) - t_last;
+	dmc_h_advance(&h, 2); /* "PROBE WATCHDOG" leaves the output queue */
+	print_message("measured: probe's last write, then fractional "
+		      "heartbeats every 10 ms: motor A off after %.0f ms "
+		      "(wdto %.0f + mainms %.0f)\n",
+		      t, wdto, mainms);
+	if (!dmc_h_axis(&h, 0).motor_off || t > wdto + mainms + 1)
+		fail_msg("motor A %s %.0f ms after the probe's last write",
+			 dmc_h_axis(&h, 0).motor_off ? "went off" : "still on",
+			 t);
+	assert_true(dmc_h_unsol_has(&h, "PROBE WATCHDOG"));
+	dmc_h_close(&h);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -314,6 +373,7 @@ int main(void)
 	    cmocka_unit_test(test_request_after_death),
 	    cmocka_unit_test(test_request_window),
 	    cmocka_unit_test(test_probe_watchdog),
+	    cmocka_unit_test(test_probe_watchdog_fraction),
 	    cmocka_unit_test_setup_teardown(test_heartbeat_slow_ok,
 					    dmc_h_fx_armed, dmc_h_fx_free),
 	    cmocka_unit_test_setup_teardown(test_thread0_halted, dmc_h_fx_armed,

@@ -77,7 +77,7 @@ static void test_table(void **state)
 	it = item(&seal, "vers", &k);
 	assert_int_equal(k, 1);
 	assert_int_equal(it->kind, RE_SEAL_CONST);
-	assert_string_equal(it->lit, "2.23");
+	assert_string_equal(it->lit, "2.24");
 	it = item(&seal, "rampov", NULL);
 	assert_true(it->value == 1.25);
 	it = item(&seal, "vmax[0]", &k);
