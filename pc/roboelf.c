@@ -403,17 +403,22 @@ static void log_stream(struct app *a)
 static void log_stop(struct app *a, int key)
 {
 	const struct re_super_view *v = re_super_view(a->sup);
+	struct re_status st;
 
+	/* the late replies counted for a summary, before the run's end */
+	re_super_wd_flush(a->sup);
+	re_super_status(a->sup, &st);
 	re_log_msg(&a->log, RE_LOG_INFO, "stop: %s",
 		   key < 0 ? "the terminal went away" : quit_reason(key));
 	re_log_msg(&a->log, RE_LOG_INFO,
 		   "stats: cycles=%llu overruns=%llu period=%.1f ms "
 		   "late p50=%.3f p99=%.3f max=%.3f ms; reply age worst=%.1f "
-		   "ms; status frames dropped=%llu",
+		   "ms, watchdog warnings=%llu; status frames dropped=%llu",
 		   (unsigned long long)v->cycles,
 		   (unsigned long long)v->overruns, ms_of_ns(v->period_ns),
 		   re_super_late_ms(a->sup, 50), re_super_late_ms(a->sup, 99),
 		   re_super_late_ms(a->sup, 100), ms_of_ns(v->age_worst_ns),
+		   (unsigned long long)st.wd_warnings,
 		   (unsigned long long)a->con.dropped);
 	log_stream(a);
 }

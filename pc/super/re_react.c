@@ -63,6 +63,36 @@ void re_super_note(struct re_super *s, enum re_log_level lvl,
 	snprintf(e->text, sizeof(e->text), "%s", text);
 }
 
+/* ---- watchdog warnings condensed (RE_SUPER_WD_WINDOW_MS) --------------- */
+
+/* What the summary counts, as the warning it stands for names it. */
+static const char *wd_what(const struct re_super *s)
+{
+	if (s->pub.cfg.stream)
+		return s->wd_held == 1 ? "late record or heartbeat reply"
+				       : "late records or heartbeat replies";
+	return s->wd_held == 1 ? "late reply" : "late replies";
+}
+
+void re_super_wd_flush(struct re_super *s)
+{
+	if (s->wd_held) {
+		snprintf(s->text, sizeof(s->text),
+			 "watchdog: %llu more %s in the last %.1f s (worst "
+			 "%.1f ms, non-critical limit %.1f ms, critical %.1f "
+			 "ms)",
+			 (unsigned long long)s->wd_held, wd_what(s),
+			 (double)(now_ns(s) - s->wd_open_ns) / 1e9,
+			 ns_to_ms(s->wd_held_worst_ns), ns_to_ms(s->noncrit_ns),
+			 ns_to_ms(s->pub.crit_ns));
+		re_io_logf(&s->pub.io, RE_LOG_WARN, "%s", s->text);
+		re_super_note(s, RE_LOG_WARN, RE_EV_WATCHDOG, s->text);
+	}
+	s->wd_open = 0;
+	s->wd_held = 0;
+	s->wd_held_worst_ns = 0;
+}
+
 int re_super_event(const struct re_super *s, uint64_t after,
 		   struct re_event *out)
 {
@@ -544,6 +574,9 @@ int re_super_fault(struct re_super *s, const struct re_fault *f)
 	s->pub.armed = 0;
 	s->pub.fault = fault;
 	compose_line(s);
+	/* the late replies counted for a summary before the fault's entry:
+	 * after the stop, which they must not delay */
+	re_super_wd_flush(s);
 	/* 5. the log entry on disk before anyone reports the relay open */
 	log_fault(s);
 	return RE_FAULT;
@@ -573,6 +606,7 @@ int re_super_shutdown(struct re_super *s, char *what, size_t cap)
 	relay_rc = relay_finish(s, relay_start(s));
 	s->pub.armed = 0;
 	s->pub.expect = 0;
+	re_super_wd_flush(s); /* after the stop, which it must not delay */
 	if (what)
 		snprintf(
 		    what, cap, "motors off: %s; motor power off (relay): %s",

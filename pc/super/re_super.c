@@ -306,9 +306,21 @@ static int exchange(struct re_super *s, struct re_fault *f)
 	return v;
 }
 
+/* A late reply (non-critical): counted; logged and shown when it is the
+ * first since the window closed (which opens one), else held for the
+ * summary with the worst age (re_super_wd_flush(), re_react.c: the fault
+ * reaction and the shutdown flush it too). */
 static void warn_watchdog(struct re_super *s)
 {
 	s->wd_warnings++;
+	if (s->wd_open) {
+		s->wd_held++;
+		if (s->pub.age_last_ns > s->wd_held_worst_ns)
+			s->wd_held_worst_ns = s->pub.age_last_ns;
+		return;
+	}
+	s->wd_open = 1;
+	s->wd_open_ns = now_ns(s);
 	snprintf(s->text, sizeof(s->text),
 		 "watchdog: %s after %.1f ms "
 		 "(non-critical limit %.1f ms, critical %.1f ms)",
@@ -318,6 +330,15 @@ static void warn_watchdog(struct re_super *s)
 		 ns_to_ms(s->pub.crit_ns));
 	re_io_logf(&s->pub.io, RE_LOG_WARN, "%s", s->text);
 	re_super_note(s, RE_LOG_WARN, RE_EV_WATCHDOG, s->text);
+}
+
+/* The window of condensed warnings ends RE_SUPER_WD_WINDOW_MS after the
+ * warning that opened it: checked each cycle, before this cycle's own. */
+static void wd_window(struct re_super *s)
+{
+	if (s->wd_open && now_ns(s) - s->wd_open_ns >=
+			      (int64_t)RE_SUPER_WD_WINDOW_MS * BASE_NS_PER_MS)
+		re_super_wd_flush(s);
 }
 
 static int check_relay(struct re_super *s, struct re_fault *f)
@@ -594,6 +615,7 @@ static int cycle_checks(struct re_super *s)
 		return re_super_fault(s, &rf);
 	if (v == RE_FAULT)
 		return re_super_fault(s, &f);
+	wd_window(s);
 	if (warn)
 		warn_watchdog(s);
 	v = s->pub.cfg.stream ? stream_checks(s, &f) : check_record(s, &f);

@@ -47,6 +47,17 @@
 #define RE_SUPER_MSGS	   8   /* unsolicited lines drained per cycle */
 #define RE_SUPER_EVENTS	   16  /* later faults and warnings kept */
 #define RE_SUPER_EVENT_LEN 240 /* one of them, bytes incl. NUL */
+/* Repeated watchdog warnings condensed: after a late reply is logged, the
+ * further ones within this window are counted and logged as one summary
+ * line when the window ends (or at a fault or the quit), ms. A steady
+ * network delay makes a late reply nearly every cycle (about 10 lines a
+ * second were seen); the log is the record of failures, and a flood of
+ * identical lines hides the one that matters and fills the disk. 10 s
+ * keeps that to two lines per 10 s, while the first late reply is still
+ * logged at once with its age, a burst is placed in time to within 10 s,
+ * and every one is counted (wd_warnings). docs/supervisor.md, "Watchdog
+ * warnings". */
+#define RE_SUPER_WD_WINDOW_MS 10000
 
 /* What a kept event is about (the console folds repeats of one kind). */
 enum re_event_kind {
@@ -159,7 +170,8 @@ struct re_status {
 	double late_worst_ms;
 	uint64_t cycles;
 	uint64_t overruns;
-	uint64_t wd_warnings; /* non-critical watchdog events */
+	uint64_t wd_warnings; /* non-critical watchdog events, each one
+			       * (also those only counted in a summary) */
 	int armed;
 	int expect;	 /* program state expected: RE_DMC_ARMED, _SERVICE, 0 */
 	int link_ok;	 /* last round trip succeeded */
@@ -303,10 +315,24 @@ void re_super_recorder(
  * re_super_cycle() - one cycle: round trip, checks, fault reaction.
  * While latched: only polls the record (for the status board) and never
  * acts on anything again.
- * Return: RE_OK; RE_WARN (a non-critical event was logged); RE_FAULT (a new
- *         fault was latched in this cycle: print re_super_fault_line()).
+ * Return: RE_OK; RE_WARN (a non-critical event: a late reply, logged or
+ *         counted for the summary, see re_super_wd_flush()); RE_FAULT (a
+ *         new fault was latched in this cycle: print re_super_fault_line()).
  */
 int re_super_cycle(struct re_super *s);
+
+/*
+ * re_super_wd_flush() - log the late replies counted since the last logged
+ * watchdog warning (RE_SUPER_WD_WINDOW_MS), if any, as one WARN line
+ * "watchdog: N more late replies in the last T s (worst A ms, ...)" and
+ * keep it for the console (re_super_note()); the window closes, so that
+ * the next late reply is logged in full. Nothing counted: nothing logged.
+ * The cycle calls it when the window ends, the fault reaction before the
+ * FAULT entry, re_super_shutdown() after its stop; call it before the
+ * run's last lines so the summary precedes them. No allocation, no I/O
+ * but the log's.
+ */
+void re_super_wd_flush(struct re_super *s);
 
 /*
  * re_super_fault() - the fault reaction, also for faults found outside the

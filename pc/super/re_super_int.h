@@ -28,7 +28,14 @@ struct re_super {
 	/* watchdog */
 	int64_t noncrit_ns;
 	int64_t last_good_ns;
-	uint64_t wd_warnings;
+	uint64_t wd_warnings; /* every late reply */
+	/* repeated warnings condensed (RE_SUPER_WD_WINDOW_MS): the window
+	 * opened by the last logged one, and the late replies counted since
+	 * (not logged one by one) with the worst of their ages */
+	int wd_open;
+	int64_t wd_open_ns;
+	uint64_t wd_held;
+	int64_t wd_held_worst_ns;
 	struct re_alive_state alive;
 	/* the last record and its checks */
 	struct re_encpot_state encpot[RE_SUPER_AXES];

@@ -1277,6 +1277,60 @@ double sys_wall_ms(void)
 	return (double)ts.tv_sec * 1000.0 + (double)(ts.tv_nsec / 1000000);
 }
 
+long sys_wd_warnings(struct sys_case *c, long *full, long *sums)
+{
+	char *buf, *p, *w;
+	long n = 0, k, nf = 0, ns = 0;
+	int end;
+	size_t len;
+
+	if (read_file(c->log, &buf, &len) < 0) {
+		seterr(c->err, "cannot read the log '%s': %s", c->log,
+		       strerror(errno));
+		return -1;
+	}
+	for (p = buf; *p;) {
+		char *nl = strchr(p, '\n');
+
+		if (nl)
+			*nl = '\0';
+		w = strstr(p, " WARN watchdog: ");
+		end = 0;
+		if (w && sscanf(w, " WARN watchdog: %ld more late %n", &k,
+				&end) == 1 &&
+		    end > 0 && k > 0) {
+			n += k;
+			ns++;
+		} else if (w && strstr(w, " (non-critical limit ")) {
+			n++;
+			nf++;
+		}
+		p = nl ? nl + 1 : p + strlen(p);
+	}
+	free(buf);
+	if (full)
+		*full = nf;
+	if (sums)
+		*sums = ns;
+	return n;
+}
+
+long sys_wd_counter(struct sys_case *c)
+{
+	char line[2048];
+	const char *p;
+	long n;
+
+	if (sys_log_find(c, "stats: cycles=", NULL, line, sizeof(line)) < 0)
+		return -1;
+	p = strstr(line, " watchdog warnings=");
+	if (!p || sscanf(p, " watchdog warnings=%ld", &n) != 1) {
+		seterr(c->err, "no 'watchdog warnings=' in '%s'", line);
+		return -1;
+	}
+	return n;
+}
+
 int sys_log_time_ms(struct sys_case *c, const char *a, double *ms)
 {
 	char line[4096];

@@ -376,6 +376,26 @@ int sys_log_find(struct sys_case *c, const char *a, const char *b, char *line,
 		 size_t cap);
 
 /*
+ * sys_wd_warnings() - the late replies the case's log accounts for: a
+ * watchdog warning logged in full ("watchdog: reply after ..." or, in the
+ * stream design, "watchdog: a record or the heartbeat's reply came after
+ * ...") counts 1, a summary of those counted after it ("watchdog: N more
+ * late ...") N. While roboelf runs, those of the current window
+ * (RE_SUPER_WD_WINDOW_MS) are not in the log yet: after a fault or a quit
+ * they are.
+ * @full, @sums: [out] optional: the lines of each kind.
+ * Return: the count, or -1 when the log cannot be read.
+ */
+long sys_wd_warnings(struct sys_case *c, long *full, long *sums);
+
+/*
+ * sys_wd_counter() - the supervisor's own count of late replies, from the
+ * log's "stats:" line (written at the quit: "watchdog warnings=N").
+ * Return: N, or -1 when there is no such line.
+ */
+long sys_wd_counter(struct sys_case *c);
+
+/*
  * sys_log_time_ms() - the wall-clock time (ms since the epoch, UTC) of the
  * first log line containing @a: its "YYYY-MM-DDTHH:MM:SS.mmmZ" stamp.
  * Return: 0 with @ms filled, -1 when there is none.

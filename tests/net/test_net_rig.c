@@ -162,7 +162,7 @@ struct outcome {
 	double relay_ms;  /* relay off after the injection, -1 none */
 	double motors_ms; /* every motor off after the injection, -1 */
 	double age_ms;	  /* the reply age the FAULT line names, -1 */
-	long warnings;	  /* "watchdog: reply after" log lines */
+	long warnings;	  /* late replies in the log (sys_wd_warnings) */
 	char line[1024];  /* the FAULT line, "" none */
 };
 
@@ -184,21 +184,15 @@ static void record(const char *name, const char *expected,
 	fclose(f);
 }
 
-/* The log's watchdog warnings so far ("watchdog: reply after ..." or, in
- * the stream design, "watchdog: a record or the heartbeat's reply came
- * after ..."). */
+/* The late replies the log accounts for so far: each logged in full
+ * ("watchdog: reply after ..." or, in the stream design, "watchdog: a
+ * record or the heartbeat's reply came after ...") and those counted in a
+ * summary ("watchdog: N more late ..."). Complete after a fault or a quit
+ * (the pending count is logged then), not while roboelf runs. -1: the log
+ * could not be read. */
 static long count_warnings(struct sys_case *c)
 {
-	char line[2048];
-	long n = 0;
-	FILE *f = fopen(c->log, "r");
-
-	while (f && fgets(line, sizeof(line), f))
-		n += strstr(line, "watchdog: ") &&
-		     strstr(line, "(non-critical limit ");
-	if (f)
-		fclose(f);
-	return n;
+	return sys_wd_warnings(c, NULL, NULL);
 }
 
 /* Wait until every motor has a "motor off" event after @after. */
@@ -342,12 +336,16 @@ static void unexpected_trip(struct sys_case *c, const char *name, double t0,
 
 /* No trip for @secs of simulated time from @t0: no FAULT line, still
  * armed (relay on, every motor on). A trip ends the wait at once and is
- * measured (unexpected_trip()). */
+ * measured (unexpected_trip()). Then roboelf quits (SIGTERM), so that the
+ * late replies still held for a summary are logged, and the log must
+ * account for every one the supervisor counted (its "stats:" line). */
 static void expect_no_trip(struct sys_case *c, const char *name, double t0,
 			   double secs, const char *expected, long max_warn)
 {
 	struct outcome o = {.relay_ms = -1, .motors_ms = -1, .age_ms = -1};
 	char st[2048];
+	long counted;
+	int status;
 
 	if (sys_wait_fault(c, (int)(secs * 1000), o.line, sizeof(o.line)) == 0)
 		unexpected_trip(c, name, t0, expected, &o);
@@ -357,13 +355,23 @@ static void expect_no_trip(struct sys_case *c, const char *name, double t0,
 	proc_find_line(&c->re, PROC_STDOUT, "FAULT ", o.line, sizeof(o.line));
 	if (o.line[0])
 		unexpected_trip(c, name, t0, expected, &o);
-	o.warnings = count_warnings(c);
-	record(name, expected, &o);
 	if (sys_state(c, st, sizeof(st)) < 0)
 		fail_msg("%s: %s", name, c->err);
+	proc_signal(&c->re, SIGTERM);
+	if (proc_wait_exit(&c->re, EXIT_WAIT_MS, &status) < 0)
+		fail_msg("%s: roboelf did not exit within %d ms of SIGTERM",
+			 name, EXIT_WAIT_MS);
+	o.warnings = count_warnings(c);
+	record(name, expected, &o);
 	if (!strstr(st, " relay=on ") || !strstr(st, " A.mo=0 ") ||
 	    !strstr(st, " B.mo=0 ") || !strstr(st, " C.mo=0 "))
 		fail_msg("%s: no longer armed: %s", name, st);
+	counted = sys_wd_counter(c);
+	if (counted < 0 || o.warnings != counted)
+		fail_msg("%s: the log accounts for %ld late replies, the "
+			 "supervisor counted %ld%s%s",
+			 name, o.warnings, counted, counted < 0 ? ": " : "",
+			 counted < 0 ? c->err : "");
 	if (max_warn >= 0 && o.warnings > max_warn)
 		fail_msg("%s: %ld watchdog warnings, at most %ld expected",
 			 name, o.warnings, max_warn);
@@ -627,23 +635,15 @@ static void expect_start_lines(const struct link_case *k)
 			fail_msg("%s: no start-up line '%s'", k->name, want[i]);
 }
 
-/* The stream design: roboelf's run ended (SIGTERM, when a no-trip case
- * left it armed), the record stream's counters that its log ends with,
- * printed beside the measurement: the datagrams the loss took. */
+/* The stream design: roboelf's run ended (a no-trip case quit it, a trip
+ * case too, once latched), the record stream's counters that its log ends
+ * with, printed beside the measurement: the datagrams the loss took. */
 static void stream_counters(struct sys_case *c, const struct link_case *k)
 {
 	char line[1024];
-	int status;
 
 	if (k->design != STREAM)
 		return;
-	if (k->expect == NO_TRIP) {
-		proc_signal(&c->re, SIGTERM);
-		if (proc_wait_exit(&c->re, EXIT_WAIT_MS, &status) < 0)
-			fail_msg("%s: roboelf did not exit within %d ms of "
-				 "SIGTERM",
-				 k->name, EXIT_WAIT_MS);
-	}
 	if (sys_log_find(c, "stream: datagrams=", NULL, line, sizeof(line)) ==
 	    0)
 		print_message("[ MEASURE  ] %s: %s\n", k->name,

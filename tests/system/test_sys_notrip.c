@@ -261,13 +261,16 @@ static void test_pot_noise_half_tolerance(void **state)
  * the link's latency makes one age of P + D; choosing P + D half-way
  * between the non-critical limit N and the critical limit C gives a
  * non-critical watchdog event (logged) and no fault. The step is repeated
- * while an axis moves.
+ * while an axis moves. After the quit, the log accounts for every late
+ * reply the supervisor counted: the first logged in full, the ones within
+ * RE_SUPER_WD_WINDOW_MS after it in a summary (the last one at the quit).
  */
 static void test_watchdog_between_limits(void **state)
 {
 	double n, c, d;
 	int steps = 6;
 	char line[4096];
+	long full = 0, sums = 0, logged, counted;
 
 	(void)state;
 	start();
@@ -301,6 +304,20 @@ static void test_watchdog_between_limits(void **state)
 	print_message("[   INFO   ] logged: %s\n", line);
 	still_moves('B');
 	quit_clean();
+	logged = sys_wd_warnings(&cs, &full, &sums);
+	counted = sys_wd_counter(&cs);
+	if (logged < 0 || counted < 0)
+		fail_msg("%s", cs.err);
+	print_message("[   INFO   ] late replies: %ld counted, %ld in the log "
+		      "(%ld lines in full, %ld summaries)\n",
+		      counted, logged, full, sums);
+	if (sums && sys_log_find(&cs, " WARN watchdog: ", " more late ", line,
+				 sizeof(line)) == 0)
+		print_message("[   INFO   ] summary: %s\n", line);
+	if (full < 1 || logged != counted)
+		fail_msg("the log accounts for %ld late replies (%ld lines, "
+			 "%ld summaries), the supervisor counted %ld",
+			 logged, full, sums, counted);
 }
 
 #define T(f) cmocka_unit_test_teardown(f, case_teardown)

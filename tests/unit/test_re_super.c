@@ -440,6 +440,159 @@ static void test_super_watchdog_noncritical(void **state)
 	assert_int_equal(fk.n_relay_off, 0);
 }
 
+/* One cycle whose reply comes @ms into it (the next ones 0.1 ms in). */
+static int late(int ms)
+{
+	int v;
+
+	fk.delay_ns = ms * MS;
+	v = step();
+	fk.delay_ns = MS / 10;
+	return v;
+}
+
+/* @n pairs of cycles: a good reply, then one 40 ms into its cycle (89.9
+ * ms after the last), or 45 ms (94.9 ms) in pair @worst. */
+static void late_pairs(int n, int worst)
+{
+	for (int k = 0; k < n; k++) {
+		assert_int_equal(step(), RE_OK);
+		assert_int_equal(late(k == worst ? 45 : 40), RE_WARN);
+	}
+}
+
+static const char *const wd_tail =
+    "non-critical limit 75.0 ms, critical 125.0 ms)";
+
+/* Repeated late replies condensed: the first logged at once; the 5 more
+ * within RE_SUPER_WD_WINDOW_MS counted, not logged, and logged as one
+ * summary with their count and worst age by the cycle that ends the
+ * window (10 s after the first, not the one before); every one counted
+ * for the board; the next late reply logged in full again. No
+ * allocation. */
+static void test_super_wd_summary(void **state)
+{
+	struct re_status st;
+	struct re_event ev;
+	char want[256];
+	long n0;
+
+	(void)state;
+	assert_int_equal(RE_SUPER_WD_WINDOW_MS, 10000);
+	assert_int_equal(run(2), RE_OK);
+	n0 = n_allocs;
+	assert_int_equal(late(40), RE_WARN); /* the window opens now */
+	late_pairs(5, 2);
+	assert_int_equal(fk.n_logs, 1);
+	assert_string_equal(fk.logs[0],
+			    "watchdog: reply after 89.9 ms (non-critical limit "
+			    "75.0 ms, critical 125.0 ms)");
+	re_super_status(&sup, &st);
+	assert_int_equal(st.wd_warnings, 6);
+	/* it opened 40 ms into its cycle: the 200th cycle after it judges
+	 * 9960.1 ms after, the 201st 10010.1 ms */
+	assert_int_equal(run(190), RE_OK);
+	assert_int_equal(fk.n_logs, 1);
+	assert_int_equal(step(), RE_OK);
+	assert_int_equal(fk.n_logs, 2);
+	assert_int_equal(fk.log_level[1], RE_LOG_WARN);
+	snprintf(want, sizeof(want),
+		 "watchdog: 5 more late replies in the last 10.0 s (worst "
+		 "94.9 ms, %s",
+		 wd_tail);
+	assert_string_equal(fk.logs[1], want);
+	assert_int_equal(re_super_event(&sup, 1, &ev), 1); /* the console's */
+	assert_int_equal(ev.kind, RE_EV_WATCHDOG);
+	assert_string_equal(ev.text, want);
+	assert_int_equal(late(40), RE_WARN);
+	assert_int_equal(fk.n_logs, 3);
+	assert_true(!strncmp(fk.logs[2], "watchdog: reply after 89.9 ms", 29));
+	re_super_status(&sup, &st);
+	assert_int_equal(st.wd_warnings, 7);
+	assert_int_equal(n_allocs, n0);
+	assert_int_equal(fk.n_relay_off, 0);
+}
+
+/* One late reply and none after it: its line alone, no summary at the
+ * window's end, none at a flush, none at the quit. */
+static void test_super_wd_no_summary(void **state)
+{
+	struct re_status st;
+	char what[128];
+
+	(void)state;
+	assert_int_equal(run(2), RE_OK);
+	assert_int_equal(late(40), RE_WARN);
+	assert_int_equal(run(250), RE_OK);
+	re_super_wd_flush(&sup);
+	assert_int_equal(re_super_shutdown(&sup, what, sizeof(what)), GL_OK);
+	assert_int_equal(fk.n_logs, 1);
+	assert_true(!strncmp(fk.logs[0], "watchdog: reply after 89.9 ms", 29));
+	re_super_status(&sup, &st);
+	assert_int_equal(st.wd_warnings, 1);
+}
+
+/* A fault inside the window: the late replies counted so far are logged
+ * before the FAULT entry, after the stop (which they must not delay). */
+static void test_super_wd_fault_flushes(void **state)
+{
+	static const char tail[] = "cmd:MG fhnew,log,log:FAULT";
+	struct re_status st;
+	char want[256];
+	size_t n;
+
+	(void)state;
+	assert_int_equal(run(2), RE_OK);
+	assert_int_equal(late(40), RE_WARN);
+	late_pairs(3, -1);
+	fk.record_rc = GL_ERR_CLOSED;
+	assert_int_equal(step(), RE_FAULT);
+	assert_int_equal(fk.n_logs, 3);
+	/* opened 40 ms into its cycle, the fault 0.1 ms into the 7th after */
+	snprintf(want, sizeof(want),
+		 "watchdog: 3 more late replies in the last 0.3 s (worst "
+		 "89.9 ms, %s",
+		 wd_tail);
+	assert_string_equal(fk.logs[1], want);
+	assert_int_equal(fk.log_level[1], RE_LOG_WARN);
+	assert_int_equal(fk.log_level[2], RE_LOG_FAULT);
+	n = strlen(fk.seq);
+	assert_true(n > strlen(tail));
+	assert_string_equal(fk.seq + n - strlen(tail), tail);
+	assert_non_null(strstr(fk.seq, "cmd:pcflt=1;AB 1;MO ABC,"));
+	re_super_status(&sup, &st);
+	assert_int_equal(st.wd_warnings, 4);
+	assert_int_equal(re_super_shutdown(&sup, NULL, 0), GL_OK);
+	assert_int_equal(fk.n_logs, 3); /* nothing left to log */
+}
+
+/* The quit inside the window: the one more late reply logged after the
+ * stop and the relay's off; a second flush logs nothing. */
+static void test_super_wd_quit_flushes(void **state)
+{
+	char want[256];
+
+	(void)state;
+	assert_int_equal(run(2), RE_OK);
+	assert_int_equal(late(40), RE_WARN);
+	late_pairs(1, 0);
+	assert_int_equal(fk.n_logs, 1);
+	fk.seq[0] = '\0';
+	assert_int_equal(re_super_shutdown(&sup, NULL, 0), GL_OK);
+	/* 105 ms after the first, and the 25 ms given to offreq */
+	snprintf(want, sizeof(want),
+		 "watchdog: 1 more late reply in the last 0.1 s (worst 94.9 "
+		 "ms, %s",
+		 wd_tail);
+	assert_int_equal(fk.n_logs, 2);
+	assert_string_equal(fk.logs[1], want);
+	assert_string_equal(fk.seq, "cmd:offreq=1,cmd:AB 1;MO ABC,cmd:MG _MOA,"
+				    "cmd:MG _MOB,cmd:MG _MOC,relay_off_start,"
+				    "relay_off_finish,log");
+	re_super_wd_flush(&sup);
+	assert_int_equal(fk.n_logs, 2);
+}
+
 /* No reply before the critical limit: WATCHDOG fault in that cycle. */
 static void test_super_watchdog_critical(void **state)
 {
@@ -1068,6 +1221,10 @@ int main(void)
 	    cmocka_unit_test_setup(test_super_encpot_fault_order, setup),
 	    cmocka_unit_test_setup(test_super_encpot_transient, setup),
 	    cmocka_unit_test_setup(test_super_watchdog_noncritical, setup),
+	    cmocka_unit_test_setup(test_super_wd_summary, setup),
+	    cmocka_unit_test_setup(test_super_wd_no_summary, setup),
+	    cmocka_unit_test_setup(test_super_wd_fault_flushes, setup),
+	    cmocka_unit_test_setup(test_super_wd_quit_flushes, setup),
 	    cmocka_unit_test_setup(test_super_watchdog_critical, setup),
 	    cmocka_unit_test_setup(test_super_stall_in_round_trip, setup),
 	    cmocka_unit_test_setup(test_super_comm_fault, setup),

@@ -326,6 +326,68 @@ static void test_stream_lost_record(void **state)
 	assert_int_equal(fk.n_relay_off, 0);
 }
 
+/* One lost record: the next cycle's is 100 ms after the last (a late
+ * one, RE_WARN). */
+static void lose_one(void)
+{
+	fk.drop_next = 1;
+	assert_int_equal(run(1), RE_OK);
+	assert_int_equal(run(1), RE_WARN);
+}
+
+/* Late records condensed as the round trip's late replies are: the first
+ * logged; the 3 more within RE_SUPER_WD_WINDOW_MS counted into one
+ * summary, worded for the stream, by the cycle 10 s after the first (not
+ * the one before); the next logged in full, and one more counted and
+ * logged at the quit, after the stop. Every one counted for the board; no
+ * allocation in the cycles. */
+static void test_stream_wd_summary(void **state)
+{
+	static const char tail[] =
+	    "(worst 100.0 ms, non-critical limit 75.0 ms, critical 125.0 ms)";
+	struct re_status st;
+	char want[256];
+	long n0;
+
+	(void)state;
+	assert_int_equal(run(5), RE_OK);
+	n0 = n_allocs;
+	lose_one(); /* logged: the window opens */
+	for (int k = 0; k < 3; k++)
+		lose_one();
+	assert_int_equal(fk.n_logs, 1);
+	assert_int_equal(run(193), RE_OK); /* 9950 ms after the first */
+	assert_int_equal(fk.n_logs, 1);
+	assert_int_equal(run(1), RE_OK);
+	assert_int_equal(fk.n_logs, 2);
+	snprintf(want, sizeof(want),
+		 "watchdog: 3 more late records or heartbeat replies in the "
+		 "last 10.0 s %s",
+		 tail);
+	assert_string_equal(fk.logs[1], want);
+	lose_one();
+	assert_string_equal(fk.logs[2],
+			    "watchdog: a record or the heartbeat's reply came "
+			    "after 100.0 ms (non-critical limit 75.0 ms, "
+			    "critical 125.0 ms)");
+	lose_one();
+	assert_int_equal(n_allocs, n0);
+	assert_int_equal(fk.n_logs, 3);
+	re_super_status(&sup, &st);
+	assert_int_equal(st.wd_warnings, 6);
+	/* the quit 10 ms later: 110 ms after the one logged, and the 25 ms
+	 * given to offreq */
+	fk.now += 10 * MS;
+	assert_int_equal(re_super_shutdown(&sup, NULL, 0), GL_OK);
+	assert_int_equal(fk.n_logs, 4);
+	snprintf(want, sizeof(want),
+		 "watchdog: 1 more late record or heartbeat reply in the last "
+		 "0.1 s %s",
+		 tail);
+	assert_string_equal(fk.logs[3], want);
+	assert_int_equal(fk.n_relay_off, 1);
+}
+
 /* The stream stops: WATCHDOG at the first cycle past 125 ms. */
 static void test_stream_stops(void **state)
 {
@@ -446,6 +508,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test_setup(test_stream_healthy, setup),
 	    cmocka_unit_test_setup(test_stream_lost_record, setup),
+	    cmocka_unit_test_setup(test_stream_wd_summary, setup),
 	    cmocka_unit_test_setup(test_stream_stops, setup),
 	    cmocka_unit_test_setup(test_stream_ack_stalls, setup),
 	    cmocka_unit_test_setup(test_stream_replies_late, setup),
