@@ -229,8 +229,52 @@ static void program_verdict(struct re_super *s, struct re_fault *f)
 		 "no program fault within %d ms", s->pub.cfg.settle_ms);
 }
 
+/* The program's latched fault as the newest record of the stream shows
+ * it: 1 and @za when one is latched, else 0 (no stream, no new record). */
+static int stream_fault(struct re_super *s, struct re_za *za)
+{
+	struct gl_record rec;
+
+	if (!s->pub.cfg.stream || !s->pub.io.ops->stream ||
+	    s->pub.io.ops->stream(s->pub.io.ud, &rec, now_ns(s)) != 1 ||
+	    rec.n_axes < 3 ||
+	    re_za_decode(rec.axis[0].za, rec.axis[1].za, rec.axis[2].za,
+			 za) != GL_OK)
+		return 0;
+	return za->fcode != 0;
+}
+
+/* The stop was not delivered, so the command link cannot tell whether
+ * the program was latching a fault of its own (its watchdog, when that
+ * link stalled): over the stream, a route beside it, poll the records
+ * for up to settle_ms; a latched fault is the one to report (its detail
+ * unknown: MG fdet would need the command link). */
+static void stream_verdict(struct re_super *s, struct re_fault *f)
+{
+	int64_t t0 = now_ns(s);
+	int64_t end = t0 + (int64_t)s->pub.cfg.settle_ms * BASE_NS_PER_MS;
+	struct re_za za;
+
+	do {
+		if (stream_fault(s, &za)) {
+			snprintf(s->verdict, sizeof(s->verdict),
+				 "program fault %d in the record stream "
+				 "after %.1f ms",
+				 za.fcode, ns_to_ms(now_ns(s) - t0));
+			re_ctrl_fault(&za, RE_VAL_UNKNOWN, f);
+			return;
+		}
+		s->pub.io.ops->sleep_until(s->pub.io.ud,
+					   now_ns(s) + 2 * BASE_NS_PER_MS);
+	} while (now_ns(s) < end);
+	snprintf(s->verdict, sizeof(s->verdict),
+		 "no program fault in the record stream within %d ms",
+		 s->pub.cfg.settle_ms);
+}
+
 /* Stop and switch off through the controller and tell the program
- * (pcflt) - after its own verdict when it may be latching one. */
+ * (pcflt) - after its own verdict when it may be latching one (over the
+ * stream when the stop could not be delivered). */
 static int stop_controller(struct re_super *s, struct re_fault *f)
 {
 	int rc;
@@ -247,6 +291,8 @@ static int stop_controller(struct re_super *s, struct re_fault *f)
 		s->pub.io.ops->command(s->pub.io.ud, "pcflt=1", s->resp,
 				       sizeof(s->resp),
 				       s->pub.cfg.fault_cmd_timeout_ms);
+	} else if (s->pub.cfg.stream) {
+		stream_verdict(s, f);
 	}
 	return rc;
 }

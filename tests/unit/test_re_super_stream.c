@@ -53,6 +53,9 @@ struct fake {
 	int stream_off;	   /* no record arrives */
 	int drop_next;	   /* the next cycle's record is lost */
 	int ack_stall;	   /* collect: never complete */
+	int cmd_rc;	   /* command: fails with this (0: answers) */
+	int zab_state;	   /* ZAB below the echo: state + 10 * fcode */
+	int latch_zab;	   /* zab_state once a command failed (0: kept) */
 	int collect_rc;	   /* collect: this error once (0: none) */
 	long echo_frozen;  /* >= 0: the program echoes this, not the last */
 	long last_hb;	   /* the value of the last "hbpc=N" posted */
@@ -114,7 +117,7 @@ static int f_stream(void *ud, struct gl_record *rec, int64_t now_ns)
 	}
 	fk.rec.sample += 50;
 	fk.rec.axis[0].za = (fk.rec.axis[0].za + 5) % 1000000;
-	fk.rec.axis[1].za = 1 + (int32_t)(echo % 10000) * 10000;
+	fk.rec.axis[1].za = fk.zab_state + (int32_t)(echo % 10000) * 10000;
 	*rec = fk.rec;
 	return 1;
 }
@@ -138,6 +141,12 @@ static int f_command(void *ud, const char *cmd, char *resp, size_t cap,
 	fk.posted = 0; /* another exchange takes the posted reply first */
 	if (fk.n_commands < 16)
 		snprintf(fk.commands[fk.n_commands++], 96, "%s", cmd);
+	if (fk.cmd_rc) {
+		/* the program goes on while the command waits */
+		if (fk.latch_zab)
+			fk.zab_state = fk.latch_zab;
+		return fk.cmd_rc;
+	}
 	snprintf(resp, cap, "%s", strncmp(cmd, "MG _MO", 6) ? " 0.0000"
 							   : " 1.0000");
 	return (int)strlen(resp);
@@ -260,6 +269,7 @@ static int setup(void **state)
 	memset(&sup, 0, sizeof(sup));
 	fk.now = 1000 * MS;
 	fk.echo_frozen = -1;
+	fk.zab_state = 1; /* armed */
 	fk.rec.layout = GL_LAYOUT_4000;
 	fk.rec.n_axes = 3;
 	fk.rec.threads = 0x03;
@@ -503,6 +513,50 @@ static void test_stream_refused(void **state)
 			    "Unrecognized command");
 }
 
+/* Thread 1 found halted while armed and no fault latched yet (the
+ * program's #FAULT half-way: it halts thread 1 before it latches), with
+ * the command link stalled: the stop is not delivered, and the record
+ * stream, beside that link, shows the fault the program latched
+ * meanwhile: its watchdog is the fault named, not the thread. */
+static void test_stream_settles_over_stream(void **state)
+{
+	char line[1024];
+
+	(void)state;
+	sup.pub.cfg.settle_ms = 25;
+	assert_int_equal(run(3), RE_OK);
+	fk.rec.threads = 0x01;
+	fk.cmd_rc = GL_ERR_TIMEOUT;
+	fk.latch_zab = 2 + 10 * 2; /* latched, fault 2 (watchdog) */
+	assert_int_equal(run(1), RE_FAULT);
+	assert_int_equal(sup.pub.fault.id, RE_F_CTRL_WATCHDOG);
+	assert_string_equal(sup.verdict,
+			    "program fault 2 in the record stream after 0.0 ms");
+	snprintf(line, sizeof(line), "%s", re_super_fault_line(&sup));
+	line[strcspn(line, ".")] = '\0';
+	assert_string_equal(line, "FAULT WATCHDOG: the controller stopped the "
+				  "robot: no heartbeat from this PC for "
+				  "unknown ms");
+	assert_int_equal(fk.n_relay_off, 1);
+}
+
+/* The same with nothing latched by the program within the settle time:
+ * the thread is the fault named, and the log says what was looked at. */
+static void test_stream_settle_nothing(void **state)
+{
+	(void)state;
+	sup.pub.cfg.settle_ms = 25;
+	assert_int_equal(run(3), RE_OK);
+	fk.rec.threads = 0x01;
+	fk.cmd_rc = GL_ERR_TIMEOUT;
+	assert_int_equal(run(1), RE_FAULT);
+	assert_int_equal(sup.pub.fault.id, RE_F_THREAD);
+	assert_int_equal(sup.pub.fault.i[0], 1);
+	assert_string_equal(sup.verdict, "no program fault in the record "
+					 "stream within 25 ms");
+	assert_int_equal(fk.n_relay_off, 1);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -516,6 +570,8 @@ int main(void)
 	    cmocka_unit_test_setup(test_stream_echo_foreign, setup),
 	    cmocka_unit_test_setup(test_stream_reply_taken, setup),
 	    cmocka_unit_test_setup(test_stream_refused, setup),
+	    cmocka_unit_test_setup(test_stream_settles_over_stream, setup),
+	    cmocka_unit_test_setup(test_stream_settle_nothing, setup),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);
