@@ -12,6 +12,9 @@
  *     own watchdog, whichever first), relay off within C + P;
  *   - the records 40 ms late (link delay 40 stream), at rest: no fault
  *     for 3 s, still armed;
+ *   - another client slows the stream on our handle: to a record every
+ *     100 ms (under C), no fault for 3 s, still armed, the late records
+ *     warned as counted; to one every 200 ms (past C), WATCHDOG;
  * each FAULT checked against galil-sim's event log (sys_truth). Each case
  * prints one "[ ROW      ]" line: what | relay off ms | FAULT line.
  * And the facts roboelf prints about the stream, against galil-sim's
@@ -80,10 +83,11 @@ static void start_armed(struct sys_case *c, int jog)
 		fail_msg("jogging A: %s", c->err);
 }
 
-/* The FAULT after @what (at simulated @t0), its class, the relay's time,
- * the safe state, the truth. */
+/* The FAULT after @what (at simulated @t0), its class, the relay's time
+ * (bound: d_stop_to_relay() after the last record, which may come up to
+ * @late_ms after @t0), the safe state, the truth. */
 static void expect_trip(struct sys_case *c, const char *what, double t0,
-			const char *prefix)
+			double late_ms, const char *prefix)
 {
 	char line[2048];
 	double t_relay;
@@ -97,12 +101,12 @@ static void expect_trip(struct sys_case *c, const char *what, double t0,
 	if (sys_truth_check(c, line, t0, 0) < 0)
 		fail_msg("'%s': %s", what, c->err);
 	print_message("[ ROW      ] %s | relay off %.0f ms (bound %.0f) | %s\n",
-		      what, t_relay - t0, d_stop_to_relay(), line);
+		      what, t_relay - t0, late_ms + d_stop_to_relay(), line);
 	if (strncmp(line, prefix, strlen(prefix)))
 		fail_msg("'%s': not '%s...': %s", what, prefix, line);
-	if (t_relay - t0 > d_stop_to_relay())
+	if (t_relay - t0 > late_ms + d_stop_to_relay())
 		fail_msg("'%s': relay off %.0f ms after (bound %.0f)", what,
-			 t_relay - t0, d_stop_to_relay());
+			 t_relay - t0, late_ms + d_stop_to_relay());
 }
 
 /* Another client's write to the controller stops the stream. */
@@ -118,7 +122,7 @@ static void foreign_write(const char *write)
 	t0 = sys_sim_time(&cs);
 	(void)sys_cmd(fd, write, 1000);
 	close(fd);
-	expect_trip(&cs, write, t0,
+	expect_trip(&cs, write, t0, 0,
 		    "FAULT WATCHDOG: no data record from the controller for ");
 }
 
@@ -144,7 +148,7 @@ static void test_stream_stalled(void **state)
 	t0 = sys_sim_time(&cs);
 	if (sys_ctl(&cs, "link stall stream") < 0)
 		fail_msg("%s", cs.err);
-	expect_trip(&cs, "link stall stream", t0,
+	expect_trip(&cs, "link stall stream", t0, 0,
 		    "FAULT WATCHDOG: no data record from the controller for ");
 }
 
@@ -159,7 +163,7 @@ static void test_tcp_stalled(void **state)
 	t0 = sys_sim_time(&cs);
 	if (sys_ctl(&cs, "link stall tcp") < 0)
 		fail_msg("%s", cs.err);
-	expect_trip(&cs, "link stall tcp", t0, "FAULT WATCHDOG: ");
+	expect_trip(&cs, "link stall tcp", t0, 0, "FAULT WATCHDOG: ");
 }
 
 /* Records 40 ms late (at rest: 3 s of jogging would reach the soft
@@ -399,6 +403,80 @@ static void test_printed_facts(void **state)
 	check_counts(&cs, handle, who);
 }
 
+/* Another client's "DR @n0,<our handle>" (the handle from roboelf's
+ * start-up line), armed at rest; the simulated time of the write. */
+static double foreign_dr(struct sys_case *c, unsigned n0)
+{
+	struct meas_line m;
+	char line[512], cmd[32];
+	double t0;
+	int fd, rc;
+
+	start_armed(c, 0);
+	if (proc_find_line(&c->re, PROC_STDOUT, "roboelf: record stream: ",
+			   line, sizeof(line)) < 0)
+		fail_msg("no 'record stream' line");
+	parse_meas(line, &m);
+	snprintf(cmd, sizeof(cmd), "DR %u,%d", n0, m.handle - 'A');
+	fd = sys_cmd_open(c);
+	if (fd < 0)
+		fail_msg("%s", c->err);
+	t0 = sys_sim_time(c);
+	rc = sys_cmd(fd, cmd, 1000);
+	close(fd);
+	if (rc != 0)
+		fail_msg("'%s' from another client: %s", cmd,
+			 rc > 0 ? "refused (?)" : "no answer");
+	return t0;
+}
+
+/* Another client slows the stream to a record every 100 samples (100 ms,
+ * under C = 125 ms): each record is judged as it comes, within the
+ * limits, so no fault; the cycles that find none warn (late records), as
+ * the log and the supervisor's own count say after the quit. */
+static void test_dr_slowed_within(void **state)
+{
+	char line[2048];
+	long counted, logged;
+	int status;
+
+	(void)state;
+	foreign_dr(&cs, 100);
+	if (sys_ctl(&cs, "watch state") < 0)
+		fail_msg("%s", cs.err);
+	if (sys_wait_fault(&cs, QUIET_MS, line, sizeof(line)) == 0)
+		fail_msg("a FAULT with a record every 100 ms: %s", line);
+	if (sys_still_armed(&cs, "after 3 s of a record every 100 ms") < 0)
+		fail_msg("%s", cs.err);
+	if (proc_signal(&cs.re, SIGTERM) < 0 ||
+	    proc_wait_exit(&cs.re, EXIT_MS, &status) < 0)
+		fail_msg("roboelf did not exit within %d ms of SIGTERM",
+			 EXIT_MS);
+	counted = sys_wd_counter(&cs);
+	logged = sys_wd_warnings(&cs, NULL, NULL);
+	if (counted < 1 || logged != counted)
+		fail_msg("late records: %ld counted, %ld in the log (want the "
+			 "same, at least 1)",
+			 counted, logged);
+	print_message("[ ROW      ] DR 100 (another client) | no fault in %d "
+		      "ms, still armed | %ld late-record warnings\n",
+		      QUIET_MS, counted);
+}
+
+/* Slowed past C (a record every 200 samples): the record's age passes C,
+ * WATCHDOG, relay off within C + P of the last record, which may come up
+ * to 200 samples after the write (galil-sim sends on the multiples of
+ * n0; a real controller's phase is not documented). */
+static void test_dr_slowed_past(void **state)
+{
+	double t0;
+
+	(void)state;
+	t0 = foreign_dr(&cs, 200);
+	expect_trip(&cs, "DR 200", t0, 200 * SIM_SAMPLE_MS,
+		    "FAULT WATCHDOG: no data record from the controller for ");
+}
+
 static int case_teardown(void **state)
 {
 	(void)state;
@@ -429,6 +507,8 @@ int main(void)
 	    cmocka_unit_test_teardown(test_tcp_stalled, case_teardown),
 	    cmocka_unit_test_teardown(test_delay_tolerated, case_teardown),
 	    cmocka_unit_test_teardown(test_printed_facts, case_teardown),
+	    cmocka_unit_test_teardown(test_dr_slowed_within, case_teardown),
+	    cmocka_unit_test_teardown(test_dr_slowed_past, case_teardown),
 	};
 
 	return cmocka_run_group_tests(tests, group_setup, group_teardown);

@@ -104,7 +104,7 @@ static void link_loss(const struct link_case *lc)
 {
 	char line[1024], logline[4096], by[3][48];
 	enum re_fault_id ids[2] = {lc->id, RE_F_NONE};
-	double t_link, t_relay, t_mo;
+	double t_link, t_relay, t_mo, t_power;
 	int status;
 
 	start_jogging_blind();
@@ -148,8 +148,10 @@ static void link_loss(const struct link_case *lc)
 				 lc->by_supervisor
 				     ? "the supervisor's new connection"
 				     : "the controller's watchdog (thread 0)");
-	if (sys_event_find(&cs, "motor power lost (amplifiers report nothing",
-			   t_link) < 0)
+	/* galil-sim logs it at its next step after the relay opened: it may
+	 * follow the events read so far */
+	if (sys_wait_event(&cs, "motor power lost (amplifiers report nothing",
+			   t_link, 1000, &t_power) < 0)
 		rig_fail("%s: no 'motor power lost' event: was the amplifier "
 			 "model off?",
 			 lc->name);
