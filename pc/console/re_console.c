@@ -677,16 +677,17 @@ static void board_keys(struct re_console *c, const struct re_status *st,
 static void board_build(struct re_console *c, const struct re_status *st,
 			int width, int rows)
 {
-	char ctl[64], moving[64];
+	char ctl[64], moving[64], stream[48];
 	int lines;
 
 	re_con_ctrl_text(st, ctl, sizeof(ctl));
+	re_con_stream_text(st, stream, sizeof(stream));
 	board_printf(
-	    c, width, "RoboELF  mode %s  up %.0f s  relay %s%s%s  link %s",
+	    c, width, "RoboELF  mode %s  up %.0f s  relay %s%s%s  link %s%s",
 	    st->mode_name, st->uptime_s,
 	    col(c, st->relay == RE_RELAY_ON ? ANSI_GREEN : ANSI_YELLOW),
 	    re_con_relay_text(st->relay), col(c, ANSI_OFF),
-	    st->link_ok ? "ok" : "DOWN (stale)");
+	    st->link_ok ? "ok" : "DOWN (stale)", stream);
 	/* the rest of the board: column header, axes, three lines; the FAULT
 	 * may take the room kept for messages but one line */
 	lines = 1 + 1 + st->n_axes + 3;

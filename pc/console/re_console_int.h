@@ -25,6 +25,14 @@ const char *re_con_cmd_text(int k);
  */
 void re_con_ctrl_text(const struct re_status *st, char *buf, size_t cap);
 
+/*
+ * re_con_stream_text() - the record stream's loss for the board's first
+ * line: ", records lost 0.02 %" (lost / (accepted + lost), while a stream
+ * is open and has had a record), else "" (polling, or none yet).
+ * @buf: [out] NUL-terminated, cut to @cap.
+ */
+void re_con_stream_text(const struct re_status *st, char *buf, size_t cap);
+
 /* re_con_motion_text() - what axis @a does now: "off", "at-lim",
  * "moving", "stopped" (never "moving" at a soft limit or motor off). */
 const char *re_con_motion_text(const struct re_axis_status *a);

@@ -56,6 +56,17 @@ void re_con_ctrl_text(const struct re_status *st, char *buf, size_t cap)
 							  : "safe");
 }
 
+void re_con_stream_text(const struct re_status *st, char *buf, size_t cap)
+{
+	uint64_t all = st->stream_records + st->stream_lost;
+
+	if (!st->stream || !all)
+		snprintf(buf, cap, "%s", "");
+	else
+		snprintf(buf, cap, ", records lost %.2f %%",
+			 100.0 * (double)st->stream_lost / (double)all);
+}
+
 #define AT_SOFT_PCT 0.5	  /* within this of 0 or 100 %: at a soft limit */
 #define STILL_CPS   100.0 /* |velocity| below this: not moving */
 

@@ -202,6 +202,19 @@ static int real_stream(void *ud, struct gl_record *rec, int64_t now_ns)
 	return rc;
 }
 
+static int real_stream_counts(void *ud, uint64_t *records, uint64_t *lost)
+{
+	struct re_io_real *r = ud;
+	struct gl_stream_stats st;
+
+	if (!r->link || gl_link_stream_info(r->link, NULL, NULL) != 1)
+		return -1;
+	gl_link_stream_stats(r->link, &st);
+	*records = st.accepted;
+	*lost = st.lost;
+	return 0;
+}
+
 static const char *real_ctrl_error(void *ud, int *code)
 {
 	struct re_io_real *r = ud;
@@ -420,6 +433,7 @@ static const struct re_io_ops real_ops = {
     .post = real_post,
     .collect = real_collect,
     .stream = real_stream,
+    .stream_counts = real_stream_counts,
     .ctrl_error = real_ctrl_error,
     .message = real_message,
     .relay_check = real_relay_check,

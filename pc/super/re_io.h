@@ -84,6 +84,10 @@ struct re_io_ops {
 	/* gl_link_stream_read(): 1 and the newest record in @rec, 0 none
 	 * new, or an error; @now_ns is the time of reception. */
 	int (*stream)(void *ud, struct gl_record *rec, int64_t now_ns);
+	/* Optional (NULL: none shown). gl_link_stream_stats(): the records
+	 * the stream's reader accepted and counted lost so far; 0, or -1
+	 * when no stream is open. No I/O. */
+	int (*stream_counts)(void *ud, uint64_t *records, uint64_t *lost);
 	/* CLOCK_MONOTONIC, ns. */
 	int64_t (*now_ns)(void *ud);
 	/* Sleep until the absolute monotonic time @t_ns. */

@@ -724,6 +724,10 @@ void re_super_status(const struct re_super *s, struct re_status *st)
 	st->log_failing = s->pub.log_failing;
 	st->foreign = s->pub.foreign;
 	st->link_ok = s->pub.link_ok;
+	st->stream = s->pub.cfg.stream && s->pub.io.ops->stream_counts &&
+		     s->pub.io.ops->stream_counts(s->pub.io.ud,
+						  &st->stream_records,
+						  &st->stream_lost) == 0;
 	st->za = s->pub.za;
 	st->have_za = s->pub.have_za;
 	st->mode_name = s->pub.cfg.mode_name ? s->pub.cfg.mode_name : "";

@@ -175,6 +175,10 @@ struct re_status {
 	int armed;
 	int expect;	 /* program state expected: RE_DMC_ARMED, _SERVICE, 0 */
 	int link_ok;	 /* last round trip succeeded */
+	/* the record stream (record: stream) while one is open: the records
+	 * its reader accepted and counted lost since it was opened */
+	int stream;
+	uint64_t stream_records, stream_lost;
 	struct re_za za; /* program fields (valid when have_za) */
 	int have_za;
 	const char *mode_name;

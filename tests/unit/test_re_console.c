@@ -460,6 +460,45 @@ static void test_history_times(void **state)
 	fclose(devnull);
 }
 
+/* Over the record stream the first line gives the share of records lost
+ * since the stream opened; polling, or no record yet, nothing. */
+static void test_stream_loss_shown(void **state)
+{
+	static struct re_console c;
+	static char buf[RE_CONSOLE_FRAME];
+	struct re_status st;
+	char l[256];
+	FILE *devnull = fopen("/dev/null", "w");
+
+	(void)state;
+	assert_non_null(devnull);
+	re_console_open(&c, devnull, -1);
+	c.tty_out = 1;
+	calibrated(&c, &st);
+	st.uptime_s = 42;
+	st.stream = 1;
+	st.stream_records = 9998;
+	st.stream_lost = 2;
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 0, l, sizeof(l));
+	assert_string_equal(l, "RoboELF  mode development  up 42 s  relay ON  "
+			       "link ok, records lost 0.02 %");
+	st.stream_records = 0;
+	st.stream_lost = 0;
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 0, l, sizeof(l));
+	assert_string_equal(l, "RoboELF  mode development  up 42 s  relay ON  "
+			       "link ok");
+	st.stream = 0;
+	st.stream_records = 100;
+	st.stream_lost = 100;
+	re_console_render(&c, &st, 80, 24, buf, sizeof(buf));
+	line_of(buf, 0, l, sizeof(l));
+	assert_string_equal(l, "RoboELF  mode development  up 42 s  relay ON  "
+			       "link ok");
+	fclose(devnull);
+}
+
 /* Without a terminal, each later fault or warning is one line. */
 static void test_event_lines(void **state)
 {
@@ -1021,6 +1060,7 @@ int main(void)
 	    cmocka_unit_test(test_units_and_bar),
 	    cmocka_unit_test(test_history),
 	    cmocka_unit_test(test_history_times),
+	    cmocka_unit_test(test_stream_loss_shown),
 	    cmocka_unit_test(test_event_lines),
 	    cmocka_unit_test(test_quiet_no_echo),
 	    cmocka_unit_test(test_moving_one_source),

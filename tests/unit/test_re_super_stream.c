@@ -122,6 +122,14 @@ static int f_stream(void *ud, struct gl_record *rec, int64_t now_ns)
 	return 1;
 }
 
+static int f_stream_counts(void *ud, uint64_t *records, uint64_t *lost)
+{
+	(void)ud;
+	*records = 4998;
+	*lost = 2;
+	return 0;
+}
+
 static int f_record(void *ud, const char *prefix, struct gl_record *rec,
 		    int timeout_ms)
 {
@@ -224,6 +232,7 @@ static const struct re_io_ops fake_ops = {
     .post = f_post,
     .collect = f_collect,
     .stream = f_stream,
+    .stream_counts = f_stream_counts,
     .ctrl_error = f_ctrl_error,
     .message = f_message,
     .relay_check = f_relay_check,
@@ -316,6 +325,19 @@ static void test_stream_healthy(void **state)
 	assert_int_equal(fk.n_logs, 0);
 	assert_int_equal(sup.pub.age_last_ns, PERIOD_MS * MS);
 	assert_string_equal(re_super_fault_line(&sup), "");
+}
+
+/* The status (the board's source) carries the stream's own counts. */
+static void test_stream_status_counts(void **state)
+{
+	struct re_status st;
+
+	(void)state;
+	assert_int_equal(run(3), RE_OK);
+	re_super_status(&sup, &st);
+	assert_int_equal(st.stream, 1);
+	assert_int_equal(st.stream_records, 4998);
+	assert_int_equal(st.stream_lost, 2);
 }
 
 /* A lost record costs nothing but its age: two periods, a warning. */
@@ -562,6 +584,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test_setup(test_stream_healthy, setup),
 	    cmocka_unit_test_setup(test_stream_lost_record, setup),
+	    cmocka_unit_test_setup(test_stream_status_counts, setup),
 	    cmocka_unit_test_setup(test_stream_wd_summary, setup),
 	    cmocka_unit_test_setup(test_stream_stops, setup),
 	    cmocka_unit_test_setup(test_stream_ack_stalls, setup),
