@@ -361,7 +361,10 @@ static void foreign_from_program(struct re_super *s)
 
 /* A program fault that our own stop caused: 12 (pcflt); a motor found
  * off (fault 10) whose stop code says nothing stopped it but a command:
- * 1 at rest, 4 ST, 7 AB; every amplifier without power (8 on no single
+ * 0 no motion ended on it yet (an axis that has not moved since the
+ * program started: our AB 1 on an axis at rest leaves the code, and MO
+ * never sets one), 1 at rest, 4 ST, 7 AB (a moving axis: our AB 1 comes
+ * before our MO); every amplifier without power (8 on no single
  * axis) once our relay's off is confirmed. Our "pcflt=1;AB 1;MO ABC" can
  * land in the middle of the program's pass, after its pcflt check and
  * before its motor check: then the program latches 10 first; and the
@@ -373,7 +376,7 @@ int re_react_own_doing(const struct re_super *s, const struct re_za *za,
 {
 	return za->fcode == RE_DMC_F_SUPERVISOR ||
 	       (za->fcode == RE_DMC_F_MOTOROFF &&
-		(det == 1 || det == 4 || det == 7)) ||
+		(det == 0 || det == 1 || det == 4 || det == 7)) ||
 	       (za->fcode == RE_DMC_F_AMPERR && za->faxis == 0 &&
 		s->confirm.relay_rc == GL_OK);
 }

@@ -669,8 +669,9 @@ static void test_super_foreign_named(void **state)
 
 /*
  * What the program latched after our stop is named as "Then:" only when it
- * is not our doing: a motor found off with stop code 1 (at rest), 4 (ST)
- * or 7 (AB) was switched off by our own "MO ABC" (it landed mid-pass);
+ * is not our doing: a motor found off with stop code 0 (no motion ended
+ * on it yet), 1 (at rest), 4 (ST) or 7 (AB) was switched off by our own
+ * "MO ABC" (it landed mid-pass);
  * stop code 8 (the position error switched it off) is a consequence.
  */
 static void test_super_consequences(void **state)
@@ -679,7 +680,8 @@ static void test_super_consequences(void **state)
 		const char *fdet;
 		int then;
 	} cases[] = {
-	    {" 1.0000", 0}, {" 4.0000", 0}, {" 7.0000", 0}, {" 8.0000", 1}};
+	    {" 0.0000", 0}, {" 1.0000", 0}, {" 4.0000", 0},
+	    {" 7.0000", 0}, {" 8.0000", 1}};
 
 	for (size_t k = 0; k < sizeof(cases) / sizeof(cases[0]); k++) {
 		const char *line;
