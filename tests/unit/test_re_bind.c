@@ -479,11 +479,11 @@ struct fake {
 };
 
 static const struct fake fakes[] = {
-    {"/dev/ttyS0", "ttyS0", NULL, SP_TRANSPORT_NATIVE, 0, 0},
+    {"/dev/ttyTEST8", "ttyTEST8", NULL, SP_TRANSPORT_NATIVE, 0, 0},
     {"/dev/ttyTEST0", "FT232R USB UART - A10KXYZ9", "A10KXYZ9", SP_TRANSPORT_USB,
      0x0403, 0x6001},
     {"/dev/rfcomm0", "rfcomm0", NULL, SP_TRANSPORT_BLUETOOTH, 0, 0},
-    {"/dev/ttyACM0", "USB2.0-Serial", NULL, SP_TRANSPORT_USB, 0x1a86, 0x7523},
+    {"/dev/ttyTEST9", "USB2.0-Serial", NULL, SP_TRANSPORT_USB, 0x1a86, 0x7523},
 };
 #define N_FAKES (sizeof(fakes) / sizeof(fakes[0]))
 
@@ -607,7 +607,7 @@ static void test_list_sp(void **state)
 	assert_string_equal(p[0].serial, "A10KXYZ9");
 	assert_int_equal(p[0].vid, 0x0403);
 	assert_int_equal(p[0].pid, 0x6001);
-	assert_string_equal(p[1].name, "/dev/ttyACM0");
+	assert_string_equal(p[1].name, "/dev/ttyTEST9");
 	assert_string_equal(p[1].serial, "");
 	assert_int_equal(p[1].vid, 0x1a86);
 	assert_int_equal(n_freed, 1);
@@ -656,11 +656,11 @@ static void test_usb_serial(void **state)
 		 link);
 	assert_string_equal(err, want);
 	assert_int_equal(n_freed, 2);
-	assert_int_equal(re_relay_usb_serial("/dev/ttyACM0", buf, sizeof(buf),
+	assert_int_equal(re_relay_usb_serial("/dev/ttyTEST9", buf, sizeof(buf),
 					     err, sizeof(err)),
 			 GL_OK);
 	assert_string_equal(buf, "");
-	assert_int_equal(re_relay_usb_serial("/dev/ttyS0", buf, sizeof(buf),
+	assert_int_equal(re_relay_usb_serial("/dev/ttyTEST8", buf, sizeof(buf),
 					     err, sizeof(err)),
 			 GL_OK);
 	assert_string_equal(buf, "");

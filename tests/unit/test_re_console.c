@@ -743,7 +743,7 @@ static void snap_fault(const struct snap_case *k, struct re_fault *f)
 	f->f[3] = 0.06;
 	if (k->id == RE_F_ESTOP_LOST)
 		snprintf(f->s, sizeof(f->s),
-			 "/dev/ttyACM0: read-back shows "
+			 "/dev/ttyTEST0: read-back shows "
 			 "channel 1 off, expected on");
 	else if (k->id == RE_F_COMM)
 		snprintf(f->s, sizeof(f->s), "cannot read record: timeout");
