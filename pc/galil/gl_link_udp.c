@@ -23,8 +23,6 @@
 #include "gl_link_int.h"
 
 #define WH_RESEND_MS 20 /* UDP may lose WH or its answer: ask again */
-#define DGRAM_MAX    512 /* the largest record is 190 bytes */
-#define DGRAM_BATCH  GL_LINK_DGRAM_BATCH
 
 /* The controller's address with @port. */
 static void udp_peer(const gl_link *l, int port, struct sockaddr_storage *ss)
@@ -52,7 +50,7 @@ static int wh_letter(const uint8_t *b, size_t n)
 /* WH on the UDP socket, resent until answered or @deadline (ms). */
 static int udp_which_handle(int fd, int64_t deadline)
 {
-	uint8_t b[DGRAM_MAX];
+	uint8_t b[GL_LINK_DGRAM_MAX];
 	struct pollfd p = {.fd = fd, .events = POLLIN};
 	ssize_t n;
 	int rc;
@@ -182,8 +180,8 @@ int gl_link_stream_open(gl_link *l, int udp_port, unsigned n0_samples,
 int gl_link_stream_read(gl_link *l, struct gl_record *rec, int64_t now_ns)
 {
 	uint8_t(*b)[GL_LINK_DGRAM_MAX];
-	struct mmsghdr m[DGRAM_BATCH];
-	struct iovec v[DGRAM_BATCH];
+	struct mmsghdr m[GL_LINK_DGRAM_BATCH];
+	struct iovec v[GL_LINK_DGRAM_BATCH];
 	struct gl_stream_peer from;
 	int fresh = 0, n;
 
@@ -191,16 +189,17 @@ int gl_link_stream_read(gl_link *l, struct gl_record *rec, int64_t now_ns)
 		return GL_ERR_ARG;
 	b = l->st_buf;
 	from = l->st.ctrl; /* connected: only the controller's get here */
+	memset(m, 0, sizeof(m));
+	for (int i = 0; i < GL_LINK_DGRAM_BATCH; i++) {
+		v[i].iov_base = b[i];
+		v[i].iov_len = GL_LINK_DGRAM_MAX;
+		m[i].msg_hdr.msg_iov = &v[i];
+		m[i].msg_hdr.msg_iovlen = 1;
+	}
 	/* a batch a system call: at 50 ms a cycle finds about 25 */
 	for (int got = 0; got < GL_LINK_STREAM_READS_MAX; got += n) {
-		memset(m, 0, sizeof(m));
-		for (int i = 0; i < DGRAM_BATCH; i++) {
-			v[i].iov_base = b[i];
-			v[i].iov_len = GL_LINK_DGRAM_MAX;
-			m[i].msg_hdr.msg_iov = &v[i];
-			m[i].msg_hdr.msg_iovlen = 1;
-		}
-		n = recvmmsg(l->st_fd, m, DGRAM_BATCH, MSG_DONTWAIT, NULL);
+		n = recvmmsg(l->st_fd, m, GL_LINK_DGRAM_BATCH, MSG_DONTWAIT,
+			     NULL);
 		if (n < 0) {
 			if (errno == EAGAIN || errno == EWOULDBLOCK)
 				break;
@@ -216,7 +215,7 @@ int gl_link_stream_read(gl_link *l, struct gl_record *rec, int64_t now_ns)
 					   now_ns, rec) == GL_STREAM_ACCEPTED)
 				fresh = 1;
 		}
-		if (n < DGRAM_BATCH)
+		if (n < GL_LINK_DGRAM_BATCH)
 			break;
 	}
 	return fresh;

@@ -465,8 +465,9 @@ static void test_dr_slowed_within(void **state)
 
 /* Slowed past C (a record every 200 samples): the record's age passes C,
  * WATCHDOG, relay off within C + P of the last record, which may come up
- * to 200 samples after the write (galil-sim sends on the multiples of
- * n0; a real controller's phase is not documented). */
+ * to 200 samples after the write (galil-sim starts the new interval at
+ * the DR, so its last record is the one before; a real controller's phase
+ * is not documented). */
 static void test_dr_slowed_past(void **state)
 {
 	double t0;
