@@ -607,6 +607,10 @@ static int cycle_checks(struct re_super *s)
 		return re_super_fault(s, &f);
 	v = s->pub.cfg.stream ? re_super_exchange_stream(s, &f)
 			      : exchange(s, &f);
+	/* the next cycle's stall gap counts from here, the last moment this
+	 * process is known to have run with a fresh exchange: a stop in the
+	 * rest of this cycle is in it too */
+	s->last_end_ns = now_ns(s);
 	warn = s->pub.link_ok && s->pub.age_last_ns > s->noncrit_ns;
 	if (s->pub.link_ok && (!s->pub.cfg.stream || s->pub.fresh))
 		watch_handles(s);
@@ -644,7 +648,8 @@ int re_super_cycle(struct re_super *s)
 		v = latched_cycle(s);
 	} else {
 		v = cycle_checks(s);
-		s->last_end_ns = s->pub.latched ? 0 : now_ns(s);
+		if (s->pub.latched)
+			s->last_end_ns = 0;
 	}
 	if (s->rec_cycle) /* flight recorder: a copy, no I/O */
 		s->rec_cycle(s->rec_ud, &s->pub);

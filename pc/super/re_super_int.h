@@ -23,7 +23,8 @@ struct re_super {
 	/* wake-up lateness histogram: RE_LATE_BIN_US bins, the last one
 	 * counts everything later (for the exit statistics; no allocation) */
 	uint32_t late_hist[RE_LATE_BINS];
-	/* the supervisor's own liveness: end of the last cycle (0: none) */
+	/* the supervisor's own liveness: end of the last cycle's round
+	 * trip (0: none) */
 	int64_t last_end_ns;
 	/* watchdog */
 	int64_t noncrit_ns;

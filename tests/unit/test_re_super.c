@@ -68,6 +68,7 @@ struct fake {
 	char last_prefix[64];
 	int last_timeout_ms;
 	int relay_check_rc;
+	int64_t check_stall_ns; /* the relay check: the clock jumps this once */
 	int relay_off_rc;
 	int n_relay_off;
 	char commands[24][96];
@@ -169,6 +170,8 @@ static int f_message(void *ud, char *line, size_t cap)
 static int f_relay_check(void *ud, char *why, size_t cap)
 {
 	(void)ud;
+	fk.now += fk.check_stall_ns; /* stopped after the round trip */
+	fk.check_stall_ns = 0;
 	if (fk.relay_check_rc != GL_OK)
 		snprintf(why, cap, "relay '/tmp/r': device vanished");
 	return fk.relay_check_rc;
@@ -633,6 +636,24 @@ static void test_super_stall_in_round_trip(void **state)
 				       " ms (limit 125 ms): the PC stalled"));
 		assert_int_equal(fk.n_relay_off, 1);
 	}
+}
+
+/* The process stopped in the tail of a cycle (after its round trip, in its
+ * checks) for 2 s: the next cycle names its own stall, from the end of
+ * that round trip, not the last good reply's age. */
+static void test_super_stall_in_cycle_tail(void **state)
+{
+	(void)state;
+	assert_int_equal(run(2), RE_OK);
+	fk.check_stall_ns = 2000 * MS;
+	assert_int_equal(step(), RE_OK);
+	assert_int_equal(step(), RE_FAULT);
+	assert_int_equal(sup.pub.fault.id, RE_F_STALL);
+	assert_true(sup.pub.fault.i[0] >= 2000);
+	assert_non_null(strstr(re_super_fault_line(&sup),
+			       "FAULT WATCHDOG: this supervisor did not run "
+			       "for "));
+	assert_int_equal(fk.n_relay_off, 1);
 }
 
 /*
@@ -1229,6 +1250,7 @@ int main(void)
 	    cmocka_unit_test_setup(test_super_wd_quit_flushes, setup),
 	    cmocka_unit_test_setup(test_super_watchdog_critical, setup),
 	    cmocka_unit_test_setup(test_super_stall_in_round_trip, setup),
+	    cmocka_unit_test_setup(test_super_stall_in_cycle_tail, setup),
 	    cmocka_unit_test_setup(test_super_comm_fault, setup),
 	    cmocka_unit_test_setup(test_super_foreign_named, setup),
 	    cmocka_unit_test_setup(test_super_consequences, setup),
